@@ -1,0 +1,32 @@
+# Skinlab: `make demo` and `make test` do all set-up on a fresh machine.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+STAMP  := $(VENV)/.skinlab-installed
+SIZE   ?= 640x640
+
+.PHONY: demo test setup sysdeps bench clean
+
+setup: $(STAMP)
+
+sysdeps:
+	@bash tools/sysdeps.sh
+
+$(STAMP): pyproject.toml tools/sysdeps.sh
+	@bash tools/sysdeps.sh
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q -e '.[dev]'
+	@touch $(STAMP)
+
+demo: $(STAMP)
+	$(VENV)/bin/skinlab demo --out out --size $(SIZE)
+
+test: $(STAMP)
+	$(PY) -m pytest -q
+
+bench: $(STAMP)
+	$(VENV)/bin/skinlab bench peer
+
+clean:
+	rm -rf out .pytest_cache
