@@ -1,0 +1,1 @@
+"""Skinlab programs: CLI, viewer, workbench, render passes and the GL context."""

@@ -1,0 +1,1 @@
+"""GL plumbing: context creation, shader sources with includes, program cache."""

@@ -1,0 +1,125 @@
+"""Compiled programs cached by (stage files, defines), with last-good fallback on failure."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Mapping
+
+import moderngl
+
+from .shader_source import ExpandedSource, ShaderError, ShaderLibrary, parse_errors
+
+_STAGES = ("vertex_shader", "fragment_shader")
+
+
+def normalize_defines(defines: Mapping[str, object] | None) -> dict[str, str]:
+    """True -> "1"; False/None dropped; everything else as its string."""
+    out = {}
+    for k, v in (defines or {}).items():
+        if v is None or v is False:
+            continue
+        out[k] = "1" if v is True else str(v)
+    return out
+
+
+def _key(vs: str, fs: str, defines: Mapping[str, object] | None) -> tuple:
+    return (vs, fs, tuple(sorted(normalize_defines(defines).items())))
+
+
+@dataclass
+class ProgramEntry:
+    program: moderngl.Program | None
+    deps: set[Path] = field(default_factory=set)
+    error: str | None = None           # last failed compile, if the current program is older
+    generation: int = 0                # bumps on every successful (re)compile
+
+
+def compile_program(ctx: moderngl.Context, library: ShaderLibrary, vs: str, fs: str,
+                    defines: Mapping[str, object] | None = None) -> tuple[moderngl.Program, set[Path]]:
+    """Compile one program; on failure raise :class:`ShaderError` naming file and line."""
+    defines = normalize_defines(defines)
+    srcs: dict[str, ExpandedSource] = {"vertex_shader": library.expand(vs, defines),
+                                       "fragment_shader": library.expand(fs, defines)}
+    deps = {p for s in srcs.values() for p in s.paths if p is not None}
+    try:
+        prog = ctx.program(**{k: s.text for k, s in srcs.items()})
+    except moderngl.Error:
+        raise _diagnose(ctx, srcs) from None
+    return prog, deps
+
+
+def _diagnose(ctx: moderngl.Context, srcs: dict[str, ExpandedSource]) -> ShaderError:
+    """Recompile the flat texts stage by stage to map errors to (file, line)."""
+    trivial = {
+        "vertex_shader": "#version 330 core\nvoid main(){ gl_Position = vec4(0.0); }\n",
+        "fragment_shader": "#version 330 core\nout vec4 o;\nvoid main(){ o = vec4(0.0); }\n",
+    }
+    messages, locs = [], []
+    for stage, src in srcs.items():
+        other = {k: v for k, v in trivial.items() if k != stage}
+        try:
+            ctx.program(**{stage: src.flat}, **other).release()
+        except moderngl.Error as exc:
+            log = str(exc)
+            if stage.split("_")[0] not in log and "link" in log.lower() and not locs:
+                continue  # a link error against the trivial partner: not this stage's fault
+            msg, where = parse_errors(log, src, stage.split("_")[0])
+            messages.append(msg)
+            locs.extend(where)
+    if not messages:
+        try:
+            ctx.program(**{k: s.flat for k, s in srcs.items()}).release()
+            messages.append("program failed to compile, but the flat source compiles (driver issue?)")
+        except moderngl.Error as exc:
+            messages.append("program failed to link:\n" + str(exc).strip())
+    return ShaderError("\n".join(messages), locs)
+
+
+class ProgramCache:
+    """Programs keyed by (stage files, defines). ``reload`` recompiles programs whose files
+    changed and keeps the last good program when the new source fails."""
+
+    def __init__(self, ctx: moderngl.Context, library: ShaderLibrary | None = None):
+        self.ctx = ctx
+        self.library = library or ShaderLibrary()
+        self.entries: dict[tuple, ProgramEntry] = {}
+        self.compiles = 0
+
+    def get(self, vs: str, fs: str, defines: Mapping[str, object] | None = None) -> moderngl.Program:
+        key = _key(vs, fs, defines)
+        entry = self.entries.get(key)
+        if entry is None:
+            prog, deps = compile_program(self.ctx, self.library, vs, fs, defines)
+            self.compiles += 1
+            entry = self.entries[key] = ProgramEntry(prog, deps, None, 1)
+        return entry.program
+
+    def dependents(self, changed: set[Path]) -> list[tuple]:
+        changed = {Path(p).resolve() for p in changed}
+        return [k for k, e in self.entries.items() if {d.resolve() for d in e.deps} & changed]
+
+    def reload(self, changed: set[Path] | None = None) -> list[ShaderError]:
+        """Recompile the programs that include any of ``changed`` (all when None)."""
+        keys = list(self.entries) if changed is None else self.dependents(changed)
+        errors = []
+        for key in keys:
+            vs, fs, defs = key
+            entry = self.entries[key]
+            try:
+                prog, deps = compile_program(self.ctx, self.library, vs, fs, dict(defs))
+            except ShaderError as exc:
+                entry.error = str(exc)
+                errors.append(exc)
+                continue
+            self.compiles += 1
+            if entry.program is not None:
+                entry.program.release()
+            entry.program, entry.deps, entry.error = prog, deps, None
+            entry.generation += 1
+        return errors
+
+    def release(self) -> None:
+        for e in self.entries.values():
+            if e.program is not None:
+                e.program.release()
+        self.entries.clear()

@@ -1,0 +1,1 @@
+"""NumPy reference implementations. Every GLSL library function has its twin here."""
