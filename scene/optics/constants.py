@@ -22,6 +22,9 @@ SPECULAR_F0_SCALE = 0.08
 SRGB_LINEAR_THRESHOLD = 0.0031308
 SRGB_ENCODED_THRESHOLD = 0.04045
 
+# Point lights: distances are clamped to at least this (metres) before the inverse square.
+MIN_LIGHT_DISTANCE_M = 1.0e-3
+
 # Shadow map depth bias in normalised light depth units (slope-scaled part added in shader).
 SHADOW_BIAS = 0.0015
 
@@ -34,6 +37,7 @@ GLSL_CONSTANTS: dict[str, float] = {
     "SRGB_LINEAR_THRESHOLD": SRGB_LINEAR_THRESHOLD,
     "SRGB_ENCODED_THRESHOLD": SRGB_ENCODED_THRESHOLD,
     "SHADOW_BIAS": SHADOW_BIAS,
+    "MIN_LIGHT_DISTANCE_M": MIN_LIGHT_DISTANCE_M,
 }
 
 

@@ -1,0 +1,1 @@
+"""Rendering: GPU resources, the frame plan, the passes and the renderer that runs them."""

@@ -1,0 +1,26 @@
+"""Per-frame state shared between passes: the scene, matrices, targets produced so far."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import moderngl
+import numpy as np
+
+from scene.graph import Scene
+
+from .settings import RenderSettings
+
+
+@dataclass
+class Frame:
+    scene: Scene
+    settings: RenderSettings
+    view: np.ndarray
+    proj: np.ndarray
+    camera_pos: np.ndarray
+    targets: dict[str, moderngl.Texture] = field(default_factory=dict)
+    shadow_matrices: dict[int, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def view_proj(self) -> np.ndarray:
+        return self.proj @ self.view

@@ -1,0 +1,1 @@
+"""One module per pass kind. Each pass class has ``run(frame, planned_pass)``."""

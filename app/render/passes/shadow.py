@@ -1,0 +1,67 @@
+"""Shadow maps: depth from a light, fitted to the scene's bounding sphere."""
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from app.gl.uniforms import set_uniforms
+from scene import transform as tf
+from scene.graph import LightNode
+
+# maps clip space [-1, 1] to texture space [0, 1]
+_BIAS = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1.0]])
+
+
+def light_view_proj(light: LightNode, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    centre = (lo + hi) / 2
+    radius = max(float(np.linalg.norm(hi - lo)) / 2, 1e-6)
+    if light.kind == "directional":
+        d = light.direction
+        eye = centre - d * 2 * radius
+        view = np.linalg.inv(tf.compose(eye, tf.look_at_rotation(eye, centre), np.ones(3)))
+        return tf.orthographic(radius, radius, radius * 0.5, radius * 3.5) @ view
+    pos = light.world_position
+    dist = float(np.linalg.norm(centre - pos))
+    if dist <= radius * 1.01:
+        raise ValueError(f"light {light.name!r}: a shadow-casting point light must be outside the scene's "
+                         f"bounding sphere (distance {dist:.3g} <= radius {radius:.3g})")
+    fov = 2 * np.arcsin(radius / dist)
+    view = np.linalg.inv(tf.compose(pos, tf.look_at_rotation(pos, centre), np.ones(3)))
+    return tf.perspective(fov, 1.0, max(dist - radius, 1e-4), dist + radius) @ view
+
+
+class ShadowPass:
+    def __init__(self, renderer):
+        self.r = renderer
+        self.maps: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
+
+    def target(self, slot: int, size: int):
+        t = self.maps.get(slot)
+        if t is None or t[0].size != (size, size):
+            if t is not None:
+                t[1].release(); t[0].release()
+            tex = self.r.ctx.depth_texture((size, size))
+            tex.compare_func = "<="
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+            t = self.maps[slot] = (tex, self.r.ctx.framebuffer(depth_attachment=tex))
+        return t
+
+    def run(self, frame, p) -> None:
+        ctx = self.r.ctx
+        light, slot = p.params["light"], p.params["slot"]
+        tex, fbo = self.target(slot, p.resolution[0])
+        lo, hi = frame.scene.world_bounds()
+        vp = light_view_proj(light, lo, hi)
+        prog = self.r.programs.get("passes/shadow.vert", "passes/shadow.frag")
+        fbo.use()
+        fbo.clear(depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.CULL_FACE)
+        ctx.polygon_offset = (2.0, 2.0)
+        for node in frame.scene.mesh_nodes():
+            set_uniforms(prog, {"u_model": node.world_matrix, "u_light_view_proj": vp})
+            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        ctx.polygon_offset = (0.0, 0.0)
+        frame.targets[f"shadow_map{slot}"] = tex
+        frame.shadow_matrices[slot] = _BIAS @ vp

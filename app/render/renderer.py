@@ -1,0 +1,96 @@
+"""The renderer owns GL: programs, GPU resources and the passes; it runs a frame plan."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from app.gl.programs import ProgramCache
+from app.gl.shader_source import ShaderLibrary
+from scene.graph import Scene
+
+from .frame import Frame
+from .gpu_resources import GpuResources
+from .passes.forward import ForwardPass
+from .passes.shadow import ShadowPass
+from .passes.tonemap import TonemapPass
+from .plan import FramePlan, plan_frame
+from .settings import RenderSettings
+from .timing import FrameTimings, PassTimer
+
+
+@dataclass
+class FrameResult:
+    hdr: np.ndarray          # (H, W, 4) float32 linear radiance, alpha = coverage; row 0 = top
+    ldr: np.ndarray          # (H, W, 4) uint8 sRGB, tone mapped
+    depth: np.ndarray        # (H, W) float32 eye-space distance along -Z (scene units), inf = background
+    timings: FrameTimings
+    plan: FramePlan
+    cpu_ms: float
+
+
+class Renderer:
+    def __init__(self, ctx: moderngl.Context, library: ShaderLibrary | None = None):
+        self.ctx = ctx
+        self.programs = ProgramCache(ctx, library)
+        self.resources = GpuResources(ctx)
+        self.timer = PassTimer(ctx)
+        self.passes = {"shadow": ShadowPass(self), "forward": ForwardPass(self), "tonemap": TonemapPass(self)}
+        self._fs_vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
+        self._fs_vaos: dict[int, moderngl.VertexArray] = {}
+        self._dummy_shadow = None
+
+    # -- helpers for passes -----------------------------------------------------------
+    def fullscreen(self, prog: moderngl.Program) -> None:
+        vao = self._fs_vaos.get(id(prog))
+        if vao is None or vao.program is not prog:
+            vao = self._fs_vaos[id(prog)] = self.ctx.vertex_array(prog, [(self._fs_vbo, "2f", "in_pos")])
+        vao.render(moderngl.TRIANGLES)
+
+    def dummy_shadow_map(self) -> moderngl.Texture:
+        if self._dummy_shadow is None:
+            t = self.ctx.depth_texture((1, 1), data=np.ones(1, np.float32).tobytes())
+            t.compare_func = "<="
+            self._dummy_shadow = t
+        return self._dummy_shadow
+
+    # -- a frame ------------------------------------------------------------------------
+    def plan(self, scene: Scene, settings: RenderSettings) -> FramePlan:
+        return plan_frame(scene, settings)
+
+    def render(self, scene: Scene, settings: RenderSettings | None = None, readback: bool = True) -> FrameResult:
+        settings = settings or RenderSettings()
+        t0 = time.perf_counter()
+        cam = scene.camera
+        if cam is None:
+            raise ValueError(f"scene {scene.name!r} has no camera")
+        plan = self.plan(scene, settings)
+        frame = Frame(scene, settings, cam.view_matrix(), cam.projection_matrix(settings.width / settings.height),
+                      cam.world_position)
+        self.timer.start_frame()
+        for p in plan.passes:
+            with self.timer.measure(p.name):
+                self.passes[p.kind].run(frame, p)
+        hdr = ldr = depth = None
+        if readback:
+            hdr, ldr, depth = self.read_targets(frame)
+        return FrameResult(hdr, ldr, depth, self.timer.frame, plan, (time.perf_counter() - t0) * 1e3)
+
+    def read_targets(self, frame: Frame):
+        w, h = frame.settings.size
+        hdr = np.frombuffer(frame.targets["hdr_color"].read(), np.float32).reshape(h, w, 4)[::-1].copy()
+        ldr = np.frombuffer(frame.targets["ldr_color"].read(), np.uint8).reshape(h, w, 4)[::-1].copy()
+        zbuf = np.frombuffer(frame.targets["depth"].read(), np.float32).reshape(h, w)[::-1]
+        cam = frame.scene.camera
+        n, f = cam.znear, cam.zfar
+        zn = zbuf.astype(np.float64) * 2.0 - 1.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lin = 2.0 * n * f / (f + n - zn * (f - n))
+        depth = np.where(zbuf >= 1.0, np.inf, lin).astype(np.float32)
+        return hdr, ldr, depth
+
+    def release(self) -> None:
+        self.programs.release()
+        self.resources.release()

@@ -1,0 +1,67 @@
+"""Per-pass timing: GPU timer queries and CPU wall time (synchronised with glFinish).
+
+On Mesa llvmpipe the timer query sees only command submission, not the software rasteriser's
+work, so the synchronised wall time is the meaningful figure there; on a real GPU the timer
+query is. ``FrameTimings.frame_ms`` picks accordingly.
+"""
+from __future__ import annotations
+
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import moderngl
+
+_INVALID = 0xFFFFFFFF  # some drivers return UINT_MAX for a query without a result
+
+
+@dataclass
+class PassTime:
+    name: str
+    gpu_ms: float | None
+    cpu_ms: float
+
+
+@dataclass
+class FrameTimings:
+    passes: list[PassTime] = field(default_factory=list)
+    software_gl: bool = False
+
+    @property
+    def frame_ms(self) -> float:
+        if not self.software_gl and self.passes and all(p.gpu_ms is not None for p in self.passes):
+            return sum(p.gpu_ms for p in self.passes)
+        return sum(p.cpu_ms for p in self.passes)
+
+    def as_dict(self) -> dict:
+        return {"frame_ms": self.frame_ms, "clock": "cpu-synchronised" if self.software_gl else "gpu-timer",
+                "passes": {p.name: {"gpu_ms": p.gpu_ms, "cpu_ms": p.cpu_ms} for p in self.passes}}
+
+
+class PassTimer:
+    def __init__(self, ctx: moderngl.Context, sync: bool = True):
+        self.ctx = ctx
+        self.sync = sync
+        self.software_gl = "llvmpipe" in ctx.info.get("GL_RENDERER", "").lower() or \
+            "softpipe" in ctx.info.get("GL_RENDERER", "").lower()
+        self.frame = FrameTimings(software_gl=self.software_gl)
+        self._queries: list[moderngl.Query] = []
+
+    def start_frame(self) -> None:
+        self.frame = FrameTimings(software_gl=self.software_gl)
+
+    @contextmanager
+    def measure(self, name: str):
+        q = self.ctx.query(time=True)
+        t0 = time.perf_counter()
+        with q:
+            yield
+        if self.sync:
+            self.ctx.finish()
+        cpu = (time.perf_counter() - t0) * 1e3
+        try:
+            ns = q.elapsed
+            gpu = None if ns in (_INVALID, 0) and self.software_gl else (None if ns >= _INVALID else ns / 1e6)
+        except Exception:
+            gpu = None
+        self.frame.passes.append(PassTime(name, gpu, cpu))

@@ -1,0 +1,218 @@
+"""Scene graph: nodes with local TRS and cached world matrices; mesh, light and camera nodes.
+
+The scene holds data only; the renderer owns GL. A node's world matrix is cached and
+recomputed only when its own transform or one above it changed (a dirty flag propagated down).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Iterator
+
+import numpy as np
+
+from . import transform as tf
+
+
+class Node:
+    def __init__(self, name: str, translation=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0, 1.0),
+                 scale=(1.0, 1.0, 1.0), visible: bool = True):
+        self.name = name
+        self.parent: Node | None = None
+        self.children: list[Node] = []
+        self.visible = visible
+        self._t = np.asarray(translation, np.float64).copy()
+        self._r = np.asarray(rotation, np.float64).copy()
+        self._s = np.asarray(scale, np.float64).copy()
+        self._world: np.ndarray | None = None
+        self.world_updates = 0  # how often the world matrix was recomputed (for tests/profiling)
+
+    # -- hierarchy ------------------------------------------------------------------
+    def add(self, child: "Node") -> "Node":
+        if child.parent is not None:
+            child.parent.children.remove(child)
+        child.parent = self
+        self.children.append(child)
+        child._invalidate()
+        return child
+
+    def walk(self) -> Iterator["Node"]:
+        yield self
+        for c in self.children:
+            yield from c.walk()
+
+    def is_visible(self) -> bool:
+        n: Node | None = self
+        while n is not None:
+            if not n.visible:
+                return False
+            n = n.parent
+        return True
+
+    # -- transforms -------------------------------------------------------------------
+    def _invalidate(self) -> None:
+        stack = [self]
+        while stack:
+            n = stack.pop()
+            if n._world is None:
+                continue  # already dirty: so are its descendants
+            n._world = None
+            stack.extend(n.children)
+
+    @property
+    def translation(self) -> np.ndarray:
+        return self._t.copy()
+
+    @translation.setter
+    def translation(self, v) -> None:
+        self._t = np.asarray(v, np.float64).copy()
+        self._invalidate()
+
+    @property
+    def rotation(self) -> np.ndarray:
+        return self._r.copy()
+
+    @rotation.setter
+    def rotation(self, q) -> None:
+        q = np.asarray(q, np.float64)
+        if q.shape != (4,) or not np.isfinite(q).all() or np.linalg.norm(q) == 0:
+            raise ValueError(f"node {self.name!r}: rotation must be a non-zero quaternion (x, y, z, w), got {q}")
+        self._r = q / np.linalg.norm(q)
+        self._invalidate()
+
+    @property
+    def scale(self) -> np.ndarray:
+        return self._s.copy()
+
+    @scale.setter
+    def scale(self, s) -> None:
+        self._s = np.asarray(s, np.float64).copy()
+        self._invalidate()
+
+    def set_matrix(self, m) -> None:
+        t, r, s = tf.decompose(m)
+        self._t, self._r, self._s = t, r, s
+        self._invalidate()
+
+    @property
+    def local_matrix(self) -> np.ndarray:
+        return tf.compose(self._t, self._r, self._s)
+
+    @property
+    def world_matrix(self) -> np.ndarray:
+        if self._world is None:
+            local = self.local_matrix
+            self._world = local if self.parent is None else self.parent.world_matrix @ local
+            self.world_updates += 1
+        return self._world
+
+    @property
+    def world_position(self) -> np.ndarray:
+        return self.world_matrix[:3, 3].copy()
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.name!r})"
+
+
+class MeshNode(Node):
+    def __init__(self, name: str, mesh, material, **kw):
+        super().__init__(name, **kw)
+        self.mesh = mesh
+        self.material = material
+
+
+class LightNode(Node):
+    KINDS = ("directional", "point")
+
+    def __init__(self, name: str, kind: str = "directional", color=(1.0, 1.0, 1.0), intensity: float = 1.0,
+                 cast_shadow: bool = False, **kw):
+        super().__init__(name, **kw)
+        if kind not in self.KINDS:
+            raise ValueError(f"light {name!r}: type must be one of {self.KINDS}, got {kind!r}")
+        if not np.isfinite(intensity) or intensity < 0:
+            raise ValueError(f"light {name!r}: intensity must be finite and >= 0, got {intensity}")
+        self.kind = kind
+        self.color = np.asarray(color, np.float64)
+        self.intensity = float(intensity)
+        self.cast_shadow = bool(cast_shadow)
+
+    @property
+    def direction(self) -> np.ndarray:
+        """Direction the light travels (world), i.e. the node's -Z axis."""
+        d = -self.world_matrix[:3, 2]
+        return d / np.linalg.norm(d)
+
+    @property
+    def radiance(self) -> np.ndarray:
+        return self.color * self.intensity
+
+
+class CameraNode(Node):
+    def __init__(self, name: str = "camera", yfov: float = np.radians(30), znear: float = 0.1,
+                 zfar: float = 1000.0, **kw):
+        super().__init__(name, **kw)
+        if not (0 < yfov < np.pi):
+            raise ValueError(f"camera {name!r}: yfov must be in (0, pi) radians, got {yfov}")
+        if not (0 < znear < zfar):
+            raise ValueError(f"camera {name!r}: need 0 < znear < zfar, got {znear}, {zfar}")
+        self.yfov, self.znear, self.zfar = float(yfov), float(znear), float(zfar)
+
+    def view_matrix(self) -> np.ndarray:
+        return np.linalg.inv(self.world_matrix)
+
+    def projection_matrix(self, aspect: float) -> np.ndarray:
+        return tf.perspective(self.yfov, aspect, self.znear, self.zfar)
+
+    def look_at(self, eye, target, up=(0.0, 1.0, 0.0)) -> None:
+        self._t = np.asarray(eye, np.float64).copy()
+        self._r = tf.look_at_rotation(eye, target, up)
+        self._invalidate()
+
+
+@dataclass
+class Environment:
+    ambient: np.ndarray = field(default_factory=lambda: np.array([0.03, 0.03, 0.035]))
+    exposure: float = 1.0
+
+
+class Scene:
+    """The data of one scene: a node tree, a camera, and the physical scale."""
+
+    def __init__(self, name: str = "scene", mm_per_unit: float = 1.0):
+        if not (np.isfinite(mm_per_unit) and mm_per_unit > 0):
+            raise ValueError(f"scene {name!r}: mm_per_unit must be > 0, got {mm_per_unit}")
+        self.name = name
+        self.mm_per_unit = float(mm_per_unit)
+        self.root = Node("root")
+        self.camera: CameraNode | None = None
+        self.environment = Environment()
+        self.source = None  # path of the scene file, if any
+
+    def add(self, node: Node, parent: Node | None = None) -> Node:
+        (parent or self.root).add(node)
+        if isinstance(node, CameraNode) and self.camera is None:
+            self.camera = node
+        return node
+
+    def nodes(self) -> Iterator[Node]:
+        return self.root.walk()
+
+    def find(self, name: str) -> Node:
+        for n in self.nodes():
+            if n.name == name:
+                return n
+        raise KeyError(f"scene {self.name!r} has no node named {name!r}")
+
+    def mesh_nodes(self, visible_only: bool = True) -> list[MeshNode]:
+        return [n for n in self.nodes() if isinstance(n, MeshNode) and (not visible_only or n.is_visible())]
+
+    def lights(self) -> list[LightNode]:
+        return [n for n in self.nodes() if isinstance(n, LightNode) and n.is_visible()]
+
+    def world_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+        for n in self.mesh_nodes():
+            p = n.mesh.bound_corners() @ n.world_matrix[:3, :3].T + n.world_matrix[:3, 3]
+            lo, hi = np.minimum(lo, p.min(0)), np.maximum(hi, p.max(0))
+        if not np.isfinite(lo).all():
+            return np.zeros(3), np.zeros(3)
+        return lo, hi

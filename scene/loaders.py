@@ -1,0 +1,89 @@
+"""Mesh files through trimesh: glTF/GLB (keeping node hierarchy and names), OBJ, PLY."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .mesh import Mesh
+
+SUPPORTED = (".glb", ".gltf", ".obj", ".ply", ".stl", ".off")
+
+
+@dataclass
+class LoadedNode:
+    name: str
+    parent: str | None        # None: a root of the file
+    matrix: np.ndarray        # local 4x4
+    mesh: Mesh | None
+
+
+_CACHE: dict[tuple[str, float], list[LoadedNode]] = {}
+
+
+def load_mesh_file(path: str | Path) -> list[LoadedNode]:
+    """Nodes of a mesh file, parents before children. Cached per (path, mtime)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"mesh file not found: {path}")
+    if path.suffix.lower() not in SUPPORTED:
+        raise ValueError(f"{path}: unsupported mesh format {path.suffix!r}; expected one of {', '.join(SUPPORTED)}")
+    key = (str(path.resolve()), path.stat().st_mtime)
+    if key not in _CACHE:
+        _CACHE[key] = _load(path)
+    # fresh Mesh objects per call would re-upload; share them (meshes are data, not mutated by the renderer)
+    return _CACHE[key]
+
+
+def _mesh_from_trimesh(name: str, tm, source: str) -> Mesh:
+    uv = None
+    vis = getattr(tm, "visual", None)
+    if vis is not None and getattr(vis, "uv", None) is not None and len(vis.uv) == len(tm.vertices):
+        uv = np.asarray(vis.uv, np.float32)
+    normals = np.asarray(tm.vertex_normals, np.float32)
+    return Mesh(name=name, positions=np.asarray(tm.vertices), indices=np.asarray(tm.faces), normals=normals,
+                uvs=uv, source=source)
+
+
+def _load(path: Path) -> list[LoadedNode]:
+    import trimesh
+
+    try:
+        loaded = trimesh.load(str(path), process=False, maintain_order=True)
+    except Exception as exc:  # trimesh raises many kinds
+        raise ValueError(f"{path}: cannot read mesh file: {exc}") from None
+    if isinstance(loaded, trimesh.Trimesh):
+        if len(loaded.faces) == 0:
+            raise ValueError(f"{path}: contains no triangles")
+        return [LoadedNode(path.stem, None, np.eye(4), _mesh_from_trimesh(path.stem, loaded, str(path)))]
+    if not isinstance(loaded, trimesh.Scene):
+        raise ValueError(f"{path}: contains no triangle mesh (got {type(loaded).__name__})")
+    graph = loaded.graph
+    base = graph.base_frame
+    out: list[LoadedNode] = []
+    meshes: dict[str, Mesh] = {}
+    # breadth-first from the base frame so parents come first
+    frontier = [base]
+    seen = {base}
+    while frontier:
+        nxt = []
+        for parent in frontier:
+            for child in sorted(graph.transforms.children.get(parent, [])):
+                if child in seen:
+                    continue
+                seen.add(child)
+                matrix, geom_name = graph.get(frame_to=child, frame_from=parent)
+                mesh = None
+                if geom_name is not None and geom_name in loaded.geometry:
+                    g = loaded.geometry[geom_name]
+                    if isinstance(g, trimesh.Trimesh) and len(g.faces):
+                        if geom_name not in meshes:
+                            meshes[geom_name] = _mesh_from_trimesh(geom_name, g, str(path))
+                        mesh = meshes[geom_name]
+                out.append(LoadedNode(str(child), None if parent == base else str(parent), np.asarray(matrix), mesh))
+                nxt.append(child)
+        frontier = nxt
+    if not any(n.mesh for n in out):
+        raise ValueError(f"{path}: contains no triangle mesh")
+    return out

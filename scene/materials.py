@@ -1,0 +1,147 @@
+"""Materials declare their parameters once; uniforms, shader variants and UI derive from that.
+
+A :class:`Param` has a name, a kind, a default and a valid range. Kinds:
+- ``float`` / ``color`` / ``vec3``: plain values, uploaded as uniforms ``u_<name>``;
+- ``texture``: a file path; when set it selects a shader variant (``HAS_<NAME>``) and binds a sampler;
+- ``choice``: an option that changes shader code (e.g. the SSS model): a define ``<NAME>_<OPTION>``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+SSS_MODELS = ("none", "dipole", "burley", "blender-burley", "gaussians", "pbd")
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str
+    kind: str                       # float | color | vec3 | texture | choice
+    default: Any
+    range: tuple[float, float] | None = None
+    choices: tuple[str, ...] = ()
+    colorspace: str = "linear"       # for textures: "srgb" colour data or "linear" data
+    doc: str = ""
+    unit: str = ""
+
+    @property
+    def uniform(self) -> str:
+        return f"u_{self.name}"
+
+    @property
+    def define(self) -> str:
+        return f"HAS_{self.name.upper()}"
+
+    def validate(self, value: Any, where: str = "") -> Any:
+        """Return the value in canonical form or raise ValueError naming the parameter."""
+        label = f"{where}{self.name}"
+        if self.kind == "texture":
+            if value is None or value == "":
+                return None
+            return Path(value)
+        if self.kind == "choice":
+            if value not in self.choices:
+                raise ValueError(f"{label}: expected one of {', '.join(self.choices)}; got {value!r}")
+            return value
+        if self.kind == "float":
+            try:
+                v = float(value)
+            except (TypeError, ValueError):
+                raise ValueError(f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}") from None
+            arr = np.array([v])
+        else:
+            try:
+                arr = np.asarray(value, dtype=np.float64).reshape(-1)
+            except (TypeError, ValueError):
+                raise ValueError(f"{label}: expected 3 numbers, got {value!r}") from None
+            if arr.size == 1:
+                arr = np.repeat(arr, 3)
+            if arr.size != 3:
+                raise ValueError(f"{label}: expected 3 numbers (R, G, B), got {arr.size}")
+        lo, hi = self.range
+        if not np.isfinite(arr).all() or (arr < lo).any() or (arr > hi).any():
+            unit = f" {self.unit}" if self.unit else ""
+            raise ValueError(f"{label}: value {value!r} outside the valid range [{lo}, {hi}]{unit}")
+        return float(arr[0]) if self.kind == "float" else tuple(float(x) for x in arr)
+
+
+PRINCIPLED_PARAMS: tuple[Param, ...] = (
+    Param("base_color", "color", (0.8, 0.8, 0.8), (0.0, 1.0), doc="diffuse albedo / metal F0 (linear RGB)"),
+    Param("base_color_map", "texture", None, colorspace="srgb", doc="colour map, sRGB; multiplies base_color"),
+    Param("roughness", "float", 0.5, (0.0, 1.0), doc="perceptual roughness; GGX alpha = roughness^2"),
+    Param("roughness_map", "texture", None, doc="roughness (R channel), linear; multiplies roughness"),
+    Param("metallic", "float", 0.0, (0.0, 1.0)),
+    Param("specular", "float", 0.5, (0.0, 1.0), doc="dielectric F0 = 0.08 * specular (0.5 -> 4 %)"),
+    Param("normal_map", "texture", None, doc="tangent-space normal map, linear"),
+    Param("normal_scale", "float", 1.0, (0.0, 4.0), doc="strength of the normal map"),
+    Param("occlusion_map", "texture", None, doc="ambient occlusion (R channel), linear"),
+    Param("subsurface", "float", 0.0, (0.0, 1.0), doc="weight of subsurface scattering against plain diffuse"),
+    Param("subsurface_radius", "vec3", (1.0, 0.2, 0.1), (0.0, 1000.0), unit="mm",
+          doc="scattering distance per channel (artist mean free path), millimetres"),
+    Param("subsurface_color", "color", (0.8, 0.4, 0.3), (0.0, 1.0), doc="multiple-scattering albedo"),
+    Param("sss_model", "choice", "burley", choices=SSS_MODELS, doc="diffusion profile for subsurface scattering"),
+)
+
+
+@dataclass
+class Material:
+    """A principled material: a name and values for the declared parameters."""
+
+    name: str = "default"
+    values: dict[str, Any] = field(default_factory=dict)
+    params: tuple[Param, ...] = PRINCIPLED_PARAMS
+
+    def __post_init__(self) -> None:
+        given = dict(self.values)
+        self.values = {p.name: p.validate(p.default) if p.default is not None else None for p in self.params}
+        self.update(given)
+
+    @property
+    def param_map(self) -> dict[str, Param]:
+        return {p.name: p for p in self.params}
+
+    def update(self, values: Mapping[str, Any]) -> "Material":
+        pm = self.param_map
+        for k, v in values.items():
+            if k not in pm:
+                raise ValueError(f"material {self.name!r}: unknown parameter {k!r}; "
+                                 f"known: {', '.join(pm)}")
+            self.values[k] = pm[k].validate(v, where=f"material {self.name!r}: ")
+        return self
+
+    def __getitem__(self, name: str) -> Any:
+        return self.values[name]
+
+    def with_overrides(self, overrides: Mapping[str, Any], name: str | None = None) -> "Material":
+        m = Material(name or self.name, dict(self.values), self.params)
+        return m.update(overrides)
+
+    # -- what the renderer derives from the declaration -------------------------------
+    def uniforms(self) -> dict[str, Any]:
+        return {p.uniform: self.values[p.name] for p in self.params if p.kind in ("float", "color", "vec3")}
+
+    def textures(self) -> dict[str, tuple[Path, str]]:
+        """sampler uniform -> (path, colorspace) for the maps that are set."""
+        return {p.uniform: (self.values[p.name], p.colorspace) for p in self.params
+                if p.kind == "texture" and self.values[p.name] is not None}
+
+    def defines(self, kinds: tuple[str, ...] = ("texture",)) -> dict[str, str]:
+        """Shader-variant defines: ``HAS_<MAP>`` for set maps and ``<CHOICE>_<OPTION>`` for choices.
+        A pass asks only for the kinds its code depends on, so unrelated settings share a program."""
+        d = {}
+        for p in self.params:
+            if p.kind not in kinds:
+                continue
+            if p.kind == "texture" and self.values[p.name] is not None:
+                d[p.define] = "1"
+            elif p.kind == "choice":
+                d[f"{p.name.upper()}_{self.values[p.name].upper().replace('-', '_')}"] = "1"
+        return d
+
+    @property
+    def has_subsurface(self) -> bool:
+        return self.values["subsurface"] > 0 and self.values["sss_model"] != "none" \
+            and max(self.values["subsurface_radius"]) > 0

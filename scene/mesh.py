@@ -1,0 +1,120 @@
+"""Triangle meshes: positions, normals, UVs, tangents; tangent generation and UV atlases."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class Mesh:
+    name: str
+    positions: np.ndarray            # (N, 3) float32
+    indices: np.ndarray              # (M, 3) uint32
+    normals: np.ndarray | None = None    # (N, 3) float32
+    uvs: np.ndarray | None = None        # (N, 2) float32, OpenGL convention (v up)
+    tangents: np.ndarray | None = None   # (N, 4) float32, w = handedness
+    source: str = ""
+    version: int = 0                 # bump when geometry changes (GPU buffers and stretch maps key on it)
+    _bounds: tuple | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        self.positions = np.ascontiguousarray(self.positions, np.float32)
+        self.indices = np.ascontiguousarray(self.indices, np.uint32).reshape(-1, 3)
+        where = f"mesh {self.name!r}" + (f" ({self.source})" if self.source else "")
+        if self.positions.ndim != 2 or self.positions.shape[1] != 3:
+            raise ValueError(f"{where}: positions must be (N, 3), got {self.positions.shape}")
+        if len(self.indices) == 0:
+            raise ValueError(f"{where}: has no triangles")
+        if self.indices.max() >= len(self.positions):
+            raise ValueError(f"{where}: triangle index {self.indices.max()} out of range ({len(self.positions)} vertices)")
+        if not np.isfinite(self.positions).all():
+            raise ValueError(f"{where}: positions contain NaN or Inf")
+        if self.normals is None:
+            self.normals = vertex_normals(self.positions, self.indices)
+        self.normals = np.ascontiguousarray(self.normals, np.float32)
+        if self.uvs is not None:
+            self.uvs = np.ascontiguousarray(self.uvs, np.float32)
+        if self.tangents is not None:
+            self.tangents = np.ascontiguousarray(self.tangents, np.float32)
+
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._bounds is None:
+            self._bounds = (self.positions.min(0).astype(np.float64), self.positions.max(0).astype(np.float64))
+        return self._bounds
+
+    def bound_corners(self) -> np.ndarray:
+        lo, hi = self.bounds
+        return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+    def ensure_tangents(self) -> np.ndarray:
+        if self.tangents is None:
+            if self.uvs is None:
+                raise ValueError(f"mesh {self.name!r}: tangents need UVs")
+            self.tangents = compute_tangents(self.positions, self.normals, self.uvs, self.indices)
+        return self.tangents
+
+    def ensure_uvs(self, reason: str = "a technique needs UVs", generate: bool = True) -> None:
+        """Generate a UV atlas with xatlas if the mesh has none (or raise naming the mesh)."""
+        if self.uvs is not None:
+            return
+        if not generate:
+            raise ValueError(f"mesh {self.name!r} ({self.source or 'no file'}) has no UV coordinates, and {reason}")
+        generate_atlas(self)
+
+
+def vertex_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """Area-weighted vertex normals; degenerate vertices get +Z rather than NaN."""
+    p = positions.astype(np.float64)
+    f = indices.astype(np.int64)
+    fn = np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]])
+    n = np.zeros_like(p)
+    for k in range(3):
+        np.add.at(n, f[:, k], fn)
+    ln = np.linalg.norm(n, axis=1, keepdims=True)
+    out = np.where(ln > 0, n / np.where(ln > 0, ln, 1), [0.0, 0.0, 1.0])
+    return out.astype(np.float32)
+
+
+def compute_tangents(positions, normals, uvs, indices) -> np.ndarray:
+    """Per-vertex tangents (xyz) and handedness (w) from UV derivatives (Lengyel 2001), with
+    Gram-Schmidt against the normal; triangles with degenerate UVs contribute nothing and
+    vertices left without a tangent get any unit vector perpendicular to the normal."""
+    p = positions.astype(np.float64)
+    uv = uvs.astype(np.float64)
+    n = normals.astype(np.float64)
+    f = indices.astype(np.int64)
+    e1, e2 = p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]
+    d1, d2 = uv[f[:, 1]] - uv[f[:, 0]], uv[f[:, 2]] - uv[f[:, 0]]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    ok = np.abs(det) > 1e-20
+    r = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)[:, None]
+    sdir = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * r
+    tdir = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * r
+    t = np.zeros_like(p)
+    b = np.zeros_like(p)
+    for k in range(3):
+        np.add.at(t, f[:, k], sdir)
+        np.add.at(b, f[:, k], tdir)
+    t = t - n * np.sum(n * t, axis=1, keepdims=True)
+    ln = np.linalg.norm(t, axis=1, keepdims=True)
+    # fallback: any perpendicular
+    alt = np.cross(n, np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
+    alt /= np.maximum(np.linalg.norm(alt, axis=1, keepdims=True), 1e-30)
+    t = np.where(ln > 1e-12, t / np.where(ln > 1e-12, ln, 1), alt)
+    w = np.where(np.sum(np.cross(n, t) * b, axis=1) < 0.0, -1.0, 1.0)
+    return np.concatenate([t, w[:, None]], axis=1).astype(np.float32)
+
+
+def generate_atlas(mesh: Mesh) -> None:
+    """Give ``mesh`` a UV atlas with xatlas (vertices are split along chart seams)."""
+    import xatlas
+
+    vmapping, idx, uvs = xatlas.parametrize(mesh.positions, mesh.indices)
+    mesh.positions = np.ascontiguousarray(mesh.positions[vmapping])
+    mesh.normals = np.ascontiguousarray(mesh.normals[vmapping])
+    mesh.indices = np.ascontiguousarray(idx, np.uint32)
+    mesh.uvs = np.ascontiguousarray(uvs, np.float32)
+    mesh.tangents = None
+    mesh.version += 1

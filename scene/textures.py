@@ -1,0 +1,46 @@
+"""Textures through OpenImageIO: colour maps decoded from sRGB to linear, data maps kept linear.
+
+Arrays are float32 (H, W, C) with row 0 at the *top* of the image as stored in the file; the
+renderer flips rows on upload so that v = 0 (OpenGL, as trimesh gives UVs) is the bottom row.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .optics.color import srgb_decode
+
+_CACHE: dict[tuple[str, float, str], np.ndarray] = {}
+
+
+def load_texture(path: str | Path, colorspace: str = "linear") -> np.ndarray:
+    if colorspace not in ("srgb", "linear"):
+        raise ValueError(f"texture {path}: colorspace must be 'srgb' or 'linear', got {colorspace!r}")
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"texture file not found: {path}")
+    key = (str(path.resolve()), path.stat().st_mtime, colorspace)
+    if key in _CACHE:
+        return _CACHE[key]
+    import OpenImageIO as oiio
+
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise ValueError(f"{path}: cannot read texture: {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        data = inp.read_image(0, 0, 0, spec.nchannels, "float")
+    finally:
+        inp.close()
+    if data is None:
+        raise ValueError(f"{path}: cannot decode texture: {oiio.geterror()}")
+    img = np.asarray(data, np.float32).reshape(spec.height, spec.width, spec.nchannels)
+    if colorspace == "srgb":
+        rgb = min(3, img.shape[2])
+        img = img.copy()
+        img[..., :rgb] = srgb_decode(img[..., :rgb]).astype(np.float32)
+    if not np.isfinite(img).all():
+        raise ValueError(f"{path}: texture contains NaN or Inf")
+    _CACHE[key] = img
+    return img
