@@ -43,8 +43,17 @@ def egl_device_index() -> int:
     return idx
 
 
-def create_headless_context() -> moderngl.Context:
-    """A standalone OpenGL 3.3+ core context through EGL."""
+_SHARED: moderngl.Context | None = None
+
+
+def create_headless_context(shared: bool = True) -> moderngl.Context:
+    """A standalone OpenGL 3.3+ core context through EGL.
+
+    By default one context per process is shared: moderngl does not make a standalone context
+    current again before each call, so a second one would silently take over the GL state."""
+    global _SHARED
+    if shared and _SHARED is not None:
+        return _SHARED
     missing = _missing_libraries()
     if missing:
         raise ContextError("cannot create a headless OpenGL context; missing: " + "; ".join(missing)
@@ -62,6 +71,8 @@ def create_headless_context() -> moderngl.Context:
         elif "libegl" in low or "egl" in low:
             hint = "; EGL needs " + _HINTS["libEGL"] + " and Mesa's drivers " + _HINTS["libGL"]
         raise ContextError(f"cannot create a headless OpenGL context through EGL: {text}{hint}") from None
+    if shared:
+        _SHARED = ctx
     return ctx
 
 

@@ -1,0 +1,62 @@
+"""The `skinlab` command line, run as a user would (in a subprocess)."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def skinlab(*args, env=None):
+    e = dict(os.environ, **(env or {}))
+    return subprocess.run([sys.executable, "-m", "app.cli", *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=300, env=e)
+
+
+def test_render_json_png_and_exr(tmp_path):
+    png, exr = tmp_path / "a.png", tmp_path / "b.exr"
+    p = skinlab("render", "--out", str(png), "--size", "48x40", "--json", "--explain")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert d["outputs"] == [str(png)] and d["size"] == [48, 40]
+    assert set(d["timings"]["passes"]) == {"shadow[key]", "forward", "tonemap"}
+    assert "frame plan:" in p.stderr
+    assert skinlab("render", "--out", str(exr), "--size", "48x40").returncode == 0
+    from app.image_output import read_image
+
+    img = read_image(exr)
+    assert img.shape == (40, 48, 4) and img.dtype == np.float32 and np.isfinite(img).all()
+    assert img[..., 3].max() == 1.0 and img[..., 3].min() == 0.0
+    png_img = read_image(png)
+    assert png_img.shape == (40, 48, 4) and png_img.dtype == np.uint8
+    assert not list(tmp_path.glob(".*"))  # no temporary files left behind
+
+
+@pytest.mark.parametrize("args, message", [
+    (["render", "--out", "x.jpg"], "x.jpg: unsupported image extension '.jpg'; expected .png or .exr"),
+    (["render", "missing.toml"], "scene file not found: missing.toml"),
+    (["render", "--size", "12"], "--size: expected WIDTHxHEIGHT"),
+])
+def test_bad_input_is_one_clear_line(args, message):
+    p = skinlab(*args)
+    assert p.returncode == 2 and message in p.stderr and "Traceback" not in p.stderr
+
+
+def test_bad_egl_device_is_reported(tmp_path):
+    p = skinlab("render", "--out", str(tmp_path / "x.png"), "--size", "8x8", env={"SKINLAB_EGL_DEVICE": "abc"})
+    assert p.returncode == 2 and "SKINLAB_EGL_DEVICE must be a device index" in p.stderr
+
+
+def test_missing_egl_library_names_the_package(monkeypatch):
+    import ctypes.util
+
+    from app.gl import context
+
+    monkeypatch.setattr(ctypes.util, "find_library", lambda name: None)
+    monkeypatch.setattr(context, "_SHARED", None)
+    with pytest.raises(context.ContextError, match=r"libEGL.so.1 \(Debian/Ubuntu: apt-get install libegl1"):
+        context.create_headless_context()
