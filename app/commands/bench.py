@@ -36,11 +36,12 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
     settings = RenderSettings(w, h)
     ctx = create_headless_context()
     r = Renderer(ctx)
+    r.timer.sync = False  # no glFinish between passes: whole frames are timed here
     r.render(scene, settings)
     ours = []
     for _ in range(frames):
         t0 = time.perf_counter()
-        r.render(scene, settings)
+        r.render(scene, settings, readback=("ldr", "depth"))  # what pyrender reads back
         ours.append((time.perf_counter() - t0) * 1e3)
     cam = scene.camera
     meshes = [(str(n.mesh.source), n.world_matrix) for n in scene.mesh_nodes()]

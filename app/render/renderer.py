@@ -60,7 +60,10 @@ class Renderer:
     def plan(self, scene: Scene, settings: RenderSettings) -> FramePlan:
         return plan_frame(scene, settings)
 
-    def render(self, scene: Scene, settings: RenderSettings | None = None, readback: bool = True) -> FrameResult:
+    def render(self, scene: Scene, settings: RenderSettings | None = None,
+               readback: bool | tuple[str, ...] = True) -> FrameResult:
+        """Plan and run a frame. ``readback``: True for all of hdr/ldr/depth, False for none, or a
+        tuple naming the ones wanted (the others come back as None)."""
         settings = settings or RenderSettings()
         t0 = time.perf_counter()
         cam = scene.camera
@@ -73,15 +76,19 @@ class Renderer:
         for p in plan.passes:
             with self.timer.measure(p.name):
                 self.passes[p.kind].run(frame, p)
-        hdr = ldr = depth = None
-        if readback:
-            hdr, ldr, depth = self.read_targets(frame)
+        wanted = ("hdr", "ldr", "depth") if readback is True else (readback or ())
+        hdr, ldr, depth = self.read_targets(frame, wanted)
         return FrameResult(hdr, ldr, depth, self.timer.frame, plan, (time.perf_counter() - t0) * 1e3)
 
-    def read_targets(self, frame: Frame):
+    def read_targets(self, frame: Frame, wanted=("hdr", "ldr", "depth")):
         w, h = frame.settings.size
-        hdr = np.frombuffer(frame.targets["hdr_color"].read(), np.float32).reshape(h, w, 4)[::-1].copy()
-        ldr = np.frombuffer(frame.targets["ldr_color"].read(), np.uint8).reshape(h, w, 4)[::-1].copy()
+        hdr = ldr = depth = None
+        if "hdr" in wanted:
+            hdr = np.frombuffer(frame.targets["hdr_color"].read(), np.float32).reshape(h, w, 4)[::-1].copy()
+        if "ldr" in wanted:
+            ldr = np.frombuffer(frame.targets["ldr_color"].read(), np.uint8).reshape(h, w, 4)[::-1].copy()
+        if "depth" not in wanted:
+            return hdr, ldr, None
         zbuf = np.frombuffer(frame.targets["depth"].read(), np.float32).reshape(h, w)[::-1]
         cam = frame.scene.camera
         n, f = cam.znear, cam.zfar
