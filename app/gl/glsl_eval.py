@@ -39,7 +39,14 @@ class GLSLEvaluator:
         self._n = 0
 
     def evaluate(self, includes: str | list[str], expr: str, inputs: Mapping[str, np.ndarray],
-                 out_components: int = 1, prelude: str = "") -> np.ndarray:
+                 out_components: int = 1, prelude: str = "", uniforms: Mapping[str, tuple[str, object]] | None = None,
+                 samplers: Mapping[str, tuple[str, moderngl.Texture]] | None = None) -> np.ndarray:
+        """``uniforms``: name -> (GLSL type, value) shared by all samples (matrices as 4x4 arrays);
+        ``samplers``: name -> (GLSL sampler type, texture) bound for the expression."""
+        from .uniforms import set_uniform
+
+        uniforms = uniforms or {}
+        samplers = samplers or {}
         if isinstance(includes, str):
             includes = [includes]
         arrays = {}
@@ -63,6 +70,8 @@ class GLSLEvaluator:
         lines = ["#version 330 core"]
         lines += [f'#include "{inc}"' for inc in includes]
         lines += [f"uniform sampler2D u_{k};" for k in arrays]
+        lines += [f"uniform {t} {k};" for k, (t, _) in uniforms.items()]
+        lines += [f"uniform {t} {k};" for k, (t, _) in samplers.items()]
         lines += ["out vec4 f_out;", prelude, "void main() {", "    ivec2 p = ivec2(gl_FragCoord.xy);"]
         for k, a in arrays.items():
             c = a.shape[1]
@@ -88,6 +97,11 @@ class GLSLEvaluator:
                 textures.append(tex)
                 if f"u_{k}" in prog:
                     prog[f"u_{k}"].value = unit
+            for unit, (k, (_, tex)) in enumerate(samplers.items(), start=len(arrays)):
+                tex.use(unit)
+                set_uniform(prog, k, unit)
+            for k, (_, v) in uniforms.items():
+                set_uniform(prog, k, v)
             target = self.ctx.texture((w, h), 4, dtype="f4")
             fbo = self.ctx.framebuffer(color_attachments=[target])
             vao = self.ctx.vertex_array(prog, [(self._vbo, "2f", "in_pos")])

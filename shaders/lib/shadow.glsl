@@ -1,5 +1,5 @@
-// Shadow-map lookups (3x3 PCF on a depth-compare sampler). Texture access, so no NumPy twin:
-// the render tests check shadows (lit vs occluded regions) instead.
+// Shadow-map lookups: 3x3 PCF on a depth-compare sampler (compare '<='), slope-scaled bias.
+// NumPy twin: scene/optics/shadow.py (exact for NEAREST compare filtering).
 #include "skinlab/constants.glsl"
 
 float shadow_pcf(sampler2DShadow map, mat4 shadow_matrix, vec3 world, float NoL) {

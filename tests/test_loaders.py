@@ -1,0 +1,83 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from scene.loaders import load_mesh_file
+from scene.scenefile import load_scene
+
+ASSETS = Path(__file__).resolve().parents[1] / "assets"
+
+
+def two_level_glb(path):
+    s = trimesh.Scene()
+    box = trimesh.creation.box(extents=(1, 1, 1))
+    ico = trimesh.creation.icosphere(subdivisions=1, radius=0.3)
+    s.add_geometry(box, node_name="Body", geom_name="body_geom")
+    s.add_geometry(ico, node_name="Eye", geom_name="eye_geom", parent_node_name="Body",
+                   transform=trimesh.transformations.translation_matrix([0.0, 0.5, 0.6]))
+    s.export(str(path))
+    return path
+
+
+def test_gltf_keeps_hierarchy_names_and_transforms(tmp_path):
+    nodes = {n.name: n for n in load_mesh_file(two_level_glb(tmp_path / "two.glb"))}
+    assert nodes["Eye"].parent == "Body" and nodes["Body"].parent is None
+    assert np.allclose(nodes["Eye"].matrix[:3, 3], [0.0, 0.5, 0.6])
+    assert len(nodes["Eye"].mesh.positions) == 42
+
+
+def test_per_node_materials_from_scene_file(tmp_path):
+    glb = two_level_glb(tmp_path / "two.glb")
+    (tmp_path / "s.toml").write_text(f'''
+[materials.skin]
+roughness = 0.5
+[materials.eye]
+roughness = 0.05
+[[meshes]]
+file = "{glb}"
+material = "skin"
+[meshes.nodes.Eye]
+material = "eye"
+overrides = {{ specular = 0.9 }}
+''')
+    s = load_scene(tmp_path / "s.toml")
+    body, eye = s.find("Body"), s.find("Eye")
+    assert body.material["roughness"] == 0.5
+    assert eye.material["roughness"] == 0.05 and eye.material["specular"] == 0.9
+    assert eye.parent is body
+    assert np.allclose(eye.world_position, [0.0, 0.5, 0.6])
+
+
+def test_obj_and_unsupported_and_empty(tmp_path):
+    obj = tmp_path / "t.obj"
+    obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n")
+    (n,) = load_mesh_file(obj)
+    assert n.mesh.uvs is not None and n.mesh.indices.shape == (1, 3)
+    with pytest.raises(ValueError, match=r"x.fbx: unsupported mesh format '.fbx'"):
+        (tmp_path / "x.fbx").write_text("")
+        load_mesh_file(tmp_path / "x.fbx")
+    bad = tmp_path / "bad.ply"
+    bad.write_text("this is not a ply file")
+    with pytest.raises(ValueError, match="bad.ply"):
+        load_mesh_file(bad)
+
+
+def test_bunny_without_uvs_gets_an_atlas_or_a_clear_error():
+    (n,) = load_mesh_file(ASSETS / "stanford-bunny" / "bunny.ply")
+    m = n.mesh
+    assert m.uvs is None
+    with pytest.raises(ValueError, match=r"mesh 'bunny' \(.*bunny.ply\) has no UV coordinates, and texture-space"):
+        m.ensure_uvs("texture-space diffusion needs them", generate=False)
+    from dataclasses import replace
+
+    copy = replace(m)  # do not mutate the cached mesh
+    copy.ensure_uvs()
+    assert copy.uvs.shape == (len(copy.positions), 2) and copy.version == m.version + 1
+    assert copy.uvs.min() >= 0 and copy.uvs.max() <= 1
+    assert np.isfinite(copy.ensure_tangents()).all()
+    # the atlas covers the whole surface: same area in 3D as the original mesh
+    def area(p, f):
+        return 0.5 * np.linalg.norm(np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]), axis=1).sum()
+    assert area(copy.positions, copy.indices) == pytest.approx(area(m.positions, m.indices), rel=1e-6)
