@@ -37,6 +37,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except (UserError, ContextError, ShaderError, ValueError, FileNotFoundError) as exc:
+        if os.environ.get("SKINLAB_DEBUG"):
+            raise  # SKINLAB_DEBUG=1 shows the traceback behind the one-line message
         print(f"skinlab {args.command}: error: {exc}", file=sys.stderr)
         return 2
 
