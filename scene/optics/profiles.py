@@ -16,7 +16,7 @@ Names:
                    16 d and renormalised.
   "gaussians"      K = 6 Gaussians with shared variances fitted to the PBD profile (fit_gaussians).
   "deon-skin"      d'Eon & Luebke's six-Gaussian skin profile scaled by the surface albedo (a fixed
-                   shape: ignores the mean free path).
+                   shape: ignores the mean free path except that l < MIN_MFP_MM gives 0).
   "pbd"            photon beam diffusion, multiple + single scattering (pbrt-v4).
 """
 from __future__ import annotations
@@ -28,6 +28,7 @@ from typing import Callable
 import numpy as np
 
 from .burley import blender_burley_profile, burley_profile
+from .constants import MIN_MFP_MM
 from .dipole import dipole_profile, dipole_total
 from .gaussians import GaussianFit, deon_skin_profile, fit_gaussians, gaussian_sum_profile
 from .media import Medium, mfp_to_radius
@@ -67,15 +68,19 @@ def gaussian_fit_for(m: Medium, K: int = 6) -> GaussianFit:
     return fit_gaussians(lambda r: pbd_profile(r, m.alpha_arr, m.mfp_arr, m.eta), K)
 
 
+def _no_profile(m: Medium) -> bool:
+    return bool(np.all((m.mfp_arr < MIN_MFP_MM) | (m.alpha_arr <= 0)))
+
+
 def _gauss_eval(r, m):
-    if np.all(m.mfp_arr <= 0) or np.all(m.alpha_arr <= 0):
+    if _no_profile(m):
         return np.zeros((len(r), 3))
     f = gaussian_fit_for(m)
     return gaussian_sum_profile(r, f.variances_mm2, f.weights)
 
 
 def _gauss_total(m):
-    if np.all(m.mfp_arr <= 0) or np.all(m.alpha_arr <= 0):
+    if _no_profile(m):
         return np.zeros(3)
     return gaussian_fit_for(m).weights.sum(axis=0)
 
@@ -101,7 +106,7 @@ _MODELS = [
                  lambda r, m: blender_burley_profile(r, _A(m), mfp_to_radius(m.mfp_mm)), _A),
     ProfileModel("gaussians", "6 shared-variance Gaussians fitted to PBD", _gauss_eval, _gauss_total),
     ProfileModel("deon-skin", "d'Eon & Luebke 2007 skin Gaussians x surface albedo",
-                 lambda r, m: deon_skin_profile(r, _A(m)), _A),
+                 lambda r, m: deon_skin_profile(r, _A(m) * (m.mfp_arr >= MIN_MFP_MM)), _A),
     ProfileModel("pbd", "photon beam diffusion (Habel 2013 / pbrt-v4), MS + SS",
                  lambda r, m: pbd_profile(r, m.alpha_arr, m.mfp_arr, m.eta),
                  lambda m: np.where(m.mfp_arr > 0, pbd_total(m.alpha_arr, m.eta), 0.0)),
