@@ -45,7 +45,7 @@ def test_albedo_inversion_round_trip(method):
     assert np.allclose(m.surface_albedo(method), A, atol=2e-4)
     # edge albedos
     e = media.invert_surface_albedo([0.0, 1.0, 1.0], 1.3, method)
-    # (the Cycles fit gives alpha(1) = 1 - e^{-0.80023} ... = 0.9989)
+    # (the Cycles fit gives alpha(1) = 1 - e^{-6.80023} = 0.9989)
     assert e[0] == pytest.approx(0.0, abs=1e-6) and e[1] == pytest.approx(1.0, abs=2e-3)
 
 
