@@ -8,6 +8,15 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
+from hypothesis import settings as _hyp_settings  # noqa: E402
+
+# Local runs explore new random examples every time; CI (CI=true) is derandomised so a landing
+# never depends on luck. Run `SKINLAB_HYPOTHESIS=thorough pytest` to search much harder.
+_hyp_settings.register_profile("ci", max_examples=60, derandomize=True, deadline=None, print_blob=True)
+_hyp_settings.register_profile("thorough", max_examples=2000, deadline=None)
+_hyp_settings.register_profile("dev", max_examples=60, deadline=None, print_blob=True)
+_hyp_settings.load_profile(os.environ.get("SKINLAB_HYPOTHESIS") or ("ci" if os.environ.get("CI") else "dev"))
+
 
 @pytest.fixture(scope="session")
 def ctx():

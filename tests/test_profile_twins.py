@@ -180,7 +180,7 @@ params = st.tuples(
 )
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(rows=st.lists(params, min_size=1, max_size=24))
 def test_profiles_property_finite_nonnegative_and_twins(glsl, rows):
     r = f32([x[0] for x in rows])

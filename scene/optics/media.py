@@ -83,7 +83,12 @@ def coefficients_to_albedo_mfp(sigma_s, sigma_a):
     if np.any(t <= 0):
         raise ValueError(f"sigma_s + sigma_a: must be > 0 in every channel (got sigma_s={s.tolist()}, "
                          f"sigma_a={a.tolist()}); a medium that neither scatters nor absorbs has no profile")
-    return s / t, 1.0 / t
+    with np.errstate(over="ignore"):
+        mfp = 1.0 / t
+    if not np.all(np.isfinite(mfp)):
+        raise ValueError(f"sigma_s + sigma_a: {t.tolist()} 1/mm is too small; its mean free path 1/sigma_t "
+                         f"overflows (need sigma_s + sigma_a > {1.0 / np.finfo(np.float64).max:.3g} 1/mm)")
+    return s / t, mfp
 
 
 def albedo_mfp_to_coefficients(alpha, mfp_mm):
