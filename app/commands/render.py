@@ -6,7 +6,6 @@ import sys
 from pathlib import Path
 
 from app.render.settings import RenderSettings, parse_size
-from scene.materials import SSS_MODELS
 
 
 def register(sub) -> None:
@@ -15,7 +14,6 @@ def register(sub) -> None:
     p.add_argument("--out", default="out/render.png", help="output image: .png (tone mapped) or .exr (linear)")
     p.add_argument("--size", default="640x640", help="WIDTHxHEIGHT (default 640x640)")
     p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
-    p.add_argument("--sss", choices=SSS_MODELS, help="override every material's subsurface model")
     p.add_argument("--json", action="store_true", help="print timings and output paths as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
     p.set_defaults(func=run)
@@ -44,7 +42,7 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
 
 def run(args) -> int:
     w, h = parse_size(args.size)
-    settings = RenderSettings(w, h, shadow_size=args.shadow_size, sss=args.sss)
+    settings = RenderSettings(w, h, shadow_size=args.shadow_size)
     scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings)
     if args.explain:
         print(result.plan.explain(), file=sys.stderr if args.json else sys.stdout)
