@@ -34,7 +34,8 @@ def refract_cos(cos_i, eta):
     """Cosine of the refracted direction for light entering a medium of relative index eta."""
     c = np.clip(f64(cos_i), 0.0, 1.0)
     eta = f64(eta)
-    return np.sqrt(np.maximum(1.0 - (1.0 - c) * (1.0 + c) / (eta * eta), 0.0))
+    # cos_t^2 = ((eta - 1)(eta + 1) + c^2)/eta^2: no cancellation at grazing incidence
+    return np.sqrt(np.maximum((eta - 1.0) * (eta + 1.0) + c * c, 0.0)) / eta
 
 
 def single_scatter_brdf(n, wi, wo, alpha, eta, g):

@@ -2,9 +2,11 @@
 // See scene/optics/single_scattering.py for the conventions.
 #include "lib/profiles_common.glsl"
 
+// cos_t^2 = 1 - (1 - c^2)/eta^2 = ((eta - 1)(eta + 1) + c^2)/eta^2: no cancellation at grazing
+// incidence (exact c at eta = 1; a sum of non-negative terms for eta >= 1).
 float refract_cos(float cos_i, float eta) {
     float c = clamp(cos_i, 0.0, 1.0);
-    return sqrt(max(1.0 - (1.0 - c) * (1.0 + c) / (eta * eta), 0.0));
+    return sqrt(max((eta - 1.0) * (eta + 1.0) + c * c, 0.0)) / eta;
 }
 
 vec3 single_scatter_brdf(vec3 n, vec3 wi, vec3 wo, vec3 alpha, float eta, float g) {
