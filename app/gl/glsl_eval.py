@@ -33,7 +33,8 @@ class GLSLEvaluator:
     def __init__(self, ctx: moderngl.Context, library: ShaderLibrary | None = None):
         self.ctx = ctx
         self.library = library or ShaderLibrary()
-        self._tmp = Path(tempfile.mkdtemp(prefix="skinlab-glsl-eval-"))
+        self._tmpdir = tempfile.TemporaryDirectory(prefix="skinlab-glsl-eval-")  # removed with the evaluator
+        self._tmp = Path(self._tmpdir.name)
         (self._tmp / "eval.vert").write_text(_VS)
         self._vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
         self._n = 0

@@ -9,9 +9,6 @@ import moderngl
 
 from .shader_source import ExpandedSource, ShaderError, ShaderLibrary, parse_errors
 
-_STAGES = ("vertex_shader", "fragment_shader")
-
-
 def normalize_defines(defines: Mapping[str, object] | None) -> dict[str, str]:
     """True -> "1"; False/None dropped; everything else as its string."""
     out = {}

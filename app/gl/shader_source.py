@@ -14,7 +14,6 @@ every driver (the approach of vispy's error display, with moderngl-window's incl
 """
 from __future__ import annotations
 
-import hashlib
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -151,14 +150,6 @@ class ShaderLibrary:
 
         visit(name, None, None)
         return ExpandedSource("\n".join(out) + "\n", "\n".join(flat) + "\n", line_map, files, paths)
-
-    def fingerprint(self, names: list[str], defines: Mapping[str, object] | None) -> str:
-        """Hash of the expanded text of the given stages and the defines: the program cache key."""
-        h = hashlib.sha1()
-        for n in names:
-            h.update(self.expand(n, defines).text.encode())
-        h.update(repr(sorted((defines or {}).items())).encode())
-        return h.hexdigest()
 
 
 def parse_errors(log: str, src: ExpandedSource, stage: str) -> tuple[str, list[tuple[str, int]]]:

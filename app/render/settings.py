@@ -9,7 +9,6 @@ class RenderSettings:
     width: int = 640
     height: int = 640
     shadow_size: int = 2048
-    sss: str | None = None             # override every material's SSS model (issue 4); None keeps them
     background: tuple[float, float, float] = (0.045, 0.045, 0.05)   # linear
     max_lights: int = 4
 
