@@ -51,6 +51,9 @@ def write_image(path: str | Path, pixels: np.ndarray) -> Path:
         out.close()
         if not ok:
             raise OSError(f"{path}: write failed: {oiio.geterror()}")
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600 files; outputs get ordinary permissions
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

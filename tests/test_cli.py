@@ -60,3 +60,17 @@ def test_missing_egl_library_names_the_package(monkeypatch):
     monkeypatch.setattr(context, "_SHARED", None)
     with pytest.raises(context.ContextError, match=r"libEGL.so.1 \(Debian/Ubuntu: apt-get install libegl1"):
         context.create_headless_context()
+
+
+def test_written_images_have_ordinary_permissions(tmp_path):
+    import os
+    import stat
+
+    from app.image_output import write_image
+
+    old = os.umask(0o022)
+    try:
+        p = write_image(tmp_path / "x.png", np.zeros((2, 3, 4), np.uint8))
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(p.stat().st_mode) == 0o644
