@@ -41,6 +41,7 @@ class Renderer:
         self._fs_vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
         self._fs_vaos: dict[int, moderngl.VertexArray] = {}
         self._dummy_shadow = None
+        self.last_frame: Frame | None = None   # the latest frame's targets (viewer's pass inspector)
 
     # -- helpers for passes -----------------------------------------------------------
     def fullscreen(self, prog: moderngl.Program) -> None:
@@ -76,6 +77,7 @@ class Renderer:
         for p in plan.passes:
             with self.timer.measure(p.name):
                 self.passes[p.kind].run(frame, p)
+        self.last_frame = frame
         wanted = ("hdr", "ldr", "depth") if readback is True else (readback or ())
         hdr, ldr, depth = self.read_targets(frame, wanted)
         return FrameResult(hdr, ldr, depth, self.timer.frame, plan, (time.perf_counter() - t0) * 1e3)

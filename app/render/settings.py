@@ -11,12 +11,25 @@ class RenderSettings:
     shadow_size: int = 2048
     background: tuple[float, float, float] = (0.045, 0.045, 0.05)   # linear
     max_lights: int = 4
+    # None: each material's own sss_model; else one of scene.materials.SSS_MODELS for every material
+    sss_model: str | None = None
+    tsd_size: int = 1024              # texture-space diffusion: irradiance texels per side
+    tsd_albedo_mix: float = 0.5       # pre-/post-scatter texturing: albedo^mix before the blur
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):
             v = getattr(self, name)
             if not isinstance(v, int) or v < 1 or v > 16384:
                 raise ValueError(f"render setting {name}: expected an integer in [1, 16384], got {v!r}")
+        if self.sss_model is not None:
+            from scene.materials import SSS_MODELS
+            if self.sss_model not in SSS_MODELS:
+                raise ValueError(f"render setting sss_model: expected one of {', '.join(SSS_MODELS)}, "
+                                 f"got {self.sss_model!r}")
+        if not isinstance(self.tsd_size, int) or not 16 <= self.tsd_size <= 8192:
+            raise ValueError(f"render setting tsd_size: expected an integer in [16, 8192], got {self.tsd_size!r}")
+        if not 0.0 <= float(self.tsd_albedo_mix) <= 1.0:
+            raise ValueError(f"render setting tsd_albedo_mix: expected a number in [0, 1], got {self.tsd_albedo_mix!r}")
 
     @property
     def size(self) -> tuple[int, int]:
