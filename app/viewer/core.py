@@ -1,0 +1,229 @@
+"""The viewer without a window: scene, renderer, hot reload, camera, panel, inspector.
+
+:class:`ViewerCore` owns everything that does not depend on pyglet or Dear ImGui, so the
+reload and display logic runs (and is tested) on a headless EGL context as well as in the
+window. All GL work happens on the thread that calls its methods.
+"""
+from __future__ import annotations
+
+import dataclasses
+import logging
+import time
+from collections import deque
+from pathlib import Path
+
+import moderngl
+import numpy as np
+
+from app.gl.hot_reload import ShaderWatcher
+from app.gl.shader_source import ShaderLibrary
+from app.render.renderer import FrameResult, Renderer
+from app.render.settings import RenderSettings
+from scene.materials import SSS_MODELS
+
+from .camera import OrbitCamera
+from .inspector import FINAL, Inspector, fit_viewport
+from .panel import PanelModel
+from .watch import preset_reloader, scene_reloader
+
+log = logging.getLogger("skinlab.view")
+
+SSS_CYCLE: tuple[str | None, ...] = (None, *SSS_MODELS)
+
+
+def next_sss_model(current: str | None, step: int = 1) -> str | None:
+    """None (each material's own model) -> every model of scene.materials.SSS_MODELS -> None."""
+    i = SSS_CYCLE.index(current) if current in SSS_CYCLE else 0
+    return SSS_CYCLE[(i + step) % len(SSS_CYCLE)]
+
+
+class ViewerCore:
+    def __init__(self, ctx: moderngl.Context, scene_path=None, settings: RenderSettings | None = None,
+                 watch: bool = True, shader_root: Path | None = None, settle_s: float = 0.1,
+                 use_watchdog: bool = True):
+        self.ctx = ctx
+        self.settings = settings or RenderSettings()
+        library = ShaderLibrary(root=Path(shader_root)) if shader_root else ShaderLibrary()
+        if not library.root.is_dir():
+            raise FileNotFoundError(f"--shader-dir: no such folder: {library.root}")
+        self.renderer = Renderer(ctx, library)
+        self.scene_src = scene_reloader(scene_path, settle_s, watch, use_watchdog)   # raises on a bad file
+        self.presets = preset_reloader(settle_s, watch, use_watchdog)
+        self.shaders = ShaderWatcher(self.renderer.programs, library.root, settle_s=settle_s,
+                                     use_watchdog=use_watchdog) if watch else None
+        self.panel = PanelModel(self.scene, presets=lambda: self.presets.value)
+        self._file_camera = self.scene.camera.world_matrix.copy()
+        self.orbit = OrbitCamera.from_camera_node(self.scene.camera, self.scene.world_bounds())
+        self.inspector = Inspector(ctx)
+        self.result: FrameResult | None = None
+        self.render_error: str | None = None
+        self.frames = 0              # frames rendered successfully
+        self.failed_frames = 0
+        self.log: deque[tuple[float, str, str]] = deque(maxlen=8)    # (time, level, text) for the overlay
+        self._seen_panel_version = -1
+        self._dirty = True
+
+    # -- state -----------------------------------------------------------------------------------
+    @property
+    def scene(self):
+        return self.scene_src.value
+
+    def note(self, level: str, text: str) -> None:
+        self.log.append((time.monotonic(), level, text))
+        getattr(log, level if level in ("info", "warning", "error") else "info")(text)
+
+    def invalidate(self) -> None:
+        self._dirty = True
+
+    @property
+    def dirty(self) -> bool:
+        return self._dirty or self.panel.version != self._seen_panel_version
+
+    def errors(self) -> list[str]:
+        """Everything currently wrong, each naming its file (shown in the overlay)."""
+        out = []
+        if self.shaders is not None and self.shaders.errors:
+            out += [f"shader: {e}" for e in self.shaders.errors]
+        if self.scene_src.error:
+            out.append(f"scene: {self.scene_src.error}")
+        if self.presets.error:
+            out.append(f"presets: {self.presets.error}")
+        if self.render_error:
+            out.append(f"render: {self.render_error}")
+        if self.panel.error:
+            out.append(f"panel: {self.panel.error}")
+        return out
+
+    def set_size(self, width: int, height: int) -> None:
+        width, height = int(width), int(height)
+        if width < 1 or height < 1 or (width, height) == self.settings.size:
+            return
+        self.settings = dataclasses.replace(self.settings, width=width, height=height)
+        self.invalidate()
+
+    def cycle_sss_model(self, step: int = 1) -> str | None:
+        model = next_sss_model(self.settings.sss_model, step)
+        self.settings = dataclasses.replace(self.settings, sss_model=model)   # validated again
+        self.note("info", f"SSS model: {model or 'per material'}")
+        self.invalidate()
+        return model
+
+    def reset_camera(self) -> None:
+        self.orbit.reset()
+        self.invalidate()
+
+    # -- hot reload --------------------------------------------------------------------------------
+    def poll_reloads(self) -> bool:
+        """Apply settled shader, scene and preset changes; True when the image may change."""
+        changed = False
+        if self.shaders is not None:
+            res = self.shaders.poll()
+            if res is not None:
+                changed = True
+                if res:
+                    for e in res:
+                        self.note("error", f"shader compile failed, keeping the last good program: {e}")
+                else:
+                    self.note("info", "shaders reloaded")
+        state = self.scene_src.poll()
+        if state == "reloaded":
+            self._adopt_scene()
+            changed = True
+        elif state == "failed":
+            self.note("error", f"scene reload failed, keeping the last good scene: {self.scene_src.error}")
+        state = self.presets.poll()
+        if state == "reloaded":
+            done = self.panel.reapply_presets()
+            self.note("info", "presets reloaded" + (f"; re-applied {', '.join(done)}" if done else ""))
+            changed = True
+        elif state == "failed":
+            self.note("error", f"preset reload failed, keeping the last good presets: {self.presets.error}")
+        if changed:
+            self.invalidate()
+        return changed
+
+    def _adopt_scene(self) -> None:
+        scene = self.scene
+        # textures are cached by path in the renderer: drop the ones whose files changed
+        changed = {p.resolve() for p in self.scene_src.last_changed}
+        cache = self.renderer.resources.textures
+        for key in [k for k in cache if Path(k[0]).resolve() in changed]:
+            cache.pop(key).release()
+        self.panel.set_scene(scene)
+        cam = scene.camera.world_matrix.copy()
+        if not np.allclose(cam, self._file_camera):   # the file's camera moved: follow it
+            self.orbit = OrbitCamera.from_camera_node(scene.camera, scene.world_bounds())
+        self._file_camera = cam
+        self.note("info", f"scene reloaded: {scene.source}")
+
+    # -- frames ------------------------------------------------------------------------------------
+    def render(self) -> bool:
+        """Render one frame into the renderer's targets; errors are reported, never raised."""
+        self._seen_panel_version = self.panel.version
+        self._dirty = False
+        self.orbit.apply(self.scene.camera)
+        try:
+            self.result = self.renderer.render(self.scene, self.settings, readback=False)
+        except Exception as exc:  # a failing new shader variant, a bad value...: keep running
+            msg = str(exc).strip() or exc.__class__.__name__
+            if msg != self.render_error:
+                self.note("error", f"frame failed: {msg}")
+            self.render_error = msg
+            self.failed_frames += 1
+            return False
+        if self.render_error:
+            self.note("info", "frames render again")
+        self.render_error = None
+        self.frames += 1
+        return True
+
+    def targets(self) -> dict:
+        frame = self.renderer.last_frame
+        return dict(frame.targets) if frame is not None else {}
+
+    def current_target(self):
+        targets = self.targets()
+        name = self.inspector.resolve(targets)
+        return (name, targets[name]) if name is not None else (None, None)
+
+    def draw(self, framebuffer, size: tuple[int, int], background=(0.1, 0.1, 0.12)) -> str | None:
+        """Show the inspected target in ``framebuffer`` (e.g. ``ctx.screen``), letterboxed."""
+        framebuffer.use()
+        self.ctx.viewport = (0, 0, *size)
+        self.ctx.clear(*background, 1.0)
+        name, tex = self.current_target()
+        if tex is None:
+            return None
+        view = self.inspector.view(name, tex)
+        if not self.inspector.draw(tex, view, fit_viewport(tex.size, size)):
+            return None
+        return name
+
+    # -- screenshots -------------------------------------------------------------------------------
+    def screenshot(self, path) -> Path:
+        """PNG: the inspected target as displayed (no UI), at its own resolution. EXR: its raw
+        linear values (the HDR radiance when the final tone-mapped image is inspected)."""
+        from app.image_output import image_format, write_image
+
+        from .inspector import read_texture
+
+        fmt = image_format(path)
+        targets = self.targets()
+        name = self.inspector.resolve(targets)
+        if name is None:
+            raise ValueError(f"{path}: no frame has been rendered yet ({self.render_error or 'no targets'})")
+        if fmt == "png":
+            pixels = self.inspector.render_image(targets[name], self.inspector.view(name, targets[name]))
+        else:
+            src = "hdr_color" if name == FINAL and "hdr_color" in targets else name
+            pixels = read_texture(targets[src])
+        out = write_image(path, pixels)
+        self.note("info", f"screenshot: {Path(out).resolve()}")
+        return Path(out)
+
+    def close(self) -> None:
+        for w in (self.shaders, self.scene_src, self.presets):
+            if w is not None:
+                w.stop()
+        self.inspector.release()
+        self.renderer.release()
