@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from app.render.settings import RenderSettings, parse_size
+from scene.materials import SSS_MODELS
 
 
 def register(sub) -> None:
@@ -14,6 +15,10 @@ def register(sub) -> None:
     p.add_argument("--out", default="out/render.png", help="output image: .png (tone mapped) or .exr (linear)")
     p.add_argument("--size", default="640x640", help="WIDTHxHEIGHT (default 640x640)")
     p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
+    p.add_argument("--sss", choices=SSS_MODELS, default=None,
+                   help="subsurface model for every material (default: each material's own sss_model)")
+    p.add_argument("--tsd-size", type=int, default=None, help="texture-space diffusion texels per side (default 1024)")
+    p.add_argument("--gaussians", type=int, default=None, help="Gaussians fitted to the profile, 1-6 (default 6)")
     p.add_argument("--json", action="store_true", help="print timings and output paths as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
     p.set_defaults(func=run)
@@ -40,10 +45,21 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
     return scene, result, written, ctx
 
 
+def settings_from_args(args, w: int, h: int) -> RenderSettings:
+    extra = {}
+    if args.tsd_size is not None:
+        extra["tsd_size"] = args.tsd_size
+    if args.gaussians is not None:
+        extra["tsd_gaussians"] = args.gaussians
+    return RenderSettings(w, h, shadow_size=args.shadow_size, sss_model=args.sss, **extra)
+
+
 def run(args) -> int:
     w, h = parse_size(args.size)
-    settings = RenderSettings(w, h, shadow_size=args.shadow_size)
+    settings = settings_from_args(args, w, h)
     scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings)
+    for warning in result.plan.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
     if args.explain:
         print(result.plan.explain(), file=sys.stderr if args.json else sys.stdout)
     if args.json:

@@ -34,10 +34,12 @@ def set_uniforms(prog: moderngl.Program, values: Mapping[str, Any]) -> None:
 
 
 def set_array(prog: moderngl.Program, name: str, rows: np.ndarray, length: int) -> None:
-    """Fill a uniform array (``vec3 name[length]`` etc.) from rows, zero-padded."""
+    """Fill a uniform array (``vec3 name[length]`` etc.) from rows, zero-padded. The compiler may keep
+    only the leading elements a variant uses; only those are written."""
     if name not in prog:
         return
-    rows = np.asarray(rows, np.float32)
+    length = min(length, max(getattr(prog[name], "array_length", length), 1))
+    rows = np.asarray(rows, np.float32)[:length]
     width = rows.shape[1] if rows.ndim == 2 else 1
     buf = np.zeros((length, width) if width > 1 else (length,), np.float32)
     buf[: len(rows)] = rows

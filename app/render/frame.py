@@ -20,6 +20,8 @@ class Frame:
     camera_pos: np.ndarray
     targets: dict[str, moderngl.Texture] = field(default_factory=dict)
     shadow_matrices: dict[int, np.ndarray] = field(default_factory=dict)
+    shadow_eyes: dict[int, np.ndarray] = field(default_factory=dict)   # slot -> light pos (w=1) / dir (w=0)
+    tsd: dict[int, object] = field(default_factory=dict)               # id(node) -> TsdFrameNode
 
     @property
     def view_proj(self) -> np.ndarray:

@@ -16,6 +16,7 @@ from .gpu_resources import GpuResources
 from .passes.forward import ForwardPass
 from .passes.shadow import ShadowPass
 from .passes.tonemap import TonemapPass
+from .passes.tsd import TsdBlurPass, TsdDilatePass, TsdIrradiancePass, TsdStore, TsdStretchPass
 from .plan import FramePlan, plan_frame
 from .settings import RenderSettings
 from .timing import FrameTimings, PassTimer
@@ -37,7 +38,10 @@ class Renderer:
         self.programs = ProgramCache(ctx, library)
         self.resources = GpuResources(ctx)
         self.timer = PassTimer(ctx)
-        self.passes = {"shadow": ShadowPass(self), "forward": ForwardPass(self), "tonemap": TonemapPass(self)}
+        self.tsd = TsdStore(ctx)
+        self.passes = {"shadow": ShadowPass(self), "tsd_stretch": TsdStretchPass(self),
+                       "tsd_irradiance": TsdIrradiancePass(self), "tsd_dilate": TsdDilatePass(self),
+                       "tsd_blur": TsdBlurPass(self), "forward": ForwardPass(self), "tonemap": TonemapPass(self)}
         self._fs_vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
         self._fs_vaos: dict[int, moderngl.VertexArray] = {}
         self._dummy_shadow = None
@@ -59,7 +63,7 @@ class Renderer:
 
     # -- a frame ------------------------------------------------------------------------
     def plan(self, scene: Scene, settings: RenderSettings) -> FramePlan:
-        return plan_frame(scene, settings)
+        return plan_frame(scene, settings, self.tsd.stretch_valid)
 
     def render(self, scene: Scene, settings: RenderSettings | None = None,
                readback: bool | tuple[str, ...] = True) -> FrameResult:
@@ -103,3 +107,4 @@ class Renderer:
     def release(self) -> None:
         self.programs.release()
         self.resources.release()
+        self.tsd.release()

@@ -15,6 +15,8 @@ class RenderSettings:
     sss_model: str | None = None
     tsd_size: int = 1024              # texture-space diffusion: irradiance texels per side
     tsd_albedo_mix: float = 0.5       # pre-/post-scatter texturing: albedo^mix before the blur
+    tsd_gaussians: int = 6            # K: Gaussians fitted to the profile
+    translucency: bool = True         # light through thin parts (needs a shadow-casting light)
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):
@@ -28,6 +30,8 @@ class RenderSettings:
                                  f"got {self.sss_model!r}")
         if not isinstance(self.tsd_size, int) or not 16 <= self.tsd_size <= 8192:
             raise ValueError(f"render setting tsd_size: expected an integer in [16, 8192], got {self.tsd_size!r}")
+        if not isinstance(self.tsd_gaussians, int) or not 1 <= self.tsd_gaussians <= 6:
+            raise ValueError(f"render setting tsd_gaussians: expected an integer in [1, 6], got {self.tsd_gaussians!r}")
         if not 0.0 <= float(self.tsd_albedo_mix) <= 1.0:
             raise ValueError(f"render setting tsd_albedo_mix: expected a number in [0, 1], got {self.tsd_albedo_mix!r}")
 

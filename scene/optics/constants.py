@@ -150,3 +150,15 @@ GLSL_CONSTANTS.update({
     **{f"SKIN6_VAR_{i}": v for i, v in enumerate(SKIN6_VARIANCES)},
     **{f"SKIN6_W{c}_{i}": w[j] for j, c in enumerate("RGB") for i, w in enumerate(SKIN6_WEIGHTS)},
 })
+
+# ---------------------------------------------------------------------------------------------
+# Texture-space diffusion (d'Eon & Luebke 2007; scene/optics/tsd.py, shaders/passes/tsd_*.frag)
+TSD_TAP_RANGE = 3.0            # blur taps span +-3 sigma
+TSD_MIN_MM_PER_TEXEL = 1e-6    # zero-area triangles (infinite stretch) clamp to this
+TSD_MAX_STEP_TEXELS = 64.0     # one sigma never spans more texels than this (finite for any stretch)
+COVERAGE_EPS = 1e-6            # premultiplied coverage below this is "no surface"
+GLSL_CONSTANTS.update({
+    "TSD_MIN_MM_PER_TEXEL": TSD_MIN_MM_PER_TEXEL,
+    "TSD_MAX_STEP_TEXELS": TSD_MAX_STEP_TEXELS,
+    "COVERAGE_EPS": COVERAGE_EPS,
+})

@@ -1,13 +1,12 @@
 #version 330 core
 // Principled shading (Burley diffuse + GGX specular) with up to MAX_LIGHTS lights and two
-// shadow maps. Variants: HAS_BASE_COLOR_MAP, HAS_ROUGHNESS_MAP, HAS_NORMAL_MAP, HAS_OCCLUSION_MAP.
+// shadow maps. Variants: HAS_BASE_COLOR_MAP, HAS_ROUGHNESS_MAP, HAS_NORMAL_MAP, HAS_OCCLUSION_MAP;
+// TSD_LEVELS = n (1..6): the texture-space diffusion gather (d'Eon & Luebke 2007): the diffuse term
+// is the weighted sum of the blurred irradiance levels x albedo^(1-mix) (post-scatter texturing),
+// mixed with plain Burley diffuse by u_subsurface; specular and ambient specular as usual.
 #include "lib/brdf.glsl"
-#include "lib/lighting.glsl"
-#include "lib/shadow.glsl"
-
-#ifndef MAX_LIGHTS
-#define MAX_LIGHTS 4
-#endif
+#include "lib/lights.glsl"
+#include "lib/subsurface.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -19,6 +18,7 @@ uniform float u_roughness;
 uniform float u_metallic;
 uniform float u_specular;
 uniform float u_normal_scale;
+uniform float u_subsurface;
 #ifdef HAS_BASE_COLOR_MAP
 uniform sampler2D u_base_color_map;
 #endif
@@ -31,32 +31,69 @@ uniform sampler2D u_normal_map;
 #ifdef HAS_OCCLUSION_MAP
 uniform sampler2D u_occlusion_map;
 #endif
-
-uniform int u_num_lights;
-uniform vec4 u_light_vec[MAX_LIGHTS];        // w = 0: direction to the light; w = 1: position
-uniform vec3 u_light_radiance[MAX_LIGHTS];   // colour * intensity
-uniform int u_light_shadow[MAX_LIGHTS];      // shadow slot, or -1
-uniform sampler2DShadow u_shadow0;
-uniform sampler2DShadow u_shadow1;
-uniform mat4 u_shadow_matrix[2];
 uniform vec3 u_camera_pos;
 uniform vec3 u_ambient;
-uniform float u_mm_per_unit;
+
+#ifdef TSD_LEVELS
+uniform float u_tsd_mix;
+uniform vec3 u_tsd_identity;         // weight of the unblurred irradiance per channel
+uniform vec3 u_tsd_w[6];             // weight of each blurred level per channel
+uniform sampler2D u_tsd_irradiance;  // premultiplied by coverage: rgb / a
+#if TSD_LEVELS > 0
+uniform sampler2D u_tsd_level0;
+#endif
+#if TSD_LEVELS > 1
+uniform sampler2D u_tsd_level1;
+#endif
+#if TSD_LEVELS > 2
+uniform sampler2D u_tsd_level2;
+#endif
+#if TSD_LEVELS > 3
+uniform sampler2D u_tsd_level3;
+#endif
+#if TSD_LEVELS > 4
+uniform sampler2D u_tsd_level4;
+#endif
+#if TSD_LEVELS > 5
+uniform sampler2D u_tsd_level5;
+#endif
+
+vec3 unpremultiply(vec4 t) { return t.a > COVERAGE_EPS ? t.rgb / t.a : vec3(0.0); }
+
+// Diffused irradiance (still x albedo^mix) at uv: I E + sum_k W_k level_k.
+vec3 tsd_diffused(vec2 uv) {
+    vec3 d = u_tsd_identity * unpremultiply(texture(u_tsd_irradiance, uv));
+#if TSD_LEVELS > 0
+    d += u_tsd_w[0] * unpremultiply(texture(u_tsd_level0, uv));
+#endif
+#if TSD_LEVELS > 1
+    d += u_tsd_w[1] * unpremultiply(texture(u_tsd_level1, uv));
+#endif
+#if TSD_LEVELS > 2
+    d += u_tsd_w[2] * unpremultiply(texture(u_tsd_level2, uv));
+#endif
+#if TSD_LEVELS > 3
+    d += u_tsd_w[3] * unpremultiply(texture(u_tsd_level3, uv));
+#endif
+#if TSD_LEVELS > 4
+    d += u_tsd_w[4] * unpremultiply(texture(u_tsd_level4, uv));
+#endif
+#if TSD_LEVELS > 5
+    d += u_tsd_w[5] * unpremultiply(texture(u_tsd_level5, uv));
+#endif
+    return d;
+}
+#endif
 
 out vec4 f_color;
 
-float shadow_slot(int slot, vec3 world, float NoL) {
-    if (slot == 0) return shadow_pcf(u_shadow0, u_shadow_matrix[0], world, NoL);
-    if (slot == 1) return shadow_pcf(u_shadow1, u_shadow_matrix[1], world, NoL);
-    return 1.0;
-}
-
 void main() {
-    vec3 n = normalize(v_normal);
+    vec3 ng = normalize(v_normal);
     vec3 v = normalize(u_camera_pos - v_world);
-    if (!gl_FrontFacing) n = -n;
+    if (!gl_FrontFacing) ng = -ng;
+    vec3 n = ng;
 #ifdef HAS_NORMAL_MAP
-    n = perturb_normal(n, vec4(gl_FrontFacing ? v_tangent.xyz : -v_tangent.xyz, v_tangent.w),
+    n = perturb_normal(ng, vec4(gl_FrontFacing ? v_tangent.xyz : -v_tangent.xyz, v_tangent.w),
                        texture(u_normal_map, v_uv).rgb, u_normal_scale);
 #endif
     vec3 base = u_base_color;
@@ -71,25 +108,34 @@ void main() {
 #ifdef HAS_OCCLUSION_MAP
     occlusion = texture(u_occlusion_map, v_uv).r;
 #endif
+#ifdef TSD_LEVELS
+    float plain = 1.0 - u_subsurface;    // weight of the surface's own Burley diffuse
+#else
+    float plain = 1.0;
+#endif
+    vec3 f0 = principled_f0(base, u_metallic, u_specular);
+    float a = ggx_alpha(rough);
+    float NoV = dot(n, v);
     vec3 color = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
-        vec3 l;
-        vec3 e = u_light_radiance[i];
-        if (u_light_vec[i].w == 0.0) {
-            l = u_light_vec[i].xyz;
-        } else {
-            vec3 d = u_light_vec[i].xyz - v_world;
-            float dist = length(d);
-            l = dist > 0.0 ? d / dist : n;
-            e *= inverse_square(dist * u_mm_per_unit);
-        }
+        vec3 l, e;
+        light_incidence(i, v_world, n, l, e);
         float NoL = dot(n, l);
         if (NoL <= 0.0) continue;
-        float vis = u_light_shadow[i] >= 0 ? shadow_slot(u_light_shadow[i], v_world, dot(normalize(v_normal), l)) : 1.0;
-        color += e * vis * principled_brdf_cos(n, v, l, base, rough, u_metallic, u_specular);
+        float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
+        vec3 h = half_vector(n, v, l);
+        float LoH = dot(l, h);
+        vec3 diffuse = base * ((1.0 - u_metallic) * plain * burley_diffuse(NoL, NoV, LoH, rough));
+        vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
+        color += e * vis * (diffuse + spec) * NoL;
     }
-    vec3 f0 = principled_f0(base, u_metallic, u_specular);
-    color += u_ambient * occlusion * (base * (1.0 - u_metallic) + f0);
+    color += u_ambient * occlusion * (base * ((1.0 - u_metallic) * plain) + f0);
+#ifdef TSD_LEVELS
+    // texture-space diffusion: the diffused light leaving toward the viewer (1/pi: Lambertian exit)
+    vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
+    color += (1.0 - u_metallic) * u_subsurface * post * tsd_diffused(v_uv)
+             * (INV_PI * sss_exit_weight(abs(NoV)));
+#endif
     f_color = vec4(color, 1.0);
 }

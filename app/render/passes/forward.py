@@ -5,6 +5,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
+from app.render.lights import bind_shadow_maps, set_light_uniforms
 
 
 class ForwardPass:
@@ -32,38 +33,19 @@ class ForwardPass:
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
         lights = p.params["lights"]
-        slots = {id(l): i for i, l in enumerate(p.params["shadow_lights"])}
         nmax = frame.settings.max_lights
-        light_vec = [np.append(-l.direction, 0.0) if l.kind == "directional" else np.append(l.world_position, 1.0)
-                     for l in lights]
-        per_frame = {
-            "u_view_proj": frame.view_proj,
-            "u_camera_pos": frame.camera_pos,
-            "u_ambient": frame.scene.environment.ambient,
-            "u_mm_per_unit": frame.scene.mm_per_unit,
-            "u_num_lights": len(lights),
-            "u_shadow0": 5,
-            "u_shadow1": 6,
-        }
-        for slot in (0, 1):
-            tex = frame.targets.get(f"shadow_map{slot}")
-            if tex is None:
-                tex = self.r.dummy_shadow_map()
-            tex.use(5 + slot)
-        shadow_mats = np.stack([frame.shadow_matrices.get(s, np.eye(4)).T for s in (0, 1)]).astype(np.float32)
+        per_frame = {"u_view_proj": frame.view_proj, "u_camera_pos": frame.camera_pos,
+                     "u_ambient": frame.scene.environment.ambient}
+        bind_shadow_maps(self.r, frame)
         for node in frame.scene.mesh_nodes():
-            mat = node.material
+            tsd = frame.tsd.get(id(node))
+            mat = tsd.material if tsd is not None else node.material
             defines = {**mat.defines(("texture",)), "MAX_LIGHTS": nmax}
+            if tsd is not None:
+                defines["TSD_LEVELS"] = tsd.kernel.levels
             prog = self.r.programs.get("passes/forward.vert", "passes/forward.frag", defines)
             set_uniforms(prog, per_frame)
-            set_array(prog, "u_light_vec", np.array(light_vec).reshape(-1, 4), nmax)
-            set_array(prog, "u_light_radiance", np.array([l.radiance for l in lights]).reshape(-1, 3), nmax)
-            if "u_light_shadow" in prog:
-                ids = np.full(nmax, -1, np.int32)
-                ids[: len(lights)] = [slots.get(id(l), -1) for l in lights]
-                prog["u_light_shadow"].write(ids.tobytes())
-            if "u_shadow_matrix" in prog:
-                prog["u_shadow_matrix"].write(shadow_mats.tobytes())
+            set_light_uniforms(prog, frame, lights, p.params["shadow_lights"], nmax)
             model = node.world_matrix
             set_uniform(prog, "u_model", model)
             set_uniform(prog, "u_normal_matrix", np.linalg.inv(model[:3, :3]).T)
@@ -71,6 +53,23 @@ class ForwardPass:
             for unit, (sampler, (path, cs)) in enumerate(mat.textures().items()):
                 self.r.resources.texture(path, cs).use(unit)
                 set_uniform(prog, sampler, unit)
+            if tsd is not None:
+                bind_tsd(prog, tsd)
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         frame.targets["hdr_color"] = color
         frame.targets["depth"] = depth
+
+
+TSD_UNITS = 7   # irradiance at 7, levels at 8..13 (material maps 0..4, shadow maps 5, 6)
+
+
+def bind_tsd(prog, tsd) -> None:
+    """Textures and weights of the texture-space diffusion gather (forward.frag TSD_LEVELS)."""
+    t, k = tsd.targets, tsd.kernel
+    t.irradiance.use(TSD_UNITS)
+    set_uniform(prog, "u_tsd_irradiance", TSD_UNITS)
+    for i in range(k.levels):
+        t.levels[i].use(TSD_UNITS + 1 + i)
+        set_uniform(prog, f"u_tsd_level{i}", TSD_UNITS + 1 + i)
+    set_array(prog, "u_tsd_w", k.weights(), 6)
+    set_uniforms(prog, {"u_tsd_identity": k.identity, "u_tsd_mix": tsd.mix})

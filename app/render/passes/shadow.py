@@ -35,27 +35,43 @@ class ShadowPass:
         self.r = renderer
         self.maps: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
 
-    def target(self, slot: int, size: int):
+    def target(self, slot: int, size: int, distance: bool = False):
+        """(depth texture, framebuffer, distance texture or None) for a slot."""
         t = self.maps.get(slot)
-        if t is None or t[0].size != (size, size):
+        if t is None or t[0].size != (size, size) or (t[2] is not None) != distance:
             if t is not None:
-                t[1].release(); t[0].release()
-            tex = self.r.ctx.depth_texture((size, size))
+                for x in (t[1], t[0], t[2]):
+                    if x is not None:
+                        x.release()
+            ctx = self.r.ctx
+            tex = ctx.depth_texture((size, size))
             tex.compare_func = "<="
             tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
             tex.repeat_x = tex.repeat_y = False
-            t = self.maps[slot] = (tex, self.r.ctx.framebuffer(depth_attachment=tex))
+            dist = None
+            if distance:
+                dist = ctx.texture((size, size), 1, dtype="f4")
+                dist.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                dist.repeat_x = dist.repeat_y = False
+            fbo = ctx.framebuffer([dist] if dist is not None else [], depth_attachment=tex)
+            t = self.maps[slot] = (tex, fbo, dist)
         return t
 
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
         light, slot = p.params["light"], p.params["slot"]
-        tex, fbo = self.target(slot, p.resolution[0])
+        distance = bool(p.params.get("distance"))
+        tex, fbo, dist = self.target(slot, p.resolution[0], distance)
         lo, hi = frame.scene.world_bounds()
         vp = light_view_proj(light, lo, hi)
-        prog = self.r.programs.get("passes/shadow.vert", "passes/shadow.frag")
+        prog = self.r.programs.get("passes/shadow.vert", "passes/shadow.frag",
+                                   {"SHADOW_DISTANCE": 1} if distance else None)
+        eye = np.append(light.direction, 0.0) if light.kind == "directional" else np.append(light.world_position, 1.0)
+        set_uniforms(prog, {"u_light_eye": eye})
         fbo.use()
-        fbo.clear(depth=1.0)
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        if dist is not None:   # "no surface": as far as it gets
+            fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE)
         ctx.polygon_offset = (2.0, 2.0)
@@ -64,4 +80,7 @@ class ShadowPass:
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         ctx.polygon_offset = (0.0, 0.0)
         frame.targets[f"shadow_map{slot}"] = tex
+        frame.shadow_eyes[slot] = eye
+        if dist is not None:
+            frame.targets[f"shadow_distance{slot}"] = dist
         frame.shadow_matrices[slot] = _BIAS @ vp

@@ -1,0 +1,32 @@
+"""Light uniforms shared by every pass that lights surfaces (shaders/lib/lights.glsl)."""
+from __future__ import annotations
+
+import numpy as np
+
+from app.gl.uniforms import set_array, set_uniforms
+
+SHADOW_UNITS = (5, 6)     # texture units of shadow slots 0 and 1 (material maps use 0..4)
+
+
+def bind_shadow_maps(renderer, frame) -> None:
+    for slot, unit in enumerate(SHADOW_UNITS):
+        tex = frame.targets.get(f"shadow_map{slot}")
+        (tex if tex is not None else renderer.dummy_shadow_map()).use(unit)
+
+
+def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
+    """Upload lights (direction or position, radiance, shadow slot) and shadow matrices to `prog`."""
+    slots = {id(l): i for i, l in enumerate(shadow_lights)}
+    vec = [np.append(-l.direction, 0.0) if l.kind == "directional" else np.append(l.world_position, 1.0)
+           for l in lights]
+    set_uniforms(prog, {"u_num_lights": len(lights), "u_mm_per_unit": frame.scene.mm_per_unit,
+                        "u_shadow0": SHADOW_UNITS[0], "u_shadow1": SHADOW_UNITS[1]})
+    set_array(prog, "u_light_vec", np.array(vec).reshape(-1, 4), nmax)
+    set_array(prog, "u_light_radiance", np.array([l.radiance for l in lights]).reshape(-1, 3), nmax)
+    if "u_light_shadow" in prog:
+        ids = np.full(nmax, -1, np.int32)
+        ids[: len(lights)] = [slots.get(id(l), -1) for l in lights]
+        prog["u_light_shadow"].write(ids.tobytes())
+    if "u_shadow_matrix" in prog:
+        mats = np.stack([frame.shadow_matrices.get(s, np.eye(4)).T for s in (0, 1)]).astype(np.float32)
+        prog["u_shadow_matrix"].write(mats.tobytes())

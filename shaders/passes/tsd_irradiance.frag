@@ -1,0 +1,102 @@
+#version 330 core
+// Texture-space irradiance (d'Eon & Luebke 2007): per texel of the mesh's UV layout, the light that
+// enters the surface - lights through Fresnel transmission, shadows, the normal map, ambient x
+// occlusion (pi L_ambient) - times albedo^mix (pre-scatter texturing). a = 1: the texel is covered.
+// Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts, attenuated through the
+// thickness d (from the shadow pass's distance map) by the profile's Gaussians: sum_k W_k e^{-d^2/2v_k}.
+#include "lib/brdf.glsl"
+#include "lib/lights.glsl"
+#include "lib/subsurface.glsl"
+
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_uv;
+in vec4 v_tangent;
+
+uniform vec3 u_base_color;
+uniform float u_specular;
+uniform float u_normal_scale;
+uniform vec3 u_ambient;
+uniform float u_tsd_mix;
+#ifdef HAS_BASE_COLOR_MAP
+uniform sampler2D u_base_color_map;
+#endif
+#ifdef HAS_NORMAL_MAP
+uniform sampler2D u_normal_map;
+#endif
+#ifdef HAS_OCCLUSION_MAP
+uniform sampler2D u_occlusion_map;
+#endif
+#ifdef TSD_TRANSLUCENCY
+uniform sampler2D u_distance0;            // light-space distance of the first surface (scene units)
+uniform sampler2D u_distance1;
+uniform vec4 u_light_eye[2];              // slot light position (w = 1) or the direction light travels (w = 0)
+uniform float u_tsd_var[6];               // the kept Gaussians' variances (mm^2)
+uniform vec3 u_tsd_w[6];
+uniform int u_tsd_levels;
+
+float first_hit_distance(int slot, vec3 world) {
+    vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
+    vec2 uv = p.xy / p.w;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return -1.0;
+    return slot == 0 ? texture(u_distance0, uv).r : texture(u_distance1, uv).r;
+}
+
+float distance_from_light(int slot, vec3 world) {
+    vec4 e = u_light_eye[slot];
+    return e.w == 0.0 ? dot(world, e.xyz) : length(world - e.xyz);
+}
+
+// Transmittance through d mm: the profile's Gaussians at depth d (G(v, sqrt(r^2+d^2)) = e^{-d^2/2v} G(v, r)).
+vec3 thickness_transmittance(float d_mm) {
+    vec3 t = vec3(0.0);
+    for (int k = 0; k < 6; ++k) {
+        if (k >= u_tsd_levels) break;
+        t += u_tsd_w[k] * exp(-d_mm * d_mm / (2.0 * max(u_tsd_var[k], 1e-12)));
+    }
+    return t;
+}
+#endif
+
+out vec4 f_irradiance;
+
+void main() {
+    vec3 ng = normalize(v_normal);
+    vec3 n = ng;
+#ifdef HAS_NORMAL_MAP
+    n = perturb_normal(ng, v_tangent, texture(u_normal_map, v_uv).rgb, u_normal_scale);
+#endif
+    vec3 base = u_base_color;
+#ifdef HAS_BASE_COLOR_MAP
+    base *= texture(u_base_color_map, v_uv).rgb;
+#endif
+    float occlusion = 1.0;
+#ifdef HAS_OCCLUSION_MAP
+    occlusion = texture(u_occlusion_map, v_uv).r;
+#endif
+    float f0 = SPECULAR_F0_SCALE * u_specular;
+    vec3 e_in = vec3(0.0);
+    for (int i = 0; i < MAX_LIGHTS; ++i) {
+        if (i >= u_num_lights) break;
+        vec3 l, e;
+        light_incidence(i, v_world, n, l, e);
+        float NoL = dot(n, l);
+        if (NoL > 0.0) {
+            float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
+            e_in += e * (vis * NoL * fresnel_transmission(f0, NoL));
+        }
+#ifdef TSD_TRANSLUCENCY
+        int slot = u_light_shadow[i];
+        float back = -dot(ng, l);
+        if (slot >= 0 && back > 0.0) {
+            float first = first_hit_distance(slot, v_world);
+            if (first >= 0.0) {
+                float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit;
+                e_in += e * back * fresnel_transmission(f0, back) * thickness_transmittance(d_mm);
+            }
+        }
+#endif
+    }
+    e_in += PI * u_ambient * occlusion;
+    f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
+}

@@ -1,0 +1,21 @@
+#version 330 core
+// Texture-space diffusion (d'Eon & Luebke 2007): rasterise a mesh at its UV coordinates, so each
+// fragment is one texel of the mesh's irradiance / stretch texture; world data is interpolated.
+in vec3 in_position;
+in vec3 in_normal;
+in vec2 in_uv;
+in vec4 in_tangent;
+uniform mat4 u_model;
+uniform mat3 u_normal_matrix;
+out vec3 v_world;
+out vec3 v_normal;
+out vec2 v_uv;
+out vec4 v_tangent;
+void main() {
+    vec4 w = u_model * vec4(in_position, 1.0);
+    v_world = w.xyz;
+    v_normal = u_normal_matrix * in_normal;
+    v_tangent = vec4(mat3(u_model) * in_tangent.xyz, in_tangent.w);
+    v_uv = in_uv;
+    gl_Position = vec4(in_uv * 2.0 - 1.0, 0.0, 1.0);
+}
