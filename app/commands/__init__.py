@@ -8,4 +8,5 @@ COMMAND_MODULES = [
     "app.commands.bench",
     "app.commands.profile",
     "app.commands.mc",
+    "app.commands.view",
 ]

@@ -102,7 +102,10 @@ class ViewerCore:
         self.invalidate()
 
     def cycle_sss_model(self, step: int = 1) -> str | None:
-        model = next_sss_model(self.settings.sss_model, step)
+        return self.set_sss_model(next_sss_model(self.settings.sss_model, step))
+
+    def set_sss_model(self, model: str | None) -> str | None:
+        """None: each material's own model; else one of SSS_MODELS for every material."""
         self.settings = dataclasses.replace(self.settings, sss_model=model)   # validated again
         self.note("info", f"SSS model: {model or 'per material'}")
         self.invalidate()

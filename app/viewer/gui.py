@@ -1,0 +1,205 @@
+"""Dear ImGui (imgui-bundle) drawing of the overlay and the parameter panel.
+
+Only drawing lives here: which widget a parameter gets, clamping and applying edits are in
+``panel.py`` (PanelModel), so this module stays a thin translation of its state into widgets.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+from imgui_bundle import imgui
+
+from scene.materials import SSS_MODELS
+
+from .core import ViewerCore
+from .inspector import display_mode
+from .panel import angles_from_direction, direction_from_angles
+
+RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
+GREY = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
+YELLOW = imgui.ImVec4(1.0, 0.85, 0.4, 1.0)
+
+
+class Gui:
+    def __init__(self, core: ViewerCore):
+        self.core = core
+        self.show_panel = True
+        self._text: dict[str, str] = {}     # texture path fields being typed
+
+    # -- overlay: timings, errors, messages ---------------------------------------------------
+    def overlay(self, ui_fps: float) -> None:
+        core = self.core
+        imgui.set_next_window_pos(imgui.ImVec2(6, 6), imgui.Cond_.always)
+        imgui.set_next_window_bg_alpha(0.55)
+        flags = (imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.always_auto_resize
+                 | imgui.WindowFlags_.no_saved_settings | imgui.WindowFlags_.no_focus_on_appearing
+                 | imgui.WindowFlags_.no_nav | imgui.WindowFlags_.no_move)
+        imgui.begin("overlay", None, flags)
+        res = core.result
+        if res is not None:
+            t = res.timings
+            clock = t.as_dict()["clock"]
+            imgui.text(f"frame {t.frame_ms:7.2f} ms ({clock}), render call {res.cpu_ms:.1f} ms")
+            for p in t.passes:
+                gpu = f"  gpu {p.gpu_ms:6.2f}" if p.gpu_ms is not None else ""
+                imgui.text(f"  {p.name:<16} {p.cpu_ms:7.2f} ms{gpu}")
+        name, _ = core.current_target()
+        s = core.settings
+        imgui.text_colored(GREY, f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'}"
+                                 f"  ui {ui_fps:4.0f} fps")
+        errors = core.errors()
+        if errors:
+            imgui.push_text_wrap_pos(max(imgui.get_io().display_size.x * 0.6, 200.0))
+            for e in errors:
+                imgui.text_colored(RED, e)
+            imgui.pop_text_wrap_pos()
+        now = time.monotonic()
+        for when, level, text in core.log:
+            if now - when < 6.0 and level != "error":
+                imgui.text_colored(YELLOW, text)
+        imgui.end()
+
+    # -- the panel ------------------------------------------------------------------------------
+    def panel(self) -> None:
+        if not self.show_panel:
+            return
+        io = imgui.get_io()
+        w = min(340.0, io.display_size.x * 0.5)
+        imgui.set_next_window_pos(imgui.ImVec2(io.display_size.x - w - 6, 6), imgui.Cond_.first_use_ever)
+        imgui.set_next_window_size(imgui.ImVec2(w, io.display_size.y * 0.9), imgui.Cond_.first_use_ever)
+        expanded, _ = imgui.begin("Skinlab (H hides)", None)
+        if expanded:
+            self._render_section()
+            self._inspector_section()
+            self._scene_section()
+            self._material_section()
+            self._light_section()
+        imgui.end()
+
+    def _render_section(self) -> None:
+        core = self.core
+        if not imgui.collapsing_header("Render", imgui.TreeNodeFlags_.default_open):
+            return
+        options = ["per material", *SSS_MODELS]
+        cur = core.settings.sss_model or "per material"
+        if imgui.begin_combo("SSS model (M)", cur):
+            for o in options:
+                clicked, _ = imgui.selectable(o, o == cur)
+                if clicked:
+                    core.set_sss_model(None if o == "per material" else o)
+            imgui.end_combo()
+        if imgui.button("Reset camera (R)"):
+            core.reset_camera()
+
+    def _inspector_section(self) -> None:
+        core = self.core
+        if not imgui.collapsing_header("Pass inspector (P / Tab)", imgui.TreeNodeFlags_.default_open):
+            return
+        targets = core.targets()
+        cur = core.inspector.resolve(targets) or "-"
+        if imgui.begin_combo("target", cur):
+            for n in core.inspector.names(targets):
+                tex = targets[n]
+                mode = display_mode(tex)
+                label = f"{n}  {tex.size[0]}x{tex.size[1]} {mode or 'not viewable'}"
+                clicked, _ = imgui.selectable(label, n == cur)
+                if clicked:
+                    core.inspector.current = n
+            imgui.end_combo()
+        if cur in targets:
+            view = core.inspector.view(cur, targets[cur])
+            mode = display_mode(targets[cur])
+            if mode in ("color", "grey", "rg"):
+                ch, v = imgui.slider_float("scale", view.scale, 1e-3, 1e4, "%.4g", imgui.SliderFlags_.logarithmic)
+                if ch:
+                    view.scale = v
+                ch, v = imgui.input_float("offset", view.offset, 0.0, 0.0, "%.5g")
+                if ch and math.isfinite(v):
+                    view.offset = v
+                if imgui.button("Auto range (N)"):
+                    core.inspector.auto_range_now(targets)
+
+    def _scene_section(self) -> None:
+        panel = self.core.panel
+        if not imgui.collapsing_header("Scene", imgui.TreeNodeFlags_.default_open):
+            return
+        imgui.text_colored(GREY, str(self.core.scene.source))
+        for row in panel.tree():
+            imgui.indent(8.0 * row.depth + 1.0)
+            clicked, _ = imgui.selectable(f"{row.label}##{id(row.node)}", row.node is panel.selected)
+            if clicked:
+                panel.selected = row.node
+            imgui.unindent(8.0 * row.depth + 1.0)
+
+    def _material_section(self) -> None:
+        panel = self.core.panel
+        m = panel.material
+        if m is None or not imgui.collapsing_header("Material", imgui.TreeNodeFlags_.default_open):
+            return
+        users = panel.material_users()
+        imgui.text(f"'{m.name}' on {len(users)} node(s)")
+        names = panel.preset_names()
+        if names and imgui.begin_combo("Jensen preset", panel.applied_presets.get(id(m), "(choose)")):
+            for n in names:
+                clicked, _ = imgui.selectable(n, False)
+                if clicked:
+                    self._try(panel.apply_preset, n)
+            imgui.end_combo()
+        for w in panel.widgets():
+            label = f"{w.param}{' (' + w.unit + ')' if w.unit else ''}"
+            if w.widget == "slider_float":
+                ch, v = imgui.slider_float(label, float(w.value), w.range[0], w.range[1])
+            elif w.widget == "color_edit3":
+                ch, v = imgui.color_edit3(label, [float(x) for x in w.value])
+            elif w.widget == "drag_float3":
+                speed = max((w.range[1] - w.range[0]) * 1e-4, 1e-3)
+                flags = imgui.SliderFlags_.logarithmic if w.logarithmic else 0
+                ch, v = imgui.drag_float3(label, [float(x) for x in w.value], speed, w.range[0], w.range[1],
+                                          "%.3f", flags)
+            elif w.widget == "combo":
+                ch, v = False, w.value
+                if imgui.begin_combo(label, str(w.value)):
+                    for c in w.choices:
+                        clicked, _ = imgui.selectable(c, c == w.value)
+                        if clicked:
+                            ch, v = True, c
+                    imgui.end_combo()
+            elif w.widget == "file_path":
+                key = f"{id(m)}:{w.param}"
+                text = self._text.get(key, "" if w.value is None else str(w.value))
+                ch_text, text = imgui.input_text(label, text, imgui.InputTextFlags_.enter_returns_true)
+                self._text[key] = text
+                ch, v = ch_text, text
+                if ch:
+                    self._text.pop(key, None)
+            else:  # widget_for() only returns the kinds above
+                raise ValueError(f"parameter {w.param}: no drawing code for widget {w.widget!r}")
+            if imgui.is_item_hovered() and w.doc:
+                imgui.set_tooltip(w.doc)
+            if ch:
+                self._try(panel.edit, w.param, v)
+        if panel.error:
+            imgui.push_text_wrap_pos(0.0)
+            imgui.text_colored(RED, panel.error)
+            imgui.pop_text_wrap_pos()
+
+    def _light_section(self) -> None:
+        panel = self.core.panel
+        light = panel.key_light()
+        if light is None or not imgui.collapsing_header("Key light", imgui.TreeNodeFlags_.default_open):
+            return
+        d = panel.light_direction()
+        az, el = angles_from_direction(d)
+        imgui.text(f"'{light.name}' ({light.kind}) travels {np.round(d, 3).tolist()}")
+        ch1, az = imgui.slider_float("azimuth (deg)", az, -180.0, 180.0)
+        ch2, el = imgui.slider_float("elevation (deg)", el, -89.0, 89.0)
+        if ch1 or ch2:
+            self._try(panel.set_light_direction, direction_from_angles(az, el))
+
+    def _try(self, fn, *args) -> None:
+        try:
+            fn(*args)
+        except ValueError as exc:   # shown in red in the panel and overlay (panel.error)
+            self.core.panel.error = str(exc)
