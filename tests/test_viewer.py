@@ -20,7 +20,7 @@ from app.viewer.panel import (WIDGETS, PanelModel, angles_from_direction, clamp_
                               direction_from_angles, medium_to_params, widget_for)
 from app.viewer.watch import Reloadable, preset_reloader, scene_reloader
 from scene import transform as tf
-from scene.materials import PRINCIPLED_PARAMS, SSS_MODELS, Material, Param
+from scene.materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
 from scene.scenefile import ASSETS, DEFAULT_SCENE
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -465,7 +465,8 @@ def test_core_scene_reload_keeps_camera_and_renders_new_scene(core):
         time.sleep(0.02)
     assert c.scene is old and any("head.toml" in e for e in c.errors())
     assert c.render()                                       # last good scene renders
-    path.write_text(path.read_text().replace("[[lights]\n", "[[lights]]", 1).replace("exposure = 1.0", "exposure = 0.25"))
+    fixed = path.read_text().replace("[[lights]\n", "[[lights]]", 1)
+    path.write_text(fixed.replace("exposure = 1.0", "exposure = 0.25"))
     t0 = time.monotonic()
     while c.scene is old and time.monotonic() - t0 < 5:
         c.poll_reloads()

@@ -52,6 +52,6 @@ def run(args) -> int:
     from app.viewer.window import ViewerWindow
 
     win = ViewerWindow(args.scene, size, watch=args.watch, screenshot_dir=args.screenshot_dir,
-                       shader_root=args.shader_dir, shadow_size=args.shadow_size, tsd_size=args.tsd_size, settle_s=args.settle,
-                       continuous=args.continuous, show_ui=not args.no_ui)
+                       shader_root=args.shader_dir, shadow_size=args.shadow_size, tsd_size=args.tsd_size,
+                       settle_s=args.settle, continuous=args.continuous, show_ui=not args.no_ui)
     return win.run(frames=args.frames, screenshot=args.screenshot)

@@ -51,7 +51,8 @@ class Gui:
                                  f"  ui {ui_fps:4.0f} fps")
         errors = core.errors()
         if errors:
-            imgui.push_text_wrap_pos(max(imgui.get_io().display_size.x * 0.6, 200.0))
+            width = imgui.get_io().display_size.x
+            imgui.push_text_wrap_pos(max(width - 360.0 if self.show_panel else width - 20.0, 200.0))
             for e in errors:
                 imgui.text_colored(RED, e)
             imgui.pop_text_wrap_pos()
