@@ -33,7 +33,7 @@ def test_edit_wraps_main_and_changes_each_time():
 
 def test_reload_bench_structure(ctx):
     res = reload_bench(repeats=2, settle_s=0.02, **FAST)
-    assert res["file"] == "passes/tonemap.frag" and res["programs"] >= 1
+    assert res["file"] == "passes/tonemap.frag" and res["programs"] >= 1 and res["mode"] == "on-demand"
     assert res["check"] == "image changed" and res["repeats"] == 2 and res["size"] == [32, 32]
     for key in ("latency_ms", "reload_applied_ms", "recompile_ms", "first_frame_ms"):
         st = res[key]
@@ -45,8 +45,9 @@ def test_reload_bench_structure(ctx):
 
 
 def test_reload_bench_lib_file_counts_every_dependent_program(ctx):
-    res = reload_bench(repeats=1, file="lib/brdf.glsl", settle_s=0.02, **FAST)
-    assert res["check"] == "program recompiled" and res["programs"] >= 1
+    res = reload_bench(repeats=1, file="lib/brdf.glsl", settle_s=0.02, mode="continuous", **FAST)
+    assert res["check"] == "program recompiled" and res["programs"] >= 1 and res["mode"] == "continuous"
+    assert res["frames_until_new"][0] >= 1 and res["latency_ms"]["min"] > res["reload_applied_ms"]["min"]
 
 
 def test_reload_bench_cli_json_and_text(ctx, capsys):
@@ -61,13 +62,14 @@ def test_reload_bench_cli_json_and_text(ctx, capsys):
     out = capsys.readouterr().out
     for line in ("save -> first new frame", "save -> reload applied", "of which recompiling", "the first new frame"):
         assert line in out
-    assert "1 edits of shaders/passes/tonemap.frag" in out and "check: image changed" in out
+    assert "on-demand frames" in out and "1 edits of shaders/passes/tonemap.frag" in out and "check: image changed" in out
 
 
 @pytest.mark.parametrize("args,needle", [
     (("--file", "passes/nope.frag"), "passes/nope.frag"),
     (("--file", "../pyproject.toml"), "../pyproject.toml"),
     (("--repeats", "0"), "--repeats"),
+    (("--settle", "-1"), "--settle"),
 ])
 def test_reload_bench_bad_input_is_one_line(args, needle):
     res = cli("reload", "--size", "16x16", *args, timeout=60)

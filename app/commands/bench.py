@@ -27,9 +27,12 @@ def register(sub) -> None:
     rel.add_argument("--file", default="passes/tonemap.frag",
                      help="shader file to edit, relative to shaders/ (default passes/tonemap.frag)")
     rel.add_argument("--settle", type=float, default=0.05,
-                     help="ShaderWatcher settle time in seconds (default 0.05, as the viewer's shaders)")
+                     help="ShaderWatcher settle time in seconds (default 0.05, as skinlab view)")
     rel.add_argument("--shadow-size", type=int, default=512)
     rel.add_argument("--tsd-size", type=int, default=256)
+    rel.add_argument("--mode", choices=("on-demand", "continuous"), default="on-demand",
+                     help="on-demand: the viewer's default loop (idle polls at 60 Hz, a frame only after a "
+                          "change); continuous: a frame every iteration (as with skinlab view --continuous)")
     rel.add_argument("--timeout", type=float, default=20.0, help="give up on one edit after this many seconds")
     rel.add_argument("--json", action="store_true")
     rel.set_defaults(func=run_reload_bench)
@@ -108,12 +111,16 @@ def _stats(values: list[float]) -> dict:
 
 
 def reload_bench(size=(128, 128), repeats: int = 10, file: str = "passes/tonemap.frag", settle_s: float = 0.05,
-                 shadow_size: int = 512, tsd_size: int = 256, timeout_s: float = 20.0) -> dict:
+                 shadow_size: int = 512, tsd_size: int = 256, timeout_s: float = 20.0,
+                 mode: str = "on-demand") -> dict:
     """Copy shaders/ to a temporary folder, render the head continuously with a Renderer on it
     while a ShaderWatcher watches the copy, write an edited ``file`` ``repeats`` times and time
     each write until the end of the first frame (tone-mapped pixels read back) whose programs
     were recompiled from it; where the edit changes the image, that frame's pixels must differ
-    from the previous frame's. This is the viewer's loop (poll, render) without a window."""
+    from the previous frame's. This is the viewer's loop without a window: ``on-demand`` polls
+    at 60 Hz while idle and renders once a reload was applied (the viewer's default);
+    ``continuous`` renders a frame every iteration, so a save usually waits for the frame in
+    flight before it is even polled."""
     import shutil
     import tempfile
 
@@ -127,6 +134,8 @@ def reload_bench(size=(128, 128), repeats: int = 10, file: str = "passes/tonemap
 
     if repeats < 1:
         raise ValueError(f"--repeats: expected >= 1, got {repeats}")
+    if mode not in ("on-demand", "continuous"):
+        raise ValueError(f"--mode: expected on-demand or continuous, got {mode!r}")
     if not 0.0 <= settle_s <= 10.0:
         raise ValueError(f"--settle: expected seconds in [0, 10], got {settle_s}")
     w, h = size
@@ -169,6 +178,11 @@ def reload_bench(size=(128, 128), repeats: int = 10, file: str = "passes/tonemap
                             raise ShaderError(f"bench edit {i} of {file} did not compile: {errors[0]}")
                         t_reload = time.perf_counter()
                         t_compile = t_reload - tp
+                    elif mode == "on-demand":
+                        if time.perf_counter() - t0 > timeout_s:
+                            raise RuntimeError(f"no reload of {file} within {timeout_s} s of writing it")
+                        time.sleep(1 / 60)
+                        continue
                     tf0 = time.perf_counter()
                     res = renderer.render(scene, settings, readback=("ldr",))
                     t_end = time.perf_counter()
@@ -188,7 +202,7 @@ def reload_bench(size=(128, 128), repeats: int = 10, file: str = "passes/tonemap
         finally:
             watcher.stop()
             renderer.release()
-    return {"gl": describe(ctx), "size": [w, h], "file": file, "programs": len(keys), "repeats": repeats,
+    return {"gl": describe(ctx), "mode": mode, "size": [w, h], "file": file, "programs": len(keys), "repeats": repeats,
             "settle_s": settle_s, "check": "image changed" if image_check else "program recompiled",
             "latency_ms": _stats(latency), "reload_applied_ms": _stats(reload_ms),
             "recompile_ms": _stats(compile_ms), "first_frame_ms": _stats(frame_ms), "frames_until_new": frames_waited}
@@ -196,13 +210,13 @@ def reload_bench(size=(128, 128), repeats: int = 10, file: str = "passes/tonemap
 
 def run_reload_bench(args) -> int:
     res = reload_bench(parse_size(args.size), args.repeats, args.file, args.settle, args.shadow_size,
-                       args.tsd_size, args.timeout)
+                       args.tsd_size, args.timeout, args.mode)
     if args.json:
         print(json.dumps(res, indent=2))
         return 0
     lat, rel, fr = res["latency_ms"], res["reload_applied_ms"], res["first_frame_ms"]
     comp = res["recompile_ms"]
-    print(f"{res['gl']}, {res['size'][0]}x{res['size'][1]}, {res['repeats']} edits of shaders/{res['file']} "
+    print(f"{res['gl']}, {res['mode']} frames, {res['size'][0]}x{res['size'][1]}, {res['repeats']} edits of shaders/{res['file']} "
           f"({res['programs']} program(s) depend on it; settle {res['settle_s']} s; check: {res['check']})")
     print(f"  save -> first new frame   median {lat['median']:8.1f} ms   max {lat['max']:8.1f} ms")
     print(f"  save -> reload applied    median {rel['median']:8.1f} ms   max {rel['max']:8.1f} ms")

@@ -20,8 +20,8 @@ def register(sub) -> None:
     w.add_argument("--watch", dest="watch", action="store_true", default=True,
                    help="reload shaders, the scene file and presets when they change (default)")
     w.add_argument("--no-watch", dest="watch", action="store_false", help="do not watch files")
-    p.add_argument("--settle", type=float, default=0.1,
-                   help="seconds a changed file must stay unchanged before it is reloaded (default 0.1)")
+    p.add_argument("--settle", type=float, default=0.05,
+                   help="seconds a changed file must stay unchanged before it is reloaded (default 0.05)")
     p.add_argument("--shader-dir", help="shader folder (default: the project's shaders/)")
     p.add_argument("--screenshot-dir", default="out/screenshots",
                    help="where S (PNG) and shift+S (EXR) save screenshots (default out/screenshots)")

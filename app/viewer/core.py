@@ -39,7 +39,7 @@ def next_sss_model(current: str | None, step: int = 1) -> str | None:
 
 class ViewerCore:
     def __init__(self, ctx: moderngl.Context, scene_path=None, settings: RenderSettings | None = None,
-                 watch: bool = True, shader_root: Path | None = None, settle_s: float = 0.1,
+                 watch: bool = True, shader_root: Path | None = None, settle_s: float = 0.05,
                  use_watchdog: bool = True):
         self.ctx = ctx
         self.settings = settings or RenderSettings()

@@ -46,7 +46,7 @@ def _select_pyopengl_platform() -> None:
 
 class ViewerWindow:
     def __init__(self, scene_path=None, size=(960, 720), watch: bool = True, screenshot_dir="out/screenshots",
-                 shader_root=None, shadow_size: int = 2048, tsd_size: int | None = None, settle_s: float = 0.1,
+                 shader_root=None, shadow_size: int = 2048, tsd_size: int | None = None, settle_s: float = 0.05,
                  continuous: bool = False, show_ui: bool = True):
         if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             raise ViewerError("no X display (DISPLAY is not set); on a machine without a screen run it under "
