@@ -5,6 +5,8 @@ recomputed only when its own transform or one above it changed (a dirty flag pro
 """
 from __future__ import annotations
 
+import itertools
+
 from dataclasses import dataclass, field
 from typing import Iterator
 
@@ -14,8 +16,11 @@ from . import transform as tf
 
 
 class Node:
+    _uids = itertools.count(1)
+
     def __init__(self, name: str, translation=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0, 1.0),
                  scale=(1.0, 1.0, 1.0), visible: bool = True):
+        self.uid = next(Node._uids)   # unique for the process (id() is reused after a node is freed)
         self.name = name
         self.parent: Node | None = None
         self.children: list[Node] = []

@@ -1,9 +1,13 @@
 """Triangle meshes: positions, normals, UVs, tangents; tangent generation and UV atlases."""
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass, field
 
 import numpy as np
+
+
+_UIDS = itertools.count(1)
 
 
 @dataclass
@@ -17,6 +21,8 @@ class Mesh:
     source: str = ""
     version: int = 0                 # bump when geometry changes (GPU buffers and stretch maps key on it)
     _bounds: tuple | None = field(default=None, repr=False)
+    # unique for the process (unlike id(), never reused after the mesh is freed): GPU caches key on it
+    uid: int = field(default_factory=lambda: next(_UIDS), repr=False, compare=False)
 
     def __post_init__(self) -> None:
         self.positions = np.ascontiguousarray(self.positions, np.float32)

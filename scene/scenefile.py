@@ -241,11 +241,11 @@ def flip_v(mesh: Mesh | None) -> Mesh | None:
     """The mesh with v -> 1 - v (for assets whose UV origin is the image's top-left corner)."""
     if mesh is None or mesh.uvs is None:
         return mesh
-    if id(mesh) not in _FLIPPED:
+    if mesh.uid not in _FLIPPED:
         uv = mesh.uvs.copy()
         uv[:, 1] = 1.0 - uv[:, 1]
-        _FLIPPED[id(mesh)] = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, uv, None, mesh.source)
-    return _FLIPPED[id(mesh)]
+        _FLIPPED[mesh.uid] = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, uv, None, mesh.source)
+    return _FLIPPED[mesh.uid]
 
 
 def default_camera(scene: Scene, yfov_deg: float = 30.0) -> CameraNode:

@@ -19,13 +19,20 @@ def skinlab(*args, env=None):
 
 def test_render_json_png_and_exr(tmp_path):
     png, exr = tmp_path / "a.png", tmp_path / "b.exr"
-    p = skinlab("render", "--out", str(png), "--size", "48x40", "--json", "--explain")
+    p = skinlab("render", "--out", str(png), "--size", "48x40", "--json", "--explain", "--tsd-size", "256")
     assert p.returncode == 0, p.stderr
     d = json.loads(p.stdout)
     assert d["outputs"] == [str(png)] and d["size"] == [48, 40]
-    assert set(d["timings"]["passes"]) == {"shadow[key]", "forward", "tonemap"}
-    assert "frame plan:" in p.stderr
-    assert skinlab("render", "--out", str(exr), "--size", "48x40").returncode == 0
+    passes = d["timings"]["passes"]
+    # the head's skin scatters: texture-space diffusion runs (the stretch map was made in the warm-up
+    # frame and is reused in the measured one)
+    assert {"shadow[key]", "tsd_irradiance[LeePerrySmith]", "tsd_dilate[LeePerrySmith]", "forward",
+            "tonemap"} <= set(passes)
+    assert any(n.startswith("tsd_blur[LeePerrySmith]") for n in passes)
+    assert all(v["cpu_ms"] > 0 for v in passes.values())
+    assert any(s["what"] == "tsd_stretch[LeePerrySmith]" for s in d["plan"]["skipped"])
+    assert "frame plan:" in p.stderr and "tsd_blur" in p.stderr
+    assert skinlab("render", "--out", str(exr), "--size", "48x40", "--tsd-size", "256").returncode == 0
     from app.image_output import read_image
 
     img = read_image(exr)
@@ -36,10 +43,27 @@ def test_render_json_png_and_exr(tmp_path):
     assert not list(tmp_path.glob(".*"))  # no temporary files left behind
 
 
+def test_render_sss_override(tmp_path):
+    """--sss none: no texture-space passes at all; --sss dipole: the chain is planned for the dipole."""
+    p = skinlab("render", "--out", str(tmp_path / "n.png"), "--size", "32x32", "--sss", "none", "--json")
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)
+    assert set(d["timings"]["passes"]) == {"shadow[key]", "forward", "tonemap"}
+    assert any("sss_model is none" in s["why"] for s in d["plan"]["skipped"])
+    p = skinlab("render", "--out", str(tmp_path / "d.png"), "--size", "32x32", "--sss", "dipole", "--explain",
+                "--tsd-size", "512", "--gaussians", "3")
+    assert p.returncode == 0, p.stderr
+    assert "scatters (dipole)" in p.stdout
+    p = skinlab("render", "--out", str(tmp_path / "x.png"), "--sss", "fog")
+    assert p.returncode == 2 and "invalid choice: 'fog'" in p.stderr
+
+
 @pytest.mark.parametrize("args, message", [
     (["render", "--out", "x.jpg"], "x.jpg: unsupported image extension '.jpg'; expected .png or .exr"),
     (["render", "missing.toml"], "scene file not found: missing.toml"),
     (["render", "--size", "12"], "--size: expected WIDTHxHEIGHT"),
+    (["render", "--size", "8x8", "--tsd-size", "3"], "tsd_size: expected an integer in [16, 8192], got 3"),
+    (["render", "--size", "8x8", "--gaussians", "9"], "tsd_gaussians: expected an integer in [1, 6], got 9"),
 ])
 def test_bad_input_is_one_clear_line(args, message):
     p = skinlab(*args)

@@ -12,7 +12,7 @@ from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
 from scene.scenefile import load_scene
 
-SET = RenderSettings(64, 64, shadow_size=128)
+SET = RenderSettings(64, 64, shadow_size=128, sss_model="none")   # the edit below changes plain diffuse
 
 
 def wait_reload(watcher, timeout=5.0):

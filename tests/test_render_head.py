@@ -19,7 +19,7 @@ def renderer(ctx):
 @pytest.fixture(scope="module")
 def head_frames(renderer):
     s = load_scene()
-    settings = RenderSettings(*SIZE, shadow_size=512)
+    settings = RenderSettings(*SIZE, shadow_size=512, tsd_size=256)
     return s, renderer.render(s, settings), renderer.render(s, settings)
 
 
@@ -42,15 +42,21 @@ def test_lips_are_where_the_lips_are(renderer, head_frames):
     wrong = load_scene()
     (head,) = wrong.mesh_nodes()
     head.mesh = scenefile.flip_v(head.mesh)  # flipping twice undoes the scene file's flip_v
-    w = renderer.render(wrong, RenderSettings(*SIZE, shadow_size=512))
+    w = renderer.render(wrong, RenderSettings(*SIZE, shadow_size=512, tsd_size=256))
     assert not redness(w.hdr, px["lips"]) > 1.25 * redness(w.hdr, px["cheek"])
 
 
 def test_key_light_shadow_darkens_and_plan_skips_unneeded_shadow_passes(renderer, head_frames):
     s, a, _ = head_frames
+    names = a.plan.names()
+    assert names[0] == "shadow[key]" and names[-2:] == ["forward", "tonemap"]
+    assert "tsd_irradiance[LeePerrySmith]" in names   # the skin scatters: texture-space passes
+    # plain diffuse (no translucency, which needs the shadow map): a shadow only removes light
+    st = RenderSettings(*SIZE, shadow_size=512, sss_model="none")
+    a = renderer.render(s, st)
     assert a.plan.names() == ["shadow[key]", "forward", "tonemap"]
     s.find("key").cast_shadow = False
-    b = renderer.render(s, RenderSettings(*SIZE, shadow_size=512))
+    b = renderer.render(s, st)
     s.find("key").cast_shadow = True
     assert b.plan.names() == ["forward", "tonemap"]
     diff = b.hdr[..., :3].sum(-1) - a.hdr[..., :3].sum(-1)
@@ -67,5 +73,5 @@ def test_explain_lists_passes_and_reasons(head_frames):
 def test_timings_reported_per_pass(head_frames):
     _, a, _ = head_frames
     d = a.timings.as_dict()
-    assert set(d["passes"]) == {"shadow[key]", "forward", "tonemap"}
+    assert set(d["passes"]) == set(a.plan.names())
     assert all(p["cpu_ms"] > 0 for p in d["passes"].values()) and d["frame_ms"] > 0

@@ -55,11 +55,11 @@ class GpuResources:
         self.uploads = 0
 
     def mesh(self, mesh: Mesh) -> GpuMesh:
-        g = self.meshes.get(id(mesh))
+        g = self.meshes.get(mesh.uid)
         if g is None or g.version != mesh.version:
             if g is not None:
                 g.release()
-            g = self.meshes[id(mesh)] = GpuMesh(self.ctx, mesh)
+            g = self.meshes[mesh.uid] = GpuMesh(self.ctx, mesh)
             self.uploads += 1
         return g
 

@@ -26,7 +26,7 @@ def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
     if "u_light_shadow" in prog:
         ids = np.full(nmax, -1, np.int32)
         ids[: len(lights)] = [slots.get(id(l), -1) for l in lights]
-        prog["u_light_shadow"].write(ids.tobytes())
+        prog["u_light_shadow"].write(ids[: max(prog["u_light_shadow"].array_length, 1)].tobytes())
     if "u_shadow_matrix" in prog:
         mats = np.stack([frame.shadow_matrices.get(s, np.eye(4)).T for s in (0, 1)]).astype(np.float32)
-        prog["u_shadow_matrix"].write(mats.tobytes())
+        prog["u_shadow_matrix"].write(mats[: max(prog["u_shadow_matrix"].array_length, 1)].tobytes())

@@ -76,7 +76,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, stretch_valid=None) -> Fr
     for l in shadow_lights[2:]:
         plan.skipped.append((f"shadow[{l.name}]", "at most 2 shadow-casting lights"))
     if not tsd_nodes:
-        plan.skipped.append(("texture-space diffusion", "no visible material scatters below the surface"))
+        plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
     for t in tsd_nodes:
         _plan_tsd_passes(plan, t, scene, settings, lights, shadow_lights[:2], translucency, stretch_valid)
     plan.passes.append(PlannedPass("forward", "forward", "hdr_color+depth", settings.size,

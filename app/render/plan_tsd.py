@@ -30,7 +30,7 @@ _OVERRIDES: dict = {}
 def _override(mat, model):
     """The material with sss_model replaced (cached per material object and value set, so shader
     programs and fits are not redone every frame)."""
-    key = (id(mat), model, tuple(sorted((k, str(v)) for k, v in mat.values.items())))
+    key = (mat.name, model, tuple(sorted((k, str(v)) for k, v in mat.values.items())))
     m = _OVERRIDES.get(key)
     if m is None:
         if len(_OVERRIDES) > 256:
@@ -48,7 +48,7 @@ _UV_CACHE: dict = {}
 
 def uv_report(node, mm_per_unit: float, size: int):
     mesh = node.mesh
-    key = (id(mesh), mesh.version, float(mm_per_unit), round(model_scale(node.world_matrix), 9), size)
+    key = (mesh.uid, mesh.version, float(mm_per_unit), round(model_scale(node.world_matrix), 9), size)
     r = _UV_CACHE.get(key)
     if r is None:
         if len(_UV_CACHE) > 64:

@@ -170,8 +170,9 @@ def design_kernel(fit: ProfileFit, mm_per_texel_p10: float, mm_per_texel_p50: fl
                                                              "in every channel"))
             continue
         if math.sqrt(max(v, 0.0)) / p50 < TSD_SUBTEXEL_SIGMA:
-            skipped.append((f"gaussian {k} (v={v:.3g} mm2)", f"sigma {math.sqrt(max(v, 0)):.3g} mm < "
-                                                             f"{TSD_SUBTEXEL_SIGMA} texel: joins the unblurred term"))
+            skipped.append((f"gaussian {k} (v={v:.3g} mm2)",
+                            f"sigma {math.sqrt(max(v, 0)):.3g} mm < {TSD_SUBTEXEL_SIGMA} texel ({p50:.3g} mm per "
+                            "texel, median): joins the unblurred term"))
             ident += w
             continue
         kept_v.append(float(v))

@@ -35,11 +35,14 @@ uniform float u_tsd_var[6];               // the kept Gaussians' variances (mm^2
 uniform vec3 u_tsd_w[6];
 uniform int u_tsd_levels;
 
-float first_hit_distance(int slot, vec3 world) {
+// Distance from the light of the first surface it meets on the way to world; false outside the map.
+bool first_hit_distance(int slot, vec3 world, out float first) {
     vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
     vec2 uv = p.xy / p.w;
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return -1.0;
-    return slot == 0 ? texture(u_distance0, uv).r : texture(u_distance1, uv).r;
+    first = 0.0;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
+    first = slot == 0 ? texture(u_distance0, uv).r : texture(u_distance1, uv).r;
+    return first < 1e29;   // cleared texels: no surface
 }
 
 float distance_from_light(int slot, vec3 world) {
@@ -89,8 +92,8 @@ void main() {
         int slot = u_light_shadow[i];
         float back = -dot(ng, l);
         if (slot >= 0 && back > 0.0) {
-            float first = first_hit_distance(slot, v_world);
-            if (first >= 0.0) {
+            float first;
+            if (first_hit_distance(slot, v_world, first)) {
                 float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit;
                 e_in += e * back * fresnel_transmission(f0, back) * thickness_transmittance(d_mm);
             }

@@ -70,7 +70,7 @@ class TsdFrameNode:
 def stretch_key(node, scene, size: int) -> tuple:
     """Everything the stretch map depends on: the mesh (identity, version), its world transform,
     the scene scale and the texture size."""
-    return (id(node.mesh), node.mesh.version, node.world_matrix.round(9).tobytes(), float(scene.mm_per_unit), size)
+    return (node.mesh.uid, node.mesh.version, node.world_matrix.round(9).tobytes(), float(scene.mm_per_unit), size)
 
 
 class TsdStore:
@@ -82,16 +82,16 @@ class TsdStore:
         self.stretch_updates = 0
 
     def targets(self, node, size: int) -> TsdNodeTargets:
-        t = self.nodes.get(id(node))
+        t = self.nodes.get(node.uid)
         if t is None or t.size != size:
             if t is not None:
                 t.release()
             c = self.ctx
-            t = self.nodes[id(node)] = TsdNodeTargets(size, _texture(c, size), _texture(c, size), _texture(c, size))
+            t = self.nodes[node.uid] = TsdNodeTargets(size, _texture(c, size), _texture(c, size), _texture(c, size))
         return t
 
     def stretch_valid(self, node, scene, size: int) -> bool:
-        t = self.nodes.get(id(node))
+        t = self.nodes.get(node.uid)
         return t is not None and t.size == size and t.stretch_key == stretch_key(node, scene, size)
 
     def release(self) -> None:
@@ -221,3 +221,10 @@ class TsdBlurPass:
             set_uniform(prog, "u_axis", axis)
             self.r.fullscreen(prog)
         frame.targets[f"tsd_level{step.level}[{node.name}]"] = dst
+
+
+def read_texture(tex: moderngl.Texture) -> np.ndarray:
+    """A float texture as (H, W, C) float32, row 0 at v = 0 (the UV layout's bottom) - the layout the
+    NumPy twins in scene/optics/tsd.py use."""
+    w, h = tex.size
+    return np.frombuffer(tex.read(), np.float32).reshape(h, w, tex.components).copy()

@@ -1,0 +1,58 @@
+"""Small scenes for texture-space diffusion tests: a flat square slab of skin-like material seen
+straight from above by a far, narrow camera (nearly orthographic), lit by a directional light."""
+from __future__ import annotations
+
+import numpy as np
+
+from scene.graph import CameraNode, LightNode, MeshNode, Scene
+from scene.materials import Material
+from scene.mesh import Mesh
+from scene import transform as tf
+
+
+def quad_mesh(name, x0, x1, y0, y1, z=0.0, uv=((0, 0), (1, 1))) -> Mesh:
+    (u0, v0), (u1, v1) = uv
+    pos = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]], np.float32)
+    uvs = np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]], np.float32)
+    return Mesh(name, pos, np.array([[0, 1, 2], [0, 2, 3]], np.uint32),
+                normals=np.tile([0, 0, 1.0], (4, 1)), uvs=uvs)
+
+
+def skin(model="burley", radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5), base=(1.0, 1.0, 1.0), **kw) -> Material:
+    return Material("slab", {"base_color": base, "subsurface": 1.0, "subsurface_radius": radius,
+                             "subsurface_color": color, "sss_model": model, "roughness": 0.5,
+                             "specular": 0.0, **kw})
+
+
+def light_from(direction, intensity=1.0, shadow=False) -> LightNode:
+    d = np.asarray(direction, np.float64)
+    d /= np.linalg.norm(d)
+    l = LightNode("sun", "directional", intensity=intensity, cast_shadow=shadow)
+    l.rotation = tf.look_at_rotation(np.zeros(3), d)
+    return l
+
+
+def slab_scene(half=1.0, mm_per_unit=20.0, material=None, light_dir=(0, 0, -1), occluder=False,
+               mesh=None, ambient=0.0) -> Scene:
+    """A 2 half x 2 half slab in z = 0 (UVs fill [0, 1]^2). occluder: an opaque plane at height
+    half covering x < -half (outside the camera's view) that, with light travelling along (1, 0, -1),
+    casts a shadow edge across x = 0."""
+    s = Scene("slab", mm_per_unit)
+    s.environment.ambient = np.full(3, ambient)
+    s.add(MeshNode("slab", mesh or quad_mesh("slab", -half, half, -half, half), material or skin()))
+    if occluder:
+        h = half * 1.02
+        s.add(MeshNode("occluder", quad_mesh("occluder", -3 * half, -h, -1.2 * half, 1.2 * half, z=h),
+                       Material("black", {"base_color": (0, 0, 0), "specular": 0.0})))
+        light_dir = (1.0, 0.0, -1.0)
+    s.add(light_from(light_dir, shadow=occluder))
+    dist = half / np.tan(np.radians(1.0))
+    cam = CameraNode("cam", yfov=np.radians(2.0), znear=0.5 * dist, zfar=2.0 * dist)
+    cam.look_at((0, 0, dist), (0, 0, 0))
+    s.add(cam)
+    return s
+
+
+def pixel_x(width: int, half: float) -> np.ndarray:
+    """World x of each pixel column's centre in slab_scene's view (the view spans exactly [-half, half])."""
+    return ((np.arange(width) + 0.5) / width * 2.0 - 1.0) * half
