@@ -474,3 +474,26 @@ def test_core_scene_reload_keeps_camera_and_renders_new_scene(core):
     assert c.scene is not old and c.scene.environment.exposure == 0.25 and c.errors() == []
     assert np.allclose(c.orbit.eye, eye)                    # same file camera: the user's view is kept
     assert c.render()
+
+
+def test_core_reloads_a_changed_texture_file(ctx, tmp_path):
+    from PIL import Image
+
+    tex = tmp_path / "col.png"
+    Image.new("RGB", (64, 64), (230, 230, 230)).save(tex)
+    scene = head_copy(tmp_path)
+    scene.write_text(scene.read_text().replace(f"{ASSETS / 'lee-perry-smith'}/Map-COL.jpg", str(tex)))
+    c = ViewerCore(ctx, scene, RenderSettings(64, 48, **SMALL), settle_s=0.05)
+    try:
+        assert tex.resolve() in c.scene_src.watcher.paths
+        assert c.render()
+        bright = np.frombuffer(c.targets()["ldr_color"].read(), np.uint8).reshape(48, 64, 4)[..., :3].mean()
+        Image.new("RGB", (64, 64), (20, 20, 20)).save(tex)      # same path, darker pixels
+        t0 = time.monotonic()
+        while not c.poll_reloads() and time.monotonic() - t0 < 5:
+            time.sleep(0.02)
+        assert c.errors() == [] and c.render()
+        dark = np.frombuffer(c.targets()["ldr_color"].read(), np.uint8).reshape(48, 64, 4)[..., :3].mean()
+        assert dark < bright - 10                                # the renderer's cached texture was replaced
+    finally:
+        c.close()
