@@ -110,6 +110,7 @@ class ViewerWindow:
     # -- pyglet events -------------------------------------------------------------------------
     def on_close(self):
         self.closed = True
+        return True   # EVENT_HANDLED: the loop releases GL objects first, then closes the window
 
     def on_resize(self, width, height):
         fw, fh = self.window.get_framebuffer_size()
