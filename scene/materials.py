@@ -145,3 +145,16 @@ class Material:
     def has_subsurface(self) -> bool:
         return self.values["subsurface"] > 0 and self.values["sss_model"] != "none" \
             and max(self.values["subsurface_radius"]) > 0
+
+
+def medium_values(medium) -> dict[str, Any]:
+    """Principled-material values that reproduce a homogeneous medium (a Jensen 2001 preset, say):
+    its diffuse surface albedo as base and subsurface colour, its artist radius (4 pi l, Blender's
+    convention) as subsurface_radius, and the specular whose F0 matches its index of refraction
+    (F0 = ((eta - 1)/(eta + 1))^2 = 0.08 specular). Values are clipped to the declared ranges."""
+    albedo = np.clip(np.asarray(medium.surface_albedo(), np.float64), 0.0, 1.0)
+    radius = np.clip(np.asarray(medium.artist_radius_mm, np.float64), 0.0, 1000.0)
+    f0 = ((medium.eta - 1.0) / (medium.eta + 1.0)) ** 2
+    return {"base_color": tuple(float(x) for x in albedo), "subsurface_color": tuple(float(x) for x in albedo),
+            "subsurface_radius": tuple(float(x) for x in radius), "subsurface": 1.0,
+            "specular": float(min(f0 / 0.08, 1.0))}

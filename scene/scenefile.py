@@ -147,6 +147,16 @@ def _build(path: Path, data: dict) -> Scene:
         if not isinstance(values, dict):
             raise SceneFileError(f"[materials.{name}]: expected a table of parameters")
         m = Material(name)
+        values = dict(values)
+        preset_name = values.pop("preset", None)
+        if preset_name is not None:   # a measured medium (assets/presets/jensen2001_table1.csv) first
+            from scene.materials import medium_values
+            from scene.optics.media import preset
+
+            try:
+                m.update(medium_values(preset(str(preset_name))))
+            except ValueError as e:
+                raise SceneFileError(f"[materials.{name}].preset: {e}") from None
         m.update(_resolve_paths(values, base, m))
         for sampler, (tex, _) in m.textures().items():
             if not Path(tex).is_file():
@@ -167,7 +177,7 @@ def _build(path: Path, data: dict) -> Scene:
     for i, entry in enumerate(data.get("meshes", [])):
         where = f"[[meshes]] #{i + 1}"
         _known(where, entry, {"name", "file", "material", "overrides", "nodes", "translation", "rotation",
-                              "rotation_deg", "scale", "visible", "flip_v"})
+                              "rotation_deg", "scale", "visible", "flip_v", "generate_uvs"})
         if "file" not in entry:
             raise SceneFileError(f"{where}: missing 'file'")
         mpath = Path(entry["file"])
@@ -185,6 +195,10 @@ def _build(path: Path, data: dict) -> Scene:
                                      f"(it has: {', '.join(sorted(names))})")
         if entry.get("flip_v", False):
             loaded = [LoadedNode(ln.name, ln.parent, ln.matrix, flip_v(ln.mesh)) for ln in loaded]
+        if entry.get("generate_uvs", False):   # an xatlas atlas where the file has no UVs
+            for ln in loaded:
+                if ln.mesh is not None:
+                    ln.mesh.ensure_uvs(f"{where}: generate_uvs", generate=True)
         created: dict[str, Node] = {}
         for ln in loaded:
             cfg = node_cfg.get(ln.name, {})

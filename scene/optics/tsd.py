@@ -30,7 +30,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .constants import (COVERAGE_EPS, SKIN6_VARIANCES, SKIN6_WEIGHTS, SPECULAR_F0_SCALE, TSD_MAX_STEP_TEXELS,
+from .constants import (COVERAGE_EPS, MIN_MFP_MM, SKIN6_VARIANCES, SKIN6_WEIGHTS, SPECULAR_F0_SCALE, TSD_MAX_STEP_TEXELS,
                         TSD_MIN_MM_PER_TEXEL, TSD_TAP_RANGE)
 from .gaussians import fit_gaussians
 from .media import Medium
@@ -83,7 +83,9 @@ def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
                          f"expected one of {', '.join(MODEL_PROFILES)}")
     if not (isinstance(K, int) and 1 <= K <= MAX_TSD_LEVELS):
         raise ValueError(f"tsd_gaussians: expected an integer in [1, {MAX_TSD_LEVELS}], got {K!r}")
-    scatter = (medium.mfp_arr > 0) & (medium.alpha_arr > 0)
+    # channels that scatter at all (mean free paths below MIN_MFP_MM are "no scattering" for every
+    # profile); the others keep the unblurred irradiance
+    scatter = (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
     if model == "gaussians":
         radius = np.where(scatter, medium.artist_radius_mm, 0.0)
         scale = float(radius[scatter].mean() / np.mean(SKIN6_RADIUS_MM)) if scatter.any() else 0.0
