@@ -4,6 +4,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 
+TECHNIQUES = ("tsd", "exact", "ssss", "tint")
+
+
 @dataclass
 class RenderSettings:
     width: int = 640
@@ -13,6 +16,13 @@ class RenderSettings:
     max_lights: int = 4
     # None: each material's own sss_model; else one of scene.materials.SSS_MODELS for every material
     sss_model: str | None = None
+    # how subsurface scattering is rendered (TECHNIQUES): texture-space diffusion with the Gaussian
+    # fit ("tsd", default), brute-force texture-space convolution with the exact profile ("exact",
+    # the slow image reference), screen-space separable SSS ("ssss", Jimenez et al.), or the
+    # per-pixel profile tint without convolution ("tint", the original study's baseline)
+    technique: str = "tsd"
+    tsd_taps: int | None = None        # None: from each blur's width in texels; else a fixed odd count (7..31)
+    ssss_taps: int = 17                # screen-space kernel samples: 11, 17 or 25 (Jimenez presets)
     tsd_size: int = 1024              # texture-space diffusion: irradiance texels per side
     tsd_albedo_mix: float = 0.5       # pre-/post-scatter texturing: albedo^mix before the blur
     tsd_gaussians: int = 6            # K: Gaussians fitted to the profile
@@ -28,6 +38,13 @@ class RenderSettings:
             if self.sss_model not in SSS_MODELS:
                 raise ValueError(f"render setting sss_model: expected one of {', '.join(SSS_MODELS)}, "
                                  f"got {self.sss_model!r}")
+        if self.technique not in TECHNIQUES:
+            raise ValueError(f"render setting technique: expected one of {', '.join(TECHNIQUES)}, got {self.technique!r}")
+        if self.tsd_taps is not None and (not isinstance(self.tsd_taps, int) or self.tsd_taps % 2 == 0
+                                          or not 7 <= self.tsd_taps <= 31):
+            raise ValueError(f"render setting tsd_taps: expected an odd integer in [7, 31] or None, got {self.tsd_taps!r}")
+        if not isinstance(self.ssss_taps, int) or self.ssss_taps % 2 == 0 or not 3 <= self.ssss_taps <= 63:
+            raise ValueError(f"render setting ssss_taps: expected an odd integer in [3, 63], got {self.ssss_taps!r}")
         if not isinstance(self.tsd_size, int) or not 16 <= self.tsd_size <= 8192:
             raise ValueError(f"render setting tsd_size: expected an integer in [16, 8192], got {self.tsd_size!r}")
         if not isinstance(self.tsd_gaussians, int) or not 1 <= self.tsd_gaussians <= 6:
