@@ -5,7 +5,7 @@ import json
 import sys
 from pathlib import Path
 
-from app.render.settings import RenderSettings, parse_size
+from app.render.settings import TECHNIQUES, RenderSettings, parse_size
 from scene.materials import SSS_MODELS
 
 
@@ -17,6 +17,12 @@ def register(sub) -> None:
     p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
     p.add_argument("--sss", choices=SSS_MODELS, default=None,
                    help="subsurface model for every material (default: each material's own sss_model)")
+    p.add_argument("--technique", choices=TECHNIQUES, default="tsd",
+                   help="tsd: texture-space diffusion (default); exact: brute-force texture-space convolution "
+                        "with the exact profile (slow reference); ssss: screen-space separable SSS; tint: the "
+                        "per-pixel profile tint baseline")
+    p.add_argument("--taps", type=int, default=None, help="texture-space blur taps (odd, 7-31; default: from width)")
+    p.add_argument("--ssss-taps", type=int, default=17, help="screen-space SSS kernel samples (11, 17, 25)")
     p.add_argument("--tsd-size", type=int, default=None, help="texture-space diffusion texels per side (default 1024)")
     p.add_argument("--gaussians", type=int, default=None, help="Gaussians fitted to the profile, 1-6 (default 6)")
     p.add_argument("--json", action="store_true", help="print timings and output paths as JSON")
@@ -51,7 +57,8 @@ def settings_from_args(args, w: int, h: int) -> RenderSettings:
         extra["tsd_size"] = args.tsd_size
     if args.gaussians is not None:
         extra["tsd_gaussians"] = args.gaussians
-    return RenderSettings(w, h, shadow_size=args.shadow_size, sss_model=args.sss, **extra)
+    return RenderSettings(w, h, shadow_size=args.shadow_size, sss_model=args.sss, technique=args.technique,
+                          tsd_taps=args.taps, ssss_taps=args.ssss_taps, **extra)
 
 
 def run(args) -> int:

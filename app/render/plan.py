@@ -5,7 +5,10 @@ from dataclasses import dataclass, field
 
 from scene.graph import LightNode, Scene
 
-from .plan_tsd import DILATE_RINGS, plan_tsd_node
+from scene.optics.tsd import material_medium, profile_tint
+
+from .plan_ssss import plan_ssss
+from .plan_tsd import DILATE_RINGS, plan_tsd_node, scattering_material
 from .settings import RenderSettings
 
 
@@ -61,7 +64,17 @@ def plan_frame(scene: Scene, settings: RenderSettings, stretch_valid=None) -> Fr
     if not meshes:
         plan.skipped.append(("shadows", "no visible mesh"))
         shadow_lights = []
-    tsd_nodes = [t for t in (plan_tsd_node(n, settings, scene, plan) for n in meshes) if t is not None]
+    technique = settings.technique
+    tsd_nodes, tint, ssss = [], {}, None
+    if technique in ("tsd", "exact"):
+        tsd_nodes = [t for t in (plan_tsd_node(n, settings, scene, plan) for n in meshes) if t is not None]
+    elif technique == "tint":
+        for n in meshes:
+            mat = scattering_material(n, settings, plan, f"tint[{n.name}]")
+            if mat is not None:
+                tint[n.uid] = (mat, profile_tint(mat["sss_model"], material_medium(mat.values)))
+    elif technique == "ssss":
+        ssss = plan_ssss(meshes, settings, plan)
     translucency = bool(tsd_nodes) and settings.translucency and bool(shadow_lights)
     if tsd_nodes and not translucency:
         plan.skipped.append(("translucency", "disabled in the settings" if not settings.translucency
@@ -76,13 +89,23 @@ def plan_frame(scene: Scene, settings: RenderSettings, stretch_valid=None) -> Fr
     for l in shadow_lights[2:]:
         plan.skipped.append((f"shadow[{l.name}]", "at most 2 shadow-casting lights"))
     if not tsd_nodes:
-        plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
+        plan.skipped.append(("texture-space diffusion", "no visible material needs it" if technique in
+                             ("tsd", "exact") else f"technique is {technique}"))
     for t in tsd_nodes:
         _plan_tsd_passes(plan, t, scene, settings, lights, shadow_lights[:2], translucency, stretch_valid)
-    plan.passes.append(PlannedPass("forward", "forward", "hdr_color+depth", settings.size,
-                                   f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)"
-                                   + (f"; gather diffusion for {len(tsd_nodes)}" if tsd_nodes else ""),
-                                   {"lights": lights, "shadow_lights": shadow_lights[:2]}))
+    what = (f"; gather diffusion for {len(tsd_nodes)}" if tsd_nodes else
+            f"; profile tint (no convolution) for {len(tint)}" if tint else
+            "; subsurface diffuse to a second target for the screen-space blur" if ssss else "")
+    plan.passes.append(PlannedPass("forward", "forward", "hdr_color+depth" + ("+diffuse" if ssss else ""),
+                                   settings.size, f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)"
+                                   + what, {"lights": lights, "shadow_lights": shadow_lights[:2], "tint": tint,
+                                            "ssss": ssss}))
+    if ssss is not None:
+        plan.passes.append(PlannedPass(
+            "ssss_blur", "ssss_blur", "hdr_color", settings.size,
+            f"screen-space separable SSS (Jimenez et al.): {settings.ssss_taps}-tap kernel of "
+            f"'{ssss.material.name}' ({ssss.material['sss_model']}), horizontal then vertical, depth-aware",
+            {"ssss": ssss}))
     plan.passes.append(PlannedPass("tonemap", "tonemap", "ldr_color", settings.size,
                                    "ACES tone mapping and sRGB encoding for display/PNG"))
     return plan
@@ -106,6 +129,12 @@ def _plan_tsd_passes(plan, t, scene, settings, lights, shadow_lights, translucen
          "mix": settings.tsd_albedo_mix}))
     plan.passes.append(PlannedPass(f"tsd_dilate[{node.name}]", "tsd_dilate", "tsd_irradiance", res,
                                    f"push irradiance {DILATE_RINGS} texels past UV chart borders (seams)", base))
+    if settings.technique == "exact":
+        plan.passes.append(PlannedPass(
+            f"tsd_exact[{node.name}]", "tsd_exact", "tsd_level0", res,
+            f"brute-force convolution with the exact {t.material['sss_model']} profile (image reference; slow "
+            "on purpose)", {**base, "model": t.material["sss_model"]}))
+        return
     for s in k.steps:
         w = ", ".join(f"{x:.3f}" for x in s.weight)
         plan.passes.append(PlannedPass(

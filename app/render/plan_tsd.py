@@ -67,14 +67,22 @@ class TsdNodePlan:
     report: object
 
 
-def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
-    """Decide TSD for one visible mesh node; record skips and warnings in `plan`."""
+def scattering_material(node, settings, plan, label: str):
+    """The node's effective material if it scatters below the surface, else None (skip recorded)."""
     mat = effective_material(node, settings)
-    label = f"tsd[{node.name}]"
     if not mat.has_subsurface:
         why = ("sss_model is none" if mat["sss_model"] == "none" else
                "subsurface weight is 0" if mat["subsurface"] <= 0 else "subsurface_radius is 0")
         plan.skipped.append((label, f"material '{mat.name}': {why}; plain diffuse"))
+        return None
+    return mat
+
+
+def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
+    """Decide TSD for one visible mesh node; record skips and warnings in `plan`."""
+    label = f"tsd[{node.name}]"
+    mat = scattering_material(node, settings, plan, label)
+    if mat is None:
         return None
     mesh = node.mesh
     if mesh.uvs is None:
@@ -96,7 +104,7 @@ def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
         plan.skipped.append((label, "no usable UV layout"))
         return None
     fit = profile_fit(mat["sss_model"], material_medium(mat.values), settings.tsd_gaussians)
-    kernel = design_kernel(fit, max(p10, 1e-9), p50)
+    kernel = design_kernel(fit, max(p10, 1e-9), p50, taps=settings.tsd_taps)
     for what, why in kernel.skipped:
         plan.skipped.append((f"{label} {what}", why))
     if kernel.levels == 0:

@@ -15,8 +15,9 @@ from .frame import Frame
 from .gpu_resources import GpuResources
 from .passes.forward import ForwardPass
 from .passes.shadow import ShadowPass
+from .passes.ssss import SsssBlurPass
 from .passes.tonemap import TonemapPass
-from .passes.tsd import TsdBlurPass, TsdDilatePass, TsdIrradiancePass, TsdStore, TsdStretchPass
+from .passes.tsd import TsdBlurPass, TsdDilatePass, TsdExactPass, TsdIrradiancePass, TsdStore, TsdStretchPass
 from .plan import FramePlan, plan_frame
 from .settings import RenderSettings
 from .timing import FrameTimings, PassTimer
@@ -41,7 +42,8 @@ class Renderer:
         self.tsd = TsdStore(ctx)
         self.passes = {"shadow": ShadowPass(self), "tsd_stretch": TsdStretchPass(self),
                        "tsd_irradiance": TsdIrradiancePass(self), "tsd_dilate": TsdDilatePass(self),
-                       "tsd_blur": TsdBlurPass(self), "forward": ForwardPass(self), "tonemap": TonemapPass(self)}
+                       "tsd_blur": TsdBlurPass(self), "tsd_exact": TsdExactPass(self),
+                       "ssss_blur": SsssBlurPass(self), "forward": ForwardPass(self), "tonemap": TonemapPass(self)}
         self._fs_vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
         self._fs_vaos: dict[int, moderngl.VertexArray] = {}
         self._dummy_shadow = None

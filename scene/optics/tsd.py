@@ -156,10 +156,12 @@ def blur_taps(n: int) -> tuple[np.ndarray, np.ndarray]:
     return t, w / w.sum()
 
 
-def design_kernel(fit: ProfileFit, mm_per_texel_p10: float, mm_per_texel_p50: float) -> DiffusionKernel:
+def design_kernel(fit: ProfileFit, mm_per_texel_p10: float, mm_per_texel_p50: float,
+                  taps: int | None = None) -> DiffusionKernel:
     """Blur chain for `fit` on a texture whose (area-weighted) 10th / 50th percentile of millimetres
     per texel are given: drop negligible Gaussians, fold sub-texel ones into the identity, choose taps
-    from each step's width in texels (at the 10th percentile, where the kernel is widest in texels)."""
+    from each step's width in texels (at the 10th percentile, where the kernel is widest in texels)
+    unless `taps` fixes the count."""
     skipped = []
     ident = fit.identity.astype(np.float64).copy()
     kept_v, kept_w = [], []
@@ -188,7 +190,7 @@ def design_kernel(fit: ProfileFit, mm_per_texel_p10: float, mm_per_texel_p50: fl
     steps, prev = [], 0.0
     for i, (v, w) in enumerate(zip(kept_v, kept_w)):
         sigma = math.sqrt(max(v - prev, 0.0))
-        steps.append(BlurStep(i, v, sigma, tap_count(sigma / p10), tuple(float(x) for x in w)))
+        steps.append(BlurStep(i, v, sigma, int(taps) if taps else tap_count(sigma / p10), tuple(float(x) for x in w)))
         prev = v
     return DiffusionKernel(tuple(steps), ident, tuple(skipped), fit)
 
@@ -263,11 +265,15 @@ def exact_profile_convolution(irradiance: np.ndarray, mm_per_texel: tuple[float,
     ss = 4
     off = (np.arange(ss) + 0.5) / ss - 0.5
     ys, xs = np.mgrid[-nv:nv + 1, -nu:nu + 1]
+    # the radial profile tabulated once (log-spaced; some profiles cost ~0.1 ms per radius) and
+    # interpolated at the 4x4 sub-samples of every kernel texel
+    r_tab = np.concatenate([[0.0], np.geomspace(1e-6, max(2.0 * radius_mm, 1e-3), 4000)])
+    R_tab = np.asarray(profile_fn(r_tab), np.float64).reshape(len(r_tab), -1)
     ker = np.zeros(ys.shape + (3,))
     for oy in off:
         for ox in off:
             r = np.hypot((xs + ox) * mu, (ys + oy) * mv)
-            ker += np.asarray(profile_fn(r.ravel())).reshape(ys.shape + (3,))
+            ker += np.stack([np.interp(r, r_tab, R_tab[:, c]) for c in range(3)], axis=-1)
     ker = np.maximum(ker, 0.0)
     ker /= np.maximum(ker.sum(axis=(0, 1)), 1e-300)
     a = irr[..., 3]
@@ -326,3 +332,42 @@ def sss_exit_weight(NoV):
     """Burley 2015 diffuse transmission 1 - (1 - NoV)^5 / 2 over its cosine-weighted mean 1 - 1/42."""
     c = np.clip(np.asarray(NoV, np.float64), 0.0, 1.0)
     return (1.0 - 0.5 * (1.0 - c) ** 5) / (1.0 - 1.0 / 42.0)
+
+
+def profile_tint(model: str, medium: Medium) -> np.ndarray:
+    """The per-pixel tint baseline (no convolution): the exact profile evaluated at one radius, the
+    mean free path averaged over the scattering channels, scaled so the brightest channel is 1.
+    Kept only as the baseline it is: it shifts colour but moves no light."""
+    scatter = (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
+    if model not in MODEL_PROFILES or not scatter.any():
+        return np.ones(3)
+    r0 = float(medium.mfp_arr[scatter].mean())
+    R = np.asarray(get_profile(MODEL_PROFILES[model]).evaluate(np.array([r0]), medium), np.float64)[0]
+    R = np.where(scatter, np.maximum(R, 0.0), R.max() if R.max() > 0 else 1.0)
+    return R / R.max() if R.max() > 0 else np.ones(3)
+
+
+def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float = 0.999):
+    """Tables for the brute-force texture-space convolution (shaders/passes/tsd_exact.frag):
+    r_max (mm, the radius holding `energy` of every scattering channel's light), R(r) at
+    r_i = i r_max / (n - 1) normalised so its integral over the disc r <= r_max is 1 per channel, and
+    the cumulative energy E(r_i) = int_0^r_i R 2 pi r dr (for the centre texel). Channels that do not
+    scatter get R = 0 and E = 1 (a delta)."""
+    scatter = (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
+    prof = get_profile(MODEL_PROFILES[model])
+    fn = lambda r: np.asarray(prof.evaluate(np.asarray(r, np.float64), medium), np.float64) * scatter[None, :]
+    if not scatter.any():
+        return 1e-3, np.zeros((n, 3)), np.ones((n, 3))
+    from .gaussians import _energy_radius
+    r_max = _energy_radius(fn, energy)
+    r = np.linspace(0.0, r_max, n)
+    # fine quadrature of the cumulative energy (the profile may be singular at 0: Burley ~ 1/r)
+    rf = np.concatenate([[0.0], np.geomspace(r_max * 1e-7, r_max, 20000)])
+    Rf = fn(np.maximum(rf, r_max * 1e-9))
+    seg = 0.5 * (Rf[1:] * rf[1:, None] + Rf[:-1] * rf[:-1, None]) * np.diff(rf)[:, None] * 2 * math.pi
+    cum = np.concatenate([np.zeros((1, 3)), np.cumsum(seg, axis=0)])
+    tot = np.where(cum[-1] > 0, cum[-1], 1.0)
+    E = np.stack([np.interp(r, rf, cum[:, c] / tot[c]) for c in range(3)], axis=1)
+    R = fn(np.maximum(r, r_max * 1e-9)) / tot[None, :]
+    E = np.where(scatter[None, :], E, 1.0)
+    return float(r_max), R, E

@@ -4,6 +4,10 @@
 // TSD_LEVELS = n (1..6): the texture-space diffusion gather (d'Eon & Luebke 2007): the diffuse term
 // is the weighted sum of the blurred irradiance levels x albedo^(1-mix) (post-scatter texturing),
 // mixed with plain Burley diffuse by u_subsurface; specular and ambient specular as usual.
+// SSS_TINT: the per-pixel profile tint baseline (no convolution): the subsurface part of the diffuse
+// term is the Burley diffuse times u_sss_tint (the profile at one radius, brightest channel = 1).
+// SSSS_SPLIT: screen-space SSS (Jimenez et al.): the subsurface diffuse radiance goes to a second
+// target (f_diffuse, a = 1 where it is) for the screen-space blur, the rest to f_color.
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/subsurface.glsl"
@@ -85,7 +89,15 @@ vec3 tsd_diffused(vec2 uv) {
 }
 #endif
 
-out vec4 f_color;
+#ifdef SSS_TINT
+uniform vec3 u_sss_tint;
+#endif
+
+layout(location = 0) out vec4 f_color;
+#ifdef SSSS_SPLIT
+uniform float u_ssss_enabled;        // 1 for a material that scatters, 0 otherwise
+layout(location = 1) out vec4 f_diffuse;
+#endif
 
 void main() {
     vec3 ng = normalize(v_normal);
@@ -108,8 +120,19 @@ void main() {
 #ifdef HAS_OCCLUSION_MAP
     occlusion = texture(u_occlusion_map, v_uv).r;
 #endif
-#ifdef TSD_LEVELS
+#if defined(TSD_LEVELS)
     float plain = 1.0 - u_subsurface;    // weight of the surface's own Burley diffuse
+#elif defined(SSS_TINT) || defined(SSSS_SPLIT)
+    // the subsurface part uses the same entry/exit model as texture-space diffusion (irradiance
+    // through Fresnel transmission, Burley 2015 exit weight): only the convolution differs
+#ifdef SSSS_SPLIT
+    float sss_w = u_subsurface * u_ssss_enabled;
+#else
+    float sss_w = u_subsurface;
+#endif
+    float plain = 1.0 - sss_w;
+    vec3 sss_in = vec3(0.0);             // irradiance entering the medium
+    float sss_f0 = SPECULAR_F0_SCALE * u_specular;
 #else
     float plain = 1.0;
 #endif
@@ -129,8 +152,20 @@ void main() {
         vec3 diffuse = base * ((1.0 - u_metallic) * plain * burley_diffuse(NoL, NoV, LoH, rough));
         vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
         color += e * vis * (diffuse + spec) * NoL;
+#if defined(SSS_TINT) || defined(SSSS_SPLIT)
+        sss_in += e * (vis * NoL * fresnel_transmission(sss_f0, NoL));
+#endif
     }
     color += u_ambient * occlusion * (base * ((1.0 - u_metallic) * plain) + f0);
+#if defined(SSS_TINT) || defined(SSSS_SPLIT)
+    sss_in += PI * u_ambient * occlusion;
+    vec3 sss_out = base * sss_in * ((1.0 - u_metallic) * sss_w * INV_PI * sss_exit_weight(abs(NoV)));
+#ifdef SSS_TINT
+    color += sss_out * u_sss_tint;
+#else
+    f_diffuse = vec4(sss_out, u_ssss_enabled);
+#endif
+#endif
 #ifdef TSD_LEVELS
     // texture-space diffusion: the diffused light leaving toward the viewer (1/pi: Lambertian exit)
     vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));

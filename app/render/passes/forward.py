@@ -13,21 +13,30 @@ class ForwardPass:
         self.r = renderer
         self._targets = None
 
-    def targets(self, size):
+    def targets(self, size, split: bool = False):
+        """(colour, depth, framebuffer, diffuse or None): `split` adds the screen-space SSS target."""
         t = self._targets
-        if t is None or t[0].size != tuple(size):
+        if t is None or t[0].size != tuple(size) or (t[3] is not None) != split:
             if t is not None:
-                for x in reversed(t):
-                    x.release()
+                for x in (t[2], t[1], t[0], t[3]):
+                    if x is not None:
+                        x.release()
             ctx = self.r.ctx
             color = ctx.texture(size, 4, dtype="f4")
             depth = ctx.depth_texture(size)
-            t = self._targets = (color, depth, ctx.framebuffer([color], depth))
+            depth.compare_func = ""          # sampled as plain depth (screen-space SSS)
+            diffuse = ctx.texture(size, 4, dtype="f4") if split else None
+            for x in (color, diffuse):
+                if x is not None:
+                    x.repeat_x = x.repeat_y = False
+            fbo = ctx.framebuffer([color] + ([diffuse] if split else []), depth)
+            t = self._targets = (color, depth, fbo, diffuse)
         return t
 
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
-        color, depth, fbo = self.targets(p.resolution)
+        ssss, tint = p.params.get("ssss"), p.params.get("tint") or {}
+        color, depth, fbo, diffuse = self.targets(p.resolution, ssss is not None)
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
@@ -39,10 +48,15 @@ class ForwardPass:
         bind_shadow_maps(self.r, frame)
         for node in frame.scene.mesh_nodes():
             tsd = frame.tsd.get(id(node))
-            mat = tsd.material if tsd is not None else node.material
+            tinted = tint.get(node.uid)
+            mat = tsd.material if tsd is not None else tinted[0] if tinted is not None else node.material
             defines = {**mat.defines(("texture",)), "MAX_LIGHTS": nmax}
             if tsd is not None:
                 defines["TSD_LEVELS"] = tsd.kernel.levels
+            elif tinted is not None:
+                defines["SSS_TINT"] = 1
+            elif ssss is not None:
+                defines["SSSS_SPLIT"] = 1
             prog = self.r.programs.get("passes/forward.vert", "passes/forward.frag", defines)
             set_uniforms(prog, per_frame)
             set_light_uniforms(prog, frame, lights, p.params["shadow_lights"], nmax)
@@ -55,9 +69,15 @@ class ForwardPass:
                 set_uniform(prog, sampler, unit)
             if tsd is not None:
                 bind_tsd(prog, tsd)
+            if tinted is not None:
+                set_uniform(prog, "u_sss_tint", tinted[1])
+            if ssss is not None:   # (sss_model overrides change no uniform: the node's own values apply)
+                set_uniform(prog, "u_ssss_enabled", float(node.uid in ssss.scattering))
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         frame.targets["hdr_color"] = color
         frame.targets["depth"] = depth
+        if diffuse is not None:
+            frame.targets["ssss_diffuse"] = diffuse
 
 
 TSD_UNITS = 7   # irradiance at 7, levels at 8..13 (material maps 0..4, shadow maps 5, 6)

@@ -17,7 +17,8 @@ import numpy as np
 
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
-from scene.optics.tsd import MAX_TSD_LEVELS, DiffusionKernel, blur_taps
+from scene.optics.tsd import (MAX_TSD_LEVELS, BlurStep, DiffusionKernel, blur_taps, exact_profile_lut,
+                              material_medium)
 
 MAX_TAPS = 31   # shaders/passes/tsd_blur.frag
 
@@ -221,6 +222,60 @@ class TsdBlurPass:
             set_uniform(prog, "u_axis", axis)
             self.r.fullscreen(prog)
         frame.targets[f"tsd_level{step.level}[{node.name}]"] = dst
+
+
+EXACT_INNER_HALF = 24     # brute force: texels summed one by one within +-24 of the centre...
+EXACT_OUTER_HALF = 24     # ...then at most 24 mip-level cells per direction out to r_max
+UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.zeros(3))
+
+
+class TsdExactPass:
+    """Brute-force convolution with the exact profile into level 0; the gather then reads that level
+    with weight 1 (UNIT_KERNEL)."""
+
+    def __init__(self, renderer):
+        self.r = renderer
+        self._luts: dict = {}
+
+    def lut(self, model, medium):
+        key = (model, medium)
+        hit = self._luts.get(key)
+        if hit is None:
+            r_max, R, E = exact_profile_lut(model, medium)
+            data = np.zeros((2, len(R), 4), np.float32)
+            data[0, :, :3], data[1, :, :3] = R, E
+            tex = self.r.ctx.texture((len(R), 2), 4, data.tobytes(), dtype="f4")
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+            if len(self._luts) > 32:
+                for t, _ in self._luts.values():
+                    t.release()
+                self._luts.clear()
+            hit = self._luts[key] = (tex, r_max)
+        return hit
+
+    def run(self, frame, p) -> None:
+        ctx, node, size = self.r.ctx, p.params["node"], p.params["size"]
+        t = self.r.tsd.targets(node, size)
+        lut, r_max = self.lut(p.params["model"], material_medium(p.params["material"].values))
+        dst = t.level(ctx, 0)
+        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_exact.frag")
+        set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_lut": 2, "u_rmax_mm": r_max,
+                            "u_inner_half": EXACT_INNER_HALF, "u_outer_half": EXACT_OUTER_HALF})
+        t.irradiance.build_mipmaps()          # box-filtered far field (textureLod); the gather keeps
+        t.irradiance.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)   # sampling level 0
+        t.irradiance.use(0)
+        t.stretch.use(1)
+        lut.use(2)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+        t.fbo(ctx, dst).use()
+        ctx.viewport = (0, 0, size, size)
+        self.r.fullscreen(prog)
+        t.irradiance.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        fn = frame.tsd.get(id(node))
+        if fn is not None:
+            fn.kernel = UNIT_KERNEL
+        frame.targets[f"tsd_exact[{node.name}]"] = dst
 
 
 def read_texture(tex: moderngl.Texture) -> np.ndarray:
