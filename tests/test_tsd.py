@@ -115,12 +115,18 @@ def test_constant_irradiance_keeps_its_mean(renderer):
 
 
 def test_scale_invariance(renderer):
-    """Doubling the scene's mm per unit makes the object twice as large in millimetres; doubling the
-    radius with it leaves radius / size unchanged, so the image must not change."""
+    """Only millimetres matter. Doubling the scene's mm per unit makes the object twice as large in
+    millimetres; doubling the radius with it (the issue's "halving" would quarter radius / size)
+    leaves the image unchanged, as does describing the same scene with half the coordinates and
+    twice the mm per unit."""
     st = RenderSettings(96, 96, shadow_size=2048, tsd_size=128)
     a = renderer.render(slab_scene(occluder=True, mm_per_unit=20.0, material=skin(radius=(8.0, 4.0, 2.0))), st).hdr
     b = renderer.render(slab_scene(occluder=True, mm_per_unit=40.0, material=skin(radius=(16.0, 8.0, 4.0))), st).hdr
     np.testing.assert_allclose(a, b, atol=2e-4 * a.max())
+    # the same physical scene described in other units: half the coordinates, twice the mm per unit
+    d = renderer.render(slab_scene(half=0.5, occluder=True, mm_per_unit=40.0, material=skin(radius=(8.0, 4.0, 2.0))),
+                        st).hdr
+    np.testing.assert_allclose(a, d, atol=2e-4 * a.max())
     # and the physics does depend on the ratio: the same radius at twice the size is a sharper edge
     c = renderer.render(slab_scene(occluder=True, mm_per_unit=40.0, material=skin(radius=(8.0, 4.0, 2.0))), st).hdr
     assert np.abs(c - a).max() > 0.02 * a.max()
