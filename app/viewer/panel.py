@@ -105,11 +105,12 @@ def material_widgets(material: Material) -> list[Widget]:
 
 
 def medium_to_params(medium) -> dict[str, tuple[float, float, float]]:
-    """subsurface_color = diffuse surface albedo, subsurface_radius = artist radius (mm)."""
-    albedo = np.clip(np.asarray(medium.surface_albedo(), np.float64), 0.0, 1.0)
-    radius = np.asarray(medium.artist_radius_mm, np.float64)
-    return {"subsurface_color": tuple(float(x) for x in albedo),
-            "subsurface_radius": tuple(float(x) for x in radius)}
+    """subsurface_color = diffuse surface albedo, subsurface_radius = artist radius (mm): the
+    scattering part of scene.materials.medium_values (the material's own colour map stays)."""
+    from scene.materials import medium_values
+
+    v = medium_values(medium)
+    return {"subsurface_color": v["subsurface_color"], "subsurface_radius": v["subsurface_radius"]}
 
 
 def direction_from_angles(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
