@@ -17,6 +17,7 @@ yfov_deg = 28
 [materials.skin]               # any declared material parameter; paths relative to this file
 base_color_map = "../lee-perry-smith/Map-COL.jpg"
 roughness = 0.45
+# preset = "marble"            # first take a Jensen 2001 medium (albedo, radius, index), then the rest
 
 [[meshes]]
 name = "head"
@@ -26,6 +27,7 @@ translation = [0, 0, 0]
 rotation_deg = [0, 0, 0]        # or rotation = [x, y, z, w]
 scale = 1.0
 flip_v = false                             # true for assets whose UV origin is the image's top-left
+generate_uvs = false                       # true: an xatlas atlas where the file has no UVs
 overrides = { roughness = 0.4 }            # per-node material overrides
 [meshes.nodes.EyeLeft]                     # nodes inside the file, by name
 material = "eye"
