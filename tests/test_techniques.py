@@ -7,24 +7,11 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from tsd_scenes import pixel_x, skin, slab_scene  # noqa: E402
+from tsd_scenes import exact_profile, pixel_x, renderer, skin, slab_scene  # noqa: E402,F401
 
 from app.render.passes.tsd import read_texture
-from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
 from scene.optics import ssss, tsd
-from scene.optics.profiles import get_profile
-
-
-@pytest.fixture(scope="module")
-def renderer(ctx):
-    r = Renderer(ctx)
-    yield r
-    r.release()
-
-
-def exact_profile(model, medium):
-    return lambda r: get_profile(tsd.MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
 
 
 def edge_row(res, n):

@@ -6,30 +6,17 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from tsd_scenes import pixel_x, quad_mesh, skin, slab_scene  # noqa: E402
+from tsd_scenes import exact_profile, pixel_x, quad_mesh, renderer, skin, slab_scene  # noqa: E402,F401
 
 from app.gl.glsl_eval import assert_close_fp32
 from app.render.passes.tsd import read_texture
-from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
 from scene.mesh import Mesh
 from scene.optics import tsd
-from scene.optics.profiles import get_profile
-
-
-@pytest.fixture(scope="module")
-def renderer(ctx):
-    r = Renderer(ctx)
-    yield r
-    r.release()
 
 
 def tsd_node(renderer, scene, name="slab"):
     return renderer.last_frame.tsd[id(scene.find(name))]
-
-
-def exact_profile(model, medium):
-    return lambda r: get_profile(tsd.MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
 
 
 def test_subsurface_glsl_twins(glsl):
@@ -42,6 +29,30 @@ def test_subsurface_glsl_twins(glsl):
     # the exit weight averages to 1 over the cosine-weighted hemisphere
     mu = np.linspace(0, 1, 20001)
     assert abs(np.trapezoid(2 * mu * tsd.sss_exit_weight(mu), mu) - 1.0) < 1e-6
+
+
+def test_dilation_pass_matches_its_twin(renderer):
+    """passes/tsd_dilate.frag against dilate_reference on a texture with islands, holes and edges."""
+    from types import SimpleNamespace
+
+    from app.render.passes.tsd import _dilate
+
+    rng = np.random.default_rng(5)
+    n = 32
+    img = np.zeros((n, n, 4), np.float32)
+    mask = rng.random((n, n)) < 0.15
+    mask[10:20, 4:12] = True
+    img[mask, :3] = rng.uniform(0.1, 2.0, (mask.sum(), 3))
+    img[mask, 3] = 1.0
+    t = renderer.tsd.targets(SimpleNamespace(uid=-1), n)
+    t.stretch.write(img.tobytes())
+    _dilate(renderer, t, t.stretch, 4)
+    gpu = read_texture(t.stretch)
+    ref = tsd.dilate_reference(img, 4)
+    np.testing.assert_allclose(gpu, ref, rtol=1e-5, atol=1e-6)
+    assert (ref[..., 3] > 0).sum() > mask.sum()          # it did grow
+    np.testing.assert_array_equal(gpu[mask], img[mask])   # covered texels are untouched
+    renderer.tsd.nodes.pop(-1).release()
 
 
 def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
@@ -169,6 +180,12 @@ def test_translucency_through_thin_parts(renderer):
     none = renderer.render(sheet(0.5 / 20.0, shadow=False), st)
     c = thin.hdr[24, 24, :3]
     assert c[0] > 0.05 and c[0] > c[2]                    # red goes furthest
+    # the irradiance texel is the light through 0.5 mm: e x cos x (1 - F) x sum_k W_k e^{-d^2/2v_k}
+    st_thin = sheet(0.5 / 20.0)
+    renderer.render(st_thin, st, readback=False)
+    t = renderer.last_frame.tsd[id(st_thin.find("slab"))]
+    irr = tsd.unpremultiply(read_texture(t.targets.irradiance))[32, 32]
+    np.testing.assert_allclose(irr, tsd.thickness_transmittance(0.5, t.kernel)[0], rtol=1e-3)
     assert thick.hdr[24, 24, 0] < 0.05 * c[0]
     assert none.hdr[24, 24, :3].max() == 0.0
     assert "translucency" in dict(none.plan.skipped)

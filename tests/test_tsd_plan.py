@@ -6,9 +6,8 @@ import numpy as np
 import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
-from tsd_scenes import quad_mesh, skin, slab_scene  # noqa: E402
+from tsd_scenes import quad_mesh, renderer, skin, slab_scene  # noqa: E402,F401
 
-from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
 from scene.materials import Material
 from scene.mesh import Mesh
@@ -16,13 +15,6 @@ from scene.optics import tsd
 from scene.scenefile import load_scene
 
 ST = RenderSettings(48, 48, shadow_size=256, tsd_size=64)
-
-
-@pytest.fixture(scope="module")
-def renderer(ctx):
-    r = Renderer(ctx)
-    yield r
-    r.release()
 
 
 def kinds(plan):

@@ -3,6 +3,7 @@ straight from above by a far, narrow camera (nearly orthographic), lit by a dire
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from scene.graph import CameraNode, LightNode, MeshNode, Scene
 from scene.materials import Material
@@ -56,3 +57,21 @@ def slab_scene(half=1.0, mm_per_unit=20.0, material=None, light_dir=(0, 0, -1), 
 def pixel_x(width: int, half: float) -> np.ndarray:
     """World x of each pixel column's centre in slab_scene's view (the view spans exactly [-half, half])."""
     return ((np.arange(width) + 0.5) / width * 2.0 - 1.0) * half
+
+
+def exact_profile(model, medium):
+    """The exact radial profile of a material's sss_model (R(r_mm) -> (N, 3))."""
+    from scene.optics.profiles import get_profile
+    from scene.optics.tsd import MODEL_PROFILES
+
+    return lambda r: get_profile(MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
+
+
+@pytest.fixture(scope="module")
+def renderer(ctx):
+    """One renderer per test module (its GPU caches are reset between modules)."""
+    from app.render.renderer import Renderer
+
+    r = Renderer(ctx)
+    yield r
+    r.release()

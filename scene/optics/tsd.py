@@ -371,3 +371,36 @@ def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float = 
     R = fn(np.maximum(r, r_max * 1e-9)) / tot[None, :]
     E = np.where(scatter[None, :], E, 1.0)
     return float(r_max), R, E
+
+
+def dilate_reference(img: np.ndarray, rings: int) -> np.ndarray:
+    """Twin of shaders/passes/tsd_dilate.frag applied `rings` times: an empty texel (alpha <=
+    COVERAGE_EPS) takes the mean of its covered 8-neighbours (each un-premultiplied, rgba / a) and
+    becomes covered; covered texels are kept."""
+    cur = np.asarray(img, np.float32).copy()
+    H, W, _ = cur.shape
+    for _ in range(rings):
+        a = cur[..., 3]
+        cov = a > COVERAGE_EPS
+        un = np.where(cov[..., None], cur / np.where(cov, a, 1.0)[..., None], 0.0).astype(np.float32)
+        pad = np.pad(un, ((1, 1), (1, 1), (0, 0)))
+        pc = np.pad(cov, 1)
+        s = np.zeros_like(un)
+        n = np.zeros((H, W), np.float32)
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                s += pad[1 + dy:1 + dy + H, 1 + dx:1 + dx + W]
+                n += pc[1 + dy:1 + dy + H, 1 + dx:1 + dx + W]
+        fill = np.where(n[..., None] > 0, s / np.maximum(n, 1)[..., None], 0.0)
+        cur = np.where(cov[..., None], cur, fill).astype(np.float32)
+    return cur
+
+
+def thickness_transmittance(d_mm, kernel: DiffusionKernel) -> np.ndarray:
+    """Twin of the translucency term in shaders/passes/tsd_irradiance.frag: light through d mm,
+    sum_k W_k e^{-d^2 / 2 v_k} over the kernel's blurred levels (per channel)."""
+    d = np.atleast_1d(np.asarray(d_mm, np.float64))
+    out = np.zeros((len(d), 3))
+    for s in kernel.steps:
+        out += np.exp(-d[:, None] ** 2 / (2.0 * max(s.variance_mm2, 1e-12))) * np.asarray(s.weight)[None, :]
+    return out
