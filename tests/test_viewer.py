@@ -426,6 +426,12 @@ def test_core_settings_follow_size_and_sss_cycle(core):
         seen.append(c.cycle_sss_model())
     assert seen == [None, *SSS_MODELS, None]
     assert next_sss_model("pbd") is None and next_sss_model(None, -1) == "pbd"
+    # T cycles the technique; the frame plan follows (screen-space SSS has its blur pass)
+    assert c.settings.technique == "tsd"
+    assert c.cycle_technique() == "exact" and c.cycle_technique() == "ssss" and c.dirty
+    c.render()
+    assert {"ssss_diffuse", "ssss_blurred"} <= set(c.targets())
+    assert c.cycle_technique(-1) == "exact"
 
 
 def test_core_shows_shader_errors_and_keeps_rendering(core):

@@ -19,6 +19,7 @@ from app.gl.hot_reload import ShaderWatcher
 from app.gl.shader_source import ShaderLibrary
 from app.render.renderer import FrameResult, Renderer
 from app.render.settings import RenderSettings
+from app.render.settings import TECHNIQUES
 from scene.materials import SSS_MODELS
 
 from .camera import OrbitCamera
@@ -110,6 +111,17 @@ class ViewerCore:
         self.note("info", f"SSS model: {model or 'per material'}")
         self.invalidate()
         return model
+
+    def cycle_technique(self, step: int = 1) -> str:
+        i = TECHNIQUES.index(self.settings.technique)
+        return self.set_technique(TECHNIQUES[(i + step) % len(TECHNIQUES)])
+
+    def set_technique(self, technique: str) -> str:
+        """How subsurface scattering is rendered (app.render.settings.TECHNIQUES)."""
+        self.settings = dataclasses.replace(self.settings, technique=technique)   # validated again
+        self.note("info", f"SSS technique: {technique}")
+        self.invalidate()
+        return technique
 
     def reset_camera(self) -> None:
         self.orbit.reset()

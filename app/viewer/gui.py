@@ -11,6 +11,7 @@ import time
 import numpy as np
 from imgui_bundle import imgui
 
+from app.render.settings import TECHNIQUES
 from scene.materials import SSS_MODELS
 
 from .core import ViewerCore
@@ -47,7 +48,7 @@ class Gui:
                 imgui.text(f"  {p.name:<16} {p.cpu_ms:7.2f} ms{gpu}")
         name, _ = core.current_target()
         s = core.settings
-        imgui.text_colored(GREY, f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'}"
+        imgui.text_colored(GREY, f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'} ({s.technique})"
                                  f"  ui {ui_fps:4.0f} fps")
         errors = core.errors()
         if errors:
@@ -90,6 +91,13 @@ class Gui:
                 clicked, _ = imgui.selectable(o, o == cur)
                 if clicked:
                     core.set_sss_model(None if o == "per material" else o)
+            imgui.end_combo()
+        cur = core.settings.technique
+        if imgui.begin_combo("technique (T)", cur):
+            for o in TECHNIQUES:
+                clicked, _ = imgui.selectable(o, o == cur)
+                if clicked:
+                    core.set_technique(o)
             imgui.end_combo()
         if imgui.button("Reset camera (R)"):
             core.reset_camera()

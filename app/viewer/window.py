@@ -149,6 +149,8 @@ class ViewerWindow:
             core.reset_camera()
         elif symbol == key.M:
             core.cycle_sss_model(-1 if shift else 1)
+        elif symbol == key.T:
+            core.cycle_technique(-1 if shift else 1)
         elif symbol in (key.P, key.TAB):
             name = core.inspector.cycle(core.targets(), -1 if shift else 1)
             core.note("info", f"inspecting {name}")
