@@ -1,7 +1,9 @@
 """`skinlab bench peer`: our plain-PBR frame time against pyrender's, same scene, size and EGL.
-`skinlab bench reload`: latency from saving a shader file to the first frame rendered with it."""
+`skinlab bench reload`: latency from saving a shader file to the first frame rendered with it.
+`skinlab bench accuracy`: the accuracy/time ledger of the SSS techniques (app/bench/accuracy.py)."""
 from __future__ import annotations
 
+import argparse
 import json
 import re
 import statistics
@@ -36,6 +38,25 @@ def register(sub) -> None:
     rel.add_argument("--timeout", type=float, default=20.0, help="give up on one edit after this many seconds")
     rel.add_argument("--json", action="store_true")
     rel.set_defaults(func=run_reload_bench)
+    acc = bsub.add_parser("accuracy", help="accuracy/time ledger: every SSS technique and setting timed and "
+                                           "compared with the exact reference image and the Monte Carlo profile")
+    acc.add_argument("--out", required=True, help="output folder (ledger.csv, ledger.md, ledger.json, pareto.png, "
+                                                  "cost.png, images/, mc_cache/)")
+    acc.add_argument("--quick", action="store_true", help="a subset at 160x160 (a few minutes at most on 2 cores)")
+    acc.add_argument("--tiny", action="store_true", help=argparse.SUPPRESS)   # tests: 4 settings, head, 64x64
+    acc.add_argument("--size", default=None, help="WIDTHxHEIGHT (default 640x640; --quick 160x160)")
+    acc.add_argument("--scenes", default=None,
+                     help="comma-separated: head, bunny (skim milk), bunny-marble, ... or .toml paths "
+                          "(default head,bunny)")
+    acc.add_argument("--frames", type=int, default=None, help="timed frames per setting (default 10; --quick 5)")
+    acc.add_argument("--photons", type=int, default=None,
+                     help="Monte Carlo photons per channel (default 200000; --quick 20000)")
+    acc.add_argument("--exact-size", type=int, default=None,
+                     help="irradiance texels per side of the exact reference (default 1024; --quick 256)")
+    acc.add_argument("--no-peer", action="store_true", help="skip the pyrender comparison")
+    acc.add_argument("--no-images", action="store_true", help="do not write images/SCENE-SETTING.png")
+    acc.add_argument("--no-progress", action="store_true", help="no progress bar")
+    acc.set_defaults(func=run_accuracy_bench)
 
 
 def peer_bench(size=(512, 512), frames: int = 30) -> dict:
@@ -222,4 +243,62 @@ def run_reload_bench(args) -> int:
     print(f"  save -> reload applied    median {rel['median']:8.1f} ms   max {rel['max']:8.1f} ms")
     print(f"    of which recompiling    median {comp['median']:8.1f} ms   max {comp['max']:8.1f} ms")
     print(f"  the first new frame       median {fr['median']:8.1f} ms   max {fr['max']:8.1f} ms")
+    return 0
+
+
+# -- accuracy/time ledger ----------------------------------------------------------------------------------
+
+def accuracy_sweep_from_args(args):
+    """The Sweep chosen by --quick/--tiny with the explicit overrides applied."""
+    from dataclasses import replace
+
+    from app.bench.accuracy import SWEEPS
+
+    if args.quick and args.tiny:
+        raise ValueError("--quick and --tiny: choose one")
+    sweep = SWEEPS["tiny" if args.tiny else "quick" if args.quick else "full"]
+    over = {}
+    if args.size:
+        over["size"] = parse_size(args.size)
+    if args.frames is not None:
+        if args.frames < 1:
+            raise ValueError(f"--frames: expected >= 1, got {args.frames}")
+        over["frames"] = args.frames
+    if args.photons is not None:
+        if args.photons < 2:
+            raise ValueError(f"--photons: expected >= 2, got {args.photons}")
+        over["photons"] = args.photons
+    if args.exact_size is not None:
+        if not 16 <= args.exact_size <= 8192:
+            raise ValueError(f"--exact-size: expected texels per side in [16, 8192], got {args.exact_size}")
+        over["exact_size"] = args.exact_size
+    if args.scenes is not None:
+        names = tuple(s.strip() for s in args.scenes.split(",") if s.strip())
+        if not names:
+            raise ValueError("--scenes: expected a comma-separated list such as head,bunny")
+        over["scenes"] = names
+    return replace(sweep, **over)
+
+
+def run_accuracy_bench(args) -> int:
+    from app.bench.accuracy import resolve_scene, run_sweep
+
+    sweep = accuracy_sweep_from_args(args)
+    for s in sweep.scenes:
+        resolve_scene(s)            # bad names fail before any rendering
+    flags = [("--quick", args.quick), ("--tiny", args.tiny), ("--no-peer", args.no_peer)]
+    opts = [("--size", args.size), ("--scenes", args.scenes), ("--frames", args.frames), ("--photons", args.photons),
+            ("--exact-size", args.exact_size)]
+    command = " ".join(["skinlab bench accuracy", *(f for f, on in flags if on),
+                        *(f"{k} {v}" for k, v in opts if v is not None), f"--out {args.out}"])
+    res = run_sweep(sweep, Path(args.out), peer=not args.no_peer, progress=not args.no_progress,
+                    images=not args.no_images, command=command)
+    rows = res["rows"]
+    n_ok = sum(r["status"] == "ok" for r in rows)
+    print(f"{res['meta']['gl']}: {len(rows)} settings ({n_ok} ok) in {res['meta']['total_s']:.1f} s")
+    for r in rows:
+        if r["status"] != "ok":
+            print(f"  {r['scene']}: {r['setting']}: {r['status']}: {r['error']}")
+    for f in res["files"]:
+        print(f"  {Path(f).resolve()}")
     return 0
