@@ -446,6 +446,13 @@ def _ssss_kernel(plan):
 
 # -- the run ---------------------------------------------------------------------------------------------
 
+def _loadavg():
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except OSError:
+        return None
+
+
 def _first_line(exc: BaseException) -> str:
     text = f"{type(exc).__name__}: {exc}".strip()
     return text.splitlines()[0][:300] if text else type(exc).__name__
@@ -468,6 +475,7 @@ def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, pe
     paths = {s: resolve_scene(s) for s in scenes}
     settings = sweep_settings(sweep)
     t_start = time.perf_counter()
+    load_start = _loadavg()
     ctx = create_headless_context()
     gl = describe(ctx)
     renderer = Renderer(ctx)
@@ -563,6 +571,7 @@ def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, pe
             "shadow_size": sweep.shadow_size, "warmup": sweep.warmup, "frames": sweep.frames,
             "budget_s": sweep.budget_s, "photons": sweep.photons, "scenes": [scene_label(s) for s in scenes],
             "sweep_s": sweep_s, "total_s": time.perf_counter() - t_start, "peer": peer_res,
+            "loadavg_start": load_start, "loadavg_end": _loadavg(),
             "command": command,
             "date": time.strftime("%Y-%m-%d %H:%M:%S %Z")}
     return write_ledger(rows, meta, out)
@@ -692,6 +701,9 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
     L.append(f"- clock: {', '.join(clocks) or 'n/a'} (cpu-synchronised: wall time with glFinish after each "
              "pass, Mesa llvmpipe's GPU timer queries see only command submission; gpu-timer: GL timer queries)")
     L.append(f"- sweep took {meta['sweep_s']:.1f} s, the whole run (with the pyrender peer) {meta['total_s']:.1f} s")
+    if meta.get("loadavg_start") is not None:
+        L.append(f"- load average (1/5/15 min) at the start {meta['loadavg_start']}, at the end "
+                 f"{meta.get('loadavg_end')}: other processes on the machine share its cores and lengthen frames")
     if meta.get("command"):
         L.append(f"- command: `{meta['command']}`")
     L += ["", "image error: against the scene's reference image (the `reference` column) on linear HDR over "

@@ -11,7 +11,10 @@ import numpy as np
 
 MARKERS = {"exact": "*", "tsd": "o", "ssss": "s", "tint": "^", "none": "X"}
 COLOURS = {"exact": "black", "tsd": "tab:blue", "ssss": "tab:orange", "tint": "tab:green", "none": "tab:red"}
-ERROR_FLOOR = 1e-5     # the reference (error 0) is drawn at this floor on the log axis
+def _floor(pts) -> float:
+    """Where the reference (error 0) is drawn on the log axis: a decade below the smallest other error."""
+    nz = [r["image_rel_l1"] for r in pts if r["image_rel_l1"] > 0]
+    return 10.0 ** (math.floor(math.log10(min(nz))) - 1) if nz else 1e-5
 
 
 def _figure_bytes(fig) -> bytes:
@@ -44,32 +47,36 @@ def pareto_plot(rows: list[dict], fronts: dict, path: Path) -> Path:
     fig, axes = plt.subplots(1, len(scenes), figsize=(6.4 * len(scenes), 4.8), squeeze=False)
     for ax, scene in zip(axes[0], scenes):
         pts = [r for r in rows if r["scene"] == scene and usable(r)]
+        floor = _floor(pts)
         for tech in MARKERS:
             sel = [r for r in pts if r["technique"] == tech]
             if not sel:
                 continue
-            ax.scatter([r["frame_ms_median"] for r in sel], [max(r["image_rel_l1"], ERROR_FLOOR) for r in sel],
+            ax.scatter([r["frame_ms_median"] for r in sel], [max(r["image_rel_l1"], floor) for r in sel],
                        marker=MARKERS[tech], c=COLOURS[tech], s=70 if tech == "exact" else 40, label=tech,
                        edgecolors="none", zorder=3)
         fr = fronts.get(scene, [])
         if fr:
             x = [r["frame_ms_median"] for r in fr]
-            y = [max(r["image_rel_l1"], ERROR_FLOOR) for r in fr]
+            y = [max(r["image_rel_l1"], floor) for r in fr]
             ax.step(x, y, where="post", color="grey", lw=1, ls="--", zorder=2, label="Pareto front")
             ax.scatter(x, y, s=140, facecolors="none", edgecolors="grey", zorder=4)
             for r, xi, yi in zip(fr, x, y):
-                ax.annotate(r["setting"], (xi, yi), textcoords="offset points", xytext=(5, 4), fontsize=7)
+                text = r["setting"] + (" (reference: 0)" if r["image_rel_l1"] == 0 else "")
+                ax.annotate(text, (xi, yi), textcoords="offset points", xytext=(5, 4), fontsize=7)
         bad = [r for r in rows if r["scene"] == scene and not usable(r)]
         if bad:
             ax.text(0.01, 0.01, "not plotted: " + ", ".join(f"{r['setting']} ({r['status']})" for r in bad),
                     transform=ax.transAxes, fontsize=6, va="bottom", wrap=True)
         ax.set_xscale("log")
+        ax.margins(x=0.25)
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())
         if pts and any(r["image_rel_l1"] > 0 for r in pts):
             ax.set_yscale("log")
         ref = next((r["reference"] for r in rows if r["scene"] == scene and r.get("reference")), "")
         ax.set_title(f"{scene}: error vs time (reference: {ref or 'none'})", fontsize=9)
         ax.set_xlabel("median frame time (ms)")
-        ax.set_ylabel(f"image rel-L1 vs reference (reference drawn at {ERROR_FLOOR:g})")
+        ax.set_ylabel(f"image rel-L1 vs reference (the reference drawn at {floor:g})")
         ax.grid(True, which="both", alpha=0.3)
         if pts:
             ax.legend(fontsize=7, loc="upper right")
@@ -98,6 +105,7 @@ def cost_plot(series: dict, slopes: dict, path: Path) -> Path:
                           (a2, "K (Gaussians fitted)", "cost vs K (auto taps)")):
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())
         ax.set_xlabel(xl)
         ax.set_ylabel("median ms")
         ax.set_title(title, fontsize=9)
