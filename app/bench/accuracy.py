@@ -64,10 +64,10 @@ RECOMMEND_THRESHOLDS = (0.01, 0.02, 0.05)
 CSV_COLUMNS = ["scene", "setting", "technique", "model", "K", "tsd_size", "taps", "ssss_taps", "width", "height",
                "blur_levels", "frames", "frame_ms_median", "frame_ms_p10", "frame_ms_p90", "wall_ms_median",
                "tsd_ms_median", "clock", "image_rel_l1", "image_max_rel", "image_p95_rel", "pixels",
-               "profile_err_mc", "profile_err_model", "reference", "status", "error", "passes_ms"]
+               "image_rel_l1_same_size", "profile_err_mc", "profile_err_model", "reference", "status", "error", "passes_ms"]
 NUMERIC_COLUMNS = ["frames", "frame_ms_median", "frame_ms_p10", "frame_ms_p90", "wall_ms_median", "tsd_ms_median",
-                   "image_rel_l1", "image_max_rel", "image_p95_rel", "pixels", "profile_err_mc",
-                   "profile_err_model"]
+                   "image_rel_l1", "image_max_rel", "image_p95_rel", "pixels", "image_rel_l1_same_size",
+                   "profile_err_mc", "profile_err_model"]
 
 
 # -- the sweep ---------------------------------------------------------------------------------------------
@@ -551,10 +551,17 @@ def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, pe
                 ref_st = None
             ref = hdrs.get(ref_st) if ref_st is not None else None
             mask = lit_mask(ref) if ref is not None else None
+            # and against the exact convolution at the same irradiance size, where there is one: the
+            # technique's own error without the texture-resolution error of the reference
+            exact_at = {st.tsd_size: hdrs[st] for st, r in scene_rows.items()
+                        if st.technique == "exact" and r["status"] == "ok" and st in hdrs}
             for st, row in scene_rows.items():
                 row["reference"] = ref_st.label if ref_st is not None else ""
                 if ref is not None and st in hdrs:
                     row.update(image_error(hdrs[st], ref, mask))
+                same = exact_at.get(st.tsd_size) if st.technique == "tsd" else None
+                if same is not None and st in hdrs:
+                    row["image_rel_l1_same_size"] = image_error(hdrs[st], same)["image_rel_l1"]
             del hdrs
     finally:
         bar.close()
@@ -646,7 +653,10 @@ def cost_series(rows: list[dict], sweep_like: dict) -> dict:
         kmax = max(r["K"] for r in tsd)
         by_size = sorted((r for r in tsd if r["K"] == kmax), key=lambda r: r["tsd_size"])
         k_size = sweep_like.get("k_size")
-        by_k = sorted((r for r in tsd if r["tsd_size"] == k_size), key=lambda r: r["K"])
+        # the cost of K where texture-space diffusion runs at all (K whose Gaussians all fold into the
+        # unblurred term render plain diffuse: a step, not a power law)
+        by_k = sorted((r for r in tsd if r["tsd_size"] == k_size and (r.get("blur_levels") or 0) > 0),
+                      key=lambda r: r["K"])
         out[scene] = {"size": by_size, "K": by_k, "kmax": kmax, "k_size": k_size}
     return out
 
@@ -709,8 +719,11 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
     L += ["", "image error: against the scene's reference image (the `reference` column) on linear HDR over "
           f"lit surface pixels (coverage > 0, luminance > {LUM_FRACTION:.0%} of the 99th percentile); "
           "rel-L1 = sum|img - ref| / sum ref; max/p95: per-pixel sum_c|img - ref| / sum_c ref. "
+          "`rel-L1 vs exact same size`: a tsd setting against the exact convolution at its own irradiance "
+          "size (the fit/blur error without the texture-resolution error). "
           "profile error: relative L1 of the edge response against the Monte Carlo random walk, "
-          "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1).", ""]
+          "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1); `vs model`: the same against the "
+          "material's own model profile (the technique's approximation alone).", ""]
     for scene in dict.fromkeys(r["scene"] for r in rows):
         srows = [r for r in rows if r["scene"] == scene]
         ref = next((r["reference"] for r in srows if r.get("reference")), "")
@@ -735,8 +748,9 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
                      "reference's own texture-resolution error (compare the exact rows at smaller sizes).")
         L.append("")
         L.append("| setting | technique | model | K | tsd size | taps | ssss taps | blur levels | frames | "
-                 "frame ms median | p10 | p90 | tsd ms | image rel-L1 | image max | image p95 | profile err vs MC | status |")
-        L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+                 "frame ms median | p10 | p90 | tsd ms | image rel-L1 | image max | image p95 | rel-L1 vs exact same size | "
+                 "profile err vs MC | profile err vs model | status |")
+        L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for r in srows:
             status = r["status"] + (f": {r['error']}" if r.get("error") else "")
             pct = lambda v: "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100 * v:.2f} %"
@@ -745,7 +759,8 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
                 _fmt(r.get("taps")), _fmt(r.get("ssss_taps")), _fmt(r.get("blur_levels", "")), _fmt(r.get("frames", "")),
                 _fmt(r.get("frame_ms_median"), 4), _fmt(r.get("frame_ms_p10"), 4), _fmt(r.get("frame_ms_p90"), 4),
                 _fmt(r.get("tsd_ms_median"), 4), pct(r.get("image_rel_l1")), pct(r.get("image_max_rel")),
-                pct(r.get("image_p95_rel")), pct(r.get("profile_err_mc")), status.replace("|", "/")]) + " |")
+                pct(r.get("image_p95_rel")), pct(r.get("image_rel_l1_same_size")), pct(r.get("profile_err_mc")),
+                pct(r.get("profile_err_model")), status.replace("|", "/")]) + " |")
         L.append("")
         fr = fronts.get(scene, [])
         if fr:
@@ -754,7 +769,9 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
             L.append("")
     L += ["## Cost slopes", "",
           "Least-squares slopes of log(time) against log(irradiance texels = tsd_size^2) over the size sweep "
-          "(K = max, auto taps) and against log(K) over the K sweep (auto taps); `tsd` is the sum of the "
+          "(K = max, auto taps) and against log(K) over the K sweep (auto taps; only the K for which at least "
+          "one blur pass runs: where every Gaussian folds into the unblurred term the frame is plain diffuse); "
+          "`tsd` is the sum of the "
           "texture-space passes (stretch when it runs, irradiance, dilation, blurs). Slope 1 = linear.", "",
           "| scene | frame vs texels | tsd passes vs texels | frame vs K | tsd passes vs K | tsd passes vs blur levels | sizes | K | blur levels per K |",
           "|---|---|---|---|---|---|---|---|---|"]
@@ -775,14 +792,17 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
     else:
         L.append(f"`skinlab bench peer --size {p['size'][0]}x{p['size'][1]} --frames {p['frames']}` "
                  f"({p['gl']}): the head, shadows off, colour+depth read back on both sides, median of "
-                 f"{p['frames']} frames; Skinlab's frame uses the default RenderSettings (so texture-space "
-                 "diffusion at the default size runs), pyrender's is plain PBR.")
+                 f"{p['frames']} whole frames (no glFinish between passes); pyrender's frame is plain PBR, "
+                 "Skinlab's plain-PBR frame has sss_model none, its default frame the default "
+                 "RenderSettings (texture-space diffusion on the skin).")
         L.append("")
-        L.append("| renderer | ms/frame |")
-        L.append("|---|---|")
-        L.append(f"| skinlab | {p['skinlab_ms']:.2f} |")
-        L.append(f"| pyrender | {p['pyrender_ms']:.2f} |")
-        L.append(f"| ratio skinlab/pyrender | {p['ratio_skinlab_over_pyrender']:.2f} |")
+        L.append("| renderer | ms/frame | / pyrender |")
+        L.append("|---|---|---|")
+        L.append(f"| skinlab, plain PBR | {p['skinlab_ms']:.2f} | {p['ratio_skinlab_over_pyrender']:.2f} |")
+        if p.get("skinlab_default_ms") is not None:
+            L.append(f"| skinlab, default settings (tsd) | {p['skinlab_default_ms']:.2f} | "
+                     f"{p['ratio_default_over_pyrender']:.2f} |")
+        L.append(f"| pyrender | {p['pyrender_ms']:.2f} | 1 |")
     L.append("")
     L += ["## Recommended defaults", "",
           "Rule: for each image-error budget tau, the cheapest setting (mean over the scenes of its median "
