@@ -112,6 +112,10 @@ def cost_plot(series: dict, slopes: dict, path: Path) -> Path:
         ax.grid(True, which="both", alpha=0.3)
         if ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7)
+    ks = sorted({r["K"] for s in series.values() for r in s["K"]})
+    if ks:
+        a2.set_xticks(ks)
+        a2.set_xticklabels([str(k) for k in ks])
     if not series:
         a1.text(0.5, 0.5, "no tsd series measured", transform=a1.transAxes, ha="center")
     return _save(fig, Path(path))
