@@ -23,7 +23,7 @@ def register(sub) -> None:
                         "per-pixel profile tint baseline")
     p.add_argument("--taps", type=int, default=None, help="texture-space blur taps (odd, 7-31; default: from width)")
     p.add_argument("--ssss-taps", type=int, default=17, help="screen-space SSS kernel samples (11, 17, 25)")
-    p.add_argument("--tsd-size", type=int, default=None, help="texture-space diffusion texels per side (default 1024)")
+    p.add_argument("--tsd-size", type=int, default=None, help="texture-space diffusion texels per side (default 512)")
     p.add_argument("--gaussians", type=int, default=None, help="Gaussians fitted to the profile, 1-6 (default 6)")
     p.add_argument("--json", action="store_true", help="print timings and output paths as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")

@@ -23,7 +23,9 @@ class RenderSettings:
     technique: str = "tsd"
     tsd_taps: int | None = None        # None: from each blur's width in texels; else a fixed odd count (7..31)
     ssss_taps: int = 17                # screen-space kernel samples: 11, 17 or 25 (Jimenez presets)
-    tsd_size: int = 1024              # texture-space diffusion: irradiance texels per side
+    # texture-space diffusion defaults from the accuracy/time ledger (docs/ledger.md): the cheapest
+    # setting within 1 % image error of the exact reference on the head and the bunny
+    tsd_size: int = 512               # irradiance texels per side
     tsd_albedo_mix: float = 0.5       # pre-/post-scatter texturing: albedo^mix before the blur
     tsd_gaussians: int = 6            # K: Gaussians fitted to the profile
     translucency: bool = True         # light through thin parts (needs a shadow-casting light)

@@ -155,7 +155,7 @@ GLSL_CONSTANTS.update({
 # Texture-space diffusion (d'Eon & Luebke 2007; scene/optics/tsd.py, shaders/passes/tsd_*.frag)
 TSD_TAP_RANGE = 3.0            # blur taps span +-3 sigma
 TSD_MIN_MM_PER_TEXEL = 1e-6    # zero-area triangles (infinite stretch) clamp to this
-TSD_MAX_STEP_TEXELS = 64.0     # one sigma never spans more texels than this (finite for any stretch)
+TSD_MAX_STEP_TEXELS = 4096.0   # one sigma never spans more texels than this (finite for any stretch)
 COVERAGE_EPS = 1e-6            # premultiplied coverage below this is "no surface"
 GLSL_CONSTANTS.update({
     "TSD_MIN_MM_PER_TEXEL": TSD_MIN_MM_PER_TEXEL,

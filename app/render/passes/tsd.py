@@ -224,8 +224,8 @@ class TsdBlurPass:
         frame.targets[f"tsd_level{step.level}[{node.name}]"] = dst
 
 
-EXACT_INNER_HALF = 24     # brute force: texels summed one by one within +-24 of the centre...
-EXACT_OUTER_HALF = 24     # ...then at most 24 mip-level cells per direction out to r_max
+EXACT_INNER_HALF = 24     # brute force: texels summed one by one within 24 texels of the centre...
+EXACT_RING_RATIO = 1.15   # ...then annuli r -> 1.15 r out to r_max, cells read from the mip pyramid
 UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.zeros(3))
 
 
@@ -261,7 +261,7 @@ class TsdExactPass:
         dst = t.level(ctx, 0)
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_exact.frag")
         set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_lut": 2, "u_rmax_mm": r_max,
-                            "u_inner_half": EXACT_INNER_HALF, "u_outer_half": EXACT_OUTER_HALF})
+                            "u_inner_half": EXACT_INNER_HALF, "u_ring_ratio": EXACT_RING_RATIO})
         t.irradiance.build_mipmaps()          # box-filtered far field (textureLod); the gather keeps
         t.irradiance.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)   # sampling level 0
         t.irradiance.use(0)
