@@ -35,6 +35,26 @@ class Param:
     def define(self) -> str:
         return f"HAS_{self.name.upper()}"
 
+    def _numbers(self, value: Any, label: str) -> np.ndarray:
+        """A float or colour/vec3 value as an array (1 or 3 numbers; a scalar fills R, G, B)."""
+        if self.kind == "float":
+            try:
+                return np.array([float(value)])
+            except (TypeError, ValueError):
+                raise ValueError(f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}") from None
+        try:
+            arr = np.asarray(value, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError):
+            raise ValueError(f"{label}: expected 3 numbers, got {value!r}") from None
+        if arr.size == 1:
+            arr = np.repeat(arr, 3)
+        if arr.size != 3:
+            raise ValueError(f"{label}: expected 3 numbers (R, G, B), got {arr.size}")
+        return arr
+
+    def _canonical(self, arr: np.ndarray):
+        return float(arr[0]) if self.kind == "float" else tuple(float(x) for x in arr)
+
     def validate(self, value: Any, where: str = "") -> Any:
         """Return the value in canonical form or raise ValueError naming the parameter."""
         label = f"{where}{self.name}"
@@ -46,26 +66,21 @@ class Param:
             if value not in self.choices:
                 raise ValueError(f"{label}: expected one of {', '.join(self.choices)}; got {value!r}")
             return value
-        if self.kind == "float":
-            try:
-                v = float(value)
-            except (TypeError, ValueError):
-                raise ValueError(f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}") from None
-            arr = np.array([v])
-        else:
-            try:
-                arr = np.asarray(value, dtype=np.float64).reshape(-1)
-            except (TypeError, ValueError):
-                raise ValueError(f"{label}: expected 3 numbers, got {value!r}") from None
-            if arr.size == 1:
-                arr = np.repeat(arr, 3)
-            if arr.size != 3:
-                raise ValueError(f"{label}: expected 3 numbers (R, G, B), got {arr.size}")
+        arr = self._numbers(value, label)
         lo, hi = self.range
         if not np.isfinite(arr).all() or (arr < lo).any() or (arr > hi).any():
             unit = f" {self.unit}" if self.unit else ""
             raise ValueError(f"{label}: value {value!r} outside the valid range [{lo}, {hi}]{unit}")
-        return float(arr[0]) if self.kind == "float" else tuple(float(x) for x in arr)
+        return self._canonical(arr)
+
+    def clamp(self, value: Any) -> Any:
+        """Like validate, but numbers out of range are clamped into it and NaN becomes the default
+        (for UI widgets); malformed values and unknown choices still raise, naming the parameter."""
+        if self.kind not in ("float", "color", "vec3"):
+            return self.validate(value)
+        arr = self._numbers(value, self.name)
+        arr = np.where(np.isnan(arr), np.asarray(self._numbers(self.default, self.name)), arr)
+        return self._canonical(np.clip(arr, *self.range))
 
 
 PRINCIPLED_PARAMS: tuple[Param, ...] = (

@@ -87,3 +87,18 @@ def test_tangents_follow_uv_u_direction():
     uv = np.array([[0, 0], [0, 1], [1, 0]], np.float32)  # u runs along +y here
     t = compute_tangents(p, n, uv, np.array([[0, 1, 2]]))
     assert np.allclose(t[:, :3], [0, 1, 0], atol=1e-6) and set(t[:, 3]) == {-1.0}
+
+
+def test_param_clamp_keeps_values_in_range_for_widgets():
+    from scene.materials import PRINCIPLED_PARAMS
+
+    pm = {p.name: p for p in PRINCIPLED_PARAMS}
+    assert pm["roughness"].clamp(3.0) == 1.0 and pm["roughness"].clamp(-1) == 0.0
+    assert pm["roughness"].clamp(float("nan")) == pm["roughness"].default
+    assert pm["subsurface_radius"].clamp((5.0, -1.0, 2000.0)) == (5.0, 0.0, 1000.0)
+    assert pm["base_color"].clamp(0.5) == (0.5, 0.5, 0.5)
+    assert pm["sss_model"].clamp("pbd") == "pbd"
+    with pytest.raises(ValueError, match="sss_model: expected one of"):
+        pm["sss_model"].clamp("fog")
+    with pytest.raises(ValueError, match="subsurface_radius: expected 3 numbers"):
+        pm["subsurface_radius"].clamp((1.0, 2.0))

@@ -64,32 +64,8 @@ def clamp_value(param: Param, value: Any) -> Any:
     """The value a widget hands back, made valid for ``param``: numbers are clamped into the
     range (NaN -> the default), colours/vec3 element-wise; choices must be one of the options;
     textures must name an existing file (or be empty: no map). Errors name the parameter."""
-    if param.kind == "float":
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            raise ValueError(f"{param.name}: expected a number, got {value!r}") from None
-        if math.isnan(v):
-            return float(param.default)
-        lo, hi = param.range
-        return float(min(max(v, lo), hi))
-    if param.kind in ("color", "vec3"):
-        try:
-            a = np.asarray(value, np.float64).reshape(-1)
-        except (TypeError, ValueError):
-            raise ValueError(f"{param.name}: expected 3 numbers, got {value!r}") from None
-        if a.size == 1:
-            a = np.repeat(a, 3)
-        if a.size != 3:
-            raise ValueError(f"{param.name}: expected 3 numbers, got {a.size}")
-        default = np.asarray(param.default, np.float64)
-        a = np.where(np.isnan(a), default, a)
-        lo, hi = param.range
-        return tuple(float(x) for x in np.clip(a, lo, hi))
-    if param.kind == "choice":
-        if value not in param.choices:
-            raise ValueError(f"{param.name}: expected one of {', '.join(param.choices)}; got {value!r}")
-        return value
+    if param.kind in ("float", "color", "vec3", "choice"):
+        return param.clamp(value)
     if param.kind == "texture":
         if value is None or str(value).strip() == "":
             return None
