@@ -77,6 +77,9 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
     renderer.render(scene, RenderSettings(64, 64, shadow_size=1024, tsd_size=128), readback=False)
     t = tsd_node(renderer, scene)
     irr, stretch = read_texture(t.targets.irradiance), read_texture(t.targets.stretch)
+    # the stretch pass: a 40 mm square on 128 texels is 0.3125 mm per texel along u and v
+    cov = stretch[..., 3] > 0
+    np.testing.assert_allclose(stretch[cov, :2], 2 * 20.0 / 128, rtol=1e-5)
     _, diffused = tsd.diffuse_reference(irr, stretch, t.kernel)
     exact = tsd.exact_profile_convolution(irr, (stretch[64, 64, 0], stretch[64, 64, 1]),
                                           exact_profile("burley", tsd.material_medium(t.material.values)))
