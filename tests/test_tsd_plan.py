@@ -54,6 +54,16 @@ def test_stretch_map_is_recomputed_only_when_geometry_changes(renderer):
     assert "tsd_stretch" in kinds(renderer.render(scene, ST).plan)
 
 
+def test_texture_space_targets_are_released_when_no_longer_used(renderer):
+    a, b = slab_scene(), slab_scene()
+    renderer.render(a, ST, readback=False)
+    assert a.find("slab").uid in renderer.tsd.nodes
+    renderer.render(b, ST, readback=False)                 # another scene (a reload, say)
+    assert set(renderer.tsd.nodes) == {b.find("slab").uid}
+    renderer.render(b, RenderSettings(48, 48, tsd_size=64, sss_model="none"), readback=False)
+    assert renderer.tsd.nodes == {}
+
+
 def test_negligible_and_subtexel_gaussians_are_skipped():
     fit = tsd.ProfileFit("test", np.array([1e-4, 0.5, 2.0, 8.0]),
                          np.array([[0.3, 0.3, 0.3], [0.4, 0.4, 0.4], [0.2999, 0.2999, 0.2999],

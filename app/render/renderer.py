@@ -77,6 +77,7 @@ class Renderer:
         if cam is None:
             raise ValueError(f"scene {scene.name!r} has no camera")
         plan = self.plan(scene, settings)
+        self.tsd.retain({p.params["node"].uid for p in plan.passes if p.kind.startswith("tsd_")})
         frame = Frame(scene, settings, cam.view_matrix(), cam.projection_matrix(settings.width / settings.height),
                       cam.world_position)
         self.timer.start_frame()

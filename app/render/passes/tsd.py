@@ -91,6 +91,14 @@ class TsdStore:
             t = self.nodes[node.uid] = TsdNodeTargets(size, _texture(c, size), _texture(c, size), _texture(c, size))
         return t
 
+    def retain(self, uids) -> int:
+        """Release the textures of nodes not in `uids` (removed nodes, a reloaded scene); returns
+        how many were released."""
+        gone = [u for u in self.nodes if u not in uids]
+        for u in gone:
+            self.nodes.pop(u).release()
+        return len(gone)
+
     def stretch_valid(self, node, scene, size: int) -> bool:
         t = self.nodes.get(node.uid)
         return t is not None and t.size == size and t.stretch_key == stretch_key(node, scene, size)
