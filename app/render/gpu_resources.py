@@ -6,6 +6,7 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
+from app.gl.uniforms import set_uniform, set_uniforms
 from scene.mesh import Mesh
 from scene.textures import load_texture
 
@@ -45,6 +46,12 @@ class GpuMesh:
         self.ibo.release()
 
 
+def node_uniforms(node) -> dict:
+    """A mesh node's transform uniforms (forward.vert, tsd_uv.vert)."""
+    model = node.world_matrix
+    return {"u_model": model, "u_normal_matrix": np.linalg.inv(model[:3, :3]).T}
+
+
 class GpuResources:
     """Caches GPU meshes (by Mesh identity and version) and textures (by path and colour space)."""
 
@@ -82,6 +89,14 @@ class GpuResources:
             self.textures[key] = tex
             self.uploads += 1
         return tex
+
+    def bind_material(self, prog: moderngl.Program, material) -> None:
+        """The material's plain values as uniforms and its maps on texture units 0, 1, ... (the
+        units below the shadow maps' 5, 6)."""
+        set_uniforms(prog, material.uniforms())
+        for unit, (sampler, (path, cs)) in enumerate(material.textures().items()):
+            self.texture(path, cs).use(unit)
+            set_uniform(prog, sampler, unit)
 
     def release(self) -> None:
         for g in self.meshes.values():

@@ -2,9 +2,9 @@
 from __future__ import annotations
 
 import moderngl
-import numpy as np
 
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
+from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
 
 
@@ -60,13 +60,8 @@ class ForwardPass:
             prog = self.r.programs.get("passes/forward.vert", "passes/forward.frag", defines)
             set_uniforms(prog, per_frame)
             set_light_uniforms(prog, frame, lights, p.params["shadow_lights"], nmax)
-            model = node.world_matrix
-            set_uniform(prog, "u_model", model)
-            set_uniform(prog, "u_normal_matrix", np.linalg.inv(model[:3, :3]).T)
-            set_uniforms(prog, mat.uniforms())
-            for unit, (sampler, (path, cs)) in enumerate(mat.textures().items()):
-                self.r.resources.texture(path, cs).use(unit)
-                set_uniform(prog, sampler, unit)
+            set_uniforms(prog, node_uniforms(node))
+            self.r.resources.bind_material(prog, mat)
             if tsd is not None:
                 bind_tsd(prog, tsd)
             if tinted is not None:

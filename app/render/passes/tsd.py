@@ -16,6 +16,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
+from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
 from scene.optics.tsd import (MAX_TSD_LEVELS, BlurStep, DiffusionKernel, blur_taps, exact_profile_lut,
                               material_medium)
@@ -141,9 +142,7 @@ class TsdStretchPass:
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_stretch.frag")
-        model = node.world_matrix
-        set_uniforms(prog, {"u_model": model, "u_normal_matrix": np.linalg.inv(model[:3, :3]).T,
-                            "u_mm_per_unit": frame.scene.mm_per_unit})
+        set_uniforms(prog, {**node_uniforms(node), "u_mm_per_unit": frame.scene.mm_per_unit})
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         _dilate(self.r, t, t.stretch, p.params["dilate"])
         t.stretch_key = stretch_key(node, frame.scene, size)
@@ -170,13 +169,9 @@ class TsdIrradiancePass:
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
         bind_shadow_maps(self.r, frame)
         set_light_uniforms(prog, frame, lights, shadow_lights, nmax)
-        model = node.world_matrix
-        set_uniforms(prog, {"u_model": model, "u_normal_matrix": np.linalg.inv(model[:3, :3]).T,
-                            "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": p.params["mix"]})
-        set_uniforms(prog, mat.uniforms())
-        for unit, (sampler, (path, cs)) in enumerate(mat.textures().items()):
-            self.r.resources.texture(path, cs).use(unit)
-            set_uniform(prog, sampler, unit)
+        set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient,
+                            "u_tsd_mix": p.params["mix"]})
+        self.r.resources.bind_material(prog, mat)
         if translucency:
             for slot in (0, 1):
                 d = frame.targets.get(f"shadow_distance{slot}")
