@@ -41,9 +41,11 @@ class GLSLEvaluator:
 
     def evaluate(self, includes: str | list[str], expr: str, inputs: Mapping[str, np.ndarray],
                  out_components: int = 1, prelude: str = "", uniforms: Mapping[str, tuple[str, object]] | None = None,
-                 samplers: Mapping[str, tuple[str, moderngl.Texture]] | None = None) -> np.ndarray:
+                 samplers: Mapping[str, tuple[str, moderngl.Texture]] | None = None,
+                 setup=None) -> np.ndarray:
         """``uniforms``: name -> (GLSL type, value) shared by all samples (matrices as 4x4 arrays);
-        ``samplers``: name -> (GLSL sampler type, texture) bound for the expression."""
+        ``samplers``: name -> (GLSL sampler type, texture) bound for the expression; ``setup``:
+        called with the compiled program to set uniforms the included files declare themselves."""
         from .uniforms import set_uniform
 
         uniforms = uniforms or {}
@@ -103,6 +105,8 @@ class GLSLEvaluator:
                 set_uniform(prog, k, unit)
             for k, (_, v) in uniforms.items():
                 set_uniform(prog, k, v)
+            if setup is not None:
+                setup(prog)
             target = self.ctx.texture((w, h), 4, dtype="f4")
             fbo = self.ctx.framebuffer(color_attachments=[target])
             vao = self.ctx.vertex_array(prog, [(self._vbo, "2f", "in_pos")])

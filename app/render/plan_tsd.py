@@ -64,7 +64,6 @@ class TsdNodePlan:
     material: object
     kernel: object
     size: int
-    report: object
 
 
 def scattering_material(node, settings, plan, label: str):
@@ -111,4 +110,4 @@ def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
         plan.skipped.append((label, "every Gaussian of the profile is narrower than a texel or negligible; "
                                     "plain diffuse"))
         return None
-    return TsdNodePlan(node, mat, kernel, size, rep)
+    return TsdNodePlan(node, mat, kernel, size)
