@@ -1,4 +1,5 @@
 """`skinlab` command line: subcommands live in app/commands/ (one module each)."""
+
 from __future__ import annotations
 
 import argparse

@@ -3,6 +3,7 @@
 Each file is written to a temporary name beside the target and renamed into place, so a
 crash never leaves a half-written image.
 """
+
 from __future__ import annotations
 
 import os
@@ -68,6 +69,8 @@ def read_image(path: str | Path) -> np.ndarray:
     if inp is None:
         raise ValueError(f"{path}: cannot read image: {oiio.geterror()}")
     spec = inp.spec()
-    data = inp.read_image(0, 0, 0, spec.nchannels, "float" if spec.format.basetype in (oiio.HALF, oiio.FLOAT) else "uint8")
+    data = inp.read_image(
+        0, 0, 0, spec.nchannels, "float" if spec.format.basetype in (oiio.HALF, oiio.FLOAT) else "uint8"
+    )
     inp.close()
     return np.asarray(data).reshape(spec.height, spec.width, spec.nchannels)

@@ -3,12 +3,12 @@
 The scene holds data only; the renderer owns GL. A node's world matrix is cached and
 recomputed only when its own transform or one above it changed (a dirty flag propagated down).
 """
+
 from __future__ import annotations
 
 import itertools
-
+from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import Iterator
 
 import numpy as np
 
@@ -18,9 +18,15 @@ from . import transform as tf
 class Node:
     _uids = itertools.count(1)
 
-    def __init__(self, name: str, translation=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0, 1.0),
-                 scale=(1.0, 1.0, 1.0), visible: bool = True):
-        self.uid = next(Node._uids)   # unique for the process (id() is reused after a node is freed)
+    def __init__(
+        self,
+        name: str,
+        translation=(0.0, 0.0, 0.0),
+        rotation=(0.0, 0.0, 0.0, 1.0),
+        scale=(1.0, 1.0, 1.0),
+        visible: bool = True,
+    ):
+        self.uid = next(Node._uids)  # unique for the process (id() is reused after a node is freed)
         self.name = name
         self.parent: Node | None = None
         self.children: list[Node] = []
@@ -32,7 +38,7 @@ class Node:
         self.world_updates = 0  # how often the world matrix was recomputed (for tests/profiling)
 
     # -- hierarchy ------------------------------------------------------------------
-    def add(self, child: "Node") -> "Node":
+    def add(self, child: Node) -> Node:
         if child.parent is not None:
             child.parent.children.remove(child)
         child.parent = self
@@ -40,7 +46,7 @@ class Node:
         child._invalidate()
         return child
 
-    def walk(self) -> Iterator["Node"]:
+    def walk(self) -> Iterator[Node]:
         yield self
         for c in self.children:
             yield from c.walk()
@@ -128,8 +134,15 @@ class MeshNode(Node):
 class LightNode(Node):
     KINDS = ("directional", "point")
 
-    def __init__(self, name: str, kind: str = "directional", color=(1.0, 1.0, 1.0), intensity: float = 1.0,
-                 cast_shadow: bool = False, **kw):
+    def __init__(
+        self,
+        name: str,
+        kind: str = "directional",
+        color=(1.0, 1.0, 1.0),
+        intensity: float = 1.0,
+        cast_shadow: bool = False,
+        **kw,
+    ):
         super().__init__(name, **kw)
         if kind not in self.KINDS:
             raise ValueError(f"light {name!r}: type must be one of {self.KINDS}, got {kind!r}")
@@ -152,8 +165,9 @@ class LightNode(Node):
 
 
 class CameraNode(Node):
-    def __init__(self, name: str = "camera", yfov: float = np.radians(30), znear: float = 0.1,
-                 zfar: float = 1000.0, **kw):
+    def __init__(
+        self, name: str = "camera", yfov: float = np.radians(30), znear: float = 0.1, zfar: float = 1000.0, **kw
+    ):
         super().__init__(name, **kw)
         if not (0 < yfov < np.pi):
             raise ValueError(f"camera {name!r}: yfov must be in (0, pi) radians, got {yfov}")

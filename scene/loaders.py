@@ -1,4 +1,5 @@
 """Mesh files through trimesh: glTF/GLB (keeping node hierarchy and names), OBJ, PLY."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -14,8 +15,8 @@ SUPPORTED = (".glb", ".gltf", ".obj", ".ply", ".stl", ".off")
 @dataclass
 class LoadedNode:
     name: str
-    parent: str | None        # None: a root of the file
-    matrix: np.ndarray        # local 4x4
+    parent: str | None  # None: a root of the file
+    matrix: np.ndarray  # local 4x4
     mesh: Mesh | None
 
 
@@ -42,8 +43,14 @@ def _mesh_from_trimesh(name: str, tm, source: str) -> Mesh:
     if vis is not None and getattr(vis, "uv", None) is not None and len(vis.uv) == len(tm.vertices):
         uv = np.asarray(vis.uv, np.float32)
     normals = np.asarray(tm.vertex_normals, np.float32)
-    return Mesh(name=name, positions=np.asarray(tm.vertices), indices=np.asarray(tm.faces), normals=normals,
-                uvs=uv, source=source)
+    return Mesh(
+        name=name,
+        positions=np.asarray(tm.vertices),
+        indices=np.asarray(tm.faces),
+        normals=normals,
+        uvs=uv,
+        source=source,
+    )
 
 
 def _load(path: Path) -> list[LoadedNode]:

@@ -5,11 +5,13 @@ A :class:`Param` has a name, a kind, a default and a valid range. Kinds:
 - ``texture``: a file path; when set it selects a shader variant (``HAS_<NAME>``) and binds a sampler;
 - ``choice``: an option that changes shader code (e.g. the SSS model): a define ``<NAME>_<OPTION>``.
 """
+
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -19,11 +21,11 @@ SSS_MODELS = ("none", "dipole", "burley", "blender-burley", "gaussians", "pbd")
 @dataclass(frozen=True)
 class Param:
     name: str
-    kind: str                       # float | color | vec3 | texture | choice
+    kind: str  # float | color | vec3 | texture | choice
     default: Any
     range: tuple[float, float] | None = None
     choices: tuple[str, ...] = ()
-    colorspace: str = "linear"       # for textures: "srgb" colour data or "linear" data
+    colorspace: str = "linear"  # for textures: "srgb" colour data or "linear" data
     doc: str = ""
     unit: str = ""
 
@@ -41,7 +43,9 @@ class Param:
             try:
                 return np.array([float(value)])
             except (TypeError, ValueError):
-                raise ValueError(f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}") from None
+                raise ValueError(
+                    f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}"
+                ) from None
         try:
             arr = np.asarray(value, dtype=np.float64).reshape(-1)
         except (TypeError, ValueError):
@@ -94,8 +98,14 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
     Param("normal_scale", "float", 1.0, (0.0, 4.0), doc="strength of the normal map"),
     Param("occlusion_map", "texture", None, doc="ambient occlusion (R channel), linear"),
     Param("subsurface", "float", 0.0, (0.0, 1.0), doc="weight of subsurface scattering against plain diffuse"),
-    Param("subsurface_radius", "vec3", (1.0, 0.2, 0.1), (0.0, 1000.0), unit="mm",
-          doc="scattering distance per channel (artist mean free path), millimetres"),
+    Param(
+        "subsurface_radius",
+        "vec3",
+        (1.0, 0.2, 0.1),
+        (0.0, 1000.0),
+        unit="mm",
+        doc="scattering distance per channel (artist mean free path), millimetres",
+    ),
     Param("subsurface_color", "color", (0.8, 0.4, 0.3), (0.0, 1.0), doc="multiple-scattering albedo"),
     Param("sss_model", "choice", "burley", choices=SSS_MODELS, doc="diffusion profile for subsurface scattering"),
 )
@@ -118,19 +128,18 @@ class Material:
     def param_map(self) -> dict[str, Param]:
         return {p.name: p for p in self.params}
 
-    def update(self, values: Mapping[str, Any]) -> "Material":
+    def update(self, values: Mapping[str, Any]) -> Material:
         pm = self.param_map
         for k, v in values.items():
             if k not in pm:
-                raise ValueError(f"material {self.name!r}: unknown parameter {k!r}; "
-                                 f"known: {', '.join(pm)}")
+                raise ValueError(f"material {self.name!r}: unknown parameter {k!r}; known: {', '.join(pm)}")
             self.values[k] = pm[k].validate(v, where=f"material {self.name!r}: ")
         return self
 
     def __getitem__(self, name: str) -> Any:
         return self.values[name]
 
-    def with_overrides(self, overrides: Mapping[str, Any], name: str | None = None) -> "Material":
+    def with_overrides(self, overrides: Mapping[str, Any], name: str | None = None) -> Material:
         m = Material(name or self.name, dict(self.values), self.params)
         return m.update(overrides)
 
@@ -140,8 +149,11 @@ class Material:
 
     def textures(self) -> dict[str, tuple[Path, str]]:
         """sampler uniform -> (path, colorspace) for the maps that are set."""
-        return {p.uniform: (self.values[p.name], p.colorspace) for p in self.params
-                if p.kind == "texture" and self.values[p.name] is not None}
+        return {
+            p.uniform: (self.values[p.name], p.colorspace)
+            for p in self.params
+            if p.kind == "texture" and self.values[p.name] is not None
+        }
 
     def defines(self, kinds: tuple[str, ...] = ("texture",)) -> dict[str, str]:
         """Shader-variant defines: ``HAS_<MAP>`` for set maps and ``<CHOICE>_<OPTION>`` for choices.
@@ -158,8 +170,11 @@ class Material:
 
     @property
     def has_subsurface(self) -> bool:
-        return self.values["subsurface"] > 0 and self.values["sss_model"] != "none" \
+        return (
+            self.values["subsurface"] > 0
+            and self.values["sss_model"] != "none"
             and max(self.values["subsurface_radius"]) > 0
+        )
 
 
 def medium_values(medium) -> dict[str, Any]:
@@ -170,6 +185,10 @@ def medium_values(medium) -> dict[str, Any]:
     albedo = np.clip(np.asarray(medium.surface_albedo(), np.float64), 0.0, 1.0)
     radius = np.clip(np.asarray(medium.artist_radius_mm, np.float64), 0.0, 1000.0)
     f0 = ((medium.eta - 1.0) / (medium.eta + 1.0)) ** 2
-    return {"base_color": tuple(float(x) for x in albedo), "subsurface_color": tuple(float(x) for x in albedo),
-            "subsurface_radius": tuple(float(x) for x in radius), "subsurface": 1.0,
-            "specular": float(min(f0 / 0.08, 1.0))}
+    return {
+        "base_color": tuple(float(x) for x in albedo),
+        "subsurface_color": tuple(float(x) for x in albedo),
+        "subsurface_radius": tuple(float(x) for x in radius),
+        "subsurface": 1.0,
+        "specular": float(min(f0 / 0.08, 1.0)),
+    }

@@ -1,4 +1,5 @@
 """Triangle meshes: positions, normals, UVs, tangents; tangent generation and UV atlases."""
+
 from __future__ import annotations
 
 import itertools
@@ -6,20 +7,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-
 _UIDS = itertools.count(1)
 
 
 @dataclass
 class Mesh:
     name: str
-    positions: np.ndarray            # (N, 3) float32
-    indices: np.ndarray              # (M, 3) uint32
-    normals: np.ndarray | None = None    # (N, 3) float32
-    uvs: np.ndarray | None = None        # (N, 2) float32, OpenGL convention (v up)
-    tangents: np.ndarray | None = None   # (N, 4) float32, w = handedness
+    positions: np.ndarray  # (N, 3) float32
+    indices: np.ndarray  # (M, 3) uint32
+    normals: np.ndarray | None = None  # (N, 3) float32
+    uvs: np.ndarray | None = None  # (N, 2) float32, OpenGL convention (v up)
+    tangents: np.ndarray | None = None  # (N, 4) float32, w = handedness
     source: str = ""
-    version: int = 0                 # bump when geometry changes (GPU buffers and stretch maps key on it)
+    version: int = 0  # bump when geometry changes (GPU buffers and stretch maps key on it)
     _bounds: tuple | None = field(default=None, repr=False)
     # unique for the process (unlike id(), never reused after the mesh is freed): GPU caches key on it
     uid: int = field(default_factory=lambda: next(_UIDS), repr=False, compare=False)
@@ -33,7 +33,9 @@ class Mesh:
         if len(self.indices) == 0:
             raise ValueError(f"{where}: has no triangles")
         if self.indices.max() >= len(self.positions):
-            raise ValueError(f"{where}: triangle index {self.indices.max()} out of range ({len(self.positions)} vertices)")
+            raise ValueError(
+                f"{where}: triangle index {self.indices.max()} out of range ({len(self.positions)} vertices)"
+            )
         if not np.isfinite(self.positions).all():
             raise ValueError(f"{where}: positions contain NaN or Inf")
         if self.normals is None:

@@ -42,6 +42,7 @@ intensity = 3.0
 cast_shadow = true
 ```
 """
+
 from __future__ import annotations
 
 import tomllib
@@ -53,8 +54,8 @@ import numpy as np
 from . import transform as tf
 from .graph import CameraNode, LightNode, MeshNode, Node, Scene
 from .loaders import LoadedNode, load_mesh_file
-from .mesh import Mesh
 from .materials import Material
+from .mesh import Mesh
 
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
 DEFAULT_SCENE = ASSETS / "scenes" / "head.toml"
@@ -79,7 +80,9 @@ def _vec(where: str, value: Any, n: int = 3) -> np.ndarray:
 def _known(where: str, table: dict, keys: set[str]) -> None:
     extra = set(table) - keys
     if extra:
-        raise SceneFileError(f"{where}: unknown key(s) {', '.join(sorted(extra))}; expected some of {', '.join(sorted(keys))}")
+        raise SceneFileError(
+            f"{where}: unknown key(s) {', '.join(sorted(extra))}; expected some of {', '.join(sorted(keys))}"
+        )
 
 
 def _trs(where: str, t: dict) -> dict:
@@ -151,7 +154,7 @@ def _build(path: Path, data: dict) -> Scene:
         m = Material(name)
         values = dict(values)
         preset_name = values.pop("preset", None)
-        if preset_name is not None:   # a measured medium (assets/presets/jensen2001_table1.csv) first
+        if preset_name is not None:  # a measured medium (assets/presets/jensen2001_table1.csv) first
             from scene.materials import medium_values
             from scene.optics.media import preset
 
@@ -160,7 +163,7 @@ def _build(path: Path, data: dict) -> Scene:
             except ValueError as e:
                 raise SceneFileError(f"[materials.{name}].preset: {e}") from None
         m.update(_resolve_paths(values, base, m))
-        for sampler, (tex, _) in m.textures().items():
+        for tex, _ in m.textures().values():
             if not Path(tex).is_file():
                 raise SceneFileError(f"[materials.{name}]: texture file not found: {tex}")
         materials[name] = m
@@ -169,7 +172,9 @@ def _build(path: Path, data: dict) -> Scene:
         if name is None:
             mat = Material("default")
         elif name not in materials:
-            raise SceneFileError(f"{where}.material: no material named {name!r} (defined: {', '.join(materials) or 'none'})")
+            raise SceneFileError(
+                f"{where}.material: no material named {name!r} (defined: {', '.join(materials) or 'none'})"
+            )
         else:
             mat = materials[name]
         if overrides:
@@ -178,8 +183,24 @@ def _build(path: Path, data: dict) -> Scene:
 
     for i, entry in enumerate(data.get("meshes", [])):
         where = f"[[meshes]] #{i + 1}"
-        _known(where, entry, {"name", "file", "material", "overrides", "nodes", "translation", "rotation",
-                              "rotation_deg", "scale", "visible", "flip_v", "generate_uvs"})
+        _known(
+            where,
+            entry,
+            {
+                "name",
+                "file",
+                "material",
+                "overrides",
+                "nodes",
+                "translation",
+                "rotation",
+                "rotation_deg",
+                "scale",
+                "visible",
+                "flip_v",
+                "generate_uvs",
+            },
+        )
         if "file" not in entry:
             raise SceneFileError(f"{where}: missing 'file'")
         mpath = Path(entry["file"])
@@ -193,11 +214,13 @@ def _build(path: Path, data: dict) -> Scene:
         names = {n.name for n in loaded}
         for nname in node_cfg:
             if nname not in names:
-                raise SceneFileError(f"{where}.nodes.{nname}: {mpath.name} has no node named {nname!r} "
-                                     f"(it has: {', '.join(sorted(names))})")
+                raise SceneFileError(
+                    f"{where}.nodes.{nname}: {mpath.name} has no node named {nname!r} "
+                    f"(it has: {', '.join(sorted(names))})"
+                )
         if entry.get("flip_v", False):
             loaded = [LoadedNode(ln.name, ln.parent, ln.matrix, flip_v(ln.mesh)) for ln in loaded]
-        if entry.get("generate_uvs", False):   # an xatlas atlas where the file has no UVs
+        if entry.get("generate_uvs", False):  # an xatlas atlas where the file has no UVs
             for ln in loaded:
                 if ln.mesh is not None:
                     ln.mesh.ensure_uvs(f"{where}: generate_uvs", generate=True)
@@ -208,8 +231,11 @@ def _build(path: Path, data: dict) -> Scene:
             if ln.mesh is not None:
                 mat = default_mat
                 if "material" in cfg or "overrides" in cfg:
-                    mat = material_for(f"{where}.nodes.{ln.name}", cfg.get("material", entry.get("material")),
-                                       {**entry.get("overrides", {}), **cfg.get("overrides", {})})
+                    mat = material_for(
+                        f"{where}.nodes.{ln.name}",
+                        cfg.get("material", entry.get("material")),
+                        {**entry.get("overrides", {}), **cfg.get("overrides", {})},
+                    )
                 node = MeshNode(ln.name, ln.mesh, mat)
             else:
                 node = Node(ln.name)
@@ -222,8 +248,13 @@ def _build(path: Path, data: dict) -> Scene:
         where = f"[[lights]] #{i + 1}"
         _known(where, entry, {"name", "type", "direction", "position", "color", "intensity", "cast_shadow"})
         kind = entry.get("type", "directional")
-        light = LightNode(entry.get("name", f"light{i + 1}"), kind, _vec(f"{where}.color", entry.get("color", 1.0)),
-                          float(entry.get("intensity", 1.0)), bool(entry.get("cast_shadow", False)))
+        light = LightNode(
+            entry.get("name", f"light{i + 1}"),
+            kind,
+            _vec(f"{where}.color", entry.get("color", 1.0)),
+            float(entry.get("intensity", 1.0)),
+            bool(entry.get("cast_shadow", False)),
+        )
         if kind == "directional":
             d = _vec(f"{where}.direction", entry.get("direction", [0, 0, -1]))
             if np.linalg.norm(d) == 0:
@@ -238,10 +269,17 @@ def _build(path: Path, data: dict) -> Scene:
     cam = data.get("camera")
     if cam is not None:
         _known("[camera]", cam, {"position", "target", "up", "yfov_deg", "znear", "zfar"})
-        c = CameraNode("camera", np.radians(float(cam.get("yfov_deg", 30.0))), float(cam.get("znear", 0.1)),
-                       float(cam.get("zfar", 1000.0)))
-        c.look_at(_vec("[camera].position", cam.get("position", [0, 0, 10])),
-                  _vec("[camera].target", cam.get("target", [0, 0, 0])), _vec("[camera].up", cam.get("up", [0, 1, 0])))
+        c = CameraNode(
+            "camera",
+            np.radians(float(cam.get("yfov_deg", 30.0))),
+            float(cam.get("znear", 0.1)),
+            float(cam.get("zfar", 1000.0)),
+        )
+        c.look_at(
+            _vec("[camera].position", cam.get("position", [0, 0, 10])),
+            _vec("[camera].target", cam.get("target", [0, 0, 0])),
+            _vec("[camera].up", cam.get("up", [0, 1, 0])),
+        )
         scene.add(c)
     if not scene.mesh_nodes(visible_only=False):
         raise SceneFileError("the scene has no meshes")

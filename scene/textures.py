@@ -3,6 +3,7 @@
 Arrays are float32 (H, W, C) with row 0 at the *top* of the image as stored in the file; the
 renderer flips rows on upload so that v = 0 (OpenGL, as trimesh gives UVs) is the bottom row.
 """
+
 from __future__ import annotations
 
 from pathlib import Path

@@ -1,4 +1,5 @@
 """Small 4x4 transform helpers (column vectors, OpenGL conventions: camera looks down -Z)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -7,11 +8,13 @@ import numpy as np
 def quat_to_matrix(q) -> np.ndarray:
     """3x3 rotation from a unit quaternion (x, y, z, w), glTF order."""
     x, y, z, w = np.asarray(q, dtype=np.float64) / np.linalg.norm(q)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def matrix_to_quat(m) -> np.ndarray:

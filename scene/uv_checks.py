@@ -18,6 +18,7 @@ measures both, in pure NumPy:
   (top-left style) rule, so two triangles sharing an edge or a vertex never both cover a texel
   and never both miss it: a clean layout reads exactly 0 overlap.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -26,11 +27,11 @@ import numpy as np
 
 from .mesh import Mesh
 
-UV_AREA_EPS = 1e-12           # UV-space triangle area (unit square = 1) at or below which a triangle is zero-UV-area
-WORLD_AREA_REL_EPS = 1e-12    # world area at or below this times (bbox diagonal)^2 is zero-world-area
-OVERLAP_WARN = 0.01           # warn when more than this fraction of covered texels is covered twice or more
-SUBTEXEL = 256                # vertex snapping: 1/SUBTEXEL of a raster texel (like a GPU's sub-pixel bits)
-_CHUNK = 1 << 20              # raster candidates (texel, triangle) evaluated per NumPy batch
+UV_AREA_EPS = 1e-12  # UV-space triangle area (unit square = 1) at or below which a triangle is zero-UV-area
+WORLD_AREA_REL_EPS = 1e-12  # world area at or below this times (bbox diagonal)^2 is zero-world-area
+OVERLAP_WARN = 0.01  # warn when more than this fraction of covered texels is covered twice or more
+SUBTEXEL = 256  # vertex snapping: 1/SUBTEXEL of a raster texel (like a GPU's sub-pixel bits)
+_CHUNK = 1 << 20  # raster candidates (texel, triangle) evaluated per NumPy batch
 _PERCENTILES = (("p10", 0.10), ("p50", 0.50), ("p90", 0.90))
 
 
@@ -40,14 +41,14 @@ class UVReport:
     0 (counts) or nan (fractions, ``mm_per_texel``, percentiles) and ``zero_area_world`` counts every
     triangle of (near-)zero world area."""
 
-    mesh: str                       # mesh name
+    mesh: str  # mesh name
     has_uvs: bool
     triangles: int
-    zero_area_world: int            # (near-)zero world area but non-zero UV area ("infinite stretch")
-    zero_area_uv: int               # (near-)zero UV area: not rasterised in UV space, no irradiance
-    out_of_range: int               # any UV outside [0, 1] (or not finite)
-    overlap_fraction: float         # of covered raster texels, the fraction covered by 2+ triangles (0 if none covered)
-    uv_coverage: float              # fraction of the unit UV square covered
+    zero_area_world: int  # (near-)zero world area but non-zero UV area ("infinite stretch")
+    zero_area_uv: int  # (near-)zero UV area: not rasterised in UV space, no irradiance
+    out_of_range: int  # any UV outside [0, 1] (or not finite)
+    overlap_fraction: float  # of covered raster texels, the fraction covered by 2+ triangles (0 if none covered)
+    uv_coverage: float  # fraction of the unit UV square covered
     mm_per_texel: np.ndarray = field(repr=False)  # (T, 2): mm per texel along u, v; nan for zero-UV-area
     #                                 (and non-finite-UV) triangles, 0 for zero-world-area ones
     mm_per_texel_percentiles: dict = field(default_factory=dict)  # {"p10": (u, v), "p50": ..., "p90": ...},
@@ -60,25 +61,35 @@ class UVReport:
         where = f"mesh {self.mesh!r}"
         out: list[str] = []
         if not self.has_uvs:
-            out.append(f"{where} has no UV coordinates: texture-space diffusion renders irradiance into UV space "
-                       f"and needs them; Mesh.ensure_uvs() generates an xatlas atlas (scene files have no option "
-                       f"for this yet)")
+            out.append(
+                f"{where} has no UV coordinates: texture-space diffusion renders irradiance into UV space "
+                f"and needs them; Mesh.ensure_uvs() generates an xatlas atlas (scene files have no option "
+                f"for this yet)"
+            )
             if self.zero_area_world:
                 out.append(f"{where}: {self.zero_area_world} of {self.triangles} triangles have (near-)zero world area")
             return out
         if self.zero_area_uv:
-            out.append(f"{where}: {self.zero_area_uv} of {self.triangles} triangles have (near-)zero UV area; they are "
-                       f"not rasterised in UV space, so their surface gets no irradiance")
+            out.append(
+                f"{where}: {self.zero_area_uv} of {self.triangles} triangles have (near-)zero UV area; they are "
+                f"not rasterised in UV space, so their surface gets no irradiance"
+            )
         if self.zero_area_world:
-            out.append(f"{where}: {self.zero_area_world} of {self.triangles} triangles have (near-)zero world area but "
-                       f"non-zero UV area (infinite stretch: their texels map onto no surface)")
+            out.append(
+                f"{where}: {self.zero_area_world} of {self.triangles} triangles have (near-)zero world area but "
+                f"non-zero UV area (infinite stretch: their texels map onto no surface)"
+            )
         if self.out_of_range:
-            out.append(f"{where}: {self.out_of_range} of {self.triangles} triangles have UVs outside [0, 1]; the "
-                       f"irradiance texture clamps or wraps them onto other parts of the layout")
+            out.append(
+                f"{where}: {self.out_of_range} of {self.triangles} triangles have UVs outside [0, 1]; the "
+                f"irradiance texture clamps or wraps them onto other parts of the layout"
+            )
         if self.overlap_fraction > OVERLAP_WARN:
-            out.append(f"{where}: UV overlap: {100 * self.overlap_fraction:.1f}% of covered texels "
-                       f"({self.grid}x{self.grid} raster) are covered by 2 or more triangles, which would share "
-                       f"(and blur together) irradiance")
+            out.append(
+                f"{where}: UV overlap: {100 * self.overlap_fraction:.1f}% of covered texels "
+                f"({self.grid}x{self.grid} raster) are covered by 2 or more triangles, which would share "
+                f"(and blur together) irradiance"
+            )
         return out
 
 
@@ -91,8 +102,9 @@ def _check_params(mm_per_unit, texels, grid, model_scale) -> None:
             raise ValueError(f"analyse_uvs: {name} must be an integer in [1, 65536], got {v!r}")
 
 
-def analyse_uvs(mesh: Mesh, mm_per_unit: float, texels: int = 1024, grid: int = 512,
-                model_scale: float = 1.0) -> UVReport:
+def analyse_uvs(
+    mesh: Mesh, mm_per_unit: float, texels: int = 1024, grid: int = 512, model_scale: float = 1.0
+) -> UVReport:
     """Check ``mesh``'s UV layout for texture-space diffusion into a ``texels``-square texture.
 
     ``mm_per_unit`` is the scene's physical scale and ``model_scale`` any extra uniform scale of the
@@ -109,15 +121,27 @@ def analyse_uvs(mesh: Mesh, mm_per_unit: float, texels: int = 1024, grid: int = 
 
     if mesh.uvs is None:
         nan2 = (float("nan"), float("nan"))
-        return UVReport(mesh.name, False, T, int(world_zero.sum()), 0, 0, float("nan"), float("nan"),
-                        np.full((T, 2), np.nan), {k: nan2 for k, _ in _PERCENTILES}, int(texels), int(grid))
+        return UVReport(
+            mesh.name,
+            False,
+            T,
+            int(world_zero.sum()),
+            0,
+            0,
+            float("nan"),
+            float("nan"),
+            np.full((T, 2), np.nan),
+            {k: nan2 for k, _ in _PERCENTILES},
+            int(texels),
+            int(grid),
+        )
 
     uv = np.asarray(mesh.uvs, np.float64)
     if uv.shape != (len(p), 2):
         raise ValueError(f"mesh {mesh.name!r}: uvs must be ({len(p)}, 2), got {uv.shape}")
-    tuv = uv[f]                                            # (T, 3, 2)
+    tuv = uv[f]  # (T, 3, 2)
     finite = np.isfinite(tuv).all(axis=(1, 2))
-    tuv = np.where(finite[:, None, None], tuv, 0.0)        # keep the arithmetic NaN-free
+    tuv = np.where(finite[:, None, None], tuv, 0.0)  # keep the arithmetic NaN-free
     d1, d2 = tuv[:, 1] - tuv[:, 0], tuv[:, 2] - tuv[:, 0]
     det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
     uv_zero = finite & (0.5 * np.abs(det) < UV_AREA_EPS)
@@ -128,7 +152,11 @@ def analyse_uvs(mesh: Mesh, mm_per_unit: float, texels: int = 1024, grid: int = 
     inv = np.where(good, 1.0 / np.where(good, det, 1.0), 0.0)[:, None]
     ju = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * inv
     jv = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * inv
-    mm = np.stack([np.linalg.norm(ju, axis=1), np.linalg.norm(jv, axis=1)], axis=1) * (mm_per_unit * model_scale) / texels
+    mm = (
+        np.stack([np.linalg.norm(ju, axis=1), np.linalg.norm(jv, axis=1)], axis=1)
+        * (mm_per_unit * model_scale)
+        / texels
+    )
     mm[~finite | uv_zero] = np.nan
     mm[stretch_inf] = 0.0
 
@@ -140,10 +168,19 @@ def analyse_uvs(mesh: Mesh, mm_per_unit: float, texels: int = 1024, grid: int = 
     covered = int(np.count_nonzero(counts))
     multi = int(np.count_nonzero(counts >= 2))
     return UVReport(
-        mesh=mesh.name, has_uvs=True, triangles=T, zero_area_world=int(stretch_inf.sum()),
-        zero_area_uv=int(uv_zero.sum()), out_of_range=int(outside.sum()),
-        overlap_fraction=multi / covered if covered else 0.0, uv_coverage=covered / float(grid * grid),
-        mm_per_texel=mm, mm_per_texel_percentiles=pct, texels=int(texels), grid=int(grid))
+        mesh=mesh.name,
+        has_uvs=True,
+        triangles=T,
+        zero_area_world=int(stretch_inf.sum()),
+        zero_area_uv=int(uv_zero.sum()),
+        out_of_range=int(outside.sum()),
+        overlap_fraction=multi / covered if covered else 0.0,
+        uv_coverage=covered / float(grid * grid),
+        mm_per_texel=mm,
+        mm_per_texel_percentiles=pct,
+        texels=int(texels),
+        grid=int(grid),
+    )
 
 
 def _weighted_percentiles(values: np.ndarray, weights: np.ndarray) -> dict:
@@ -184,7 +221,7 @@ def _raster_counts(tuv: np.ndarray, grid: int) -> np.ndarray:
     if not len(tuv):
         return counts
     S = float(SUBTEXEL)
-    q = np.rint(tuv * (grid * S))                          # (n, 3, 2) integer-valued float64
+    q = np.rint(tuv * (grid * S))  # (n, 3, 2) integer-valued float64
     x, y = q[..., 0], q[..., 1]
     area2 = (x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (x[:, 2] - x[:, 0]) * (y[:, 1] - y[:, 0])
     flip = area2 < 0
@@ -208,16 +245,16 @@ def _raster_counts(tuv: np.ndarray, grid: int) -> np.ndarray:
     dx, dy = bx - ax, by - ay
     owned = (dy > 0) | ((dy == 0) & (dx < 0))
     cx0, cy0 = (i0 * S + half)[:, None], (j0 * S + half)[:, None]
-    e0 = dx * (cy0 - ay) - dy * (cx0 - ax) + owned     # E at the box's first centre, +1 on owned edges:
-    stepx, stepy = -dy * S, dx * S                      # inside iff E + owned > 0 (E is integer-valued)
+    e0 = dx * (cy0 - ay) - dy * (cx0 - ax) + owned  # E at the box's first centre, +1 on owned edges:
+    stepx, stepy = -dy * S, dx * S  # inside iff E + owned > 0 (E is integer-valued)
 
     # one row per (triangle, texel row of its box), then one candidate per texel of that row
     nt = len(W)
     row_t = np.repeat(np.arange(nt), H)
     row_j = np.arange(len(row_t)) - np.repeat(np.cumsum(H) - H, H)
-    row_e = e0[row_t] + stepy[row_t] * row_j[:, None]   # (R, 3)
+    row_e = e0[row_t] + stepy[row_t] * row_j[:, None]  # (R, 3)
     row_w = W[row_t]
-    row_base = (j0[row_t] + row_j) * grid + i0[row_t]   # flat index of the row's first texel
+    row_base = (j0[row_t] + row_j) * grid + i0[row_t]  # flat index of the row's first texel
     row_sx = stepx[row_t]
     ends = np.cumsum(row_w)
     r = 0

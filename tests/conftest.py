@@ -1,11 +1,7 @@
 import os
-import sys
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 from hypothesis import settings as _hyp_settings  # noqa: E402
@@ -31,3 +27,13 @@ def glsl(ctx):
     from app.gl.glsl_eval import GLSLEvaluator
 
     return GLSLEvaluator(ctx)
+
+
+@pytest.fixture(scope="module")
+def renderer(ctx):
+    """One renderer per test module (its GPU caches are reset between modules)."""
+    from app.render.renderer import Renderer
+
+    r = Renderer(ctx)
+    yield r
+    r.release()

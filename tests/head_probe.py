@@ -1,4 +1,5 @@
 """Geometric landmarks on the head scan, for render tests (lips, cheek)."""
+
 import numpy as np
 
 
@@ -28,6 +29,6 @@ def project(scene, point, size):
 
 def redness(img, point_px, r=2):
     x, y = point_px
-    patch = img[y - r:y + r + 1, x - r:x + r + 1, :3].astype(np.float64)
+    patch = img[y - r : y + r + 1, x - r : x + r + 1, :3].astype(np.float64)
     rgb = patch.reshape(-1, 3).mean(0)
     return rgb[0] / max(rgb[1], 1e-6)

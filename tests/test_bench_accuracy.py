@@ -1,5 +1,6 @@
 """`skinlab bench accuracy`: the ledger's files and their structure on a tiny sweep (head, 64x64,
 five settings; timings are measured, never asserted), and the pieces it is computed from."""
+
 import csv
 import json
 import math
@@ -18,8 +19,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def cli(*args, timeout=180):
-    return subprocess.run([sys.executable, "-m", "app.cli", "bench", *args], cwd=ROOT, env=dict(os.environ),
-                          capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli", "bench", *args],
+        cwd=ROOT,
+        env=dict(os.environ),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
 
 
 @pytest.fixture(scope="module")
@@ -41,13 +48,13 @@ def test_csv_structure(tiny):
     header, rows = read_rows(out / "ledger.csv")
     assert header == acc.CSV_COLUMNS
     settings = acc.sweep_settings(acc.TINY)
-    assert [r["setting"] for r in rows] == [s.label for s in settings]       # one row per setting, in order
+    assert [r["setting"] for r in rows] == [s.label for s in settings]  # one row per setting, in order
     assert {r["scene"] for r in rows} == {"head"}
     assert {r["technique"] for r in rows} == {"exact", "none", "tint", "tsd"}
     for r in rows:
         assert r["status"] in ("ok", "error", "ignored"), r
         for c in acc.NUMERIC_COLUMNS:
-            float(r[c])                                                        # parses (nan allowed)
+            float(r[c])  # parses (nan allowed)
         if r["status"] == "ok":
             assert float(r["frame_ms_p10"]) <= float(r["frame_ms_median"]) <= float(r["frame_ms_p90"])
             assert int(r["frames"]) >= 1 and r["clock"] in ("cpu-synchronised", "gpu-timer")
@@ -69,8 +76,16 @@ def test_csv_structure(tiny):
 def test_markdown_json_and_figures(tiny):
     out, res = tiny
     md = (out / "ledger.md").read_text()
-    for needle in ("# Accuracy/time ledger (tiny sweep)", "## head", "| setting | technique | model |",
-                   "## Cost slopes", "frame vs texels", "## Peer: pyrender", "## Recommended defaults", "Rule:"):
+    for needle in (
+        "# Accuracy/time ledger (tiny sweep)",
+        "## head",
+        "| setting | technique | model |",
+        "## Cost slopes",
+        "frame vs texels",
+        "## Peer: pyrender",
+        "## Recommended defaults",
+        "Rule:",
+    ):
         assert needle in md, needle
     assert md.index("## Recommended defaults") > md.index("## Cost slopes")
     table = [line for line in md.splitlines() if line.startswith("| ") and " | head" not in line]
@@ -78,17 +93,18 @@ def test_markdown_json_and_figures(tiny):
     doc = json.loads((out / "ledger.json").read_text())
     assert len(doc["rows"]) == 5 and doc["meta"]["sweep"] == "tiny" and "head" in doc["pareto"]
     from app.image_output import read_image
+
     for name in ("pareto.png", "cost.png"):
         img = read_image(out / name)
         assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 100 and img.std() > 0
     assert len(list((out / "images").glob("head-*.png"))) == 5
-    assert not [p for p in out.rglob(".*") if p.is_file()]            # no temporary files left behind
+    assert not [p for p in out.rglob(".*") if p.is_file()]  # no temporary files left behind
     for name in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png"):
         assert str((out / name).resolve()) in res.stdout
 
 
 def test_failing_setting_is_an_error_row_and_the_sweep_goes_on(ctx, tmp_path):
-    bad = acc.Setting("ssss", ssss_taps=4)                    # RenderSettings refuses an even tap count
+    bad = acc.Setting("ssss", ssss_taps=4)  # RenderSettings refuses an even tap count
     sweep = replace(acc.TINY, ks=(6,), extra=(bad,), frames=1, warmup=1)
     res = acc.run_sweep(sweep, tmp_path, peer=False, progress=False, images=False)
     rows = {r["setting"]: r for r in res["rows"]}
@@ -107,27 +123,41 @@ def test_bad_scene_is_one_line():
 
 def test_pareto_front_and_recommendation_rule():
     def row(scene, label, ms, err, tech="tsd"):
-        return {"scene": scene, "setting": label, "technique": tech, "status": "ok", "frame_ms_median": ms,
-                "image_rel_l1": err}
-    rows = [row("a", "ref", 100.0, 0.0, "exact"), row("a", "x", 10.0, 0.04), row("a", "y", 20.0, 0.05),
-            row("a", "z", 30.0, 0.01), row("b", "ref", 90.0, 0.0, "exact"), row("b", "x", 12.0, 0.03),
-            row("b", "y", 22.0, 0.002), row("b", "z", 28.0, 0.008)]
+        return {
+            "scene": scene,
+            "setting": label,
+            "technique": tech,
+            "status": "ok",
+            "frame_ms_median": ms,
+            "image_rel_l1": err,
+        }
+
+    rows = [
+        row("a", "ref", 100.0, 0.0, "exact"),
+        row("a", "x", 10.0, 0.04),
+        row("a", "y", 20.0, 0.05),
+        row("a", "z", 30.0, 0.01),
+        row("b", "ref", 90.0, 0.0, "exact"),
+        row("b", "x", 12.0, 0.03),
+        row("b", "y", 22.0, 0.002),
+        row("b", "z", 28.0, 0.008),
+    ]
     front = acc.pareto_front([r for r in rows if r["scene"] == "a"])
-    assert [r["setting"] for r in front] == ["x", "z", "ref"]                  # y is dominated by x
+    assert [r["setting"] for r in front] == ["x", "z", "ref"]  # y is dominated by x
     recs = {r["threshold"]: r for r in acc.recommendations(rows, (0.01, 0.05, 0.001))}
-    assert recs[0.01]["best"][1] == "z"         # y fails in scene a; z is within 1 % in both
+    assert recs[0.01]["best"][1] == "z"  # y fails in scene a; z is within 1 % in both
     assert recs[0.05]["best"][1] == "x"
     assert recs[0.001]["best"][1] == "ref" and recs[0.001]["best_tsd"] is None
 
 
 def test_log_slope_and_image_error():
     x = np.array([256.0, 512, 1024, 2048]) ** 2
-    b, a, n = acc.log_slope(x, 3.0 * x ** 0.8)
+    b, a, n = acc.log_slope(x, 3.0 * x**0.8)
     assert b == pytest.approx(0.8) and n == 4
     assert math.isnan(acc.log_slope([1.0], [2.0])[0])
     ref = np.zeros((8, 8, 4), np.float32)
     ref[2:6, 2:6] = (1.0, 0.5, 0.25, 1.0)
-    ref[2, 2, :3] = 0.001                                          # too dark to count
+    ref[2, 2, :3] = 0.001  # too dark to count
     img = ref.copy()
     img[3, 3, :3] *= 1.1
     e = acc.image_error(img, ref)
@@ -138,6 +168,7 @@ def test_log_slope_and_image_error():
 
 def test_edge_error_scores_a_step_one_and_the_reference_zero():
     from scene.optics.media import Medium
+
     medium = Medium.from_artist_radius((0.8, 0.55, 0.45), (3.67, 1.37, 0.68), eta=1.4)
     ref = acc.model_reference("burley", medium)
     exact = acc.technique_edge_fn("exact", "burley", medium)

@@ -1,5 +1,6 @@
 """`skinlab bench reload`: runs quickly with few repeats; its JSON and text structure (timings are
 measured, never asserted beyond being positive and ordered)."""
+
 import json
 import os
 import subprocess
@@ -16,8 +17,14 @@ FAST = dict(size=(32, 32), shadow_size=64, tsd_size=16)
 
 def cli(*args, timeout=120):
     env = dict(os.environ)
-    return subprocess.run([sys.executable, "-m", "app.cli", "bench", *args], cwd=ROOT, env=env,
-                          capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli", "bench", *args],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
 
 
 def test_edit_wraps_main_and_changes_each_time():
@@ -57,20 +64,42 @@ def test_reload_bench_cli_json_and_text(ctx, capsys):
     assert data["repeats"] == 2 and len(data["latency_ms"]["samples"]) == 2 and data["gl"]
     from app.cli import main
 
-    assert main(["bench", "reload", "--repeats", "1", "--size", "32x32", "--shadow-size", "64",
-                 "--tsd-size", "16", "--settle", "0.02"]) == 0
+    assert (
+        main(
+            [
+                "bench",
+                "reload",
+                "--repeats",
+                "1",
+                "--size",
+                "32x32",
+                "--shadow-size",
+                "64",
+                "--tsd-size",
+                "16",
+                "--settle",
+                "0.02",
+            ]
+        )
+        == 0
+    )
     out = capsys.readouterr().out
     for line in ("save -> first new frame", "save -> reload applied", "of which recompiling", "the first new frame"):
         assert line in out
-    assert "on-demand frames" in out and "1 edits of shaders/passes/tonemap.frag" in out and "check: image changed" in out
+    assert (
+        "on-demand frames" in out and "1 edits of shaders/passes/tonemap.frag" in out and "check: image changed" in out
+    )
 
 
-@pytest.mark.parametrize("args,needle", [
-    (("--file", "passes/nope.frag"), "passes/nope.frag"),
-    (("--file", "../pyproject.toml"), "../pyproject.toml"),
-    (("--repeats", "0"), "--repeats"),
-    (("--settle", "-1"), "--settle"),
-])
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (("--file", "passes/nope.frag"), "passes/nope.frag"),
+        (("--file", "../pyproject.toml"), "../pyproject.toml"),
+        (("--repeats", "0"), "--repeats"),
+        (("--settle", "-1"), "--settle"),
+    ],
+)
 def test_reload_bench_bad_input_is_one_line(args, needle):
     res = cli("reload", "--size", "16x16", *args, timeout=60)
     assert res.returncode == 2 and needle in res.stderr and "Traceback" not in res.stderr

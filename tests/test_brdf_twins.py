@@ -1,4 +1,5 @@
 """GLSL BRDF library vs its NumPy twin over parameter grids, hard cases included."""
+
 import itertools
 
 import numpy as np
@@ -25,7 +26,7 @@ def test_ggx_d_matches_numpy_including_mirror_peak(glsl):
     gpu = glsl.evaluate("lib/brdf.glsl", "ggx_d(NoH, ggx_alpha(r))", {"NoH": nh, "r": r})
     assert_close_fp32(gpu[:, 0], brdf.ggx_d(nh, a), what="ggx_d")
     # roughness 0 at the exact peak stays finite and is the clamped maximum
-    assert np.isfinite(gpu).all() and gpu.max() == pytest.approx(1 / (np.pi * brdf.MIN_GGX_ALPHA ** 2), rel=1e-4)
+    assert np.isfinite(gpu).all() and gpu.max() == pytest.approx(1 / (np.pi * brdf.MIN_GGX_ALPHA**2), rel=1e-4)
 
 
 def test_ggx_d_is_normalised():
@@ -39,8 +40,12 @@ def test_ggx_d_is_normalised():
 
 def test_smith_terms_match_numpy_at_grazing(glsl):
     nl, nv, r = grid(COS, COS[::2], ROUGH)
-    gpu = glsl.evaluate("lib/brdf.glsl", "vec2(smith_lambda(NoL, ggx_alpha(r)), smith_g2(NoL, NoV, ggx_alpha(r)))",
-                        {"NoL": nl, "NoV": nv, "r": r}, out_components=2)
+    gpu = glsl.evaluate(
+        "lib/brdf.glsl",
+        "vec2(smith_lambda(NoL, ggx_alpha(r)), smith_g2(NoL, NoV, ggx_alpha(r)))",
+        {"NoL": nl, "NoV": nv, "r": r},
+        out_components=2,
+    )
     a = brdf.ggx_alpha(r)
     assert_close_fp32(gpu[:, 0], brdf.smith_lambda(nl, a), what="smith_lambda")
     assert_close_fp32(gpu[:, 1], brdf.smith_g2(nl, nv, a), what="smith_g2")
@@ -51,8 +56,12 @@ def test_smith_terms_match_numpy_at_grazing(glsl):
 def test_fresnel_and_burley_match_numpy(glsl):
     nl, nv, loh, r = grid(COS[::2], COS[1::2], [0.0, 0.3, 0.7, 1.0], [0.0, 0.5, 1.0])
     f0 = np.tile(np.array([0.04, 0.5, 1.0], F32), (len(nl), 1)).astype(np.float64)
-    gpu = glsl.evaluate("lib/brdf.glsl", "vec4(fresnel_schlick(f0, LoH), burley_diffuse(NoL, NoV, LoH, r))",
-                        {"NoL": nl, "NoV": nv, "LoH": loh, "r": r, "f0": f0}, out_components=4)
+    gpu = glsl.evaluate(
+        "lib/brdf.glsl",
+        "vec4(fresnel_schlick(f0, LoH), burley_diffuse(NoL, NoV, LoH, r))",
+        {"NoL": nl, "NoV": nv, "LoH": loh, "r": r, "f0": f0},
+        out_components=4,
+    )
     assert_close_fp32(gpu[:, :3], brdf.fresnel_schlick(f0, loh), what="fresnel_schlick")
     assert_close_fp32(gpu[:, 3], brdf.burley_diffuse(nl, nv, loh, r), what="burley_diffuse")
     # Burley retro-reflection: normal incidence, rough: f = 1/pi
@@ -71,8 +80,10 @@ def test_principled_brdf_matches_numpy_hard_cases(glsl):
     th = np.radians([0, 30, 60, 85, 89.9, 90, 120, 180])
     dirs = _dirs(th, np.radians([0, 90, 200]))
     dirs[np.abs(dirs) < 1e-12] = 0.0
-    vi, li, ri, mi = (a.ravel() for a in np.meshgrid(np.arange(len(dirs)), np.arange(len(dirs)),
-                                                      np.arange(len(ROUGH)), [0, 1], indexing="ij"))
+    vi, li, ri, mi = (
+        a.ravel()
+        for a in np.meshgrid(np.arange(len(dirs)), np.arange(len(dirs)), np.arange(len(ROUGH)), [0, 1], indexing="ij")
+    )
     v = dirs[vi].astype(F32).astype(np.float64)
     l = dirs[li].astype(F32).astype(np.float64)
     r = np.array(ROUGH)[ri]

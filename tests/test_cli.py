@@ -1,4 +1,5 @@
 """The `skinlab` command line, run as a user would (in a subprocess)."""
+
 import json
 import os
 import subprocess
@@ -13,8 +14,9 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def skinlab(*args, env=None):
     e = dict(os.environ, **(env or {}))
-    return subprocess.run([sys.executable, "-m", "app.cli", *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=300, env=e)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli", *args], cwd=ROOT, capture_output=True, text=True, timeout=300, env=e
+    )
 
 
 def test_render_json_png_and_exr(tmp_path):
@@ -26,8 +28,9 @@ def test_render_json_png_and_exr(tmp_path):
     passes = d["timings"]["passes"]
     # the head's skin scatters: texture-space diffusion runs (the stretch map was made in the warm-up
     # frame and is reused in the measured one)
-    assert {"shadow[key]", "tsd_irradiance[LeePerrySmith]", "tsd_dilate[LeePerrySmith]", "forward",
-            "tonemap"} <= set(passes)
+    assert {"shadow[key]", "tsd_irradiance[LeePerrySmith]", "tsd_dilate[LeePerrySmith]", "forward", "tonemap"} <= set(
+        passes
+    )
     assert any(n.startswith("tsd_blur[LeePerrySmith]") for n in passes)
     assert all(v["cpu_ms"] > 0 for v in passes.values())
     assert any(s["what"] == "tsd_stretch[LeePerrySmith]" for s in d["plan"]["skipped"])
@@ -50,21 +53,36 @@ def test_render_sss_override(tmp_path):
     d = json.loads(p.stdout)
     assert set(d["timings"]["passes"]) == {"shadow[key]", "forward", "tonemap"}
     assert any("sss_model is none" in s["why"] for s in d["plan"]["skipped"])
-    p = skinlab("render", "--out", str(tmp_path / "d.png"), "--size", "32x32", "--sss", "dipole", "--explain",
-                "--tsd-size", "512", "--gaussians", "3")
+    p = skinlab(
+        "render",
+        "--out",
+        str(tmp_path / "d.png"),
+        "--size",
+        "32x32",
+        "--sss",
+        "dipole",
+        "--explain",
+        "--tsd-size",
+        "512",
+        "--gaussians",
+        "3",
+    )
     assert p.returncode == 0, p.stderr
     assert "scatters (dipole)" in p.stdout
     p = skinlab("render", "--out", str(tmp_path / "x.png"), "--sss", "fog")
     assert p.returncode == 2 and "invalid choice: 'fog'" in p.stderr
 
 
-@pytest.mark.parametrize("args, message", [
-    (["render", "--out", "x.jpg"], "x.jpg: unsupported image extension '.jpg'; expected .png or .exr"),
-    (["render", "missing.toml"], "scene file not found: missing.toml"),
-    (["render", "--size", "12"], "--size: expected WIDTHxHEIGHT"),
-    (["render", "--size", "8x8", "--tsd-size", "3"], "tsd_size: expected an integer in [16, 8192], got 3"),
-    (["render", "--size", "8x8", "--gaussians", "9"], "tsd_gaussians: expected an integer in [1, 6], got 9"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["render", "--out", "x.jpg"], "x.jpg: unsupported image extension '.jpg'; expected .png or .exr"),
+        (["render", "missing.toml"], "scene file not found: missing.toml"),
+        (["render", "--size", "12"], "--size: expected WIDTHxHEIGHT"),
+        (["render", "--size", "8x8", "--tsd-size", "3"], "tsd_size: expected an integer in [16, 8192], got 3"),
+        (["render", "--size", "8x8", "--gaussians", "9"], "tsd_gaussians: expected an integer in [1, 6], got 9"),
+    ],
+)
 def test_bad_input_is_one_clear_line(args, message):
     p = skinlab(*args)
     assert p.returncode == 2 and message in p.stderr and "Traceback" not in p.stderr

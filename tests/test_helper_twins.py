@@ -2,6 +2,7 @@
 use them are compared in test_brdf_twins.py / test_profile_twins.py; these pin each helper down on
 its own, hard cases included). cheb/fm_cheb_t are the Chebyshev evaluation inside
 fresnel_moment1/2 and are covered by those functions' comparison."""
+
 import itertools
 
 import numpy as np
@@ -40,8 +41,12 @@ def test_brdf_helpers(glsl):
     nl, nv, nh, r = grid(COS, COS[::2], [0.0, 0.5, 0.99, 0.9999, 1.0], [0.0, 0.05, 0.5, 1.0])
     voh = f32(np.roll(nh, 3))
     f0 = f32(np.tile([0.04, 0.5, 1.0], (len(nl), 1)))
-    gpu = glsl.evaluate("lib/brdf.glsl", "specular_ggx(NoL, NoV, NoH, VoH, ggx_alpha(r), f0)",
-                        {"NoL": nl, "NoV": nv, "NoH": nh, "VoH": voh, "r": r, "f0": f0}, 3)
+    gpu = glsl.evaluate(
+        "lib/brdf.glsl",
+        "specular_ggx(NoL, NoV, NoH, VoH, ggx_alpha(r), f0)",
+        {"NoL": nl, "NoV": nv, "NoH": nh, "VoH": voh, "r": r, "f0": f0},
+        3,
+    )
     ref = brdf.specular_ggx(nl, nv, nh, voh, brdf.ggx_alpha(r), f0)
     assert_close_fp32(gpu, ref, what="specular_ggx")
     assert (ref[nl <= 0] == 0).all() and np.isfinite(ref).all()  # back-facing light, grazing view
@@ -60,8 +65,9 @@ def test_fresnel_and_refraction_helpers(glsl):
     assert ss.refract_cos(1e-6, 1.0) == pytest.approx(1e-6, rel=1e-12)  # eta = 1: straight through
     ct = f32(ss.refract_cos(ci, e))
     # grazing incidence (cos_i = 0) included; total internal reflection appears as cos_t = 0
-    gpu = glsl.evaluate("lib/profiles_common.glsl", "fresnel_from_cosines(ci, ct, 1.0, e)",
-                        {"ci": ci, "ct": ct, "e": e})[:, 0]
+    gpu = glsl.evaluate(
+        "lib/profiles_common.glsl", "fresnel_from_cosines(ci, ct, 1.0, e)", {"ci": ci, "ct": ct, "e": e}
+    )[:, 0]
     ref = fresnel.fresnel_from_cosines(ci, ct, 1.0, e)
     assert_close_fp32(gpu, ref, what="fresnel_from_cosines")
     assert ((ref >= 0) & (ref <= 1)).all()
@@ -85,9 +91,11 @@ def test_dipole_and_depth_helpers(glsl):
 def test_optical_radius_including_zero_and_absurd_mfp(glsl):
     r, l = grid([0.0, 1e-9, 0.5, 10.0, 1e8, 1e30], [0.0, 1e-9, 1e-4, 1.0, 1e4])
     l3 = np.stack([l, l * 2, l / 2], 1)
-    prelude = ("vec3 ox(float r, vec3 m) { vec3 v, il; return optical_radius(r, m, v, il); }\n"
-               "vec3 ov(float r, vec3 m) { vec3 v, il; optical_radius(r, m, v, il); return v; }\n"
-               "vec3 oi(float r, vec3 m) { vec3 v, il; optical_radius(r, m, v, il); return il; }\n")
+    prelude = (
+        "vec3 ox(float r, vec3 m) { vec3 v, il; return optical_radius(r, m, v, il); }\n"
+        "vec3 ov(float r, vec3 m) { vec3 v, il; optical_radius(r, m, v, il); return v; }\n"
+        "vec3 oi(float r, vec3 m) { vec3 v, il; optical_radius(r, m, v, il); return il; }\n"
+    )
     x, inv_l2, valid = optical(r[:, None], l3)
     for fn, ref in (("ox", x), ("ov", valid.astype(float)), ("oi", inv_l2)):
         gpu = glsl.evaluate("lib/profiles_common.glsl", f"{fn}(r, l)", {"r": r, "l": l3}, 3, prelude=prelude)
@@ -97,8 +105,13 @@ def test_optical_radius_including_zero_and_absurd_mfp(glsl):
 @pytest.mark.parametrize("A, d", [((0.0, 0.5, 1.0), (1.0, 0.1, 3.0)), ((0.8, 0.8, 0.8), (0.0, 1e-9, 1e4))])
 def test_burley_helpers(glsl, A, d):
     r = f32([0.0, 1e-9, 1e-4, 0.01, 0.3, 1.0, 5.0, 50.0, 1e6, 1e30])
-    gpu = glsl.evaluate("lib/profiles_burley.glsl", "burley_profile_d(r, u_A, u_d)", {"r": r},
-                        3, uniforms={"u_A": ("vec3", f32(A)), "u_d": ("vec3", f32(d))})
+    gpu = glsl.evaluate(
+        "lib/profiles_burley.glsl",
+        "burley_profile_d(r, u_A, u_d)",
+        {"r": r},
+        3,
+        uniforms={"u_A": ("vec3", f32(A)), "u_d": ("vec3", f32(d))},
+    )
     assert_close_fp32(gpu, burley.burley_profile_d(r, f32(A), f32(d)), what="burley_profile_d")
     xi = f32([0.0, 1e-6, 0.1, 0.5, 0.9, 0.90001, 0.95, 0.999, 0.999999])
     gpu = glsl.evaluate("lib/profiles_burley.glsl", "burley_root_find(xi)", {"xi": xi})[:, 0]
@@ -113,12 +126,18 @@ def test_burley_helpers(glsl, A, d):
     assert_close_fp32(gpu[pinned], ref[pinned], rtol=1e-3, what="burley_root_find")
 
 
-@pytest.mark.parametrize("alpha, mfp, eta", [((0.0, 0.5, 1.0), (1.0, 0.3, 2.0), 1.3),
-                                             ((0.99, 0.9, 0.2), (0.0, 1e-9, 1e3), 1.0)])
+@pytest.mark.parametrize(
+    "alpha, mfp, eta", [((0.0, 0.5, 1.0), (1.0, 0.3, 2.0), 1.3), ((0.99, 0.9, 0.2), (0.0, 1e-9, 1e3), 1.0)]
+)
 def test_pbd_multiple_scattering_term(glsl, alpha, mfp, eta):
     r = f32([0.0, 1e-6, 0.01, 0.2, 1.0, 4.0, 30.0, 1e5, 1e30])
-    gpu = glsl.evaluate("lib/profiles_pbd.glsl", "pbd_ms_profile(r, u_a, u_l, u_eta)", {"r": r}, 3,
-                        uniforms={"u_a": ("vec3", f32(alpha)), "u_l": ("vec3", f32(mfp)), "u_eta": ("float", eta)})
+    gpu = glsl.evaluate(
+        "lib/profiles_pbd.glsl",
+        "pbd_ms_profile(r, u_a, u_l, u_eta)",
+        {"r": r},
+        3,
+        uniforms={"u_a": ("vec3", f32(alpha)), "u_l": ("vec3", f32(mfp)), "u_eta": ("float", eta)},
+    )
     ref = pbd.pbd_ms_profile(r, f32(alpha), f32(mfp), eta)
     assert_close_fp32(gpu, ref, what="pbd_ms_profile")
     assert (ref >= 0).all()

@@ -1,7 +1,7 @@
 """Hot reload, headless: edit a copy of the shader library while frames render."""
+
 import shutil
 import time
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,7 +12,7 @@ from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
 from scene.scenefile import load_scene
 
-SET = RenderSettings(64, 64, shadow_size=128, sss_model="none")   # the edit below changes plain diffuse
+SET = RenderSettings(64, 64, shadow_size=128, sss_model="none")  # the edit below changes plain diffuse
 
 
 def wait_reload(watcher, timeout=5.0):
@@ -63,7 +63,7 @@ def test_only_dependent_programs_recompile_and_rapid_saves_settle(setup):
     root, r, watcher, scene = setup
     r.render(scene, SET)
     n_before = r.programs.compiles
-    color = root / "lib" / "color.glsl"   # included by the tonemap pass only
+    color = root / "lib" / "color.glsl"  # included by the tonemap pass only
     text = color.read_text()
     for i in range(20):  # many saves, some half-written
         color.write_text(text[: len(text) * (i + 1) // 20])
@@ -75,4 +75,4 @@ def test_only_dependent_programs_recompile_and_rapid_saves_settle(setup):
     assert watcher.errors == []  # settled on the final, complete file
     assert r.programs.compiles - n_before <= 3  # the tonemap program, not the forward/shadow ones
     img = r.render(scene, SET).ldr
-    assert img[..., :3].max() < 188   # tone-mapped output halved in linear: below sRGB(0.5) = 188
+    assert img[..., :3].max() < 188  # tone-mapped output halved in linear: below sRGB(0.5) = 188

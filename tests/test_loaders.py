@@ -15,8 +15,13 @@ def two_level_glb(path):
     box = trimesh.creation.box(extents=(1, 1, 1))
     ico = trimesh.creation.icosphere(subdivisions=1, radius=0.3)
     s.add_geometry(box, node_name="Body", geom_name="body_geom")
-    s.add_geometry(ico, node_name="Eye", geom_name="eye_geom", parent_node_name="Body",
-                   transform=trimesh.transformations.translation_matrix([0.0, 0.5, 0.6]))
+    s.add_geometry(
+        ico,
+        node_name="Eye",
+        geom_name="eye_geom",
+        parent_node_name="Body",
+        transform=trimesh.transformations.translation_matrix([0.0, 0.5, 0.6]),
+    )
     s.export(str(path))
     return path
 
@@ -77,7 +82,9 @@ def test_bunny_without_uvs_gets_an_atlas_or_a_clear_error():
     assert copy.uvs.shape == (len(copy.positions), 2) and copy.version == m.version + 1
     assert copy.uvs.min() >= 0 and copy.uvs.max() <= 1
     assert np.isfinite(copy.ensure_tangents()).all()
+
     # the atlas covers the whole surface: same area in 3D as the original mesh
     def area(p, f):
         return 0.5 * np.linalg.norm(np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]), axis=1).sum()
+
     assert area(copy.positions, copy.indices) == pytest.approx(area(m.positions, m.indices), rel=1e-6)

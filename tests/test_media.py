@@ -1,4 +1,5 @@
 """Media: presets, conversions, albedo inversion, validation."""
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -60,29 +61,31 @@ def test_artist_radius_convention():
     assert np.allclose(m.mfp_arr, [1.0, 0.5, 0.25])
 
 
-@pytest.mark.parametrize("call,name", [
-    (lambda: Medium.from_coefficients([-1, 1, 1], [0, 0, 0]), "sigma_s"),
-    (lambda: Medium.from_coefficients([1, 1, 1], [0, -0.1, 0]), "sigma_a"),
-    (lambda: Medium.from_coefficients([0, 1, 1], [0, 0, 0]), "sigma_s \\+ sigma_a"),
-    (lambda: Medium.from_coefficients([1, 1, 1], [0, 0, 0], eta=0.0), "eta"),
-    (lambda: Medium.from_coefficients([1, 1, 1], [0, 0, 0], eta=-1.3), "eta"),
-    (lambda: Medium.from_surface_albedo([1.2, 0.5, 0.5], 1.0), "albedo"),
-    (lambda: Medium.from_surface_albedo([0.5, -0.01, 0.5], 1.0), "albedo"),
-    (lambda: Medium.from_surface_albedo(0.5, [1, -1, 1]), "mfp"),
-    (lambda: Medium((0.5, 0.5, 1.5), (1, 1, 1)), "alpha"),
-    (lambda: Medium.from_artist_radius(0.5, -2.0), "radius"),
-    (lambda: Medium.from_coefficients([1, np.nan, 1], [0, 0, 0]), "sigma_s"),
-    (lambda: Medium.from_coefficients([1, 1], [0, 0]), "sigma_s"),
-    (lambda: media.surface_albedo(0.5, 1.3, method="magic"), "method"),
-])
+@pytest.mark.parametrize(
+    "call,name",
+    [
+        (lambda: Medium.from_coefficients([-1, 1, 1], [0, 0, 0]), "sigma_s"),
+        (lambda: Medium.from_coefficients([1, 1, 1], [0, -0.1, 0]), "sigma_a"),
+        (lambda: Medium.from_coefficients([0, 1, 1], [0, 0, 0]), "sigma_s \\+ sigma_a"),
+        (lambda: Medium.from_coefficients([1, 1, 1], [0, 0, 0], eta=0.0), "eta"),
+        (lambda: Medium.from_coefficients([1, 1, 1], [0, 0, 0], eta=-1.3), "eta"),
+        (lambda: Medium.from_surface_albedo([1.2, 0.5, 0.5], 1.0), "albedo"),
+        (lambda: Medium.from_surface_albedo([0.5, -0.01, 0.5], 1.0), "albedo"),
+        (lambda: Medium.from_surface_albedo(0.5, [1, -1, 1]), "mfp"),
+        (lambda: Medium((0.5, 0.5, 1.5), (1, 1, 1)), "alpha"),
+        (lambda: Medium.from_artist_radius(0.5, -2.0), "radius"),
+        (lambda: Medium.from_coefficients([1, np.nan, 1], [0, 0, 0]), "sigma_s"),
+        (lambda: Medium.from_coefficients([1, 1], [0, 0]), "sigma_s"),
+        (lambda: media.surface_albedo(0.5, 1.3, method="magic"), "method"),
+    ],
+)
 def test_invalid_parameters_raise_naming_the_parameter(call, name):
     with pytest.raises(ValueError, match=name):
         call()
 
 
 @settings(deadline=None)
-@given(ss=st.tuples(*[st.floats(0, 1e3)] * 3), sa=st.tuples(*[st.floats(0, 1e3)] * 3),
-       eta=st.floats(0.05, 5.0))
+@given(ss=st.tuples(*[st.floats(0, 1e3)] * 3), sa=st.tuples(*[st.floats(0, 1e3)] * 3), eta=st.floats(0.05, 5.0))
 def test_conversions_over_domain(ss, sa, eta):
     t_min = min(a + b for a, b in zip(ss, sa))
     if t_min <= 0 or not np.isfinite(1.0 / t_min):  # no medium, or a mean free path beyond float64

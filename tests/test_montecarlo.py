@@ -1,5 +1,6 @@
 """Monte Carlo reference: exactness against Chandrasekhar, conservation, seeds, error scaling,
 and agreement of the analytic profiles with it."""
+
 import numpy as np
 import pytest
 
@@ -47,7 +48,7 @@ def test_energy_conservation_without_absorption():
     # the binned profile integrates to the total (all exits within the last edge here)
     e = np.concatenate([[0], np.geomspace(1e-3, 1e6, 200)])
     r4 = mc.simulate(0.9, 1.3, photons=5000, seed=5, r_edges=e, progress=False)
-    area = np.pi * np.diff(e ** 2)
+    area = np.pi * np.diff(e**2)
     assert np.sum(r4.R * area) == pytest.approx(r4.total, rel=1e-12)
 
 
@@ -83,9 +84,17 @@ def test_hg_anisotropy_and_entry_fresnel():
     assert b.total == pytest.approx(a.total * (1 - 0.04), rel=1e-12)
 
 
-@pytest.mark.parametrize("bad,msg", [(dict(albedo=1.2), "albedo"), (dict(albedo=-0.1), "albedo"),
-                                      (dict(eta=0.0), "eta"), (dict(g=1.0), "g"),
-                                      (dict(incidence="oblique"), "incidence"), (dict(photons=1), "photons")])
+@pytest.mark.parametrize(
+    "bad,msg",
+    [
+        (dict(albedo=1.2), "albedo"),
+        (dict(albedo=-0.1), "albedo"),
+        (dict(eta=0.0), "eta"),
+        (dict(g=1.0), "g"),
+        (dict(incidence="oblique"), "incidence"),
+        (dict(photons=1), "photons"),
+    ],
+)
 def test_invalid_parameters_name_the_parameter(bad, msg):
     args = dict(albedo=0.5, eta=1.3, photons=100, progress=False)
     args.update(bad)
@@ -107,8 +116,14 @@ def test_models_agree_with_monte_carlo_mid_albedo():
     pbd_t = pbd_total([a], eta)[0]
     assert abs(pbd_t - r.total) < 0.12 * r.total + 4 * r.total_se
     assert abs(dipole_total(a, eta) - r.total) < 0.12 * r.total + 4 * r.total_se
-    ss_t = 2 * np.pi * np.trapezoid(single_scatter_profile(np.linspace(0, 60, 20001), a, 1.0, eta)[:, 0]
-                                    * np.linspace(0, 60, 20001), np.linspace(0, 60, 20001))
+    ss_t = (
+        2
+        * np.pi
+        * np.trapezoid(
+            single_scatter_profile(np.linspace(0, 60, 20001), a, 1.0, eta)[:, 0] * np.linspace(0, 60, 20001),
+            np.linspace(0, 60, 20001),
+        )
+    )
     jensen_t = dipole_total(a, eta) + ss_t
     assert jensen_t > r.total + 4 * r.total_se
     # bin averages of the analytic profile (fine quadrature in each annulus)
@@ -117,11 +132,11 @@ def test_models_agree_with_monte_carlo_mid_albedo():
     for r0, r1 in zip(edges[:-1][sel], edges[1:][sel]):
         rr = np.linspace(r0, r1, 41)
         f = pbd_profile(rr, a, 1.0, eta)[:, 0] * 2 * np.pi * rr
-        model.append(np.trapezoid(f, rr) / (np.pi * (r1 ** 2 - r0 ** 2)))
+        model.append(np.trapezoid(f, rr) / (np.pi * (r1**2 - r0**2)))
     model = np.array(model)
     rel = np.abs(model - r.R[sel]) / r.R[sel]
     assert (rel < 0.20 + 4 * r.R_se[sel] / r.R[sel]).all(), rel
-    w = r.R[sel] * np.diff(edges ** 2)[sel]
+    w = r.R[sel] * np.diff(edges**2)[sel]
     assert np.sum(rel * w) / np.sum(w) < 0.12
     # the dipole's shape is poor at this albedo (sigma_tr = 0.77 per mfp: diffusion is a weak
     # approximation); it is only required to be in the right range (docs/accuracy.md has numbers)

@@ -1,4 +1,5 @@
 """`skinlab profile` and `skinlab mc` command lines."""
+
 import json
 
 import numpy as np
@@ -28,27 +29,53 @@ def test_profile_albedo_mfp_round_trips_colour(capsys):
     assert rc == 0 and np.allclose(d["total"], [0.8, 0.5, 0.3], atol=1e-3)
     assert np.allclose(d["medium"]["surface_albedo"], [0.8, 0.5, 0.3], atol=1e-3)
     rc, out, _ = run(capsys, "profile", "all", "--albedo", "0.5", "--radius", "3", "--r", "1", "--json")
-    assert rc == 0 and set(json.loads(out)["models"]) >= {"dipole", "burley", "blender-burley", "gaussians", "pbd", "none"}
+    assert rc == 0 and set(json.loads(out)["models"]) >= {
+        "dipole",
+        "burley",
+        "blender-burley",
+        "gaussians",
+        "pbd",
+        "none",
+    }
 
 
-@pytest.mark.parametrize("argv,word", [
-    (["profile", "pbd", "--albedo", "1.5,0.5,0.5", "--mfp", "1"], "albedo"),
-    (["profile", "pbd", "--albedo", "0.5", "--mfp", "-1"], "mfp"),
-    (["profile", "pbd", "--albedo", "0.5"], "mfp"),
-    (["profile", "pbd", "--preset", "jade"], "preset"),
-    (["profile", "pbd", "--preset", "skin1", "--eta", "0"], "eta"),
-    (["profile", "pbd", "--preset", "skin1", "--r", "1,-2"], "r"),
-    (["mc", "--albedo", "2", "--photons", "100"], "albedo"),
-    (["mc", "--albedo", "0.5", "--eta", "-1", "--photons", "100"], "eta"),
-])
+@pytest.mark.parametrize(
+    "argv,word",
+    [
+        (["profile", "pbd", "--albedo", "1.5,0.5,0.5", "--mfp", "1"], "albedo"),
+        (["profile", "pbd", "--albedo", "0.5", "--mfp", "-1"], "mfp"),
+        (["profile", "pbd", "--albedo", "0.5"], "mfp"),
+        (["profile", "pbd", "--preset", "jade"], "preset"),
+        (["profile", "pbd", "--preset", "skin1", "--eta", "0"], "eta"),
+        (["profile", "pbd", "--preset", "skin1", "--r", "1,-2"], "r"),
+        (["mc", "--albedo", "2", "--photons", "100"], "albedo"),
+        (["mc", "--albedo", "0.5", "--eta", "-1", "--photons", "100"], "eta"),
+    ],
+)
 def test_bad_input_is_one_line_exit_2(capsys, argv, word):
     rc, out, err = run(capsys, *argv)
     assert rc == 2 and err.count("\n") == 1 and word in err
 
 
 def test_mc_json(capsys):
-    rc, out, _ = run(capsys, "mc", "--albedo", "0.9", "--eta", "1.3", "--incidence", "diffuse", "--photons", "3000",
-                     "--seed", "4", "--json", "--no-progress", "--workers", "1")
+    rc, out, _ = run(
+        capsys,
+        "mc",
+        "--albedo",
+        "0.9",
+        "--eta",
+        "1.3",
+        "--incidence",
+        "diffuse",
+        "--photons",
+        "3000",
+        "--seed",
+        "4",
+        "--json",
+        "--no-progress",
+        "--workers",
+        "1",
+    )
     d = json.loads(out)
     assert rc == 0 and d["photons"] == 3000 and len(d["R"]) == len(d["r"]) == len(d["R_se"])
     assert 0 < d["total"] < 1 and d["total_se"] > 0 and d["params"]["incidence"] == "diffuse"

@@ -1,4 +1,5 @@
 """NumPy profile models: closed forms, normalisation, sampling, limits, scale invariance, fitter, registry."""
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -35,8 +36,10 @@ def test_dipole_fdr_matches_fresnel_integral():
 
 
 def test_fresnel_moment_chebyshev_matches_pbrt_polynomials():
-    for lo, hi, c1, c2 in ((constants.DIFFUSION_ETA_MIN, 1.0, constants.FM1_CHEB_LT1, constants.FM2_CHEB_LT1),
-                           (1.0, constants.DIFFUSION_ETA_MAX, constants.FM1_CHEB_GE1, constants.FM2_CHEB_GE1)):
+    for lo, hi, c1, c2 in (
+        (constants.DIFFUSION_ETA_MIN, 1.0, constants.FM1_CHEB_LT1, constants.FM2_CHEB_LT1),
+        (1.0, constants.DIFFUSION_ETA_MAX, constants.FM1_CHEB_GE1, constants.FM2_CHEB_GE1),
+    ):
         e = np.linspace(lo, hi, 2001)[:-1] if hi == 1.0 else np.linspace(lo, hi, 2001)
         t = (2 * e - lo - hi) / (hi - lo)
         assert np.abs(C.chebval(t, c1) - fresnel.fresnel_moment1(e)).max() < 1e-10
@@ -134,7 +137,9 @@ def test_fit_shared_variances_to_pbd_profile():
         gaussians.fit_gaussians(fn, 0)
 
 
-@pytest.mark.parametrize("name", ["dipole", "dipole+ss", "burley", "blender-burley", "pbd", "gaussians", "deon-skin", "none"])
+@pytest.mark.parametrize(
+    "name", ["dipole", "dipole+ss", "burley", "blender-burley", "pbd", "gaussians", "deon-skin", "none"]
+)
 def test_registry_models(name):
     m = preset("skin2")
     r = np.concatenate([[0.0], np.geomspace(1e-4, 1e3, 200), [1e30]])
@@ -176,13 +181,16 @@ def test_no_scattering_limits_and_extremes():
 
 
 @settings(deadline=None)
-@given(k=st.floats(1e-2, 1e4), a=st.floats(0, 1), l=st.floats(0.01, 10), eta=st.floats(0.2, 4.0),
-       x=st.floats(0, 50))
+@given(k=st.floats(1e-2, 1e4), a=st.floats(0, 1), l=st.floats(0.01, 10), eta=st.floats(0.2, 4.0), x=st.floats(0, 50))
 def test_scale_invariance_and_domain(k, a, l, eta, x):
     """R(k r; k l) = R(r; l) / k^2 for every model (very small and very large scene scales)."""
     r = x * l
-    for fn in (lambda r, l: dipole.dipole_profile(r, a, l, eta), lambda r, l: pbd.pbd_profile(r, a, l, eta),
-               lambda r, l: burley.burley_profile(r, a, l), lambda r, l: burley.blender_burley_profile(r, a, l)):
+    for fn in (
+        lambda r, l: dipole.dipole_profile(r, a, l, eta),
+        lambda r, l: pbd.pbd_profile(r, a, l, eta),
+        lambda r, l: burley.burley_profile(r, a, l),
+        lambda r, l: burley.blender_burley_profile(r, a, l),
+    ):
         base = fn(r, l)
         scaled = fn(k * r, k * l)
         assert np.isfinite(base).all() and (base >= 0).all()

@@ -1,4 +1,5 @@
 """GLSL profile library (shaders/lib/profiles_*.glsl) vs its NumPy twins, hard cases included."""
+
 import itertools
 
 import numpy as np
@@ -7,9 +8,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from app.gl.glsl_eval import assert_close_fp32
-from scene.optics.constants import MIN_MFP_MM
 from scene.optics import burley, dipole, fresnel, gaussians, pbd
 from scene.optics import single_scattering as ss
+from scene.optics.constants import MIN_MFP_MM
 
 F32 = np.float32
 
@@ -26,22 +27,42 @@ ETAS = [0.3, 0.5, 1.0, 1.3, 1.5, 2.5, 5.0]
 
 # (include, GLSL expression, NumPy reference f(r, a, l, eta) -> (N, 3))
 MODELS = {
-    "dipole": ("lib/profiles_dipole.glsl", "dipole_profile(r, a, l, eta)",
-               lambda r, a, l, e: dipole.dipole_profile(r, a, l, e)),
-    "single": ("lib/profiles_single.glsl", "single_scatter_profile(r, a, l, eta, 0.0)",
-               lambda r, a, l, e: ss.single_scatter_profile(r, a, l, e, 0.0)),
-    "pbd": ("lib/profiles_pbd.glsl", "pbd_profile(r, a, l, eta)",
-            lambda r, a, l, e: pbd.pbd_profile(r, a, l, e)),
-    "burley": ("lib/profiles_burley.glsl", "burley_profile(r, a, l, BURLEY_SEARCHLIGHT)",
-               lambda r, a, l, e: burley.burley_profile(r, a, l, "searchlight")),
-    "burley-diffuse": ("lib/profiles_burley.glsl", "burley_profile(r, a, l, BURLEY_DIFFUSE)",
-                       lambda r, a, l, e: burley.burley_profile(r, a, l, "diffuse")),
-    "burley-dmfp": ("lib/profiles_burley.glsl", "burley_profile(r, a, l, BURLEY_DMFP)",
-                    lambda r, a, l, e: burley.burley_profile(r, a, l, "dmfp")),
-    "blender-burley": ("lib/profiles_burley.glsl", "blender_burley_profile(r, a, l)",
-                       lambda r, a, l, e: burley.blender_burley_profile(r, a, l)),
-    "deon-skin": ("lib/profiles_gaussians.glsl", "deon_skin_profile(r, a)",
-                  lambda r, a, l, e: gaussians.deon_skin_profile(r, a)),
+    "dipole": (
+        "lib/profiles_dipole.glsl",
+        "dipole_profile(r, a, l, eta)",
+        lambda r, a, l, e: dipole.dipole_profile(r, a, l, e),
+    ),
+    "single": (
+        "lib/profiles_single.glsl",
+        "single_scatter_profile(r, a, l, eta, 0.0)",
+        lambda r, a, l, e: ss.single_scatter_profile(r, a, l, e, 0.0),
+    ),
+    "pbd": ("lib/profiles_pbd.glsl", "pbd_profile(r, a, l, eta)", lambda r, a, l, e: pbd.pbd_profile(r, a, l, e)),
+    "burley": (
+        "lib/profiles_burley.glsl",
+        "burley_profile(r, a, l, BURLEY_SEARCHLIGHT)",
+        lambda r, a, l, e: burley.burley_profile(r, a, l, "searchlight"),
+    ),
+    "burley-diffuse": (
+        "lib/profiles_burley.glsl",
+        "burley_profile(r, a, l, BURLEY_DIFFUSE)",
+        lambda r, a, l, e: burley.burley_profile(r, a, l, "diffuse"),
+    ),
+    "burley-dmfp": (
+        "lib/profiles_burley.glsl",
+        "burley_profile(r, a, l, BURLEY_DMFP)",
+        lambda r, a, l, e: burley.burley_profile(r, a, l, "dmfp"),
+    ),
+    "blender-burley": (
+        "lib/profiles_burley.glsl",
+        "blender_burley_profile(r, a, l)",
+        lambda r, a, l, e: burley.blender_burley_profile(r, a, l),
+    ),
+    "deon-skin": (
+        "lib/profiles_gaussians.glsl",
+        "deon_skin_profile(r, a)",
+        lambda r, a, l, e: gaussians.deon_skin_profile(r, a),
+    ),
 }
 
 
@@ -103,13 +124,15 @@ def test_totals_and_fresnel_twins(glsl):
     eta = f32(np.repeat([0.3, 0.8, 1.0, 1.3, 1.5, 2.0, 2.5, 4.0], 101 // 8 + 1)[:101])
     gpu = glsl.evaluate("lib/profiles_dipole.glsl", "dipole_total(a, eta)", {"a": a, "eta": eta}, 3)
     assert_close_fp32(gpu, np.stack([dipole.dipole_total(a[i], eta[i]) for i in range(len(a))]), what="dipole_total")
-    gpu = glsl.evaluate("lib/profiles_common.glsl", "vec3(fdr(eta), fresnel_moment1(eta), fresnel_moment2(eta))",
-                        {"eta": eta}, 3)
+    gpu = glsl.evaluate(
+        "lib/profiles_common.glsl", "vec3(fdr(eta), fresnel_moment1(eta), fresnel_moment2(eta))", {"eta": eta}, 3
+    )
     ref = np.stack([fresnel.fdr(eta), fresnel.fresnel_moment1(eta), fresnel.fresnel_moment2(eta)], 1)
     assert_close_fp32(gpu, ref, what="fresnel fits")
     c, e = (x.ravel() for x in np.meshgrid(f32(np.linspace(-1, 1, 81)), f32([0.5, 1.0, 1.33, 1.5, 2.4]), indexing="ij"))
-    gpu = glsl.evaluate("lib/profiles_common.glsl", "vec2(fresnel_dielectric(c, e), hg_phase(c, e - 1.2))",
-                        {"c": c, "e": e}, 2)
+    gpu = glsl.evaluate(
+        "lib/profiles_common.glsl", "vec2(fresnel_dielectric(c, e), hg_phase(c, e - 1.2))", {"c": c, "e": e}, 2
+    )
     assert_close_fp32(gpu[:, 0], fresnel.fresnel_dielectric(c, e), what="fresnel_dielectric")
     assert_close_fp32(gpu[:, 1], fresnel.hg_phase(c, e - 1.2), what="hg_phase")
 
@@ -132,8 +155,12 @@ def test_single_scatter_brdf_twin(glsl):
     eta = f32(np.array([1.3, 1.0, 1.5, 2.0])[k])
     n = np.tile([0.0, 0.0, 1.0], (len(wi), 1))
     alpha = np.tile(f32([0.2, 0.7, 1.0]), (len(wi), 1))
-    gpu = glsl.evaluate("lib/profiles_single.glsl", "single_scatter_brdf(n, wi, wo, a, eta, g)",
-                        {"n": n, "wi": wi, "wo": wo, "a": alpha, "eta": eta, "g": g}, 3)
+    gpu = glsl.evaluate(
+        "lib/profiles_single.glsl",
+        "single_scatter_brdf(n, wi, wo, a, eta, g)",
+        {"n": n, "wi": wi, "wo": wo, "a": alpha, "eta": eta, "g": g},
+        3,
+    )
     ref = ss.single_scatter_brdf(n, wi, wo, alpha[0], eta, g)
     assert_close_fp32(gpu, ref, what="single_scatter_brdf")
     assert (ref >= 0).all()
@@ -144,9 +171,12 @@ def test_single_scatter_brdf_twin(glsl):
 def test_burley_samplers_twin(glsl):
     xi = f32(np.concatenate([np.linspace(0, 0.999, 400), [0.9, 0.9999, 0.99999]]))
     d = f32(np.geomspace(1e-3, 10, len(xi)))
-    gpu = glsl.evaluate("lib/profiles_burley.glsl",
-                        "vec3(blender_burley_sample(xi, d), burley_sample_golubev(xi, d), burley_cdf(d, d))",
-                        {"xi": xi, "d": d}, 3)
+    gpu = glsl.evaluate(
+        "lib/profiles_burley.glsl",
+        "vec3(blender_burley_sample(xi, d), burley_sample_golubev(xi, d), burley_cdf(d, d))",
+        {"xi": xi, "d": d},
+        3,
+    )
     ref_n = burley.blender_burley_sample(xi, d)
     ref_g = burley.burley_sample_golubev(xi, d)
     # The samplers invert a CDF whose slope -> 0 at the tail: compare through the CDF (the
@@ -160,12 +190,20 @@ def test_burley_samplers_twin(glsl):
 
 
 def test_gaussian_sum_twin_with_a_fit(glsl):
-    fit = gaussians.fit_gaussians(lambda r: burley.burley_profile(r, [0.8, 0.5, 0.2], [1.0, 0.5, 0.25]), 5,
-                                  optimise="geometric")
+    fit = gaussians.fit_gaussians(
+        lambda r: burley.burley_profile(r, [0.8, 0.5, 0.2], [1.0, 0.5, 0.25]), 5, optimise="geometric"
+    )
     v, w = f32(fit.variances_mm2), f32(fit.weights)
-    prelude = ("const float V[GAUSS_MAX] = float[GAUSS_MAX](" + ", ".join(f"{float(x)!r}" for x in list(v) + [0.0] * 3) + ");\n"
-               "const vec3 W[GAUSS_MAX] = vec3[GAUSS_MAX](" +
-               ", ".join(f"vec3({float(a)!r}, {float(b)!r}, {float(c)!r})" for a, b, c in list(map(tuple, w)) + [(0.0, 0.0, 0.0)] * 3) + ");")
+    prelude = (
+        "const float V[GAUSS_MAX] = float[GAUSS_MAX]("
+        + ", ".join(f"{float(x)!r}" for x in list(v) + [0.0] * 3)
+        + ");\n"
+        "const vec3 W[GAUSS_MAX] = vec3[GAUSS_MAX]("
+        + ", ".join(
+            f"vec3({float(a)!r}, {float(b)!r}, {float(c)!r})" for a, b, c in list(map(tuple, w)) + [(0.0, 0.0, 0.0)] * 3
+        )
+        + ");"
+    )
     r = f32(np.concatenate([[0.0], np.geomspace(1e-4, 1e3, 300)]))
     gpu = glsl.evaluate("lib/profiles_gaussians.glsl", "gaussian_sum(r, V, W, 5)", {"r": r}, 3, prelude=prelude)
     assert_close_fp32(gpu, gaussians.gaussian_sum_profile(r, v, w), what="gaussian_sum")
@@ -173,10 +211,10 @@ def test_gaussian_sum_twin_with_a_fit(glsl):
 
 finite = dict(allow_nan=False, allow_infinity=False)
 params = st.tuples(
-    st.one_of(st.floats(0, 1e3, **finite), st.sampled_from([0.0, 1e-30, 1e38])),          # r
-    st.tuples(*[st.floats(0, 1, **finite)] * 3),                                         # alpha
+    st.one_of(st.floats(0, 1e3, **finite), st.sampled_from([0.0, 1e-30, 1e38])),  # r
+    st.tuples(*[st.floats(0, 1, **finite)] * 3),  # alpha
     st.tuples(*[st.one_of(st.floats(0, 1e4, **finite), st.floats(0, 1e-5, **finite))] * 3),  # mfp
-    st.floats(0.01, 10, **finite),                                                         # eta
+    st.floats(0.01, 10, **finite),  # eta
 )
 
 

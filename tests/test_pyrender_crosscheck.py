@@ -1,5 +1,6 @@
 """pyrender, an independent renderer, must see the same silhouette and depth as Skinlab:
 this checks our camera, transforms and mesh loading against someone else's."""
+
 import numpy as np
 import pytest
 
@@ -21,12 +22,12 @@ def test_silhouette_and_depth_match_pyrender(ctx, turn):
     head.parent.translation = (0.3, -0.2, 0.5)
     ours = Renderer(ctx).render(s, RenderSettings(*SIZE, shadow_size=256))
     cam = s.camera
-    peer = run_peer([(str(head.mesh.source), head.world_matrix)], cam.world_matrix, cam.yfov, cam.znear,
-                    cam.zfar, SIZE)
+    peer = run_peer([(str(head.mesh.source), head.world_matrix)], cam.world_matrix, cam.yfov, cam.znear, cam.zfar, SIZE)
     mine = np.isfinite(ours.depth)
     theirs = peer["depth"] > 0
     assert mine.mean() > 0.2
     mismatch = mine ^ theirs
+
     # rasterisation rules may differ on edge pixels only
     def edges(m):
         return m ^ np.roll(m, 1, 0) | m ^ np.roll(m, 1, 1) | m ^ np.roll(m, -1, 0) | m ^ np.roll(m, -1, 1)

@@ -1,10 +1,11 @@
 """Render the head at small size: deterministic, finite, lips on the lips, shadows from the key."""
+
 import numpy as np
 import pytest
+from head_probe import landmarks, project, redness
 
 from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
-from head_probe import landmarks, project, redness
 from scene import scenefile
 from scene.scenefile import load_scene
 
@@ -50,7 +51,7 @@ def test_key_light_shadow_darkens_and_plan_skips_unneeded_shadow_passes(renderer
     s, a, _ = head_frames
     names = a.plan.names()
     assert names[0] == "shadow[key]" and names[-2:] == ["forward", "tonemap"]
-    assert "tsd_irradiance[LeePerrySmith]" in names   # the skin scatters: texture-space passes
+    assert "tsd_irradiance[LeePerrySmith]" in names  # the skin scatters: texture-space passes
     # plain diffuse (no translucency, which needs the shadow map): a shadow only removes light
     st = RenderSettings(*SIZE, shadow_size=512, sss_model="none")
     a = renderer.render(s, st)
@@ -60,8 +61,8 @@ def test_key_light_shadow_darkens_and_plan_skips_unneeded_shadow_passes(renderer
     s.find("key").cast_shadow = True
     assert b.plan.names() == ["forward", "tonemap"]
     diff = b.hdr[..., :3].sum(-1) - a.hdr[..., :3].sum(-1)
-    assert (diff >= -1e-6).all()            # a shadow only removes light
-    assert (diff > 0.05).mean() > 0.01      # and it does remove some (nose, neck)
+    assert (diff >= -1e-6).all()  # a shadow only removes light
+    assert (diff > 0.05).mean() > 0.01  # and it does remove some (nose, neck)
 
 
 def test_explain_lists_passes_and_reasons(head_frames):

@@ -12,18 +12,24 @@ def tri_mesh():
 
 
 def test_world_matrix_composes_and_is_cached_until_something_above_changes():
-    a, b, c = Node("a", translation=(1, 0, 0)), Node("b", rotation=tf.euler_deg_to_quat([0, 0, 90])), Node("c", scale=(2, 2, 2))
-    a.add(b); b.add(c)
+    a, b, c = (
+        Node("a", translation=(1, 0, 0)),
+        Node("b", rotation=tf.euler_deg_to_quat([0, 0, 90])),
+        Node("c", scale=(2, 2, 2)),
+    )
+    a.add(b)
+    b.add(c)
     c.translation = (1, 0, 0)
     p = c.world_matrix @ [0, 0, 0, 1]
     assert np.allclose(p[:3], [1, 1, 0])  # a moves +x, b rotates c's +x offset to +y
     n = c.world_updates
     for _ in range(5):
-        c.world_matrix
+        _ = c.world_matrix
     assert c.world_updates == n  # cached
-    sibling = Node("s"); a.add(sibling)
+    sibling = Node("s")
+    a.add(sibling)
     sibling.translation = (5, 5, 5)
-    c.world_matrix
+    _ = c.world_matrix
     assert c.world_updates == n  # a sibling's change does not touch c
     a.translation = (0, 0, 1)
     assert np.allclose((c.world_matrix @ [0, 0, 0, 1])[:3], [0, 1, 1])
@@ -74,7 +80,8 @@ def test_mesh_validation_and_degenerate_normals():
         Mesh("bad", np.zeros((3, 3)), np.array([[0, 1, 5]]))
     m = Mesh("flat", np.zeros((3, 3)), np.array([[0, 1, 2]]))  # zero-area triangle
     assert np.isfinite(m.normals).all()
-    s = Scene("s"); s.add(MeshNode("m", tri_mesh(), Material()))
+    s = Scene("s")
+    s.add(MeshNode("m", tri_mesh(), Material()))
     lo, hi = s.world_bounds()
     assert np.allclose(lo, [0, 0, 0]) and np.allclose(hi, [1, 1, 0])
 

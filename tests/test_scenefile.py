@@ -21,7 +21,7 @@ mm_per_unit = 1000.0
 base_color = [0.9, 0.9, 0.88]
 [[meshes]]
 name = "bunny"
-file = "{ASSETS / 'stanford-bunny' / 'bunny.ply'}"
+file = "{ASSETS / "stanford-bunny" / "bunny.ply"}"
 material = "marble"
 overrides = {{ roughness = 0.2 }}
 [[lights]]
@@ -38,7 +38,9 @@ def test_default_scene_loads_head_with_maps_lights_and_camera():
     assert head.mesh.uvs is not None and len(head.mesh.positions) == 9279
     assert set(head.material.textures()) == {"u_base_color_map", "u_normal_map"}
     key = s.find("key")
-    assert key.cast_shadow and np.allclose(key.direction, np.array([-0.55, -0.35, -0.75]) / np.linalg.norm([-0.55, -0.35, -0.75]))
+    assert key.cast_shadow and np.allclose(
+        key.direction, np.array([-0.55, -0.35, -0.75]) / np.linalg.norm([-0.55, -0.35, -0.75])
+    )
     assert s.camera is not None
 
 
@@ -52,15 +54,18 @@ def test_overrides_and_default_camera(tmp_path):
     assert np.linalg.norm(s.camera.world_position - (lo + hi) / 2) > np.linalg.norm(hi - lo) / 2
 
 
-@pytest.mark.parametrize("text, match", [
-    ("[scene\n", r"s.toml: not valid TOML"),
-    ("[scene]\nmm_per_unit = 1\n[[meshes]]\nfile='nope.glb'\n", r"s.toml: mesh file not found: .*nope.glb"),
-    ("[[meshes]]\nfil='x'\n", r"s.toml: \[\[meshes\]\] #1: unknown key\(s\) fil"),
-    ("[materials.m]\nroughness = 2\n", r"s.toml: material 'm': roughness: value 2 outside the valid range"),
-    ("[materials.m]\nbase_color_map = 'missing.png'\n", r"\[materials.m\]: texture file not found: .*missing.png"),
-    ("[[lights]]\ntype='point'\n", r"\[\[lights\]\] #1: a point light needs 'position'"),
-    ("[scene]\nmm_per_unit = 1\n", r"the scene has no meshes"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ("[scene\n", r"s.toml: not valid TOML"),
+        ("[scene]\nmm_per_unit = 1\n[[meshes]]\nfile='nope.glb'\n", r"s.toml: mesh file not found: .*nope.glb"),
+        ("[[meshes]]\nfil='x'\n", r"s.toml: \[\[meshes\]\] #1: unknown key\(s\) fil"),
+        ("[materials.m]\nroughness = 2\n", r"s.toml: material 'm': roughness: value 2 outside the valid range"),
+        ("[materials.m]\nbase_color_map = 'missing.png'\n", r"\[materials.m\]: texture file not found: .*missing.png"),
+        ("[[lights]]\ntype='point'\n", r"\[\[lights\]\] #1: a point light needs 'position'"),
+        ("[scene]\nmm_per_unit = 1\n", r"the scene has no meshes"),
+    ],
+)
 def test_bad_scene_files_name_file_and_key(tmp_path, text, match):
     with pytest.raises((SceneFileError, FileNotFoundError), match=match):
         load_scene(write(tmp_path, text))

@@ -1,6 +1,4 @@
 """#include expansion, #line directives, error locations through includes, last-good programs."""
-import shutil
-from pathlib import Path
 
 import pytest
 

@@ -1,13 +1,9 @@
 """The alternatives to texture-space diffusion: the brute-force exact reference, screen-space
 separable SSS and the per-pixel tint baseline, each against its own NumPy model."""
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-
-sys.path.insert(0, str(Path(__file__).parent))
-from tsd_scenes import exact_profile, pixel_x, renderer, skin, slab_scene  # noqa: E402,F401
+from tsd_scenes import exact_profile, pixel_x, skin, slab_scene
 
 from app.render.passes.tsd import read_texture
 from app.render.settings import RenderSettings
@@ -36,8 +32,9 @@ def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer
     # texture level against the NumPy brute-force convolution of the same irradiance
     irr, stretch = read_texture(t.targets.irradiance), read_texture(t.targets.stretch)
     gpu = read_texture(t.targets.levels[0])[..., :3]
-    ref = tsd.exact_profile_convolution(irr, (stretch[n // 2, n // 2, 0], stretch[n // 2, n // 2, 1]),
-                                        exact_profile(model, medium))
+    ref = tsd.exact_profile_convolution(
+        irr, (stretch[n // 2, n // 2, 0], stretch[n // 2, n // 2, 1]), exact_profile(model, medium)
+    )
     core = (slice(16, -16), slice(16, -16))
     rel = np.abs(gpu[core] - ref[core]).sum(axis=(0, 1)) / np.abs(ref[core]).sum(axis=(0, 1))
     assert np.all(rel < 0.02), rel
@@ -71,10 +68,12 @@ def test_screen_space_sss_follows_its_separable_kernel(renderer):
 def test_screen_space_sss_does_not_bleed_across_depth_discontinuities(renderer):
     """A second, nearer slab over half the view: its scattering must not pull in the far slab's
     light across the silhouette (follow-the-surface), so the near slab's unlit side stays dark."""
-    from scene.graph import MeshNode
     from tsd_scenes import quad_mesh
+
+    from scene.graph import MeshNode
+
     scene = slab_scene(material=skin("burley"))
-    near = quad_mesh("near", -1.5, 0.0, -1.5, 1.5, z=10.0)   # 10 units = 200 mm nearer the camera
+    near = quad_mesh("near", -1.5, 0.0, -1.5, 1.5, z=10.0)  # 10 units = 200 mm nearer the camera
     near_mat = skin("burley", base=(1.0, 1.0, 1.0))
     scene.add(MeshNode("near", near, near_mat))
     scene.lights()[0].intensity = 1.0

@@ -1,12 +1,8 @@
 """Texture-space diffusion on the GPU against its NumPy references (scene/optics/tsd.py)."""
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-
-sys.path.insert(0, str(Path(__file__).parent))
-from tsd_scenes import exact_profile, pixel_x, quad_mesh, renderer, skin, slab_scene  # noqa: E402,F401
+from tsd_scenes import exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 from app.gl.glsl_eval import assert_close_fp32
 from app.render.passes.tsd import read_texture
@@ -50,22 +46,26 @@ def test_dilation_pass_matches_its_twin(renderer):
     gpu = read_texture(t.stretch)
     ref = tsd.dilate_reference(img, 4)
     np.testing.assert_allclose(gpu, ref, rtol=1e-5, atol=1e-6)
-    assert (ref[..., 3] > 0).sum() > mask.sum()          # it did grow
-    np.testing.assert_array_equal(gpu[mask], img[mask])   # covered texels are untouched
+    assert (ref[..., 3] > 0).sum() > mask.sum()  # it did grow
+    np.testing.assert_array_equal(gpu[mask], img[mask])  # covered texels are untouched
     renderer.tsd.nodes.pop(-1).release()
 
 
 def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
     """Irradiance and stretch read back from the GPU, convolved in NumPy with the same Gaussian chain,
     must give the GPU's blurred levels to fp32 rounding. A trapezoid slab makes the stretch vary."""
-    mesh = Mesh("slab", np.array([[-1, -1, 0], [1, -1, 0], [1.6, 1, 0], [-1.6, 1, 0]], np.float32),
-                np.array([[0, 1, 2], [0, 2, 3]], np.uint32), normals=np.tile([0, 0, 1.0], (4, 1)),
-                uvs=np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32))
+    mesh = Mesh(
+        "slab",
+        np.array([[-1, -1, 0], [1, -1, 0], [1.6, 1, 0], [-1.6, 1, 0]], np.float32),
+        np.array([[0, 1, 2], [0, 2, 3]], np.uint32),
+        normals=np.tile([0, 0, 1.0], (4, 1)),
+        uvs=np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32),
+    )
     scene = slab_scene(occluder=True, mesh=mesh)
     renderer.render(scene, RenderSettings(64, 64, shadow_size=1024, tsd_size=128), readback=False)
     t = tsd_node(renderer, scene)
     irr, stretch = read_texture(t.targets.irradiance), read_texture(t.targets.stretch)
-    assert np.ptp(stretch[..., 0]) > 0.05 * stretch[..., 0].mean()     # the stretch does vary
+    assert np.ptp(stretch[..., 0]) > 0.05 * stretch[..., 0].mean()  # the stretch does vary
     assert t.kernel.levels >= 3
     levels, diffused = tsd.diffuse_reference(irr, stretch, t.kernel)
     for k, ref in enumerate(levels):
@@ -81,8 +81,9 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
     cov = stretch[..., 3] > 0
     np.testing.assert_allclose(stretch[cov, :2], 2 * 20.0 / 128, rtol=1e-5)
     _, diffused = tsd.diffuse_reference(irr, stretch, t.kernel)
-    exact = tsd.exact_profile_convolution(irr, (stretch[64, 64, 0], stretch[64, 64, 1]),
-                                          exact_profile("burley", tsd.material_medium(t.material.values)))
+    exact = tsd.exact_profile_convolution(
+        irr, (stretch[64, 64, 0], stretch[64, 64, 1]), exact_profile("burley", tsd.material_medium(t.material.values))
+    )
     rel_l1 = np.abs(diffused - exact).sum(axis=(0, 1)) / np.abs(exact).sum(axis=(0, 1))
     print(f"K=6 Gaussian fit vs exact Burley convolution, relative L1 per channel: {rel_l1.round(4)}")
     assert np.all(np.isfinite(rel_l1)) and np.all(rel_l1 < 0.03), rel_l1
@@ -105,7 +106,7 @@ def test_shadow_edge_follows_the_profile_edge_response(renderer, model):
     assert err.max() < 0.02, (model, err.max(axis=0), int(err.argmax()) // 3)
     # and the edge is really there: the shadowed side is dark, the red channel bleeds furthest
     assert row[: n // 8].max() < 0.02 * lit.max()
-    mid = (row[n // 2 - 6] / lit)
+    mid = row[n // 2 - 6] / lit
     assert mid[0] > mid[2]
 
 
@@ -123,8 +124,9 @@ def test_constant_irradiance_keeps_its_mean(renderer):
     img = res.hdr[..., :3]
     np.testing.assert_allclose(img, np.broadcast_to(img[32, 32], img.shape), rtol=1e-4)
     # the diffuse level is albedo x irradiance / pi x exit weight (normal view, NoV = 1)
-    expected = np.array([0.7, 0.5, 0.4]) * irr[64, 64] / np.power([0.7, 0.5, 0.4], 0.5) / np.pi \
-        * tsd.sss_exit_weight(1.0)
+    expected = (
+        np.array([0.7, 0.5, 0.4]) * irr[64, 64] / np.power([0.7, 0.5, 0.4], 0.5) / np.pi * tsd.sss_exit_weight(1.0)
+    )
     np.testing.assert_allclose(img[32, 32], expected, rtol=1e-3)
 
 
@@ -138,8 +140,9 @@ def test_scale_invariance(renderer):
     b = renderer.render(slab_scene(occluder=True, mm_per_unit=40.0, material=skin(radius=(16.0, 8.0, 4.0))), st).hdr
     np.testing.assert_allclose(a, b, atol=2e-4 * a.max())
     # the same physical scene described in other units: half the coordinates, twice the mm per unit
-    d = renderer.render(slab_scene(half=0.5, occluder=True, mm_per_unit=40.0, material=skin(radius=(8.0, 4.0, 2.0))),
-                        st).hdr
+    d = renderer.render(
+        slab_scene(half=0.5, occluder=True, mm_per_unit=40.0, material=skin(radius=(8.0, 4.0, 2.0))), st
+    ).hdr
     np.testing.assert_allclose(a, d, atol=2e-4 * a.max())
     # and the physics does depend on the ratio: the same radius at twice the size is a sharper edge
     c = renderer.render(slab_scene(occluder=True, mm_per_unit=40.0, material=skin(radius=(8.0, 4.0, 2.0))), st).hdr
@@ -150,39 +153,50 @@ def test_uv_seam_does_not_darken(renderer):
     """The slab cut at x = 0 into two UV charts far apart: under uniform light the seam must look
     like the rest (dilation + coverage-normalised blurs); a kernel pulling in empty texels would
     darken both sides of the cut by up to half."""
-    pos = np.array([[-1, -1, 0], [0, -1, 0], [0, 1, 0], [-1, 1, 0],
-                    [0, -1, 0], [1, -1, 0], [1, 1, 0], [0, 1, 0]], np.float32)
-    uv = np.array([[0.05, 0.05], [0.4, 0.05], [0.4, 0.95], [0.05, 0.95],
-                   [0.6, 0.05], [0.95, 0.05], [0.95, 0.95], [0.6, 0.95]], np.float32)
-    mesh = Mesh("seamed", pos, np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]], np.uint32),
-                normals=np.tile([0, 0, 1.0], (8, 1)), uvs=uv)
+    pos = np.array(
+        [[-1, -1, 0], [0, -1, 0], [0, 1, 0], [-1, 1, 0], [0, -1, 0], [1, -1, 0], [1, 1, 0], [0, 1, 0]], np.float32
+    )
+    uv = np.array(
+        [[0.05, 0.05], [0.4, 0.05], [0.4, 0.95], [0.05, 0.95], [0.6, 0.05], [0.95, 0.05], [0.95, 0.95], [0.6, 0.95]],
+        np.float32,
+    )
+    mesh = Mesh(
+        "seamed",
+        pos,
+        np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]], np.uint32),
+        normals=np.tile([0, 0, 1.0], (8, 1)),
+        uvs=uv,
+    )
     scene = slab_scene(mesh=mesh, material=skin(radius=(20.0, 10.0, 5.0)))
     res = renderer.render(scene, RenderSettings(96, 96, tsd_size=128))
     img = res.hdr[..., :3]
     core = img[20:76, 20:76]
     ref = img[48, 24]
     np.testing.assert_allclose(core, np.broadcast_to(ref, core.shape), rtol=0.01)
-    assert tsd_node(renderer, scene, "slab").kernel.steps[-1].sigma_mm > 1.0   # wide enough to reach the seam
+    assert tsd_node(renderer, scene, "slab").kernel.steps[-1].sigma_mm > 1.0  # wide enough to reach the seam
 
 
 def test_translucency_through_thin_parts(renderer):
     """Light from behind a thin sheet comes through (attenuated by the profile's Gaussians at the
     sheet's thickness); a thick block lets almost nothing through; no shadow-casting light, no
     translucency."""
+
     def sheet(thickness_units, shadow=True):
         s = slab_scene(material=skin(radius=(8.0, 4.0, 2.0)), light_dir=(0, 0, 1))
         s.lights()[0].cast_shadow = shadow
         from scene.graph import MeshNode
         from scene.materials import Material
-        back = quad_mesh("back", -1, 1, 1, -1, z=-thickness_units)   # facing -z, toward the light
+
+        back = quad_mesh("back", -1, 1, 1, -1, z=-thickness_units)  # facing -z, toward the light
         s.add(MeshNode("back", back, Material("back", {"specular": 0.0})))
         return s
+
     st = RenderSettings(48, 48, shadow_size=1024, tsd_size=64)
-    thin = renderer.render(sheet(0.5 / 20.0), st)        # 0.5 mm
-    thick = renderer.render(sheet(20.0 / 20.0), st)      # 20 mm
+    thin = renderer.render(sheet(0.5 / 20.0), st)  # 0.5 mm
+    thick = renderer.render(sheet(20.0 / 20.0), st)  # 20 mm
     none = renderer.render(sheet(0.5 / 20.0, shadow=False), st)
     c = thin.hdr[24, 24, :3]
-    assert c[0] > 0.05 and c[0] > c[2]                    # red goes furthest
+    assert c[0] > 0.05 and c[0] > c[2]  # red goes furthest
     # the irradiance texel is the light through 0.5 mm: e x cos x (1 - F) x sum_k W_k e^{-d^2/2v_k}
     st_thin = sheet(0.5 / 20.0)
     renderer.render(st_thin, st, readback=False)

@@ -1,12 +1,10 @@
 """Texture-space diffusion is planned from the scene; bad input gives warnings or errors, never NaN."""
-import sys
+
 from pathlib import Path
 
 import numpy as np
 import pytest
-
-sys.path.insert(0, str(Path(__file__).parent))
-from tsd_scenes import quad_mesh, renderer, skin, slab_scene  # noqa: E402,F401
+from tsd_scenes import quad_mesh, skin, slab_scene
 
 from app.render.settings import RenderSettings
 from scene.materials import Material
@@ -22,16 +20,21 @@ def kinds(plan):
 
 
 def test_no_scattering_material_means_no_texture_space_passes(renderer):
-    for mat in (skin(model="none"), skin(subsurface=0.0), skin(radius=(0.0, 0.0, 0.0)),
-                Material("plain", {"base_color": (0.5, 0.5, 0.5)})):
+    for mat in (
+        skin(model="none"),
+        skin(subsurface=0.0),
+        skin(radius=(0.0, 0.0, 0.0)),
+        Material("plain", {"base_color": (0.5, 0.5, 0.5)}),
+    ):
         res = renderer.render(slab_scene(material=mat), ST)
         assert not any(k.startswith("tsd") for k in kinds(res.plan)), mat.values
         assert np.isfinite(res.hdr).all() and res.hdr[24, 24, :3].max() > 0
     # and settings override per render: --sss none / --sss dipole
     res = renderer.render(slab_scene(), RenderSettings(48, 48, tsd_size=64, sss_model="none"))
     assert kinds(res.plan) == ["forward", "tonemap"]
-    res = renderer.render(slab_scene(material=skin(model="none")),
-                          RenderSettings(48, 48, tsd_size=64, sss_model="dipole"))
+    res = renderer.render(
+        slab_scene(material=skin(model="none")), RenderSettings(48, 48, tsd_size=64, sss_model="dipole")
+    )
     assert "tsd_irradiance" in kinds(res.plan) and "scatters (dipole)" in res.plan.explain()
 
 
@@ -44,13 +47,13 @@ def test_stretch_map_is_recomputed_only_when_geometry_changes(renderer):
     second = renderer.render(scene, ST)
     assert "tsd_stretch" not in kinds(second.plan) and renderer.tsd.stretch_updates == n
     assert any("stretch map reused" in why for _, why in second.plan.skipped)
-    node.mesh.positions = node.mesh.positions * np.float32(2.0)     # the geometry changes...
+    node.mesh.positions = node.mesh.positions * np.float32(2.0)  # the geometry changes...
     node.mesh.version += 1
     third = renderer.render(scene, ST)
     assert "tsd_stretch" in kinds(third.plan) and renderer.tsd.stretch_updates == n + 1
-    scene.mm_per_unit *= 2                                              # ...or the scene scale
+    scene.mm_per_unit *= 2  # ...or the scene scale
     assert "tsd_stretch" in kinds(renderer.render(scene, ST).plan)
-    node.scale = (1.0, 3.0, 1.0)                                        # ...or the node's transform
+    node.scale = (1.0, 3.0, 1.0)  # ...or the node's transform
     assert "tsd_stretch" in kinds(renderer.render(scene, ST).plan)
 
 
@@ -58,30 +61,34 @@ def test_texture_space_targets_are_released_when_no_longer_used(renderer):
     a, b = slab_scene(), slab_scene()
     renderer.render(a, ST, readback=False)
     assert a.find("slab").uid in renderer.tsd.nodes
-    renderer.render(b, ST, readback=False)                 # another scene (a reload, say)
+    renderer.render(b, ST, readback=False)  # another scene (a reload, say)
     assert set(renderer.tsd.nodes) == {b.find("slab").uid}
     renderer.render(b, RenderSettings(48, 48, tsd_size=64, sss_model="none"), readback=False)
     assert renderer.tsd.nodes == {}
 
 
 def test_negligible_and_subtexel_gaussians_are_skipped():
-    fit = tsd.ProfileFit("test", np.array([1e-4, 0.5, 2.0, 8.0]),
-                         np.array([[0.3, 0.3, 0.3], [0.4, 0.4, 0.4], [0.2999, 0.2999, 0.2999],
-                                   [1e-4, 5e-4, 0.0]]), np.zeros(3), np.zeros(3))
+    fit = tsd.ProfileFit(
+        "test",
+        np.array([1e-4, 0.5, 2.0, 8.0]),
+        np.array([[0.3, 0.3, 0.3], [0.4, 0.4, 0.4], [0.2999, 0.2999, 0.2999], [1e-4, 5e-4, 0.0]]),
+        np.zeros(3),
+        np.zeros(3),
+    )
     k = tsd.design_kernel(fit, 0.1, 0.1)
     assert [s.variance_mm2 for s in k.steps] == [0.5, 2.0]
     skipped = dict(k.skipped)
-    assert any("weight" in why for why in skipped.values())               # the 8 mm2 one
-    assert any("texel" in why for why in skipped.values())                # the 1e-4 mm2 one
+    assert any("weight" in why for why in skipped.values())  # the 8 mm2 one
+    assert any("texel" in why for why in skipped.values())  # the 1e-4 mm2 one
     np.testing.assert_allclose(k.identity + k.weights().sum(axis=0), 1.0)
-    np.testing.assert_allclose(k.identity, 0.3 / 0.9999, rtol=1e-6)       # sub-texel mass is kept, unblurred
+    np.testing.assert_allclose(k.identity, 0.3 / 0.9999, rtol=1e-6)  # sub-texel mass is kept, unblurred
     # chained variances: each step blurs by the difference
     assert k.steps[1].sigma_mm == pytest.approx(np.sqrt(1.5))
 
 
 def test_tap_count_follows_kernel_width():
     assert tsd.tap_count(0.1) == tsd.TSD_MIN_TAPS
-    assert tsd.tap_count(2.0) == 13                       # 2 * ceil(3 * 2) + 1
+    assert tsd.tap_count(2.0) == 13  # 2 * ceil(3 * 2) + 1
     assert tsd.tap_count(1e9) == tsd.TSD_MAX_TAPS
     t, w = tsd.blur_taps(13)
     assert len(t) == 13 and abs(w.sum() - 1) < 1e-12 and abs(np.sum(w * t * t) - 1.0) < 0.05
@@ -104,8 +111,7 @@ def test_missing_uvs_generate_an_atlas_with_a_warning(renderer):
 
 
 def test_overlapping_uvs_and_zero_area_triangles_warn_but_render_finite(renderer):
-    pos = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0], [0, 0, 0], [0.5, 0.5, 0], [1, 1, 0]],
-                   np.float32)
+    pos = np.array([[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0], [0, 0, 0], [0.5, 0.5, 0], [1, 1, 0]], np.float32)
     # triangle 3: collinear world positions (zero area: infinite stretch) over a real UV triangle;
     # triangle 4: the same UVs as triangle 1 (overlap)
     uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.1, 0.1], [0.3, 0.1], [0.2, 0.3]], np.float32)
@@ -116,21 +122,25 @@ def test_overlapping_uvs_and_zero_area_triangles_warn_but_render_finite(renderer
     assert "overlap" in text and "zero world area" in text, res.plan.warnings
     assert np.isfinite(res.hdr).all()
     from app.render.passes.tsd import read_texture
+
     for name, tex in renderer.last_frame.targets.items():
         if name.startswith("tsd"):
             assert np.isfinite(read_texture(tex)).all(), name
 
 
-@pytest.mark.parametrize("values", [
-    {"subsurface_radius": (0.0, 0.0, 0.0)},
-    {"subsurface_radius": (5.0, 0.0, 1.0)},          # one channel does not scatter
-    {"subsurface_radius": (1000.0, 1000.0, 1000.0)},  # far wider than the object
-    {"subsurface_radius": (1e-6, 1e-6, 1e-6)},       # far narrower than a texel
-    {"subsurface_color": (0.0, 0.0, 0.0)},           # albedo 0
-    {"subsurface_color": (1.0, 1.0, 1.0)},           # albedo 1: no absorption
-    {"base_color": (0.0, 0.0, 0.0)},
-    {"roughness": 0.0, "specular": 1.0},
-])
+@pytest.mark.parametrize(
+    "values",
+    [
+        {"subsurface_radius": (0.0, 0.0, 0.0)},
+        {"subsurface_radius": (5.0, 0.0, 1.0)},  # one channel does not scatter
+        {"subsurface_radius": (1000.0, 1000.0, 1000.0)},  # far wider than the object
+        {"subsurface_radius": (1e-6, 1e-6, 1e-6)},  # far narrower than a texel
+        {"subsurface_color": (0.0, 0.0, 0.0)},  # albedo 0
+        {"subsurface_color": (1.0, 1.0, 1.0)},  # albedo 1: no absorption
+        {"base_color": (0.0, 0.0, 0.0)},
+        {"roughness": 0.0, "specular": 1.0},
+    ],
+)
 @pytest.mark.parametrize("model", ["dipole", "burley", "blender-burley", "gaussians", "pbd"])
 def test_hard_material_values_stay_finite(renderer, model, values):
     res = renderer.render(slab_scene(occluder=True, material=skin(model=model, **values)), ST)
@@ -139,16 +149,18 @@ def test_hard_material_values_stay_finite(renderer, model, values):
 
 
 def test_zero_radius_channel_is_unblurred():
-    m = tsd.material_medium({"subsurface_color": (0.8, 0.5, 0.4), "subsurface_radius": (5.0, 0.0, 1.0),
-                             "specular": 0.5})
+    m = tsd.material_medium(
+        {"subsurface_color": (0.8, 0.5, 0.4), "subsurface_radius": (5.0, 0.0, 1.0), "specular": 0.5}
+    )
     f = tsd.profile_fit("burley", m, 4)
     assert f.identity[1] == 1.0 and np.all(f.weights[:, 1] == 0)
     assert f.identity[0] == 0.0 and f.weights[:, 0].sum() == pytest.approx(1.0)
 
 
 def test_unknown_model_and_bad_settings_are_clear_errors():
-    m = tsd.material_medium({"subsurface_color": (0.8, 0.5, 0.4), "subsurface_radius": (5.0, 1.0, 1.0),
-                             "specular": 0.5})
+    m = tsd.material_medium(
+        {"subsurface_color": (0.8, 0.5, 0.4), "subsurface_radius": (5.0, 1.0, 1.0), "specular": 0.5}
+    )
     with pytest.raises(ValueError, match="texture-space diffusion has no profile for 'fog'"):
         tsd.profile_fit("fog", m, 4)
     with pytest.raises(ValueError, match="render setting sss_model: expected one of"):
@@ -160,8 +172,8 @@ def test_unknown_model_and_bad_settings_are_clear_errors():
 def test_bunny_preset_scene_generates_uvs_and_scatters(renderer, tmp_path):
     scene = load_scene(Path(__file__).resolve().parents[1] / "assets" / "scenes" / "bunny-skimmilk.toml")
     (node,) = scene.mesh_nodes()
-    assert node.mesh.uvs is not None                        # generate_uvs = true
-    assert node.material["subsurface_radius"][0] > 10       # skim milk scatters far (Jensen 2001)
+    assert node.mesh.uvs is not None  # generate_uvs = true
+    assert node.material["subsurface_radius"][0] > 10  # skim milk scatters far (Jensen 2001)
     res = renderer.render(scene, RenderSettings(64, 64, shadow_size=256, tsd_size=128))
     assert "tsd_irradiance" in kinds(res.plan) and np.isfinite(res.hdr).all()
     cover = res.hdr[..., 3] > 0

@@ -18,7 +18,7 @@ def test_unit_quad_is_clean():
     r = analyse_uvs(quad(), mm_per_unit=2.0, texels=100, grid=64)
     assert r.has_uvs and r.triangles == 2
     assert r.mm_per_texel.shape == (2, 2)
-    assert np.allclose(r.mm_per_texel, 0.2, rtol=1e-12, atol=0)   # 10 units * 2 mm / 100 texels
+    assert np.allclose(r.mm_per_texel, 0.2, rtol=1e-12, atol=0)  # 10 units * 2 mm / 100 texels
     for key in ("p10", "p50", "p90"):
         assert r.mm_per_texel_percentiles[key] == pytest.approx((0.2, 0.2), rel=1e-12)
     # texel centres lie exactly on the diagonal: the half-open rule gives each to one triangle
@@ -49,13 +49,14 @@ def test_anisotropic_quad_stretches_u_only():
 
 def test_percentiles_are_area_weighted():
     # left half of the UV square: a 10x20 patch; right half: a 1x2 patch (1% of the area)
-    pos = np.array([[0, 0, 0], [10, 0, 0], [10, 20, 0], [0, 20, 0],
-                    [50, 0, 0], [51, 0, 0], [51, 2, 0], [50, 2, 0]], float)
+    pos = np.array(
+        [[0, 0, 0], [10, 0, 0], [10, 20, 0], [0, 20, 0], [50, 0, 0], [51, 0, 0], [51, 2, 0], [50, 2, 0]], float
+    )
     uv = np.array([[0, 0], [0.5, 0], [0.5, 1], [0, 1], [0.5, 0], [1, 0], [1, 1], [0.5, 1]], float)
     idx = np.array(QUAD_IDX + [[4, 5, 6], [4, 6, 7]])
     r = analyse_uvs(Mesh("two", pos, idx, uvs=uv), mm_per_unit=1.0, texels=10)
     assert np.allclose(r.mm_per_texel[:2], 2.0) and np.allclose(r.mm_per_texel[2:], 0.2)
-    for key in ("p10", "p50", "p90"):   # unweighted, p10 would be the small patch's 0.2
+    for key in ("p10", "p50", "p90"):  # unweighted, p10 would be the small patch's 0.2
         assert r.mm_per_texel_percentiles[key] == pytest.approx((2.0, 2.0))
     assert r.uv_coverage == 1.0 and r.overlap_fraction == 0.0
 
@@ -81,7 +82,7 @@ def test_mirrored_copy_overlaps_too():
 def test_zero_world_area_triangle():
     pos = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [3, 0, 0], [4, 0, 0]], float)
     uv = np.array([[0, 0], [0.5, 0], [0.5, 1], [0, 1], [0.5, 0], [1, 0], [1, 1]], float)
-    idx = np.array(QUAD_IDX + [[4, 5, 6]])      # collinear positions, non-zero UV area
+    idx = np.array(QUAD_IDX + [[4, 5, 6]])  # collinear positions, non-zero UV area
     r = analyse_uvs(Mesh("sliver", pos, idx, uvs=uv), mm_per_unit=10.0)
     assert r.zero_area_world == 1 and r.zero_area_uv == 0
     assert np.all(r.mm_per_texel[2] == 0.0)
@@ -94,7 +95,7 @@ def test_zero_world_area_triangle():
 def test_zero_uv_area_and_out_of_range_triangles():
     pos = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [2, 0, 0], [3, 0, 0], [2, 1, 0]], float)
     uv = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.2, 0.2], [0.4, 0.4], [0.6, 0.6]], float)
-    idx = np.array(QUAD_IDX + [[4, 5, 6]])      # collinear UVs, non-zero world area
+    idx = np.array(QUAD_IDX + [[4, 5, 6]])  # collinear UVs, non-zero world area
     r = analyse_uvs(Mesh("flat", pos, idx, uvs=uv), mm_per_unit=1.0)
     assert r.zero_area_uv == 1 and r.zero_area_world == 0 and r.out_of_range == 0
     assert np.isnan(r.mm_per_texel[2]).all() and np.isfinite(r.mm_per_texel[:2]).all()
@@ -103,10 +104,10 @@ def test_zero_uv_area_and_out_of_range_triangles():
     assert "'flat'" in w and "zero UV area" in w and "no irradiance" in w
 
     uv2 = uv.copy()
-    uv2[4:] = [[1.5, 0.5], [2.0, 0.5], [1.5, 1.0]]   # a proper triangle entirely outside the square
+    uv2[4:] = [[1.5, 0.5], [2.0, 0.5], [1.5, 1.0]]  # a proper triangle entirely outside the square
     r2 = analyse_uvs(Mesh("outside", pos, idx, uvs=uv2), mm_per_unit=1.0)
     assert r2.out_of_range == 1 and r2.zero_area_uv == 0
-    assert r2.uv_coverage == 1.0 and r2.overlap_fraction == 0.0   # clipped away, not wrapped
+    assert r2.uv_coverage == 1.0 and r2.overlap_fraction == 0.0  # clipped away, not wrapped
     assert any("outside [0, 1]" in w for w in r2.warnings())
 
 
@@ -131,13 +132,13 @@ def test_head_uv_layout():
     (node,) = scene.mesh_nodes()
     r = analyse_uvs(node.mesh, scene.mm_per_unit, texels=1024, grid=512)
     assert r.has_uvs and r.triangles == len(node.mesh.indices) > 10000
-    assert r.overlap_fraction < 0.002          # measured 1.9e-4: stray texels along a few seams
-    assert 0.85 < r.uv_coverage < 0.98         # measured 0.916
+    assert r.overlap_fraction < 0.002  # measured 1.9e-4: stray texels along a few seams
+    assert 0.85 < r.uv_coverage < 0.98  # measured 0.916
     assert r.out_of_range == 0 and r.zero_area_world == 0
     pct = r.mm_per_texel_percentiles
     assert all(np.isfinite(pct[k]).all() for k in ("p10", "p50", "p90"))
     for c in range(2):
-        assert 0.1 < pct["p10"][c] <= pct["p50"][c] <= pct["p90"][c] < 5.0   # p50 ~ 0.7 mm per texel
+        assert 0.1 < pct["p10"][c] <= pct["p50"][c] <= pct["p90"][c] < 5.0  # p50 ~ 0.7 mm per texel
     # the eye corners hold a dozen triangles collapsed in UV; they are all that is warned about
     assert 0 < r.zero_area_uv < 50
     assert [w for w in r.warnings() if "zero UV area" not in w] == []

@@ -1,5 +1,6 @@
 """The desktop viewer: a real window under Xvfb (subprocess), and its window-independent parts
 (camera math, panel model, scene/preset reload, inspector, ViewerCore) headless."""
+
 import math
 import os
 import shutil
@@ -14,10 +15,16 @@ import pytest
 from app.render.settings import RenderSettings
 from app.viewer.camera import PITCH_LIMIT, OrbitCamera
 from app.viewer.core import SSS_CYCLE, ViewerCore, next_sss_model
-from app.viewer.inspector import (FINAL, Inspector, View, auto_range, display_mode, fit_viewport,
-                                  target_names)
-from app.viewer.panel import (WIDGETS, PanelModel, angles_from_direction, clamp_value,
-                              direction_from_angles, medium_to_params, widget_for)
+from app.viewer.inspector import FINAL, Inspector, View, auto_range, display_mode, fit_viewport, target_names
+from app.viewer.panel import (
+    WIDGETS,
+    PanelModel,
+    angles_from_direction,
+    clamp_value,
+    direction_from_angles,
+    medium_to_params,
+    widget_for,
+)
 from app.viewer.watch import Reloadable, preset_reloader, scene_reloader
 from scene import transform as tf
 from scene.materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
@@ -28,6 +35,7 @@ SMALL = dict(shadow_size=256, tsd_size=64)
 
 
 # -- Xvfb ----------------------------------------------------------------------------------------
+
 
 def _xvfb_binary():
     exe = shutil.which("Xvfb")
@@ -42,12 +50,18 @@ def _xvfb_binary():
 def xdisplay():
     exe = _xvfb_binary()
     if exe is None:
-        pytest.skip("Xvfb is not installed and tools/sysdeps.sh could not install it "
-                    "(needs apt-get as root or passwordless sudo)")
+        pytest.skip(
+            "Xvfb is not installed and tools/sysdeps.sh could not install it "
+            "(needs apt-get as root or passwordless sudo)"
+        )
     r, w = os.pipe()
     # -displayfd: Xvfb picks a free display number itself and writes it to the pipe when ready
-    proc = subprocess.Popen([exe, "-displayfd", str(w), "-screen", "0", "640x480x24", "-nolisten", "tcp"],
-                            pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [exe, "-displayfd", str(w), "-screen", "0", "640x480x24", "-nolisten", "tcp"],
+        pass_fds=(w,),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+    )
     os.close(w)
     try:
         with os.fdopen(r) as fh:
@@ -68,14 +82,35 @@ def run_view(args, display, timeout=180):
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "PYOPENGL_PLATFORM")}
     if display:
         env["DISPLAY"] = display
-    return subprocess.run([sys.executable, "-m", "app.cli", "view", *args], cwd=ROOT, env=env,
-                          capture_output=True, text=True, timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "app.cli", "view", *args],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
 
 
 def test_view_window_renders_and_saves_screenshot(xdisplay, tmp_path):
     shot = tmp_path / "x.png"
-    res = run_view([str(DEFAULT_SCENE), "--frames", "3", "--screenshot", str(shot), "--size", "160x120",
-                    "--shadow-size", "512", "--tsd-size", "128", "--no-watch"], xdisplay)
+    res = run_view(
+        [
+            str(DEFAULT_SCENE),
+            "--frames",
+            "3",
+            "--screenshot",
+            str(shot),
+            "--size",
+            "160x120",
+            "--shadow-size",
+            "512",
+            "--tsd-size",
+            "128",
+            "--no-watch",
+        ],
+        xdisplay,
+    )
     assert res.returncode == 0, res.stderr
     assert str(shot.resolve()) in res.stdout
     from app.image_output import read_image
@@ -83,10 +118,10 @@ def test_view_window_renders_and_saves_screenshot(xdisplay, tmp_path):
     img = read_image(shot)
     assert img.shape == (120, 160, 4)
     rgb = img[..., :3].astype(np.float64)
-    assert rgb.std() > 10.0                         # not a flat image
-    background = rgb[0, 0]                          # the head does not reach the top-left corner
+    assert rgb.std() > 10.0  # not a flat image
+    background = rgb[0, 0]  # the head does not reach the top-left corner
     differs = np.abs(rgb - background).max(-1) > 12
-    assert 0.15 < differs.mean() < 0.95, differs.mean()   # the head covers a good part, not all
+    assert 0.15 < differs.mean() < 0.95, differs.mean()  # the head covers a good part, not all
 
 
 def test_view_without_display_is_one_clear_line(tmp_path):
@@ -104,6 +139,7 @@ def test_view_rejects_bad_options_before_opening_a_window(xdisplay, tmp_path):
 
 # -- camera math -----------------------------------------------------------------------------------
 
+
 def project(cam: OrbitCamera, point, w, h, yfov):
     view = np.linalg.inv(tf.compose(cam.eye, tf.look_at_rotation(cam.eye, cam.target), np.ones(3)))
     clip = tf.perspective(yfov, w / h, 0.1, 100.0) @ view @ np.append(point, 1.0)
@@ -114,10 +150,10 @@ def project(cam: OrbitCamera, point, w, h, yfov):
 def test_orbit_keeps_target_and_distance_and_turns_the_right_way():
     cam = OrbitCamera.from_look_at([0, 0, 10], [0, 0, 0])
     assert np.allclose(cam.eye, [0, 0, 10]) and cam.distance == pytest.approx(10)
-    cam.orbit(90 / math.degrees(cam.orbit_speed), 0)          # drag right by 90 degrees' worth
-    assert np.allclose(cam.eye, [-10, 0, 0], atol=1e-9)       # camera went left: the scene turned right
+    cam.orbit(90 / math.degrees(cam.orbit_speed), 0)  # drag right by 90 degrees' worth
+    assert np.allclose(cam.eye, [-10, 0, 0], atol=1e-9)  # camera went left: the scene turned right
     assert np.allclose(cam.target, 0) and np.linalg.norm(cam.eye - cam.target) == pytest.approx(10)
-    cam.orbit(0, -1e6)                                        # drag far down: pitch stops short of the pole
+    cam.orbit(0, -1e6)  # drag far down: pitch stops short of the pole
     assert cam.pitch == pytest.approx(PITCH_LIMIT)
     assert np.linalg.norm(cam.eye - cam.target) == pytest.approx(10)
     right, up, fwd = cam.basis()
@@ -133,7 +169,7 @@ def test_pan_moves_target_depth_points_with_the_cursor(dx, dy):
     dist = cam.distance
     cam.pan(dx, dy, h, yfov)
     after = project(cam, anchor, w, h, yfov)
-    assert np.allclose(after - before, [dx, dy], atol=1e-6)     # the grabbed point follows the cursor
+    assert np.allclose(after - before, [dx, dy], atol=1e-6)  # the grabbed point follows the cursor
     assert cam.distance == pytest.approx(dist)
 
 
@@ -167,9 +203,10 @@ def test_orbit_from_scene_camera_looks_the_same_way():
 
 # -- panel model -------------------------------------------------------------------------------------
 
+
 def test_every_param_kind_has_a_widget():
     kinds = {p.kind for p in PRINCIPLED_PARAMS}
-    assert kinds == set(WIDGETS)                 # the declarations use every kind the panel knows
+    assert kinds == set(WIDGETS)  # the declarations use every kind the panel knows
     for p in PRINCIPLED_PARAMS:
         w = widget_for(p)
         assert w.widget == WIDGETS[p.kind] and w.param == p.name
@@ -221,13 +258,13 @@ def test_panel_edits_go_through_material_update_and_presets_map_media():
         panel.edit("glow", 1)
     with pytest.raises(ValueError, match="sss_model: expected one of"):
         panel.edit("sss_model", "nope")
-    assert "sss_model" in panel.error and mat["sss_model"] == "dipole"   # rejected edit changed nothing
+    assert "sss_model" in panel.error and mat["sss_model"] == "dipole"  # rejected edit changed nothing
     values = panel.apply_preset("skin1")
     m = preset("skin1")
     assert np.allclose(mat["subsurface_color"], np.clip(m.surface_albedo(), 0, 1))
     assert np.allclose(mat["subsurface_radius"], m.artist_radius_mm)
     assert values == medium_to_params(m)
-    assert mat["subsurface_radius"][0] > mat["subsurface_radius"][2]   # red scatters furthest in skin
+    assert mat["subsurface_radius"][0] > mat["subsurface_radius"][2]  # red scatters furthest in skin
     with pytest.raises(ValueError, match="unknown material 'jam'"):
         panel.apply_preset("jam")
     # widgets reflect the current values
@@ -249,12 +286,13 @@ def test_key_light_direction_round_trip():
     got = panel.set_light_direction(d * 5)
     assert np.allclose(light.direction, got, atol=1e-9) and np.allclose(got, d / np.linalg.norm(d))
     assert np.allclose(angles_from_direction(light.direction), (30.0, 40.0), atol=1e-6)
-    assert direction_from_angles(0, 89)[1] < -0.99        # a light overhead shines down
+    assert direction_from_angles(0, 89)[1] < -0.99  # a light overhead shines down
     with pytest.raises(ValueError, match="light direction"):
         panel.set_light_direction([0, 0, 0])
 
 
 # -- scene and preset reload ----------------------------------------------------------------------------
+
 
 def head_copy(tmp_path) -> Path:
     text = DEFAULT_SCENE.read_text().replace("../lee-perry-smith/", f"{ASSETS / 'lee-perry-smith'}/")
@@ -280,12 +318,12 @@ def test_scene_reload_keeps_last_good_and_recovers(tmp_path):
     try:
         good = src.value
         assert good.environment.exposure == 1.0 and path.resolve() in src.watcher.paths
-        assert any(p.name == "LeePerrySmith.glb" for p in src.watcher.paths)   # referenced files too
+        assert any(p.name == "LeePerrySmith.glb" for p in src.watcher.paths)  # referenced files too
         text = path.read_text()
-        path.write_text(text.replace("[camera]", "[camera\n"))            # broken TOML
+        path.write_text(text.replace("[camera]", "[camera\n"))  # broken TOML
         wait_for(src, "failed")
         assert src.value is good and "head.toml" in src.error and "not valid TOML" in src.error
-        path.write_text(text.replace("[scene]", "[scene]\nbogus = 1"))     # valid TOML, bad key
+        path.write_text(text.replace("[scene]", "[scene]\nbogus = 1"))  # valid TOML, bad key
         wait_for(src, "failed")
         assert src.value is good and "head.toml" in src.error and "bogus" in src.error
         path.write_text(text.replace("exposure = 1.0", "exposure = 2.5"))  # fixed
@@ -300,7 +338,7 @@ def test_rapid_half_written_saves_settle_on_the_final_file(tmp_path):
     src = scene_reloader(path, settle_s=0.15)
     try:
         final = path.read_text().replace("exposure = 1.0", "exposure = 3.0")
-        for i in range(1, 25):                       # an editor writing in pieces, no pause
+        for i in range(1, 25):  # an editor writing in pieces, no pause
             path.write_text(final[: len(final) * i // 25])
         path.write_text(final)
         t0 = time.monotonic()
@@ -309,10 +347,10 @@ def test_rapid_half_written_saves_settle_on_the_final_file(tmp_path):
             outcomes.append(src.poll())
             time.sleep(0.02)
         t1 = time.monotonic()
-        while time.monotonic() - t1 < 0.4:          # late events must not load anything else
+        while time.monotonic() - t1 < 0.4:  # late events must not load anything else
             outcomes.append(src.poll())
             time.sleep(0.02)
-        assert "reloaded" in outcomes and "failed" not in outcomes, outcomes   # never a partial file
+        assert "reloaded" in outcomes and "failed" not in outcomes, outcomes  # never a partial file
         assert src.value.environment.exposure == 3.0 and src.error is None
     finally:
         src.stop()
@@ -336,7 +374,7 @@ def test_preset_file_reload(tmp_path, monkeypatch):
         wait_for(src, "reloaded")
         assert panel.reapply_presets() == [f"{panel.material.name}: skin1"]
         after = panel.material["subsurface_radius"]
-        assert all(a > b for a, b in zip(after, before))           # less scattering -> longer paths
+        assert all(a > b for a, b in zip(after, before))  # less scattering -> longer paths
         good = src.value
         csv.write_text(csv.read_text().replace("skin1,0.37", "skin1,zero"))
         wait_for(src, "failed")
@@ -348,6 +386,7 @@ def test_preset_file_reload(tmp_path, monkeypatch):
 
 
 # -- inspector and core (headless EGL) ----------------------------------------------------------------------
+
 
 def test_display_modes_and_layout(ctx):
     assert display_mode(ctx.texture((2, 2), 4, dtype="f1")) == "ldr"
@@ -362,7 +401,7 @@ def test_display_modes_and_layout(ctx):
     assert fit_viewport((100, 50), (200, 200)) == (0, 50, 200, 100)
     assert fit_viewport((64, 64), (300, 100)) == (100, 0, 100, 100)
     off, scale = auto_range(np.array([[[0.5], [0.7]], [[1.0], [0.6]]], np.float32), "grey")
-    assert off == pytest.approx(0.5) and scale == pytest.approx(5.0)      # far plane (1.0) ignored
+    assert off == pytest.approx(0.5) and scale == pytest.approx(5.0)  # far plane (1.0) ignored
 
 
 def test_depth_texture_shown_as_grey_without_touching_its_compare_mode(ctx):
@@ -371,8 +410,8 @@ def test_depth_texture_shown_as_grey_without_touching_its_compare_mode(ctx):
     tex.compare_func = "<="
     ins = Inspector(ctx)
     img = ins.render_image(tex, View(offset=0.2, scale=1 / 0.6, auto=False))
-    got = img[::-1, :, 0].astype(np.float64) / 255.0                    # back to bottom-up rows
-    assert np.allclose(got, (vals - 0.2) / 0.6, atol=1.5 / 255)         # depth values, not comparisons
+    got = img[::-1, :, 0].astype(np.float64) / 255.0  # back to bottom-up rows
+    assert np.allclose(got, (vals - 0.2) / 0.6, atol=1.5 / 255)  # depth values, not comparisons
     assert tex.compare_func == "<="
     ins.release()
 
@@ -409,7 +448,7 @@ def test_core_renders_every_target_and_screenshots(core, ctx, tmp_path):
 
     assert read_image(png).shape == (48, 64, 4)
     hdr = read_image(exr)
-    assert hdr.shape == (48, 64, 4) and hdr[..., :3].max() > 0.05       # linear radiance, not 8-bit
+    assert hdr.shape == (48, 64, 4) and hdr[..., :3].max() > 0.05  # linear radiance, not 8-bit
     with pytest.raises(ValueError, match="unsupported image extension"):
         c.screenshot(tmp_path / "s.bmp")
 
@@ -448,7 +487,7 @@ def test_core_shows_shader_errors_and_keeps_rendering(core):
         time.sleep(0.02)
     errs = c.errors()
     assert errs and f"shaders/passes/tonemap.frag:{line}:" in errs[0], errs
-    assert c.render()                                       # the last good program still renders
+    assert c.render()  # the last good program still renders
     assert np.array_equal(np.frombuffer(c.targets()["ldr_color"].read(), np.uint8), before)
     frag.write_text(good)
     t0 = time.monotonic()
@@ -470,7 +509,7 @@ def test_core_scene_reload_keeps_camera_and_renders_new_scene(core):
         c.poll_reloads()
         time.sleep(0.02)
     assert c.scene is old and any("head.toml" in e for e in c.errors())
-    assert c.render()                                       # last good scene renders
+    assert c.render()  # last good scene renders
     fixed = path.read_text().replace("[[lights]\n", "[[lights]]", 1)
     path.write_text(fixed.replace("exposure = 1.0", "exposure = 0.25"))
     t0 = time.monotonic()
@@ -478,7 +517,7 @@ def test_core_scene_reload_keeps_camera_and_renders_new_scene(core):
         c.poll_reloads()
         time.sleep(0.02)
     assert c.scene is not old and c.scene.environment.exposure == 0.25 and c.errors() == []
-    assert np.allclose(c.orbit.eye, eye)                    # same file camera: the user's view is kept
+    assert np.allclose(c.orbit.eye, eye)  # same file camera: the user's view is kept
     assert c.render()
 
 
@@ -494,12 +533,12 @@ def test_core_reloads_a_changed_texture_file(ctx, tmp_path):
         assert tex.resolve() in c.scene_src.watcher.paths
         assert c.render()
         bright = np.frombuffer(c.targets()["ldr_color"].read(), np.uint8).reshape(48, 64, 4)[..., :3].mean()
-        Image.new("RGB", (64, 64), (20, 20, 20)).save(tex)      # same path, darker pixels
+        Image.new("RGB", (64, 64), (20, 20, 20)).save(tex)  # same path, darker pixels
         t0 = time.monotonic()
         while not c.poll_reloads() and time.monotonic() - t0 < 5:
             time.sleep(0.02)
         assert c.errors() == [] and c.render()
         dark = np.frombuffer(c.targets()["ldr_color"].read(), np.uint8).reshape(48, 64, 4)[..., :3].mean()
-        assert dark < bright - 10                                # the renderer's cached texture was replaced
+        assert dark < bright - 10  # the renderer's cached texture was replaced
     finally:
         c.close()

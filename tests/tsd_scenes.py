@@ -1,28 +1,37 @@
 """Small scenes for texture-space diffusion tests: a flat square slab of skin-like material seen
 straight from above by a far, narrow camera (nearly orthographic), lit by a directional light."""
+
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
+from scene import transform as tf
 from scene.graph import CameraNode, LightNode, MeshNode, Scene
 from scene.materials import Material
 from scene.mesh import Mesh
-from scene import transform as tf
 
 
 def quad_mesh(name, x0, x1, y0, y1, z=0.0, uv=((0, 0), (1, 1))) -> Mesh:
     (u0, v0), (u1, v1) = uv
     pos = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]], np.float32)
     uvs = np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]], np.float32)
-    return Mesh(name, pos, np.array([[0, 1, 2], [0, 2, 3]], np.uint32),
-                normals=np.tile([0, 0, 1.0], (4, 1)), uvs=uvs)
+    return Mesh(name, pos, np.array([[0, 1, 2], [0, 2, 3]], np.uint32), normals=np.tile([0, 0, 1.0], (4, 1)), uvs=uvs)
 
 
 def skin(model="burley", radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5), base=(1.0, 1.0, 1.0), **kw) -> Material:
-    return Material("slab", {"base_color": base, "subsurface": 1.0, "subsurface_radius": radius,
-                             "subsurface_color": color, "sss_model": model, "roughness": 0.5,
-                             "specular": 0.0, **kw})
+    return Material(
+        "slab",
+        {
+            "base_color": base,
+            "subsurface": 1.0,
+            "subsurface_radius": radius,
+            "subsurface_color": color,
+            "sss_model": model,
+            "roughness": 0.5,
+            "specular": 0.0,
+            **kw,
+        },
+    )
 
 
 def light_from(direction, intensity=1.0, shadow=False) -> LightNode:
@@ -33,8 +42,9 @@ def light_from(direction, intensity=1.0, shadow=False) -> LightNode:
     return l
 
 
-def slab_scene(half=1.0, mm_per_unit=20.0, material=None, light_dir=(0, 0, -1), occluder=False,
-               mesh=None, ambient=0.0) -> Scene:
+def slab_scene(
+    half=1.0, mm_per_unit=20.0, material=None, light_dir=(0, 0, -1), occluder=False, mesh=None, ambient=0.0
+) -> Scene:
     """A 2 half x 2 half slab in z = 0 (UVs fill [0, 1]^2). occluder: an opaque plane at height
     half covering x < -half (outside the camera's view) that, with light travelling along (1, 0, -1),
     casts a shadow edge across x = 0."""
@@ -43,8 +53,13 @@ def slab_scene(half=1.0, mm_per_unit=20.0, material=None, light_dir=(0, 0, -1), 
     s.add(MeshNode("slab", mesh or quad_mesh("slab", -half, half, -half, half), material or skin()))
     if occluder:
         h = half * 1.02
-        s.add(MeshNode("occluder", quad_mesh("occluder", -3 * half, -h, -1.2 * half, 1.2 * half, z=h),
-                       Material("black", {"base_color": (0, 0, 0), "specular": 0.0})))
+        s.add(
+            MeshNode(
+                "occluder",
+                quad_mesh("occluder", -3 * half, -h, -1.2 * half, 1.2 * half, z=h),
+                Material("black", {"base_color": (0, 0, 0), "specular": 0.0}),
+            )
+        )
         light_dir = (1.0, 0.0, -1.0)
     s.add(light_from(light_dir, shadow=occluder))
     dist = half / np.tan(np.radians(1.0))
@@ -65,13 +80,3 @@ def exact_profile(model, medium):
     from scene.optics.tsd import MODEL_PROFILES
 
     return lambda r: get_profile(MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
-
-
-@pytest.fixture(scope="module")
-def renderer(ctx):
-    """One renderer per test module (its GPU caches are reset between modules)."""
-    from app.render.renderer import Renderer
-
-    r = Renderer(ctx)
-    yield r
-    r.release()

@@ -11,6 +11,7 @@ the analytic profiles). For each albedo and model:
            sum |Rbar_model - R_mc| A_bin / sum R_mc A_bin, with Rbar_model the model averaged over
            each annulus (41-point quadrature) and A_bin the annulus area.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -35,7 +36,7 @@ def bin_average(name, m, edges):
     for r0, r1 in zip(edges[:-1], edges[1:]):
         rr = np.linspace(max(r0, 1e-6), r1, 41)
         f = evaluate_profile(name, rr, m)[:, 0] * 2 * np.pi * rr
-        out.append(np.trapezoid(f, rr) / (np.pi * (r1 ** 2 - r0 ** 2)))
+        out.append(np.trapezoid(f, rr) / (np.pi * (r1**2 - r0**2)))
     return np.array(out)
 
 
@@ -45,7 +46,7 @@ def measure(photons, eta, seed, progress=True):
         res = simulate(a, eta, 0.0, "normal", photons, seed + k, r_edges=EDGES, progress=progress, workers=2)
         m = Medium((a,) * 3, (1.0,) * 3, eta)
         sel = EDGES[:-1] >= 0.05
-        area = np.pi * np.diff(EDGES ** 2)[sel]
+        area = np.pi * np.diff(EDGES**2)[sel]
         ref = res.R[sel]
         row = {"albedo": a, "mc_total": res.total, "mc_se": res.total_se, "models": {}}
         for name in MODELS:
@@ -60,13 +61,25 @@ def measure(photons, eta, seed, progress=True):
 def markdown(rows, photons, eta, seed):
     head = "| albedo alpha' | MC total +- s.e. | " + " | ".join(MODELS) + " |"
     sep = "|---|---|" + "---|" * len(MODELS)
-    lines = [f"Total reflectance error (model - MC)/MC, eta = {eta}, {photons:,} photons per albedo, seed {seed}:", "",
-             head, sep]
+    lines = [
+        f"Total reflectance error (model - MC)/MC, eta = {eta}, {photons:,} photons per albedo, seed {seed}:",
+        "",
+        head,
+        sep,
+    ]
     for r in rows:
-        lines.append(f"| {r['albedo']} | {r['mc_total']:.4f} +- {r['mc_se']:.4f} | "
-                     + " | ".join(f"{100 * r['models'][n][0]:+.1f} %" for n in MODELS) + " |")
-    lines += ["", "Profile shape error (energy-weighted L1 over 0.05-10 mfp):", "",
-              "| albedo alpha' | " + " | ".join(MODELS) + " |", "|---|" + "---|" * len(MODELS)]
+        lines.append(
+            f"| {r['albedo']} | {r['mc_total']:.4f} +- {r['mc_se']:.4f} | "
+            + " | ".join(f"{100 * r['models'][n][0]:+.1f} %" for n in MODELS)
+            + " |"
+        )
+    lines += [
+        "",
+        "Profile shape error (energy-weighted L1 over 0.05-10 mfp):",
+        "",
+        "| albedo alpha' | " + " | ".join(MODELS) + " |",
+        "|---|" + "---|" * len(MODELS),
+    ]
     for r in rows:
         lines.append(f"| {r['albedo']} | " + " | ".join(f"{100 * r['models'][n][1]:.1f} %" for n in MODELS) + " |")
     return "\n".join(lines) + "\n"

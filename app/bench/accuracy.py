@@ -37,6 +37,7 @@ compared with the tsd frame of the same settings, and an identical image is reco
 ``ignored``. Without a working exact reference the most accurate tsd setting (largest irradiance
 texture, largest K) stands in as a *proxy* reference, named in the ``reference`` column.
 """
+
 from __future__ import annotations
 
 import csv
@@ -55,59 +56,142 @@ import numpy as np
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 SCENE_ALIASES = {"head": None, "bunny": ASSETS / "bunny-skimmilk.toml"}
-LUM_FRACTION = 0.05           # lit pixels: reference luminance above 5 % of its 99th percentile
+LUM_FRACTION = 0.05  # lit pixels: reference luminance above 5 % of its 99th percentile
 REC709 = np.array([0.2126, 0.7152, 0.0722])
-EDGE_RANGE_MFP = 50.0         # the edge-response integral spans +-50 mean free paths per channel
+EDGE_RANGE_MFP = 50.0  # the edge-response integral spans +-50 mean free paths per channel
 MC_SEED = 1
 RECOMMEND_THRESHOLDS = (0.01, 0.02, 0.05)
 
-CSV_COLUMNS = ["scene", "setting", "technique", "model", "K", "tsd_size", "taps", "ssss_taps", "width", "height",
-               "blur_levels", "frames", "frame_ms_median", "frame_ms_p10", "frame_ms_p90", "wall_ms_median",
-               "tsd_ms_median", "clock", "image_rel_l1", "image_max_rel", "image_p95_rel", "pixels",
-               "image_rel_l1_same_size", "profile_err_mc", "profile_err_model", "reference", "status", "error", "passes_ms"]
-NUMERIC_COLUMNS = ["frames", "frame_ms_median", "frame_ms_p10", "frame_ms_p90", "wall_ms_median", "tsd_ms_median",
-                   "image_rel_l1", "image_max_rel", "image_p95_rel", "pixels", "image_rel_l1_same_size",
-                   "profile_err_mc", "profile_err_model"]
+CSV_COLUMNS = [
+    "scene",
+    "setting",
+    "technique",
+    "model",
+    "K",
+    "tsd_size",
+    "taps",
+    "ssss_taps",
+    "width",
+    "height",
+    "blur_levels",
+    "frames",
+    "frame_ms_median",
+    "frame_ms_p10",
+    "frame_ms_p90",
+    "wall_ms_median",
+    "tsd_ms_median",
+    "clock",
+    "image_rel_l1",
+    "image_max_rel",
+    "image_p95_rel",
+    "pixels",
+    "image_rel_l1_same_size",
+    "profile_err_mc",
+    "profile_err_model",
+    "reference",
+    "status",
+    "error",
+    "passes_ms",
+]
+NUMERIC_COLUMNS = [
+    "frames",
+    "frame_ms_median",
+    "frame_ms_p10",
+    "frame_ms_p90",
+    "wall_ms_median",
+    "tsd_ms_median",
+    "image_rel_l1",
+    "image_max_rel",
+    "image_p95_rel",
+    "pixels",
+    "image_rel_l1_same_size",
+    "profile_err_mc",
+    "profile_err_model",
+]
 
 
 # -- the sweep ---------------------------------------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class Sweep:
     name: str
     size: tuple[int, int]
     shadow_size: int
-    k_size: int                      # irradiance size of the K and tap sweeps
-    ks: tuple[int, ...]              # K at k_size
-    sizes: tuple[int, ...]           # irradiance sizes at K = max(ks)
-    taps: tuple                      # tap counts (None = auto) at k_size, K = max(ks)
+    k_size: int  # irradiance size of the K and tap sweeps
+    ks: tuple[int, ...]  # K at k_size
+    sizes: tuple[int, ...]  # irradiance sizes at K = max(ks)
+    taps: tuple  # tap counts (None = auto) at k_size, K = max(ks)
     ssss: tuple[int, ...]
-    exact_size: int                  # irradiance size of the exact reference
-    frames: int                      # timed frames per setting (fewer if over budget_s)
+    exact_size: int  # irradiance size of the exact reference
+    frames: int  # timed frames per setting (fewer if over budget_s)
     warmup: int
-    budget_s: float                  # rough time budget of the timed frames of one setting
-    photons: int                     # Monte Carlo photons per channel
+    budget_s: float  # rough time budget of the timed frames of one setting
+    photons: int  # Monte Carlo photons per channel
     peer_frames: int
     scenes: tuple[str, ...] = ("head", "bunny")
-    extra: tuple = ()                # extra settings (tiny sweep)
+    extra: tuple = ()  # extra settings (tiny sweep)
 
 
-FULL = Sweep("full", (640, 640), 2048, 1024, (1, 2, 3, 4, 5, 6), (256, 512, 1024, 2048), (None, 7, 15, 31),
-             (11, 17, 25), 1024, frames=10, warmup=2, budget_s=25.0, photons=200_000, peer_frames=30)
-QUICK = Sweep("quick", (160, 160), 1024, 256, (1, 3, 6), (256, 512), (None, 7), (11, 25), 512,
-              frames=5, warmup=2, budget_s=2.0, photons=20_000, peer_frames=5)
+FULL = Sweep(
+    "full",
+    (640, 640),
+    2048,
+    1024,
+    (1, 2, 3, 4, 5, 6),
+    (256, 512, 1024, 2048),
+    (None, 7, 15, 31),
+    (11, 17, 25),
+    1024,
+    frames=10,
+    warmup=2,
+    budget_s=25.0,
+    photons=200_000,
+    peer_frames=30,
+)
+QUICK = Sweep(
+    "quick",
+    (160, 160),
+    1024,
+    256,
+    (1, 3, 6),
+    (256, 512),
+    (None, 7),
+    (11, 25),
+    512,
+    frames=5,
+    warmup=2,
+    budget_s=2.0,
+    photons=20_000,
+    peer_frames=5,
+)
 # for the tests: four settings on the head at 64x64
-TINY = Sweep("tiny", (64, 64), 256, 256, (1, 6), (256,), (None,), (), 256,
-             frames=2, warmup=2, budget_s=0.5, photons=4_000, peer_frames=1, scenes=("head",))
+TINY = Sweep(
+    "tiny",
+    (64, 64),
+    256,
+    256,
+    (1, 6),
+    (256,),
+    (None,),
+    (),
+    256,
+    frames=2,
+    warmup=2,
+    budget_s=0.5,
+    photons=4_000,
+    peer_frames=1,
+    scenes=("head",),
+)
 SWEEPS = {"full": FULL, "quick": QUICK, "tiny": TINY}
 
 
 @dataclass(frozen=True)
 class Setting:
-    technique: str                   # ledger technique: none | tint | tsd | ssss | exact
+    technique: str  # ledger technique: none | tint | tsd | ssss | exact
     K: int | None = None
     tsd_size: int | None = None
-    taps: int | None = None          # tsd taps; None = auto (only meaningful for tsd)
+    taps: int | None = None  # tsd taps; None = auto (only meaningful for tsd)
     ssss_taps: int | None = None
 
     @property
@@ -132,8 +216,9 @@ class Setting:
         if self.technique == "tint":
             return RenderSettings(**base, technique="tint", tsd_size=sweep.k_size)
         if self.technique == "tsd":
-            return RenderSettings(**base, technique="tsd", tsd_size=self.tsd_size, tsd_gaussians=self.K,
-                                  tsd_taps=self.taps)
+            return RenderSettings(
+                **base, technique="tsd", tsd_size=self.tsd_size, tsd_gaussians=self.K, tsd_taps=self.taps
+            )
         if self.technique == "ssss":
             return RenderSettings(**base, technique="ssss", ssss_taps=self.ssss_taps, tsd_size=sweep.k_size)
         if self.technique == "exact":
@@ -142,10 +227,12 @@ class Setting:
 
     def cells(self) -> dict:
         """The parameter columns; empty where the parameter does not apply to the technique."""
-        return {"K": self.K if self.technique == "tsd" else "",
-                "tsd_size": self.tsd_size if self.technique in ("tsd", "exact") else "",
-                "taps": (self.taps or "auto") if self.technique == "tsd" else "",
-                "ssss_taps": self.ssss_taps if self.technique == "ssss" else ""}
+        return {
+            "K": self.K if self.technique == "tsd" else "",
+            "tsd_size": self.tsd_size if self.technique in ("tsd", "exact") else "",
+            "taps": (self.taps or "auto") if self.technique == "tsd" else "",
+            "ssss_taps": self.ssss_taps if self.technique == "ssss" else "",
+        }
 
 
 def sweep_settings(sweep: Sweep) -> list[Setting]:
@@ -195,6 +282,7 @@ def scene_label(name: str) -> str:
 
 # -- statistics, image error ---------------------------------------------------------------------------------
 
+
 def percentile(values, q: float) -> float:
     return float(np.percentile(np.asarray(values, np.float64), q)) if len(values) else math.nan
 
@@ -220,11 +308,16 @@ def image_error(img: np.ndarray, ref: np.ndarray, mask: np.ndarray | None = None
     d = np.abs(img[..., :3].astype(np.float64) - ref[..., :3].astype(np.float64)).sum(axis=-1)[mask]
     s = ref[..., :3].astype(np.float64).sum(axis=-1)[mask]
     per = d / s
-    return {"image_rel_l1": float(d.sum() / s.sum()), "image_max_rel": float(per.max()),
-            "image_p95_rel": float(np.percentile(per, 95)), "pixels": n}
+    return {
+        "image_rel_l1": float(d.sum() / s.sum()),
+        "image_max_rel": float(per.max()),
+        "image_p95_rel": float(np.percentile(per, 95)),
+        "pixels": n,
+    }
 
 
 # -- profile error against Monte Carlo -------------------------------------------------------------------
+
 
 def _atomic_bytes(path: Path, data: bytes) -> Path:
     path = Path(path)
@@ -260,7 +353,7 @@ def mc_profile(alpha: float, eta: float, photons: int, cache_dir: Path | None, s
                 d = np.load(path)
                 return d["r_edges"], d["R"], float(d["total"])
             except Exception:
-                pass    # a corrupt cache entry is recomputed
+                pass  # a corrupt cache entry is recomputed
     res = simulate(alpha, eta, 0.0, "normal", photons, seed, progress=False, workers=min(2, os.cpu_count() or 1))
     if path is not None:
         buf = io.BytesIO()
@@ -272,11 +365,12 @@ def mc_profile(alpha: float, eta: float, photons: int, cache_dir: Path | None, s
 @dataclass
 class ProfileReference:
     """Monte Carlo edge responses of one medium, per scattering channel, on a fixed x grid (mm)."""
+
     medium: object
-    scatter: np.ndarray               # (3,) bool
-    x: list                           # per channel: x grid (mm) or None
-    e_mc: list                        # per channel: MC edge response on x
-    denom: list                       # per channel: int |H - E_mc| dx
+    scatter: np.ndarray  # (3,) bool
+    x: list  # per channel: x grid (mm) or None
+    e_mc: list  # per channel: MC edge response on x
+    denom: list  # per channel: int |H - E_mc| dx
     photons: int
     cache: dict = field(default_factory=dict)
 
@@ -318,10 +412,11 @@ def profile_reference(medium, photons: int, cache_dir: Path | None) -> ProfileRe
         mfp = float(medium.mfp_arr[c])
         edges, R, _ = mc_profile(float(medium.alpha_arr[c]), float(medium.eta), photons, cache_dir)
         r_mid = np.sqrt(0.5 * (edges[:-1] ** 2 + edges[1:] ** 2)) * mfp
-        R_mm = R / mfp ** 2
+        R_mm = R / mfp**2
         r_max = edges[-1] * mfp
         fn = lambda r: np.where(np.asarray(r) <= r_max, np.interp(r, r_mid, R_mm), 0.0)[:, None]
         return edge_response(x, fn, "profile")[:, 0]
+
     return _reference(medium, edge, photons)
 
 
@@ -362,6 +457,7 @@ def technique_edge_fn(technique: str, model: str, medium, kernel=None, ssss=None
         if ssss is None:
             return None
         from scene.optics.ssss import separable_edge_response
+
         offsets, weights = ssss
         return lambda x: separable_edge_response(x, np.asarray(offsets), np.asarray(weights))
     if technique == "exact":
@@ -382,6 +478,7 @@ def fit_kernel(model: str, medium, K: int):
 
 
 # -- measuring one setting -------------------------------------------------------------------------------
+
 
 def _clock(timings) -> str:
     if not timings.software_gl and timings.passes and all(p.gpu_ms is not None for p in timings.passes):
@@ -428,11 +525,22 @@ def measure_setting(renderer, scene, rs, warmup: int, frames: int, budget_s: flo
     final = renderer.render(scene, rs, readback=("hdr", "ldr"))
     levels = sum(1 for p in final.plan.passes if p.kind == "tsd_blur")
     pm = {k: statistics.median(v) for k, v in passes.items()}
-    return {"frames": n, "frame_ms_median": statistics.median(fm), "frame_ms_p10": percentile(fm, 10),
-            "frame_ms_p90": percentile(fm, 90), "wall_ms_median": statistics.median(wall),
-            "tsd_ms_median": statistics.median(tsd_ms), "clock": "+".join(sorted(clocks)), "passes": pm, "blur_levels": levels,
-            "hdr": final.hdr, "ldr": final.ldr, "plan": final.plan.names(),
-            "kinds": [p.kind for p in final.plan.passes], "ssss": _ssss_kernel(final.plan)}
+    return {
+        "frames": n,
+        "frame_ms_median": statistics.median(fm),
+        "frame_ms_p10": percentile(fm, 10),
+        "frame_ms_p90": percentile(fm, 90),
+        "wall_ms_median": statistics.median(wall),
+        "tsd_ms_median": statistics.median(tsd_ms),
+        "clock": "+".join(sorted(clocks)),
+        "passes": pm,
+        "blur_levels": levels,
+        "hdr": final.hdr,
+        "ldr": final.ldr,
+        "plan": final.plan.names(),
+        "kinds": [p.kind for p in final.plan.passes],
+        "ssss": _ssss_kernel(final.plan),
+    }
 
 
 def _ssss_kernel(plan):
@@ -446,6 +554,7 @@ def _ssss_kernel(plan):
 
 # -- the run ---------------------------------------------------------------------------------------------
 
+
 def _loadavg():
     try:
         return [round(x, 2) for x in os.getloadavg()]
@@ -458,14 +567,21 @@ def _first_line(exc: BaseException) -> str:
     return text.splitlines()[0][:300] if text else type(exc).__name__
 
 
-def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, peer: bool = True,
-              progress: bool = True, images: bool = True, command: str | None = None) -> dict:
+def run_sweep(
+    sweep: Sweep,
+    out: Path,
+    scenes: tuple[str, ...] | None = None,
+    peer: bool = True,
+    progress: bool = True,
+    images: bool = True,
+    command: str | None = None,
+) -> dict:
     """Run the whole ledger and write DIR/ledger.csv, ledger.md, ledger.json, pareto.png and cost.png."""
     from tqdm import tqdm
 
     from app.gl.context import create_headless_context, describe
-    from app.render.renderer import Renderer
     from app.render.plan_tsd import effective_material
+    from app.render.renderer import Renderer
     from scene.optics.tsd import material_medium
     from scene.scenefile import load_scene
 
@@ -480,8 +596,14 @@ def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, pe
     gl = describe(ctx)
     renderer = Renderer(ctx)
     rows: list[dict] = []
-    bar = tqdm(total=len(settings) * len(scenes), file=sys.stderr, unit="setting", disable=not progress,
-               desc="ledger", dynamic_ncols=True)
+    bar = tqdm(
+        total=len(settings) * len(scenes),
+        file=sys.stderr,
+        unit="setting",
+        disable=not progress,
+        desc="ledger",
+        dynamic_ncols=True,
+    )
     try:
         for sname in scenes:
             label = scene_label(sname)
@@ -505,8 +627,16 @@ def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, pe
             tsd_images: dict = {}
             for st in settings:
                 bar.set_postfix_str(f"{label}: {st.label}")
-                row = {"scene": label, "setting": st.label, "technique": st.technique, **st.cells(),
-                       "width": sweep.size[0], "height": sweep.size[1], "status": "ok", "error": ""}
+                row = {
+                    "scene": label,
+                    "setting": st.label,
+                    "technique": st.technique,
+                    **st.cells(),
+                    "width": sweep.size[0],
+                    "height": sweep.size[1],
+                    "status": "ok",
+                    "error": "",
+                }
                 try:
                     rs = st.render_settings(sweep)
                     row["model"] = effective_material(base_node, rs)["sss_model"] if base_node is not None else ""
@@ -520,26 +650,42 @@ def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, pe
                             tsd_images[key] = renderer.render(scene, twin, readback=("hdr",)).hdr
                         if np.array_equal(tsd_images[key], m["hdr"]):
                             row["status"] = "ignored"
-                            row["error"] = (f"the renderer drew technique {st.technique!r} exactly as 'tsd' "
-                                            "(not implemented yet?)")
-                    row.update({k: m[k] for k in ("frames", "frame_ms_median", "frame_ms_p10", "frame_ms_p90",
-                                                  "wall_ms_median", "tsd_ms_median", "clock", "blur_levels")})
+                            row["error"] = (
+                                f"the renderer drew technique {st.technique!r} exactly as 'tsd' (not implemented yet?)"
+                            )
+                    row.update(
+                        {
+                            k: m[k]
+                            for k in (
+                                "frames",
+                                "frame_ms_median",
+                                "frame_ms_p10",
+                                "frame_ms_p90",
+                                "wall_ms_median",
+                                "tsd_ms_median",
+                                "clock",
+                                "blur_levels",
+                            )
+                        }
+                    )
                     row["passes"] = m["passes"]
                     hdrs[st] = m["hdr"]
                     if images:
                         from app.image_output import write_image
+
                         safe = st.label.replace(" ", "-")
                         write_image(out / "images" / f"{label}-{safe}.png", m["ldr"])
                     # profile error against Monte Carlo and against the material's own model profile
                     if base_mat is not None:
                         tech = "none" if row["model"] == "none" else st.technique
                         if tech in ("tsd", "exact") and not {"tsd_blur", "tsd_exact"} & set(m["kinds"]):
-                            tech = "none"   # every Gaussian folded into the unblurred term: plain diffuse
+                            tech = "none"  # every Gaussian folded into the unblurred term: plain diffuse
                         fn = technique_edge_fn(tech, row["model"], base_medium, kernel, m["ssss"])
                         row["profile_err_mc"] = edge_error(pref, fn) if fn is not None else math.nan
-                        row["profile_err_model"] = edge_error(mref, fn) if (fn is not None and mref is not None) \
-                            else math.nan
-                except Exception as exc:   # a failing technique is a row, not the end of the sweep
+                        row["profile_err_model"] = (
+                            edge_error(mref, fn) if (fn is not None and mref is not None) else math.nan
+                        )
+                except Exception as exc:  # a failing technique is a row, not the end of the sweep
                     row["status"] = "error"
                     row["error"] = _first_line(exc)
                 scene_rows[st] = row
@@ -553,8 +699,11 @@ def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, pe
             mask = lit_mask(ref) if ref is not None else None
             # and against the exact convolution at the same irradiance size, where there is one: the
             # technique's own error without the texture-resolution error of the reference
-            exact_at = {st.tsd_size: hdrs[st] for st, r in scene_rows.items()
-                        if st.technique == "exact" and r["status"] == "ok" and st in hdrs}
+            exact_at = {
+                st.tsd_size: hdrs[st]
+                for st, r in scene_rows.items()
+                if st.technique == "exact" and r["status"] == "ok" and st in hdrs
+            }
             for st, row in scene_rows.items():
                 row["reference"] = ref_st.label if ref_st is not None else ""
                 if ref is not None and st in hdrs:
@@ -571,20 +720,34 @@ def run_sweep(sweep: Sweep, out: Path, scenes: tuple[str, ...] | None = None, pe
     if peer:
         try:
             from app.commands.bench import peer_bench
+
             peer_res = peer_bench(sweep.size, sweep.peer_frames)
         except Exception as exc:
             peer_res = {"error": _first_line(exc)}
-    meta = {"sweep": sweep.name, "gl": gl, "cpus": os.cpu_count(), "size": list(sweep.size),
-            "shadow_size": sweep.shadow_size, "warmup": sweep.warmup, "frames": sweep.frames,
-            "budget_s": sweep.budget_s, "photons": sweep.photons, "scenes": [scene_label(s) for s in scenes],
-            "sweep_s": sweep_s, "total_s": time.perf_counter() - t_start, "peer": peer_res,
-            "loadavg_start": load_start, "loadavg_end": _loadavg(),
-            "command": command,
-            "date": time.strftime("%Y-%m-%d %H:%M:%S %Z")}
+    meta = {
+        "sweep": sweep.name,
+        "gl": gl,
+        "cpus": os.cpu_count(),
+        "size": list(sweep.size),
+        "shadow_size": sweep.shadow_size,
+        "warmup": sweep.warmup,
+        "frames": sweep.frames,
+        "budget_s": sweep.budget_s,
+        "photons": sweep.photons,
+        "scenes": [scene_label(s) for s in scenes],
+        "sweep_s": sweep_s,
+        "total_s": time.perf_counter() - t_start,
+        "peer": peer_res,
+        "loadavg_start": load_start,
+        "loadavg_end": _loadavg(),
+        "command": command,
+        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+    }
     return write_ledger(rows, meta, out)
 
 
 # -- outputs -----------------------------------------------------------------------------------------------
+
 
 def _fmt(v, digits=4) -> str:
     if v is None or v == "":
@@ -607,8 +770,11 @@ def csv_text(rows: list[dict]) -> str:
                 cells[c] = ";".join(f"{k}={v:.3f}" for k, v in (r.get("passes") or {}).items())
             elif c in NUMERIC_COLUMNS:
                 v = r.get(c, math.nan)
-                cells[c] = "nan" if v in (None, "") or (isinstance(v, float) and math.isnan(v)) else (
-                    str(v) if isinstance(v, int) else f"{float(v):.6g}")
+                cells[c] = (
+                    "nan"
+                    if v in (None, "") or (isinstance(v, float) and math.isnan(v))
+                    else (str(v) if isinstance(v, int) else f"{float(v):.6g}")
+                )
             else:
                 cells[c] = _fmt(r.get(c, ""), 6)
         w.writerow(cells)
@@ -616,8 +782,11 @@ def csv_text(rows: list[dict]) -> str:
 
 
 def usable(r: dict) -> bool:
-    return r.get("status") == "ok" and np.isfinite(r.get("frame_ms_median", math.nan)) \
+    return (
+        r.get("status") == "ok"
+        and np.isfinite(r.get("frame_ms_median", math.nan))
         and np.isfinite(r.get("image_rel_l1", math.nan))
+    )
 
 
 def pareto_front(rows: list[dict]) -> list[dict]:
@@ -646,8 +815,11 @@ def cost_series(rows: list[dict], sweep_like: dict) -> dict:
     """Per scene: the size series (K = kmax, auto taps) and the K series (at k_size, auto taps)."""
     out = {}
     for scene in dict.fromkeys(r["scene"] for r in rows):
-        tsd = [r for r in rows if r["scene"] == scene and r["technique"] == "tsd" and r["status"] == "ok"
-               and r["taps"] == "auto"]
+        tsd = [
+            r
+            for r in rows
+            if r["scene"] == scene and r["technique"] == "tsd" and r["status"] == "ok" and r["taps"] == "auto"
+        ]
         if not tsd:
             continue
         kmax = max(r["K"] for r in tsd)
@@ -655,8 +827,9 @@ def cost_series(rows: list[dict], sweep_like: dict) -> dict:
         k_size = sweep_like.get("k_size")
         # the cost of K where texture-space diffusion runs at all (K whose Gaussians all fold into the
         # unblurred term render plain diffuse: a step, not a power law)
-        by_k = sorted((r for r in tsd if r["tsd_size"] == k_size and (r.get("blur_levels") or 0) > 0),
-                      key=lambda r: r["K"])
+        by_k = sorted(
+            (r for r in tsd if r["tsd_size"] == k_size and (r.get("blur_levels") or 0) > 0), key=lambda r: r["K"]
+        )
         out[scene] = {"size": by_size, "K": by_k, "kmax": kmax, "k_size": k_size}
     return out
 
@@ -673,8 +846,12 @@ def slopes(series: dict) -> dict:
             "frame_vs_K": log_slope(ks, [r["frame_ms_median"] for r in s["K"]]),
             "tsd_vs_K": log_slope(ks, [r["tsd_ms_median"] for r in s["K"]]),
             "tsd_vs_levels": log_slope(lv, [r["tsd_ms_median"] for r in s["K"]]),
-            "sizes": [r["tsd_size"] for r in s["size"]], "Ks": ks, "levels": lv,
-            "kmax": s["kmax"], "k_size": s["k_size"]}
+            "sizes": [r["tsd_size"] for r in s["size"]],
+            "Ks": ks,
+            "levels": lv,
+            "kmax": s["kmax"],
+            "k_size": s["k_size"],
+        }
     return res
 
 
@@ -703,27 +880,37 @@ def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS) -> list[d
 def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: dict) -> str:
     L = [f"# Accuracy/time ledger ({meta['sweep']} sweep)", ""]
     L.append(f"- GL: {meta['gl']}; {meta['cpus']} CPU(s); {meta['date']}")
-    L.append(f"- image {meta['size'][0]}x{meta['size'][1]}, shadow maps {meta['shadow_size']}; "
-             f"{meta['warmup']} warm-up frames, then the median (p10/p90) of up to {meta['frames']} frames "
-             f"of `render(readback=False)` per setting (fewer, at least 3, where they would take over "
-             f"{meta['budget_s']:g} s); Monte Carlo {meta['photons']:,} photons per channel")
+    L.append(
+        f"- image {meta['size'][0]}x{meta['size'][1]}, shadow maps {meta['shadow_size']}; "
+        f"{meta['warmup']} warm-up frames, then the median (p10/p90) of up to {meta['frames']} frames "
+        f"of `render(readback=False)` per setting (fewer, at least 3, where they would take over "
+        f"{meta['budget_s']:g} s); Monte Carlo {meta['photons']:,} photons per channel"
+    )
     clocks = sorted({r.get("clock") for r in rows if r.get("clock")})
-    L.append(f"- clock: {', '.join(clocks) or 'n/a'} (cpu-synchronised: wall time with glFinish after each "
-             "pass, Mesa llvmpipe's GPU timer queries see only command submission; gpu-timer: GL timer queries)")
+    L.append(
+        f"- clock: {', '.join(clocks) or 'n/a'} (cpu-synchronised: wall time with glFinish after each "
+        "pass, Mesa llvmpipe's GPU timer queries see only command submission; gpu-timer: GL timer queries)"
+    )
     L.append(f"- sweep took {meta['sweep_s']:.1f} s, the whole run (with the pyrender peer) {meta['total_s']:.1f} s")
     if meta.get("loadavg_start") is not None:
-        L.append(f"- load average (1/5/15 min) at the start {meta['loadavg_start']}, at the end "
-                 f"{meta.get('loadavg_end')}: other processes on the machine share its cores and lengthen frames")
+        L.append(
+            f"- load average (1/5/15 min) at the start {meta['loadavg_start']}, at the end "
+            f"{meta.get('loadavg_end')}: other processes on the machine share its cores and lengthen frames"
+        )
     if meta.get("command"):
         L.append(f"- command: `{meta['command']}`")
-    L += ["", "image error: against the scene's reference image (the `reference` column) on linear HDR over "
-          f"lit surface pixels (coverage > 0, luminance > {LUM_FRACTION:.0%} of the 99th percentile); "
-          "rel-L1 = sum|img - ref| / sum ref; max/p95: per-pixel sum_c|img - ref| / sum_c ref. "
-          "`rel-L1 vs exact same size`: a tsd setting against the exact convolution at its own irradiance "
-          "size (the fit/blur error without the texture-resolution error). "
-          "profile error: relative L1 of the edge response against the Monte Carlo random walk, "
-          "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1); `vs model`: the same against the "
-          "material's own model profile (the technique's approximation alone).", ""]
+    L += [
+        "",
+        "image error: against the scene's reference image (the `reference` column) on linear HDR over "
+        f"lit surface pixels (coverage > 0, luminance > {LUM_FRACTION:.0%} of the 99th percentile); "
+        "rel-L1 = sum|img - ref| / sum ref; max/p95: per-pixel sum_c|img - ref| / sum_c ref. "
+        "`rel-L1 vs exact same size`: a tsd setting against the exact convolution at its own irradiance "
+        "size (the fit/blur error without the texture-resolution error). "
+        "profile error: relative L1 of the edge response against the Monte Carlo random walk, "
+        "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1); `vs model`: the same against the "
+        "material's own model profile (the technique's approximation alone).",
+        "",
+    ]
     for scene in dict.fromkeys(r["scene"] for r in rows):
         srows = [r for r in rows if r["scene"] == scene]
         ref = next((r["reference"] for r in srows if r.get("reference")), "")
@@ -731,55 +918,96 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         L.append(f"## {scene}")
         L.append("")
         if not ref:
-            L.append("**No reference image**: neither the exact convolution nor a tsd proxy rendered; "
-                     "image errors are empty.")
+            L.append(
+                "**No reference image**: neither the exact convolution nor a tsd proxy rendered; "
+                "image errors are empty."
+            )
         elif proxy:
-            L.append(f"**Proxy reference**: the exact technique did not render (see its row), so `{ref}` "
-                     "stands in as the image reference; image errors are relative to it, not to the exact "
-                     "profile.")
+            L.append(
+                f"**Proxy reference**: the exact technique did not render (see its row), so `{ref}` "
+                "stands in as the image reference; image errors are relative to it, not to the exact "
+                "profile."
+            )
         else:
             L.append(f"Reference image: `{ref}`.")
         ref_size = next((r.get("tsd_size") for r in srows if r["setting"] == ref), None)
-        finer = [r["setting"] for r in srows if ref_size and r.get("tsd_size") not in ("", None)
-                 and r["tsd_size"] > ref_size]
+        finer = [
+            r["setting"] for r in srows if ref_size and r.get("tsd_size") not in ("", None) and r["tsd_size"] > ref_size
+        ]
         if finer:
-            L.append(f"Settings with a finer irradiance texture than the reference's {ref_size} texels "
-                     f"({', '.join(finer)}) are compared with a coarser image: their error includes the "
-                     "reference's own texture-resolution error (compare the exact rows at smaller sizes).")
+            L.append(
+                f"Settings with a finer irradiance texture than the reference's {ref_size} texels "
+                f"({', '.join(finer)}) are compared with a coarser image: their error includes the "
+                "reference's own texture-resolution error (compare the exact rows at smaller sizes)."
+            )
         L.append("")
-        L.append("| setting | technique | model | K | tsd size | taps | ssss taps | blur levels | frames | "
-                 "frame ms median | p10 | p90 | tsd ms | image rel-L1 | image max | image p95 | rel-L1 vs exact same size | "
-                 "profile err vs MC | profile err vs model | status |")
+        L.append(
+            "| setting | technique | model | K | tsd size | taps | ssss taps | blur levels | frames | "
+            "frame ms median | p10 | p90 | tsd ms | image rel-L1 | image max | image p95 | rel-L1 vs exact same size | "
+            "profile err vs MC | profile err vs model | status |"
+        )
         L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for r in srows:
             status = r["status"] + (f": {r['error']}" if r.get("error") else "")
             pct = lambda v: "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100 * v:.2f} %"
-            L.append("| " + " | ".join([
-                r["setting"], r["technique"], r.get("model", ""), _fmt(r.get("K")), _fmt(r.get("tsd_size")),
-                _fmt(r.get("taps")), _fmt(r.get("ssss_taps")), _fmt(r.get("blur_levels", "")), _fmt(r.get("frames", "")),
-                _fmt(r.get("frame_ms_median"), 4), _fmt(r.get("frame_ms_p10"), 4), _fmt(r.get("frame_ms_p90"), 4),
-                _fmt(r.get("tsd_ms_median"), 4), pct(r.get("image_rel_l1")), pct(r.get("image_max_rel")),
-                pct(r.get("image_p95_rel")), pct(r.get("image_rel_l1_same_size")), pct(r.get("profile_err_mc")),
-                pct(r.get("profile_err_model")), status.replace("|", "/")]) + " |")
+            L.append(
+                "| "
+                + " | ".join(
+                    [
+                        r["setting"],
+                        r["technique"],
+                        r.get("model", ""),
+                        _fmt(r.get("K")),
+                        _fmt(r.get("tsd_size")),
+                        _fmt(r.get("taps")),
+                        _fmt(r.get("ssss_taps")),
+                        _fmt(r.get("blur_levels", "")),
+                        _fmt(r.get("frames", "")),
+                        _fmt(r.get("frame_ms_median"), 4),
+                        _fmt(r.get("frame_ms_p10"), 4),
+                        _fmt(r.get("frame_ms_p90"), 4),
+                        _fmt(r.get("tsd_ms_median"), 4),
+                        pct(r.get("image_rel_l1")),
+                        pct(r.get("image_max_rel")),
+                        pct(r.get("image_p95_rel")),
+                        pct(r.get("image_rel_l1_same_size")),
+                        pct(r.get("profile_err_mc")),
+                        pct(r.get("profile_err_model")),
+                        status.replace("|", "/"),
+                    ]
+                )
+                + " |"
+            )
         L.append("")
         fr = fronts.get(scene, [])
         if fr:
-            L.append("Pareto front (time, image rel-L1): " + " -> ".join(
-                f"`{r['setting']}` ({r['frame_ms_median']:.1f} ms, {100 * r['image_rel_l1']:.2f} %)" for r in fr))
+            L.append(
+                "Pareto front (time, image rel-L1): "
+                + " -> ".join(
+                    f"`{r['setting']}` ({r['frame_ms_median']:.1f} ms, {100 * r['image_rel_l1']:.2f} %)" for r in fr
+                )
+            )
             L.append("")
-    L += ["## Cost slopes", "",
-          "Least-squares slopes of log(time) against log(irradiance texels = tsd_size^2) over the size sweep "
-          "(K = max, auto taps) and against log(K) over the K sweep (auto taps; only the K for which at least "
-          "one blur pass runs: where every Gaussian folds into the unblurred term the frame is plain diffuse); "
-          "`tsd` is the sum of the "
-          "texture-space passes (stretch when it runs, irradiance, dilation, blurs). Slope 1 = linear.", "",
-          "| scene | frame vs texels | tsd passes vs texels | frame vs K | tsd passes vs K | tsd passes vs blur levels | sizes | K | blur levels per K |",
-          "|---|---|---|---|---|---|---|---|---|"]
+    L += [
+        "## Cost slopes",
+        "",
+        "Least-squares slopes of log(time) against log(irradiance texels = tsd_size^2) over the size sweep "
+        "(K = max, auto taps) and against log(K) over the K sweep (auto taps; only the K for which at least "
+        "one blur pass runs: where every Gaussian folds into the unblurred term the frame is plain diffuse); "
+        "`tsd` is the sum of the "
+        "texture-space passes (stretch when it runs, irradiance, dilation, blurs). Slope 1 = linear.",
+        "",
+        "| scene | frame vs texels | tsd passes vs texels | frame vs K | tsd passes vs K "
+        "| tsd passes vs blur levels | sizes | K | blur levels per K |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for scene, s in sl.items():
         f = lambda t: "n/a" if math.isnan(t[0]) else f"{t[0]:.3f}"
-        L.append(f"| {scene} | {f(s['frame_vs_texels'])} | {f(s['tsd_vs_texels'])} | {f(s['frame_vs_K'])} | "
-                 f"{f(s['tsd_vs_K'])} | {f(s['tsd_vs_levels'])} | {', '.join(map(str, s['sizes']))} | "
-                 f"{', '.join(map(str, s['Ks']))} (at {s['k_size']}) | {', '.join(map(str, s['levels']))} |")
+        L.append(
+            f"| {scene} | {f(s['frame_vs_texels'])} | {f(s['tsd_vs_texels'])} | {f(s['frame_vs_K'])} | "
+            f"{f(s['tsd_vs_K'])} | {f(s['tsd_vs_levels'])} | {', '.join(map(str, s['sizes']))} | "
+            f"{', '.join(map(str, s['Ks']))} (at {s['k_size']}) | {', '.join(map(str, s['levels']))} |"
+        )
     if not sl:
         L.append("| (no tsd series measured) | | | | | | | | |")
     L.append("")
@@ -790,39 +1018,56 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
     elif "error" in p:
         L.append(f"The pyrender peer failed: {p['error']}")
     else:
-        L.append(f"`skinlab bench peer --size {p['size'][0]}x{p['size'][1]} --frames {p['frames']}` "
-                 f"({p['gl']}): the head, shadows off, colour+depth read back on both sides, median of "
-                 f"{p['frames']} whole frames (no glFinish between passes); pyrender's frame is plain PBR, "
-                 "Skinlab's plain-PBR frame has sss_model none, its default frame the default "
-                 "RenderSettings (texture-space diffusion on the skin).")
+        L.append(
+            f"`skinlab bench peer --size {p['size'][0]}x{p['size'][1]} --frames {p['frames']}` "
+            f"({p['gl']}): the head, shadows off, colour+depth read back on both sides, median of "
+            f"{p['frames']} whole frames (no glFinish between passes); pyrender's frame is plain PBR, "
+            "Skinlab's plain-PBR frame has sss_model none, its default frame the default "
+            "RenderSettings (texture-space diffusion on the skin)."
+        )
         L.append("")
         L.append("| renderer | ms/frame | / pyrender |")
         L.append("|---|---|---|")
         L.append(f"| skinlab, plain PBR | {p['skinlab_ms']:.2f} | {p['ratio_skinlab_over_pyrender']:.2f} |")
         if p.get("skinlab_default_ms") is not None:
-            L.append(f"| skinlab, default settings (tsd) | {p['skinlab_default_ms']:.2f} | "
-                     f"{p['ratio_default_over_pyrender']:.2f} |")
+            L.append(
+                f"| skinlab, default settings (tsd) | {p['skinlab_default_ms']:.2f} | "
+                f"{p['ratio_default_over_pyrender']:.2f} |"
+            )
         L.append(f"| pyrender | {p['pyrender_ms']:.2f} | 1 |")
     L.append("")
-    L += ["## Recommended defaults", "",
-          "Rule: for each image-error budget tau, the cheapest setting (mean over the scenes of its median "
-          "frame time) whose image rel-L1 against the reference is <= tau in *every* scene; the reference "
-          "itself qualifies trivially. `tsd only` restricts this to texture-space diffusion settings "
-          "(what RenderSettings' tsd_size / tsd_gaussians / tsd_taps defaults choose among). A setting "
-          "must have been measured in every scene.", "",
-          "| budget tau | cheapest setting | mean ms | errors per scene | cheapest tsd setting | mean ms | errors per scene |",
-          "|---|---|---|---|---|---|---|"]
+    L += [
+        "## Recommended defaults",
+        "",
+        "Rule: for each image-error budget tau, the cheapest setting (mean over the scenes of its median "
+        "frame time) whose image rel-L1 against the reference is <= tau in *every* scene; the reference "
+        "itself qualifies trivially. `tsd only` restricts this to texture-space diffusion settings "
+        "(what RenderSettings' tsd_size / tsd_gaussians / tsd_taps defaults choose among). A setting "
+        "must have been measured in every scene.",
+        "",
+        "| budget tau | cheapest setting | mean ms | errors per scene "
+        "| cheapest tsd setting | mean ms | errors per scene |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for rec in recs:
+
         def cell(t):
             if t is None:
                 return ["none qualifies", "", ""]
             cost, labl, per = t
-            return [f"`{labl}`", f"{cost:.1f}",
-                    ", ".join(f"{s} {100 * r['image_rel_l1']:.2f} %" for s, r in per.items())]
+            return [
+                f"`{labl}`",
+                f"{cost:.1f}",
+                ", ".join(f"{s} {100 * r['image_rel_l1']:.2f} %" for s, r in per.items()),
+            ]
+
         L.append(f"| {100 * rec['threshold']:g} % | " + " | ".join(cell(rec["best"]) + cell(rec["best_tsd"])) + " |")
     if any(r.get("reference") and not r["reference"].startswith("exact") for r in rows):
-        L += ["", "These recommendations are relative to a proxy reference (see above), not to the exact "
-                  "convolution: re-run once the exact technique renders."]
+        L += [
+            "",
+            "These recommendations are relative to a proxy reference (see above), not to the exact "
+            "convolution: re-run once the exact technique renders.",
+        ]
     L.append("")
     return "\n".join(L)
 
@@ -862,12 +1107,28 @@ def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
         if isinstance(v, (list, tuple)):
             return [clean(x) for x in v]
         return v
-    rec_json = [{"threshold": r["threshold"],
-                 "best": r["best"][1] if r["best"] else None,
-                 "best_tsd": r["best_tsd"][1] if r["best_tsd"] else None} for r in recs]
-    doc = {"meta": meta, "rows": rows, "slopes": {s: {k: (list(v) if isinstance(v, tuple) else v)
-                                                       for k, v in d.items()} for s, d in sl.items()},
-           "pareto": {s: [r["setting"] for r in f] for s, f in fronts.items()}, "recommendations": rec_json}
+
+    rec_json = [
+        {
+            "threshold": r["threshold"],
+            "best": r["best"][1] if r["best"] else None,
+            "best_tsd": r["best_tsd"][1] if r["best_tsd"] else None,
+        }
+        for r in recs
+    ]
+    doc = {
+        "meta": meta,
+        "rows": rows,
+        "slopes": {s: {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()} for s, d in sl.items()},
+        "pareto": {s: [r["setting"] for r in f] for s, f in fronts.items()},
+        "recommendations": rec_json,
+    }
     write_text_atomic(out / "ledger.json", json.dumps(clean(doc), indent=1))
-    return {"rows": rows, "meta": meta, "slopes": sl, "recommendations": recs, "fronts": fronts,
-            "files": [str(out / n) for n in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png")]}
+    return {
+        "rows": rows,
+        "meta": meta,
+        "slopes": sl,
+        "recommendations": recs,
+        "fronts": fronts,
+        "files": [str(out / n) for n in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png")],
+    }

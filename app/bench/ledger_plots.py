@@ -1,6 +1,7 @@
 """Figures of the accuracy/time ledger (matplotlib, Agg backend, written atomically):
 pareto.png (image error against frame time, one panel per scene) and cost.png (frame time against
 irradiance texels and against K, log-log, with the fitted slopes)."""
+
 from __future__ import annotations
 
 import io
@@ -11,6 +12,8 @@ import numpy as np
 
 MARKERS = {"exact": "*", "tsd": "o", "ssss": "s", "tint": "^", "none": "X"}
 COLOURS = {"exact": "black", "tsd": "tab:blue", "ssss": "tab:orange", "tint": "tab:green", "none": "tab:red"}
+
+
 def _floor(pts) -> float:
     """Where the reference (error 0) is drawn on the log axis: a decade below the smallest other error."""
     nz = [r["image_rel_l1"] for r in pts if r["image_rel_l1"] > 0]
@@ -24,9 +27,10 @@ def _figure_bytes(fig) -> bytes:
 
 
 def _save(fig, path: Path) -> Path:
+    import matplotlib.pyplot as plt
+
     from app.bench.accuracy import _atomic_bytes
 
-    import matplotlib.pyplot as plt
     data = _figure_bytes(fig)
     plt.close(fig)
     return _atomic_bytes(path, data)
@@ -34,8 +38,10 @@ def _save(fig, path: Path) -> Path:
 
 def _plt():
     import matplotlib
+
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
+
     return plt
 
 
@@ -52,9 +58,16 @@ def pareto_plot(rows: list[dict], fronts: dict, path: Path) -> Path:
             sel = [r for r in pts if r["technique"] == tech]
             if not sel:
                 continue
-            ax.scatter([r["frame_ms_median"] for r in sel], [max(r["image_rel_l1"], floor) for r in sel],
-                       marker=MARKERS[tech], c=COLOURS[tech], s=70 if tech == "exact" else 40, label=tech,
-                       edgecolors="none", zorder=3)
+            ax.scatter(
+                [r["frame_ms_median"] for r in sel],
+                [max(r["image_rel_l1"], floor) for r in sel],
+                marker=MARKERS[tech],
+                c=COLOURS[tech],
+                s=70 if tech == "exact" else 40,
+                label=tech,
+                edgecolors="none",
+                zorder=3,
+            )
         fr = fronts.get(scene, [])
         if fr:
             x = [r["frame_ms_median"] for r in fr]
@@ -66,8 +79,15 @@ def pareto_plot(rows: list[dict], fronts: dict, path: Path) -> Path:
                 ax.annotate(text, (xi, yi), textcoords="offset points", xytext=(5, 4), fontsize=7)
         bad = [r for r in rows if r["scene"] == scene and not usable(r)]
         if bad:
-            ax.text(0.01, 0.01, "not plotted: " + ", ".join(f"{r['setting']} ({r['status']})" for r in bad),
-                    transform=ax.transAxes, fontsize=6, va="bottom", wrap=True)
+            ax.text(
+                0.01,
+                0.01,
+                "not plotted: " + ", ".join(f"{r['setting']} ({r['status']})" for r in bad),
+                transform=ax.transAxes,
+                fontsize=6,
+                va="bottom",
+                wrap=True,
+            )
         ax.set_xscale("log")
         ax.margins(x=0.25)
         ax.xaxis.set_minor_formatter(plt.NullFormatter())
@@ -90,19 +110,26 @@ def cost_plot(series: dict, slopes: dict, path: Path) -> Path:
     for i, (scene, s) in enumerate(series.items()):
         col = colours[i % len(colours)]
         sl = slopes.get(scene, {})
-        for ax, key, xs, xkey in ((a1, "texels", [r["tsd_size"] ** 2 for r in s["size"]], "size"),
-                                  (a2, "K", [r["K"] for r in s["K"]], "K")):
+        for ax, key, xs, xkey in (
+            (a1, "texels", [r["tsd_size"] ** 2 for r in s["size"]], "size"),
+            (a2, "K", [r["K"] for r in s["K"]], "K"),
+        ):
             rs = s[xkey]
-            for ykey, ls, mk, what in (("frame_ms_median", "-", "o", "frame"), ("tsd_ms_median", ":", "s", "tsd passes")):
+            for ykey, ls, mk, what in (
+                ("frame_ms_median", "-", "o", "frame"),
+                ("tsd_ms_median", ":", "s", "tsd passes"),
+            ):
                 ys = [r[ykey] for r in rs]
                 b, a, n = sl.get(f"{'frame' if ykey == 'frame_ms_median' else 'tsd'}_vs_{key}", (math.nan,) * 3)
                 lab = f"{scene} {what}" + ("" if math.isnan(b) else f" (slope {b:.2f})")
                 ax.plot(xs, ys, mk, color=col, label=lab, mfc="none" if ykey == "tsd_ms_median" else col)
                 if not math.isnan(b) and len(xs) >= 2:
                     xf = np.geomspace(min(xs), max(xs), 20)
-                    ax.plot(xf, np.exp(a) * xf ** b, ls, color=col, lw=1)
-    for ax, xl, title in ((a1, "irradiance texels (tsd_size^2)", "cost vs irradiance texels (K = max, auto taps)"),
-                          (a2, "K (Gaussians fitted)", "cost vs K (auto taps)")):
+                    ax.plot(xf, np.exp(a) * xf**b, ls, color=col, lw=1)
+    for ax, xl, title in (
+        (a1, "irradiance texels (tsd_size^2)", "cost vs irradiance texels (K = max, auto taps)"),
+        (a2, "K (Gaussians fitted)", "cost vs K (auto taps)"),
+    ):
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.xaxis.set_minor_formatter(plt.NullFormatter())

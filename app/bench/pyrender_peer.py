@@ -5,6 +5,7 @@ under moderngl in the same process, so the peer always runs in a child process
 (:func:`run_peer`). The child loads the mesh with trimesh itself and takes the camera as plain
 matrices, so the only things shared with Skinlab are the file and the numbers.
 """
+
 from __future__ import annotations
 
 import json
@@ -46,18 +47,34 @@ def _child(spec_path: str, out_path: str) -> None:
     r.delete()
 
 
-def run_peer(meshes: list[tuple[str, np.ndarray]], camera_pose: np.ndarray, yfov: float, znear: float,
-             zfar: float, size: tuple[int, int], frames: int = 0, timeout: float = 600) -> dict:
+def run_peer(
+    meshes: list[tuple[str, np.ndarray]],
+    camera_pose: np.ndarray,
+    yfov: float,
+    znear: float,
+    zfar: float,
+    size: tuple[int, int],
+    frames: int = 0,
+    timeout: float = 600,
+) -> dict:
     """Render with pyrender in a subprocess; returns color (H,W,3), depth (H,W; 0 = background),
     and per-frame times in ms if ``frames`` > 0."""
     with tempfile.TemporaryDirectory(prefix="skinlab-peer-") as tmp:
-        spec = {"meshes": [{"file": str(f), "matrix": np.asarray(m).tolist()} for f, m in meshes],
-                "camera_pose": np.asarray(camera_pose).tolist(), "yfov": yfov, "znear": znear, "zfar": zfar,
-                "size": list(size), "frames": frames}
+        spec = {
+            "meshes": [{"file": str(f), "matrix": np.asarray(m).tolist()} for f, m in meshes],
+            "camera_pose": np.asarray(camera_pose).tolist(),
+            "yfov": yfov,
+            "znear": znear,
+            "zfar": zfar,
+            "size": list(size),
+            "frames": frames,
+        }
         sp, op = Path(tmp) / "spec.json", Path(tmp) / "out.npz"
         sp.write_text(json.dumps(spec))
-        code = f"import sys; sys.path.insert(0, {str(Path(__file__).resolve().parents[2])!r}); " \
-               f"from app.bench.pyrender_peer import _child; _child({str(sp)!r}, {str(op)!r})"
+        code = (
+            f"import sys; sys.path.insert(0, {str(Path(__file__).resolve().parents[2])!r}); "
+            f"from app.bench.pyrender_peer import _child; _child({str(sp)!r}, {str(op)!r})"
+        )
         env = dict(os.environ, PYOPENGL_PLATFORM="egl")
         proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout, env=env)
         if proc.returncode != 0:

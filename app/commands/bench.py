@@ -1,6 +1,7 @@
 """`skinlab bench peer`: our plain-PBR frame time against pyrender's, same scene, size and EGL.
 `skinlab bench reload`: latency from saving a shader file to the first frame rendered with it.
 `skinlab bench accuracy`: the accuracy/time ledger of the SSS techniques (app/bench/accuracy.py)."""
+
 from __future__ import annotations
 
 import argparse
@@ -22,37 +23,63 @@ def register(sub) -> None:
     peer.add_argument("--frames", type=int, default=30, help="timed frames per renderer (after warm-up)")
     peer.add_argument("--json", action="store_true")
     peer.set_defaults(func=run_peer_bench)
-    rel = bsub.add_parser("reload", help="shader hot reload: time from saving a file to the first frame "
-                                         "rendered with the new program (headless)")
+    rel = bsub.add_parser(
+        "reload",
+        help="shader hot reload: time from saving a file to the first frame rendered with the new program (headless)",
+    )
     rel.add_argument("--size", default="128x128", help="frame size (default 128x128)")
     rel.add_argument("--repeats", type=int, default=10, help="edits to time (default 10)")
-    rel.add_argument("--file", default="passes/tonemap.frag",
-                     help="shader file to edit, relative to shaders/ (default passes/tonemap.frag)")
-    rel.add_argument("--settle", type=float, default=0.05,
-                     help="ShaderWatcher settle time in seconds (default 0.05, as skinlab view)")
+    rel.add_argument(
+        "--file",
+        default="passes/tonemap.frag",
+        help="shader file to edit, relative to shaders/ (default passes/tonemap.frag)",
+    )
+    rel.add_argument(
+        "--settle",
+        type=float,
+        default=0.05,
+        help="ShaderWatcher settle time in seconds (default 0.05, as skinlab view)",
+    )
     rel.add_argument("--shadow-size", type=int, default=512)
     rel.add_argument("--tsd-size", type=int, default=256)
-    rel.add_argument("--mode", choices=("on-demand", "continuous"), default="on-demand",
-                     help="on-demand: the viewer's default loop (idle polls at 60 Hz, a frame only after a "
-                          "change); continuous: a frame every iteration (as with skinlab view --continuous)")
+    rel.add_argument(
+        "--mode",
+        choices=("on-demand", "continuous"),
+        default="on-demand",
+        help="on-demand: the viewer's default loop (idle polls at 60 Hz, a frame only after a "
+        "change); continuous: a frame every iteration (as with skinlab view --continuous)",
+    )
     rel.add_argument("--timeout", type=float, default=20.0, help="give up on one edit after this many seconds")
     rel.add_argument("--json", action="store_true")
     rel.set_defaults(func=run_reload_bench)
-    acc = bsub.add_parser("accuracy", help="accuracy/time ledger: every SSS technique and setting timed and "
-                                           "compared with the exact reference image and the Monte Carlo profile")
-    acc.add_argument("--out", required=True, help="output folder (ledger.csv, ledger.md, ledger.json, pareto.png, "
-                                                  "cost.png, images/, mc_cache/)")
+    acc = bsub.add_parser(
+        "accuracy",
+        help="accuracy/time ledger: every SSS technique and setting timed and "
+        "compared with the exact reference image and the Monte Carlo profile",
+    )
+    acc.add_argument(
+        "--out",
+        required=True,
+        help="output folder (ledger.csv, ledger.md, ledger.json, pareto.png, cost.png, images/, mc_cache/)",
+    )
     acc.add_argument("--quick", action="store_true", help="a subset at 160x160 (a few minutes at most on 2 cores)")
-    acc.add_argument("--tiny", action="store_true", help=argparse.SUPPRESS)   # tests: 4 settings, head, 64x64
+    acc.add_argument("--tiny", action="store_true", help=argparse.SUPPRESS)  # tests: 4 settings, head, 64x64
     acc.add_argument("--size", default=None, help="WIDTHxHEIGHT (default 640x640; --quick 160x160)")
-    acc.add_argument("--scenes", default=None,
-                     help="comma-separated: head, bunny (skim milk), bunny-marble, ... or .toml paths "
-                          "(default head,bunny)")
+    acc.add_argument(
+        "--scenes",
+        default=None,
+        help="comma-separated: head, bunny (skim milk), bunny-marble, ... or .toml paths (default head,bunny)",
+    )
     acc.add_argument("--frames", type=int, default=None, help="timed frames per setting (default 10; --quick 5)")
-    acc.add_argument("--photons", type=int, default=None,
-                     help="Monte Carlo photons per channel (default 200000; --quick 20000)")
-    acc.add_argument("--exact-size", type=int, default=None,
-                     help="irradiance texels per side of the exact reference (default 1024; --quick 256)")
+    acc.add_argument(
+        "--photons", type=int, default=None, help="Monte Carlo photons per channel (default 200000; --quick 20000)"
+    )
+    acc.add_argument(
+        "--exact-size",
+        type=int,
+        default=None,
+        help="irradiance texels per side of the exact reference (default 1024; --quick 256)",
+    )
     acc.add_argument("--no-peer", action="store_true", help="skip the pyrender comparison")
     acc.add_argument("--no-images", action="store_true", help="do not write images/SCENE-SETTING.png")
     acc.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -89,6 +116,7 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
             r.render(scene, settings, readback=("ldr", "depth"))  # what pyrender reads back
             out.append((time.perf_counter() - t0) * 1e3)
         return out
+
     try:
         ours = timed(RenderSettings(w, h, sss_model="none"))
         ours_default = timed(RenderSettings(w, h))
@@ -100,9 +128,16 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
     theirs = list(map(float, peer["times"]))
     mo, mt = statistics.median(ours), statistics.median(theirs)
     md = statistics.median(ours_default)
-    return {"size": [w, h], "frames": frames, "gl": describe(ctx), "skinlab_ms": mo, "pyrender_ms": mt,
-            "ratio_skinlab_over_pyrender": mo / mt, "skinlab_default_ms": md,
-            "ratio_default_over_pyrender": md / mt}
+    return {
+        "size": [w, h],
+        "frames": frames,
+        "gl": describe(ctx),
+        "skinlab_ms": mo,
+        "pyrender_ms": mt,
+        "ratio_skinlab_over_pyrender": mo / mt,
+        "skinlab_default_ms": md,
+        "ratio_default_over_pyrender": md / mt,
+    }
 
 
 def run_peer_bench(args) -> int:
@@ -110,13 +145,17 @@ def run_peer_bench(args) -> int:
     if args.json:
         print(json.dumps(res, indent=2))
     else:
-        print(f"{res['gl']}, {res['size'][0]}x{res['size'][1]}, median of {res['frames']} frames "
-              f"(colour+depth read back on both):")
+        print(
+            f"{res['gl']}, {res['size'][0]}x{res['size'][1]}, median of {res['frames']} frames "
+            f"(colour+depth read back on both):"
+        )
         print(f"  skinlab   {res['skinlab_ms']:8.2f} ms/frame (plain PBR: sss_model none)")
         print(f"  pyrender  {res['pyrender_ms']:8.2f} ms/frame")
         print(f"  ratio skinlab/pyrender = {res['ratio_skinlab_over_pyrender']:.2f}")
-        print(f"  skinlab with the default settings (texture-space diffusion on the skin) "
-              f"{res['skinlab_default_ms']:8.2f} ms/frame, ratio {res['ratio_default_over_pyrender']:.2f}")
+        print(
+            f"  skinlab with the default settings (texture-space diffusion on the skin) "
+            f"{res['skinlab_default_ms']:8.2f} ms/frame, ratio {res['ratio_default_over_pyrender']:.2f}"
+        )
     return 0
 
 
@@ -136,19 +175,32 @@ def bench_edit(text: str, i: int) -> tuple[str, bool]:
     if len(outs) == 1 and len(_MAIN.findall(text)) == 1:
         factor = 0.5 if i % 2 == 0 else 0.75
         body = _MAIN.sub("void skinlab_bench_main()", text, count=1)
-        return (body + f"\n// skinlab bench reload edit {i}\nvoid main() {{\n    skinlab_bench_main();\n"
-                f"    {outs[0]}.rgb *= {factor};\n}}\n"), True
+        return (
+            body + f"\n// skinlab bench reload edit {i}\nvoid main() {{\n    skinlab_bench_main();\n"
+            f"    {outs[0]}.rgb *= {factor};\n}}\n"
+        ), True
     return text + f"\n// skinlab bench reload edit {i}\n", False
 
 
 def _stats(values: list[float]) -> dict:
-    return {"median": statistics.median(values), "max": max(values), "min": min(values),
-            "samples": [round(v, 3) for v in values]}
+    return {
+        "median": statistics.median(values),
+        "max": max(values),
+        "min": min(values),
+        "samples": [round(v, 3) for v in values],
+    }
 
 
-def reload_bench(size=(128, 128), repeats: int = 10, file: str = "passes/tonemap.frag", settle_s: float = 0.05,
-                 shadow_size: int = 512, tsd_size: int = 256, timeout_s: float = 20.0,
-                 mode: str = "on-demand") -> dict:
+def reload_bench(
+    size=(128, 128),
+    repeats: int = 10,
+    file: str = "passes/tonemap.frag",
+    settle_s: float = 0.05,
+    shadow_size: int = 512,
+    tsd_size: int = 256,
+    timeout_s: float = 20.0,
+    mode: str = "on-demand",
+) -> dict:
     """Copy shaders/ to a temporary folder, render the head continuously with a Renderer on it
     while a ShaderWatcher watches the copy, write an edited ``file`` ``repeats`` times and time
     each write until the end of the first frame (tone-mapped pixels read back) whose programs
@@ -187,7 +239,7 @@ def reload_bench(size=(128, 128), repeats: int = 10, file: str = "passes/tonemap
         renderer = Renderer(ctx, ShaderLibrary(root=root))
         watcher = ShaderWatcher(renderer.programs, root, settle_s=settle_s)
         try:
-            prev = renderer.render(scene, settings, readback=("ldr",)).ldr   # compile everything once
+            prev = renderer.render(scene, settings, readback=("ldr",)).ldr  # compile everything once
             keys = renderer.programs.dependents({target})
             if not keys:
                 raise ValueError(f"--file: no program of the head's frame includes {file}")
@@ -238,22 +290,44 @@ def reload_bench(size=(128, 128), repeats: int = 10, file: str = "passes/tonemap
         finally:
             watcher.stop()
             renderer.release()
-    return {"gl": describe(ctx), "mode": mode, "size": [w, h], "file": file, "programs": len(keys), "repeats": repeats,
-            "settle_s": settle_s, "check": "image changed" if image_check else "program recompiled",
-            "latency_ms": _stats(latency), "reload_applied_ms": _stats(reload_ms),
-            "recompile_ms": _stats(compile_ms), "first_frame_ms": _stats(frame_ms), "frames_until_new": frames_waited}
+    return {
+        "gl": describe(ctx),
+        "mode": mode,
+        "size": [w, h],
+        "file": file,
+        "programs": len(keys),
+        "repeats": repeats,
+        "settle_s": settle_s,
+        "check": "image changed" if image_check else "program recompiled",
+        "latency_ms": _stats(latency),
+        "reload_applied_ms": _stats(reload_ms),
+        "recompile_ms": _stats(compile_ms),
+        "first_frame_ms": _stats(frame_ms),
+        "frames_until_new": frames_waited,
+    }
 
 
 def run_reload_bench(args) -> int:
-    res = reload_bench(parse_size(args.size), args.repeats, args.file, args.settle, args.shadow_size,
-                       args.tsd_size, args.timeout, args.mode)
+    res = reload_bench(
+        parse_size(args.size),
+        args.repeats,
+        args.file,
+        args.settle,
+        args.shadow_size,
+        args.tsd_size,
+        args.timeout,
+        args.mode,
+    )
     if args.json:
         print(json.dumps(res, indent=2))
         return 0
     lat, rel, fr = res["latency_ms"], res["reload_applied_ms"], res["first_frame_ms"]
     comp = res["recompile_ms"]
-    print(f"{res['gl']}, {res['mode']} frames, {res['size'][0]}x{res['size'][1]}, {res['repeats']} edits of shaders/{res['file']} "
-          f"({res['programs']} program(s) depend on it; settle {res['settle_s']} s; check: {res['check']})")
+    print(
+        f"{res['gl']}, {res['mode']} frames, {res['size'][0]}x{res['size'][1]}, "
+        f"{res['repeats']} edits of shaders/{res['file']} "
+        f"({res['programs']} program(s) depend on it; settle {res['settle_s']} s; check: {res['check']})"
+    )
     print(f"  save -> first new frame   median {lat['median']:8.1f} ms   max {lat['max']:8.1f} ms")
     print(f"  save -> reload applied    median {rel['median']:8.1f} ms   max {rel['max']:8.1f} ms")
     print(f"    of which recompiling    median {comp['median']:8.1f} ms   max {comp['max']:8.1f} ms")
@@ -262,6 +336,7 @@ def run_reload_bench(args) -> int:
 
 
 # -- accuracy/time ledger ----------------------------------------------------------------------------------
+
 
 def accuracy_sweep_from_args(args):
     """The Sweep chosen by --quick/--tiny with the explicit overrides applied."""
@@ -300,14 +375,31 @@ def run_accuracy_bench(args) -> int:
 
     sweep = accuracy_sweep_from_args(args)
     for s in sweep.scenes:
-        resolve_scene(s)            # bad names fail before any rendering
+        resolve_scene(s)  # bad names fail before any rendering
     flags = [("--quick", args.quick), ("--tiny", args.tiny), ("--no-peer", args.no_peer)]
-    opts = [("--size", args.size), ("--scenes", args.scenes), ("--frames", args.frames), ("--photons", args.photons),
-            ("--exact-size", args.exact_size)]
-    command = " ".join(["skinlab bench accuracy", *(f for f, on in flags if on),
-                        *(f"{k} {v}" for k, v in opts if v is not None), f"--out {args.out}"])
-    res = run_sweep(sweep, Path(args.out), peer=not args.no_peer, progress=not args.no_progress,
-                    images=not args.no_images, command=command)
+    opts = [
+        ("--size", args.size),
+        ("--scenes", args.scenes),
+        ("--frames", args.frames),
+        ("--photons", args.photons),
+        ("--exact-size", args.exact_size),
+    ]
+    command = " ".join(
+        [
+            "skinlab bench accuracy",
+            *(f for f, on in flags if on),
+            *(f"{k} {v}" for k, v in opts if v is not None),
+            f"--out {args.out}",
+        ]
+    )
+    res = run_sweep(
+        sweep,
+        Path(args.out),
+        peer=not args.no_peer,
+        progress=not args.no_progress,
+        images=not args.no_images,
+        command=command,
+    )
     rows = res["rows"]
     n_ok = sum(r["status"] == "ok" for r in rows)
     print(f"{res['meta']['gl']}: {len(rows)} settings ({n_ok} ok) in {res['meta']['total_s']:.1f} s")

@@ -1,6 +1,7 @@
 """`skinlab demo`: render the default head scene headless (PNG and EXR) and say where it is;
 `--gallery` also renders the head with every subsurface model and the bunny as marble, skim milk
 and ketchup (Jensen 2001 presets) into OUT/gallery."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -15,8 +16,11 @@ def register(sub) -> None:
     p = sub.add_parser("demo", help="render the default head scene into OUT (PNG + EXR)")
     p.add_argument("--out", default="out", help="output folder (default out/)")
     p.add_argument("--size", default="640x640")
-    p.add_argument("--gallery", action="store_true",
-                   help="also render the head with each SSS model and the bunny presets into OUT/gallery")
+    p.add_argument(
+        "--gallery",
+        action="store_true",
+        help="also render the head with each SSS model and the bunny presets into OUT/gallery",
+    )
     p.set_defaults(func=run)
 
 
@@ -26,8 +30,7 @@ def run(args) -> int:
 
     w, h = parse_size(args.size)
     out = Path(args.out)
-    scene, result, written, ctx = render_to_files(None, [out / "head.png", out / "head.exr"],
-                                                  RenderSettings(w, h))
+    scene, result, written, ctx = render_to_files(None, [out / "head.png", out / "head.exr"], RenderSettings(w, h))
     print(f"Rendered '{scene.name}' ({scene.source}) at {w}x{h} on {describe(ctx)}")
     print(result.plan.explain())
     print("per-pass time (ms, " + result.timings.as_dict()["clock"] + "):")
@@ -52,21 +55,30 @@ def gallery(folder: Path, w: int, h: int) -> list[Path]:
     from scene.scenefile import load_scene
 
     renderer = Renderer(create_headless_context())
-    jobs = [(f"head-{m}", None, m) for m in SSS_MODELS] + \
-           [(f"bunny-{b}", ASSETS / f"bunny-{b}.toml", None) for b in BUNNIES]
+    jobs = [(f"head-{m}", None, m) for m in SSS_MODELS] + [
+        (f"bunny-{b}", ASSETS / f"bunny-{b}.toml", None) for b in BUNNIES
+    ]
     rows, written = [], []
     for name, path, model in jobs:
         scene = load_scene(path)
         st = RenderSettings(w, h, sss_model=model)
-        renderer.render(scene, st, readback=False)          # warm-up: compiles, uploads, stretch maps
+        renderer.render(scene, st, readback=False)  # warm-up: compiles, uploads, stretch maps
         res = renderer.render(scene, st, readback=("ldr",))
         p = write_image(folder / f"{name}.png", res.ldr)
         written.append(p)
         rows.append(f"| ![{name}]({p.name}) | {name} | {res.timings.frame_ms:.1f} |")
         print(f"  {p.resolve()}  ({res.timings.frame_ms:.1f} ms)")
-    md = ["# Skinlab gallery", "", f"Rendered by `skinlab demo --gallery --size {w}x{h}`; frame times are "
-          f"{'CPU-synchronised (software GL)' if renderer.timer.software_gl else 'GPU timer queries'}.", "",
-          "| image | scene / model | frame ms |", "|---|---|---|", *rows, ""]
+    md = [
+        "# Skinlab gallery",
+        "",
+        f"Rendered by `skinlab demo --gallery --size {w}x{h}`; frame times are "
+        f"{'CPU-synchronised (software GL)' if renderer.timer.software_gl else 'GPU timer queries'}.",
+        "",
+        "| image | scene / model | frame ms |",
+        "|---|---|---|",
+        *rows,
+        "",
+    ]
     tmp = folder / ".gallery.md.tmp"
     tmp.write_text("\n".join(md))
     tmp.replace(folder / "gallery.md")

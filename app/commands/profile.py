@@ -1,6 +1,7 @@
 """`skinlab profile MODEL [--preset NAME | --albedo R,G,B --mfp R,G,B] [--r LIST] [--json] [--plot PATH]`:
 evaluate a diffusion profile (scene/optics/profiles.py) for a medium; optionally plot every model
 against the Monte Carlo reference."""
+
 from __future__ import annotations
 
 import json
@@ -42,9 +43,15 @@ def register(sub) -> None:
     src.add_argument("--albedo", help="surface albedo (diffuse reflectance) R,G,B in [0, 1]; needs --mfp or --radius")
     p.add_argument("--mfp", help="mean free path 1/sigma_t' in mm, R,G,B (with --albedo)")
     p.add_argument("--radius", help="Blender artist radius in mm, R,G,B (with --albedo; l = R/(4 pi))")
-    p.add_argument("--eta", type=float, default=None, help="relative index of refraction (default 1.3, or the preset's)")
-    p.add_argument("--albedo-method", choices=("pbd", "dipole", "cycles"), default="pbd",
-                   help="how --albedo is inverted to the single-scattering albedo (default pbd)")
+    p.add_argument(
+        "--eta", type=float, default=None, help="relative index of refraction (default 1.3, or the preset's)"
+    )
+    p.add_argument(
+        "--albedo-method",
+        choices=("pbd", "dipole", "cycles"),
+        default="pbd",
+        help="how --albedo is inverted to the single-scattering albedo (default pbd)",
+    )
     p.add_argument("--r", default=DEFAULT_R, help=f"radii in mm (default {DEFAULT_R})")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--plot", help="PNG path: every model vs the Monte Carlo reference (log axes)")
@@ -83,9 +90,15 @@ def run(args) -> int:
     models = {}
     for n in names:
         models[n] = {"R": evaluate_profile(n, r, m).tolist(), "total": total_reflectance(n, m).tolist()}
-    medium = {"name": m.name, "alpha": list(m.alpha), "mfp_mm": list(m.mfp_mm), "eta": m.eta,
-              "sigma_s_per_mm": m.sigma_s.tolist(), "sigma_a_per_mm": m.sigma_a.tolist(),
-              "surface_albedo": m.surface_albedo().tolist()}
+    medium = {
+        "name": m.name,
+        "alpha": list(m.alpha),
+        "mfp_mm": list(m.mfp_mm),
+        "eta": m.eta,
+        "sigma_s_per_mm": m.sigma_s.tolist(),
+        "sigma_a_per_mm": m.sigma_a.tolist(),
+        "surface_albedo": m.surface_albedo().tolist(),
+    }
     if args.plot:
         plot_models(m, args.plot, int(args.mc_photons), args.seed)
     if args.json:
@@ -98,8 +111,10 @@ def run(args) -> int:
             out["plot"] = args.plot
         print(json.dumps(out))
     else:
-        print(f"medium {m.name or '(custom)'}: alpha' = {np.round(m.alpha, 5).tolist()}, "
-              f"mfp = {np.round(m.mfp_mm, 5).tolist()} mm, eta = {m.eta}")
+        print(
+            f"medium {m.name or '(custom)'}: alpha' = {np.round(m.alpha, 5).tolist()}, "
+            f"mfp = {np.round(m.mfp_mm, 5).tolist()} mm, eta = {m.eta}"
+        )
         for n in names:
             print(f"\n{n}: total reflectance R,G,B = {np.round(models[n]['total'], 5).tolist()}")
             print(f"{'r (mm)':>10} {'R':>12} {'G':>12} {'B':>12}   (1/mm^2)")
@@ -126,8 +141,7 @@ def plot_models(m, path, photons, seed=0):
         if l <= 0 or m.alpha[c] <= 0:
             ax.set_title(f"{chan}: no scattering")
             continue
-        res = simulate(m.alpha[c], m.eta, 0.0, "normal", photons, seed + c, progress=True,
-                       workers=2)
+        res = simulate(m.alpha[c], m.eta, 0.0, "normal", photons, seed + c, progress=True, workers=2)
         edges, R, se = res.scaled(l)
         rm = res.r_mid * l
         ok = R > 0

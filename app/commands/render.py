@@ -1,4 +1,5 @@
 """`skinlab render [SCENE] --out PATH --size WxH [--json] [--explain]`."""
+
 from __future__ import annotations
 
 import json
@@ -15,12 +16,20 @@ def register(sub) -> None:
     p.add_argument("--out", default="out/render.png", help="output image: .png (tone mapped) or .exr (linear)")
     p.add_argument("--size", default="640x640", help="WIDTHxHEIGHT (default 640x640)")
     p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
-    p.add_argument("--sss", choices=SSS_MODELS, default=None,
-                   help="subsurface model for every material (default: each material's own sss_model)")
-    p.add_argument("--technique", choices=TECHNIQUES, default="tsd",
-                   help="tsd: texture-space diffusion (default); exact: brute-force texture-space convolution "
-                        "with the exact profile (slow reference); ssss: screen-space separable SSS; tint: the "
-                        "per-pixel profile tint baseline")
+    p.add_argument(
+        "--sss",
+        choices=SSS_MODELS,
+        default=None,
+        help="subsurface model for every material (default: each material's own sss_model)",
+    )
+    p.add_argument(
+        "--technique",
+        choices=TECHNIQUES,
+        default="tsd",
+        help="tsd: texture-space diffusion (default); exact: brute-force texture-space convolution "
+        "with the exact profile (slow reference); ssss: screen-space separable SSS; tint: the "
+        "per-pixel profile tint baseline",
+    )
     p.add_argument("--taps", type=int, default=None, help="texture-space blur taps (odd, 7-31; default: from width)")
     p.add_argument("--ssss-taps", type=int, default=17, help="screen-space SSS kernel samples (11, 17, 25)")
     p.add_argument("--tsd-size", type=int, default=None, help="texture-space diffusion texels per side (default 512)")
@@ -57,8 +66,16 @@ def settings_from_args(args, w: int, h: int) -> RenderSettings:
         extra["tsd_size"] = args.tsd_size
     if args.gaussians is not None:
         extra["tsd_gaussians"] = args.gaussians
-    return RenderSettings(w, h, shadow_size=args.shadow_size, sss_model=args.sss, technique=args.technique,
-                          tsd_taps=args.taps, ssss_taps=args.ssss_taps, **extra)
+    return RenderSettings(
+        w,
+        h,
+        shadow_size=args.shadow_size,
+        sss_model=args.sss,
+        technique=args.technique,
+        tsd_taps=args.taps,
+        ssss_taps=args.ssss_taps,
+        **extra,
+    )
 
 
 def run(args) -> int:
@@ -72,8 +89,19 @@ def run(args) -> int:
     if args.json:
         from app.gl.context import describe
 
-        print(json.dumps({"scene": str(scene.source), "outputs": written, "size": [w, h], "gl": describe(ctx),
-                          "timings": result.timings.as_dict(), "plan": result.plan.as_dict()}, indent=2))
+        print(
+            json.dumps(
+                {
+                    "scene": str(scene.source),
+                    "outputs": written,
+                    "size": [w, h],
+                    "gl": describe(ctx),
+                    "timings": result.timings.as_dict(),
+                    "plan": result.plan.as_dict(),
+                },
+                indent=2,
+            )
+        )
     else:
         for path in written:
             print(f"wrote {path}")

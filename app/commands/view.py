@@ -1,5 +1,6 @@
 """`skinlab view [SCENE]`: the desktop viewer (pyglet window, Dear ImGui panel, pass inspector,
 hot reload of shaders, scene and presets). See docs/viewer.md."""
+
 from __future__ import annotations
 
 import logging
@@ -9,22 +10,39 @@ from app.render.settings import RenderSettings, parse_size
 
 
 def register(sub) -> None:
-    p = sub.add_parser("view", help="open the desktop viewer (orbit camera, parameter panel, pass "
-                                    "inspector, hot reload)")
+    p = sub.add_parser(
+        "view", help="open the desktop viewer (orbit camera, parameter panel, pass inspector, hot reload)"
+    )
     p.add_argument("scene", nargs="?", help="scene file (TOML); default: the Lee Perry-Smith head")
     p.add_argument("--size", default="960x720", help="window size WIDTHxHEIGHT (default 960x720)")
     p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
-    p.add_argument("--tsd-size", type=int, default=RenderSettings.tsd_size,
-                   help=f"texture-space diffusion texels per side (default {RenderSettings.tsd_size})")
+    p.add_argument(
+        "--tsd-size",
+        type=int,
+        default=RenderSettings.tsd_size,
+        help=f"texture-space diffusion texels per side (default {RenderSettings.tsd_size})",
+    )
     w = p.add_mutually_exclusive_group()
-    w.add_argument("--watch", dest="watch", action="store_true", default=True,
-                   help="reload shaders, the scene file and presets when they change (default)")
+    w.add_argument(
+        "--watch",
+        dest="watch",
+        action="store_true",
+        default=True,
+        help="reload shaders, the scene file and presets when they change (default)",
+    )
     w.add_argument("--no-watch", dest="watch", action="store_false", help="do not watch files")
-    p.add_argument("--settle", type=float, default=0.05,
-                   help="seconds a changed file must stay unchanged before it is reloaded (default 0.05)")
+    p.add_argument(
+        "--settle",
+        type=float,
+        default=0.05,
+        help="seconds a changed file must stay unchanged before it is reloaded (default 0.05)",
+    )
     p.add_argument("--shader-dir", help="shader folder (default: the project's shaders/)")
-    p.add_argument("--screenshot-dir", default="out/screenshots",
-                   help="where S (PNG) and shift+S (EXR) save screenshots (default out/screenshots)")
+    p.add_argument(
+        "--screenshot-dir",
+        default="out/screenshots",
+        help="where S (PNG) and shift+S (EXR) save screenshots (default out/screenshots)",
+    )
     p.add_argument("--frames", type=int, help="render this many frames, then exit (for tests and scripts)")
     p.add_argument("--screenshot", help="with --frames: save the last frame here (.png or .exr) before exiting")
     p.add_argument("--continuous", action="store_true", help="render every loop iteration, not only on changes")
@@ -41,17 +59,26 @@ def run(args) -> int:
     if args.screenshot:
         if args.frames is None:
             raise ValueError("--screenshot: needs --frames N (interactive screenshots: press S)")
-        image_format(args.screenshot)   # fail before opening a window
+        image_format(args.screenshot)  # fail before opening a window
     if not (0.0 <= args.settle <= 10.0):
         raise ValueError(f"--settle: expected seconds in [0, 10], got {args.settle}")
-    RenderSettings(shadow_size=args.shadow_size, tsd_size=args.tsd_size)   # errors name the option's setting
+    RenderSettings(shadow_size=args.shadow_size, tsd_size=args.tsd_size)  # errors name the option's setting
     if not logging.getLogger().handlers:
         logging.basicConfig(level=logging.INFO, stream=sys.stderr, format="skinlab view: %(message)s")
-    logging.getLogger("OpenGL").setLevel(logging.WARNING)   # PyOpenGL's "no OpenGL_accelerate" notice
+    logging.getLogger("OpenGL").setLevel(logging.WARNING)  # PyOpenGL's "no OpenGL_accelerate" notice
 
     from app.viewer.window import ViewerWindow
 
-    win = ViewerWindow(args.scene, size, watch=args.watch, screenshot_dir=args.screenshot_dir,
-                       shader_root=args.shader_dir, shadow_size=args.shadow_size, tsd_size=args.tsd_size,
-                       settle_s=args.settle, continuous=args.continuous, show_ui=not args.no_ui)
+    win = ViewerWindow(
+        args.scene,
+        size,
+        watch=args.watch,
+        screenshot_dir=args.screenshot_dir,
+        shader_root=args.shader_dir,
+        shadow_size=args.shadow_size,
+        tsd_size=args.tsd_size,
+        settle_s=args.settle,
+        continuous=args.continuous,
+        show_ui=not args.no_ui,
+    )
     return win.run(frames=args.frames, screenshot=args.screenshot)

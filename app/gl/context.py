@@ -4,6 +4,7 @@ Works on Mesa llvmpipe without a GPU and on NVIDIA's EGL. Where several EGL devi
 ``SKINLAB_EGL_DEVICE`` (an index) chooses one. A failure names the missing library and the
 package that provides it instead of a traceback from the loader.
 """
+
 from __future__ import annotations
 
 import ctypes.util
@@ -56,8 +57,11 @@ def create_headless_context(shared: bool = True) -> moderngl.Context:
         return _SHARED
     missing = _missing_libraries()
     if missing:
-        raise ContextError("cannot create a headless OpenGL context; missing: " + "; ".join(missing)
-                           + ". `make setup` installs them where apt-get is available.")
+        raise ContextError(
+            "cannot create a headless OpenGL context; missing: "
+            + "; ".join(missing)
+            + ". `make setup` installs them where apt-get is available."
+        )
     idx = egl_device_index()
     kwargs = {"device_index": idx} if idx else {}
     try:

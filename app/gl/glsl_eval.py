@@ -5,11 +5,12 @@ includes the library file, fetches the inputs at its texel, evaluates an express
 to four floats into an RGBA32F target, which is read back. No interpolation, no blending, so the
 only differences from the NumPy twin are the GPU's fp32 arithmetic.
 """
+
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Mapping
 
 import moderngl
 import numpy as np
@@ -39,10 +40,17 @@ class GLSLEvaluator:
         self._vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
         self._n = 0
 
-    def evaluate(self, includes: str | list[str], expr: str, inputs: Mapping[str, np.ndarray],
-                 out_components: int = 1, prelude: str = "", uniforms: Mapping[str, tuple[str, object]] | None = None,
-                 samplers: Mapping[str, tuple[str, moderngl.Texture]] | None = None,
-                 setup=None) -> np.ndarray:
+    def evaluate(
+        self,
+        includes: str | list[str],
+        expr: str,
+        inputs: Mapping[str, np.ndarray],
+        out_components: int = 1,
+        prelude: str = "",
+        uniforms: Mapping[str, tuple[str, object]] | None = None,
+        samplers: Mapping[str, tuple[str, moderngl.Texture]] | None = None,
+        setup=None,
+    ) -> np.ndarray:
         """``uniforms``: name -> (GLSL type, value) shared by all samples (matrices as 4x4 arrays);
         ``samplers``: name -> (GLSL sampler type, texture) bound for the expression; ``setup``:
         called with the compiled program to set uniforms the included files declare themselves."""
@@ -114,7 +122,9 @@ class GLSLEvaluator:
             self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
             vao.render(moderngl.TRIANGLES)
             out = np.frombuffer(fbo.read(components=4, dtype="f4"), np.float32).reshape(h * w, 4)
-            vao.release(); fbo.release(); target.release()
+            vao.release()
+            fbo.release()
+            target.release()
         finally:
             for t in textures:
                 t.release()
@@ -122,8 +132,7 @@ class GLSLEvaluator:
         return out[:n, :out_components].astype(np.float64)
 
 
-def assert_close_fp32(gpu: np.ndarray, ref: np.ndarray, rtol: float = 1e-4, atol: float = 1e-6,
-                      what: str = "") -> None:
+def assert_close_fp32(gpu: np.ndarray, ref: np.ndarray, rtol: float = 1e-4, atol: float = 1e-6, what: str = "") -> None:
     """GPU (fp32) vs NumPy (float64): each value within rtol relative OR atol absolute; no NaN/Inf."""
     gpu = np.asarray(gpu, np.float64)
     ref = np.asarray(ref, np.float64).reshape(gpu.shape)
@@ -137,4 +146,5 @@ def assert_close_fp32(gpu: np.ndarray, ref: np.ndarray, rtol: float = 1e-4, atol
         i = np.unravel_index(np.argmax(np.where(ok, 0, err / np.maximum(np.abs(ref), atol))), err.shape)
         raise AssertionError(
             f"{what}: {np.sum(~ok)} of {ok.size} values outside rtol={rtol} / atol={atol}; "
-            f"worst at {i}: gpu={gpu[i]!r} numpy={ref[i]!r}")
+            f"worst at {i}: gpu={gpu[i]!r} numpy={ref[i]!r}"
+        )

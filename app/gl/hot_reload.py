@@ -6,6 +6,7 @@ render thread calls :meth:`ShaderWatcher.poll` once per frame, which applies the
 have been quiet for ``settle_s`` (editors save in several writes; half-written files must not
 win), so GL is only touched from the thread that owns the context.
 """
+
 from __future__ import annotations
 
 import threading
@@ -20,15 +21,16 @@ CHANGE_EVENTS = {"created", "modified", "moved", "deleted", "closed"}
 
 
 class ShaderWatcher:
-    def __init__(self, cache: ProgramCache, root: Path | None = None, settle_s: float = 0.05,
-                 use_watchdog: bool = True):
+    def __init__(
+        self, cache: ProgramCache, root: Path | None = None, settle_s: float = 0.05, use_watchdog: bool = True
+    ):
         self.cache = cache
         self.root = Path(root or cache.library.root).resolve()
         self.settle_s = settle_s
         self._pending: dict[Path, float] = {}
         self._lock = threading.Lock()
         self._observer = None
-        self.errors: list[ShaderError] = []     # errors of the last reload that failed
+        self.errors: list[ShaderError] = []  # errors of the last reload that failed
         self.reloads = 0
         self._mtimes = self._scan()
         if use_watchdog:

@@ -1,13 +1,15 @@
 """Compiled programs cached by (stage files, defines), with last-good fallback on failure."""
+
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Mapping
 
 import moderngl
 
 from .shader_source import ExpandedSource, ShaderError, ShaderLibrary, parse_errors
+
 
 def normalize_defines(defines: Mapping[str, object] | None) -> dict[str, str]:
     """True -> "1"; False/None dropped; everything else as its string."""
@@ -27,16 +29,19 @@ def _key(vs: str, fs: str, defines: Mapping[str, object] | None) -> tuple:
 class ProgramEntry:
     program: moderngl.Program | None
     deps: set[Path] = field(default_factory=set)
-    error: str | None = None           # last failed compile, if the current program is older
-    generation: int = 0                # bumps on every successful (re)compile
+    error: str | None = None  # last failed compile, if the current program is older
+    generation: int = 0  # bumps on every successful (re)compile
 
 
-def compile_program(ctx: moderngl.Context, library: ShaderLibrary, vs: str, fs: str,
-                    defines: Mapping[str, object] | None = None) -> tuple[moderngl.Program, set[Path]]:
+def compile_program(
+    ctx: moderngl.Context, library: ShaderLibrary, vs: str, fs: str, defines: Mapping[str, object] | None = None
+) -> tuple[moderngl.Program, set[Path]]:
     """Compile one program; on failure raise :class:`ShaderError` naming file and line."""
     defines = normalize_defines(defines)
-    srcs: dict[str, ExpandedSource] = {"vertex_shader": library.expand(vs, defines),
-                                       "fragment_shader": library.expand(fs, defines)}
+    srcs: dict[str, ExpandedSource] = {
+        "vertex_shader": library.expand(vs, defines),
+        "fragment_shader": library.expand(fs, defines),
+    }
     deps = {p for s in srcs.values() for p in s.paths if p is not None}
     try:
         prog = ctx.program(**{k: s.text for k, s in srcs.items()})

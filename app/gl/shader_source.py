@@ -12,12 +12,13 @@ text when a compile fails and maps its global line numbers back through the tabl
 an error like ``shaders/lib/brdf.glsl:42: error: ...`` followed by the offending source line on
 every driver (the approach of vispy's error display, with moderngl-window's include handling).
 """
+
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Mapping
 
 SHADER_ROOT = Path(__file__).resolve().parents[2] / "shaders"
 
@@ -43,11 +44,11 @@ class ShaderError(Exception):
 class ExpandedSource:
     """One shader stage after include expansion."""
 
-    text: str                      # with #line directives: what is compiled
-    flat: str                      # same code without #line directives (for error mapping)
+    text: str  # with #line directives: what is compiled
+    flat: str  # same code without #line directives (for error mapping)
     line_map: list[tuple[int, int]]  # flat line index (0-based) -> (file index, 1-based line)
-    files: list[str]               # file index -> display name
-    paths: list[Path | None]       # file index -> path on disk (None for virtual files)
+    files: list[str]  # file index -> display name
+    paths: list[Path | None]  # file index -> path on disk (None for virtual files)
 
     def locate(self, flat_line: int) -> tuple[str, int]:
         """(file name, line) for a 1-based line number of the flat text."""
@@ -99,10 +100,7 @@ class ShaderLibrary:
                 except (OSError, UnicodeDecodeError) as exc:
                     raise ShaderError(f"{self.display_name(c)}: cannot read shader file: {exc}") from exc
         where = f" (included from {self.display_name(including)})" if including else ""
-        raise ShaderError(
-            f"shader file '{name}' not found{where}; looked in: "
-            + ", ".join(str(c) for c in candidates)
-        )
+        raise ShaderError(f"shader file '{name}' not found{where}; looked in: " + ", ".join(str(c) for c in candidates))
 
     # -- expansion -----------------------------------------------------------------------
     def expand(self, name: str, defines: Mapping[str, object] | None = None) -> ExpandedSource:

@@ -1,8 +1,10 @@
 """Write Python/NumPy values into program uniforms; names the program lacks are skipped (the
 compiler drops unused uniforms, which is not an error)."""
+
 from __future__ import annotations
 
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import moderngl
 import numpy as np

@@ -1,4 +1,5 @@
 """Per-frame state shared between passes: the scene, matrices, targets produced so far."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -20,8 +21,8 @@ class Frame:
     camera_pos: np.ndarray
     targets: dict[str, moderngl.Texture] = field(default_factory=dict)
     shadow_matrices: dict[int, np.ndarray] = field(default_factory=dict)
-    shadow_eyes: dict[int, np.ndarray] = field(default_factory=dict)   # slot -> light pos (w=1) / dir (w=0)
-    tsd: dict[int, object] = field(default_factory=dict)               # id(node) -> TsdFrameNode
+    shadow_eyes: dict[int, np.ndarray] = field(default_factory=dict)  # slot -> light pos (w=1) / dir (w=0)
+    tsd: dict[int, object] = field(default_factory=dict)  # id(node) -> TsdFrameNode
 
     @property
     def view_proj(self) -> np.ndarray:

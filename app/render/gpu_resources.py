@@ -1,4 +1,5 @@
 """GPU copies of scene data: vertex buffers per mesh, textures per file. Owned by the renderer."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -34,8 +35,13 @@ class GpuMesh:
         key = id(program)
         vao = self._vaos.get(key)
         if vao is None or vao.program is not program:
-            vao = self.ctx.vertex_array(program, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRS)],
-                                        index_buffer=self.ibo, index_element_size=4, skip_errors=True)
+            vao = self.ctx.vertex_array(
+                program,
+                [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRS)],
+                index_buffer=self.ibo,
+                index_element_size=4,
+                skip_errors=True,
+            )
             self._vaos[key] = vao
         return vao
 

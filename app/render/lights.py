@@ -1,11 +1,12 @@
 """Light uniforms shared by every pass that lights surfaces (shaders/lib/lights.glsl)."""
+
 from __future__ import annotations
 
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
 
-SHADOW_UNITS = (5, 6)     # texture units of shadow slots 0 and 1 (material maps use 0..4)
+SHADOW_UNITS = (5, 6)  # texture units of shadow slots 0 and 1 (material maps use 0..4)
 
 
 def bind_shadow_maps(renderer, frame) -> None:
@@ -17,10 +18,18 @@ def bind_shadow_maps(renderer, frame) -> None:
 def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
     """Upload lights (direction or position, radiance, shadow slot) and shadow matrices to `prog`."""
     slots = {id(l): i for i, l in enumerate(shadow_lights)}
-    vec = [np.append(-l.direction, 0.0) if l.kind == "directional" else np.append(l.world_position, 1.0)
-           for l in lights]
-    set_uniforms(prog, {"u_num_lights": len(lights), "u_mm_per_unit": frame.scene.mm_per_unit,
-                        "u_shadow0": SHADOW_UNITS[0], "u_shadow1": SHADOW_UNITS[1]})
+    vec = [
+        np.append(-l.direction, 0.0) if l.kind == "directional" else np.append(l.world_position, 1.0) for l in lights
+    ]
+    set_uniforms(
+        prog,
+        {
+            "u_num_lights": len(lights),
+            "u_mm_per_unit": frame.scene.mm_per_unit,
+            "u_shadow0": SHADOW_UNITS[0],
+            "u_shadow1": SHADOW_UNITS[1],
+        },
+    )
     set_array(prog, "u_light_vec", np.array(vec).reshape(-1, 4), nmax)
     set_array(prog, "u_light_radiance", np.array([l.radiance for l in lights]).reshape(-1, 3), nmax)
     if "u_light_shadow" in prog:

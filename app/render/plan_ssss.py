@@ -1,5 +1,6 @@
 """Planning screen-space separable SSS: one kernel per frame (Jimenez et al.'s post-process works on
 the whole image), taken from the first visible scattering material."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -15,10 +16,10 @@ from .plan_tsd import scattering_material
 @dataclass
 class SsssPlan:
     material: object
-    offsets_mm: np.ndarray     # (n,)
-    weights: np.ndarray        # (n, 3)
+    offsets_mm: np.ndarray  # (n,)
+    weights: np.ndarray  # (n, 3)
     range_mm: float
-    scattering: set            # uids of the nodes whose diffuse is blurred
+    scattering: set  # uids of the nodes whose diffuse is blurred
 
 
 def plan_ssss(meshes, settings, plan) -> SsssPlan | None:
@@ -30,8 +31,10 @@ def plan_ssss(meshes, settings, plan) -> SsssPlan | None:
         if chosen is None:
             chosen = mat
         elif mat.values != chosen.values:
-            plan.warnings.append(f"screen-space SSS blurs the whole image with one kernel: node '{n.name}' "
-                                 f"(material '{mat.name}') is blurred with material '{chosen.name}''s profile")
+            plan.warnings.append(
+                f"screen-space SSS blurs the whole image with one kernel: node '{n.name}' "
+                f"(material '{mat.name}') is blurred with material '{chosen.name}''s profile"
+            )
         uids.add(n.uid)
     if chosen is None:
         plan.skipped.append(("ssss_blur", "no visible material scatters below the surface"))

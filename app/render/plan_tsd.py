@@ -4,6 +4,7 @@ A mesh node gets TSD passes only when its (effective) material scatters below th
 subsurface weight above 0, a model other than "none" and a radius above 0, and a kernel wider than a
 texel. Everything decided here is recorded in the plan (pass reasons, skipped items, warnings).
 """
+
 from __future__ import annotations
 
 import math
@@ -14,7 +15,7 @@ import numpy as np
 from scene.optics.tsd import design_kernel, material_medium, profile_fit
 from scene.uv_checks import analyse_uvs
 
-DILATE_RINGS = 4          # texels of dilation past chart borders (irradiance and stretch)
+DILATE_RINGS = 4  # texels of dilation past chart borders (irradiance and stretch)
 
 
 def effective_material(node, settings):
@@ -53,8 +54,9 @@ def uv_report(node, mm_per_unit: float, size: int):
     if r is None:
         if len(_UV_CACHE) > 64:
             _UV_CACHE.clear()
-        r = _UV_CACHE[key] = analyse_uvs(mesh, mm_per_unit, texels=size, grid=512,
-                                         model_scale=model_scale(node.world_matrix))
+        r = _UV_CACHE[key] = analyse_uvs(
+            mesh, mm_per_unit, texels=size, grid=512, model_scale=model_scale(node.world_matrix)
+        )
     return r
 
 
@@ -70,8 +72,13 @@ def scattering_material(node, settings, plan, label: str):
     """The node's effective material if it scatters below the surface, else None (skip recorded)."""
     mat = effective_material(node, settings)
     if not mat.has_subsurface:
-        why = ("sss_model is none" if mat["sss_model"] == "none" else
-               "subsurface weight is 0" if mat["subsurface"] <= 0 else "subsurface_radius is 0")
+        why = (
+            "sss_model is none"
+            if mat["sss_model"] == "none"
+            else "subsurface weight is 0"
+            if mat["subsurface"] <= 0
+            else "subsurface_radius is 0"
+        )
         plan.skipped.append((label, f"material '{mat.name}': {why}; plain diffuse"))
         return None
     return mat
@@ -85,9 +92,11 @@ def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
         return None
     mesh = node.mesh
     if mesh.uvs is None:
-        plan.warnings.append(f"mesh {mesh.name!r} ({mesh.source or 'no file'}) has no UVs; texture-space "
-                             "diffusion generated an atlas with xatlas (set generate_uvs = true in the scene "
-                             "file to do it at load time)")
+        plan.warnings.append(
+            f"mesh {mesh.name!r} ({mesh.source or 'no file'}) has no UVs; texture-space "
+            "diffusion generated an atlas with xatlas (set generate_uvs = true in the scene "
+            "file to do it at load time)"
+        )
         mesh.ensure_uvs("texture-space diffusion needs UVs", generate=True)
     size = settings.tsd_size
     rep = uv_report(node, scene.mm_per_unit, size)
@@ -98,8 +107,9 @@ def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
     p10 = float(np.nanmin(pct["p10"])) if pct else math.nan
     p50 = float(np.nanmean(pct["p50"])) if pct else math.nan
     if not (np.isfinite(p10) and np.isfinite(p50) and p50 > 0):
-        plan.warnings.append(f"mesh {mesh.name!r}: no triangle with a usable UV-to-surface scale; "
-                             "rendered without subsurface scattering")
+        plan.warnings.append(
+            f"mesh {mesh.name!r}: no triangle with a usable UV-to-surface scale; rendered without subsurface scattering"
+        )
         plan.skipped.append((label, "no usable UV layout"))
         return None
     fit = profile_fit(mat["sss_model"], material_medium(mat.values), settings.tsd_gaussians)
@@ -107,7 +117,8 @@ def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
     for what, why in kernel.skipped:
         plan.skipped.append((f"{label} {what}", why))
     if kernel.levels == 0:
-        plan.skipped.append((label, "every Gaussian of the profile is narrower than a texel or negligible; "
-                                    "plain diffuse"))
+        plan.skipped.append(
+            (label, "every Gaussian of the profile is narrower than a texel or negligible; plain diffuse")
+        )
         return None
     return TsdNodePlan(node, mat, kernel, size)

@@ -1,4 +1,5 @@
 """The renderer owns GL: programs, GPU resources and the passes; it runs a frame plan."""
+
 from __future__ import annotations
 
 import time
@@ -25,9 +26,9 @@ from .timing import FrameTimings, PassTimer
 
 @dataclass
 class FrameResult:
-    hdr: np.ndarray          # (H, W, 4) float32 linear radiance, alpha = coverage; row 0 = top
-    ldr: np.ndarray          # (H, W, 4) uint8 sRGB, tone mapped
-    depth: np.ndarray        # (H, W) float32 eye-space distance along -Z (scene units), inf = background
+    hdr: np.ndarray  # (H, W, 4) float32 linear radiance, alpha = coverage; row 0 = top
+    ldr: np.ndarray  # (H, W, 4) uint8 sRGB, tone mapped
+    depth: np.ndarray  # (H, W) float32 eye-space distance along -Z (scene units), inf = background
     timings: FrameTimings
     plan: FramePlan
     cpu_ms: float
@@ -40,14 +41,21 @@ class Renderer:
         self.resources = GpuResources(ctx)
         self.timer = PassTimer(ctx)
         self.tsd = TsdStore(ctx)
-        self.passes = {"shadow": ShadowPass(self), "tsd_stretch": TsdStretchPass(self),
-                       "tsd_irradiance": TsdIrradiancePass(self), "tsd_dilate": TsdDilatePass(self),
-                       "tsd_blur": TsdBlurPass(self), "tsd_exact": TsdExactPass(self),
-                       "ssss_blur": SsssBlurPass(self), "forward": ForwardPass(self), "tonemap": TonemapPass(self)}
+        self.passes = {
+            "shadow": ShadowPass(self),
+            "tsd_stretch": TsdStretchPass(self),
+            "tsd_irradiance": TsdIrradiancePass(self),
+            "tsd_dilate": TsdDilatePass(self),
+            "tsd_blur": TsdBlurPass(self),
+            "tsd_exact": TsdExactPass(self),
+            "ssss_blur": SsssBlurPass(self),
+            "forward": ForwardPass(self),
+            "tonemap": TonemapPass(self),
+        }
         self._fs_vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
         self._fs_vaos: dict[int, moderngl.VertexArray] = {}
         self._dummy_shadow = None
-        self.last_frame: Frame | None = None   # the latest frame's targets (viewer's pass inspector)
+        self.last_frame: Frame | None = None  # the latest frame's targets (viewer's pass inspector)
 
     # -- helpers for passes -----------------------------------------------------------
     def fullscreen(self, prog: moderngl.Program) -> None:
@@ -67,8 +75,9 @@ class Renderer:
     def plan(self, scene: Scene, settings: RenderSettings) -> FramePlan:
         return plan_frame(scene, settings, self.tsd.stretch_valid)
 
-    def render(self, scene: Scene, settings: RenderSettings | None = None,
-               readback: bool | tuple[str, ...] = True) -> FrameResult:
+    def render(
+        self, scene: Scene, settings: RenderSettings | None = None, readback: bool | tuple[str, ...] = True
+    ) -> FrameResult:
         """Plan and run a frame. ``readback``: True for all of hdr/ldr/depth, False for none, or a
         tuple naming the ones wanted (the others come back as None)."""
         settings = settings or RenderSettings()
@@ -78,8 +87,13 @@ class Renderer:
             raise ValueError(f"scene {scene.name!r} has no camera")
         plan = self.plan(scene, settings)
         self.tsd.retain({p.params["node"].uid for p in plan.passes if p.kind.startswith("tsd_")})
-        frame = Frame(scene, settings, cam.view_matrix(), cam.projection_matrix(settings.width / settings.height),
-                      cam.world_position)
+        frame = Frame(
+            scene,
+            settings,
+            cam.view_matrix(),
+            cam.projection_matrix(settings.width / settings.height),
+            cam.world_position,
+        )
         self.timer.start_frame()
         for p in plan.passes:
             with self.timer.measure(p.name):

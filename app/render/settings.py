@@ -1,8 +1,8 @@
 """What a render is asked to do (beyond the scene itself)."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass
-
 
 TECHNIQUES = ("tsd", "exact", "ssss", "tint")
 
@@ -12,7 +12,7 @@ class RenderSettings:
     width: int = 640
     height: int = 640
     shadow_size: int = 2048
-    background: tuple[float, float, float] = (0.045, 0.045, 0.05)   # linear
+    background: tuple[float, float, float] = (0.045, 0.045, 0.05)  # linear
     max_lights: int = 4
     # None: each material's own sss_model; else one of scene.materials.SSS_MODELS for every material
     sss_model: str | None = None
@@ -21,14 +21,14 @@ class RenderSettings:
     # the slow image reference), screen-space separable SSS ("ssss", Jimenez et al.), or the
     # per-pixel profile tint without convolution ("tint", the original study's baseline)
     technique: str = "tsd"
-    tsd_taps: int | None = None        # None: from each blur's width in texels; else a fixed odd count (7..31)
-    ssss_taps: int = 17                # screen-space kernel samples: 11, 17 or 25 (Jimenez presets)
+    tsd_taps: int | None = None  # None: from each blur's width in texels; else a fixed odd count (7..31)
+    ssss_taps: int = 17  # screen-space kernel samples: 11, 17 or 25 (Jimenez presets)
     # texture-space diffusion defaults from the accuracy/time ledger (docs/ledger.md): the cheapest
     # setting within 1 % image error of the exact reference on the head and the bunny
-    tsd_size: int = 512               # irradiance texels per side
-    tsd_albedo_mix: float = 0.5       # pre-/post-scatter texturing: albedo^mix before the blur
-    tsd_gaussians: int = 6            # K: Gaussians fitted to the profile
-    translucency: bool = True         # light through thin parts (needs a shadow-casting light)
+    tsd_size: int = 512  # irradiance texels per side
+    tsd_albedo_mix: float = 0.5  # pre-/post-scatter texturing: albedo^mix before the blur
+    tsd_gaussians: int = 6  # K: Gaussians fitted to the profile
+    translucency: bool = True  # light through thin parts (needs a shadow-casting light)
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):
@@ -37,14 +37,21 @@ class RenderSettings:
                 raise ValueError(f"render setting {name}: expected an integer in [1, 16384], got {v!r}")
         if self.sss_model is not None:
             from scene.materials import SSS_MODELS
+
             if self.sss_model not in SSS_MODELS:
-                raise ValueError(f"render setting sss_model: expected one of {', '.join(SSS_MODELS)}, "
-                                 f"got {self.sss_model!r}")
+                raise ValueError(
+                    f"render setting sss_model: expected one of {', '.join(SSS_MODELS)}, got {self.sss_model!r}"
+                )
         if self.technique not in TECHNIQUES:
-            raise ValueError(f"render setting technique: expected one of {', '.join(TECHNIQUES)}, got {self.technique!r}")
-        if self.tsd_taps is not None and (not isinstance(self.tsd_taps, int) or self.tsd_taps % 2 == 0
-                                          or not 7 <= self.tsd_taps <= 31):
-            raise ValueError(f"render setting tsd_taps: expected an odd integer in [7, 31] or None, got {self.tsd_taps!r}")
+            raise ValueError(
+                f"render setting technique: expected one of {', '.join(TECHNIQUES)}, got {self.technique!r}"
+            )
+        if self.tsd_taps is not None and (
+            not isinstance(self.tsd_taps, int) or self.tsd_taps % 2 == 0 or not 7 <= self.tsd_taps <= 31
+        ):
+            raise ValueError(
+                f"render setting tsd_taps: expected an odd integer in [7, 31] or None, got {self.tsd_taps!r}"
+            )
         if not isinstance(self.ssss_taps, int) or self.ssss_taps % 2 == 0 or not 3 <= self.ssss_taps <= 63:
             raise ValueError(f"render setting ssss_taps: expected an odd integer in [3, 63], got {self.ssss_taps!r}")
         if not isinstance(self.tsd_size, int) or not 16 <= self.tsd_size <= 8192:

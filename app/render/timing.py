@@ -4,6 +4,7 @@ On Mesa llvmpipe the timer query sees only command submission, not the software 
 work, so the synchronised wall time is the meaningful figure there; on a real GPU the timer
 query is. ``FrameTimings.frame_ms`` picks accordingly.
 """
+
 from __future__ import annotations
 
 import time
@@ -34,16 +35,21 @@ class FrameTimings:
         return sum(p.cpu_ms for p in self.passes)
 
     def as_dict(self) -> dict:
-        return {"frame_ms": self.frame_ms, "clock": "cpu-synchronised" if self.software_gl else "gpu-timer",
-                "passes": {p.name: {"gpu_ms": p.gpu_ms, "cpu_ms": p.cpu_ms} for p in self.passes}}
+        return {
+            "frame_ms": self.frame_ms,
+            "clock": "cpu-synchronised" if self.software_gl else "gpu-timer",
+            "passes": {p.name: {"gpu_ms": p.gpu_ms, "cpu_ms": p.cpu_ms} for p in self.passes},
+        }
 
 
 class PassTimer:
     def __init__(self, ctx: moderngl.Context, sync: bool = True):
         self.ctx = ctx
         self.sync = sync
-        self.software_gl = "llvmpipe" in ctx.info.get("GL_RENDERER", "").lower() or \
-            "softpipe" in ctx.info.get("GL_RENDERER", "").lower()
+        self.software_gl = (
+            "llvmpipe" in ctx.info.get("GL_RENDERER", "").lower()
+            or "softpipe" in ctx.info.get("GL_RENDERER", "").lower()
+        )
         self.frame = FrameTimings(software_gl=self.software_gl)
         self._queries: list[moderngl.Query] = []
 

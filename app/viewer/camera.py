@@ -16,6 +16,7 @@ depth: with a perspective camera of vertical field of view ``yfov`` the view fru
 the cursor pixel for pixel. Zoom scales the distance geometrically (``factor ** steps``) so each
 scroll step changes the apparent size by the same ratio.
 """
+
 from __future__ import annotations
 
 import math
@@ -39,8 +40,8 @@ class OrbitCamera:
     distance: float
     yaw: float = 0.0
     pitch: float = 0.0
-    orbit_speed: float = math.radians(0.4)   # radians per pixel of mouse motion
-    zoom_factor: float = 0.9                 # distance multiplier per scroll step (towards the target)
+    orbit_speed: float = math.radians(0.4)  # radians per pixel of mouse motion
+    zoom_factor: float = 0.9  # distance multiplier per scroll step (towards the target)
     min_distance: float = 1e-3
     max_distance: float = 1e6
 
@@ -56,7 +57,7 @@ class OrbitCamera:
 
     # -- construction ---------------------------------------------------------------------
     @classmethod
-    def from_look_at(cls, eye, target, **kw) -> "OrbitCamera":
+    def from_look_at(cls, eye, target, **kw) -> OrbitCamera:
         eye = np.asarray(eye, np.float64)
         target = np.asarray(target, np.float64)
         off = eye - target
@@ -68,7 +69,7 @@ class OrbitCamera:
         return cls(target, dist, yaw, pitch, **kw)
 
     @classmethod
-    def from_camera_node(cls, camera, bounds: tuple[np.ndarray, np.ndarray] | None = None, **kw) -> "OrbitCamera":
+    def from_camera_node(cls, camera, bounds: tuple[np.ndarray, np.ndarray] | None = None, **kw) -> OrbitCamera:
         """Orbit around the point on the camera's view axis nearest to the scene's centre (the
         scene file's look-at target is not kept by the camera node, only its orientation)."""
         m = camera.world_matrix

@@ -4,6 +4,7 @@
 reload and display logic runs (and is tested) on a headless EGL context as well as in the
 window. All GL work happens on the thread that calls its methods.
 """
+
 from __future__ import annotations
 
 import dataclasses
@@ -18,8 +19,7 @@ import numpy as np
 from app.gl.hot_reload import ShaderWatcher
 from app.gl.shader_source import ShaderLibrary
 from app.render.renderer import FrameResult, Renderer
-from app.render.settings import RenderSettings
-from app.render.settings import TECHNIQUES
+from app.render.settings import TECHNIQUES, RenderSettings
 from scene.materials import SSS_MODELS
 
 from .camera import OrbitCamera
@@ -39,28 +39,38 @@ def next_sss_model(current: str | None, step: int = 1) -> str | None:
 
 
 class ViewerCore:
-    def __init__(self, ctx: moderngl.Context, scene_path=None, settings: RenderSettings | None = None,
-                 watch: bool = True, shader_root: Path | None = None, settle_s: float = 0.05,
-                 use_watchdog: bool = True):
+    def __init__(
+        self,
+        ctx: moderngl.Context,
+        scene_path=None,
+        settings: RenderSettings | None = None,
+        watch: bool = True,
+        shader_root: Path | None = None,
+        settle_s: float = 0.05,
+        use_watchdog: bool = True,
+    ):
         self.ctx = ctx
         self.settings = settings or RenderSettings()
         library = ShaderLibrary(root=Path(shader_root)) if shader_root else ShaderLibrary()
         if not library.root.is_dir():
             raise FileNotFoundError(f"--shader-dir: no such folder: {library.root}")
         self.renderer = Renderer(ctx, library)
-        self.scene_src = scene_reloader(scene_path, settle_s, watch, use_watchdog)   # raises on a bad file
+        self.scene_src = scene_reloader(scene_path, settle_s, watch, use_watchdog)  # raises on a bad file
         self.presets = preset_reloader(settle_s, watch, use_watchdog)
-        self.shaders = ShaderWatcher(self.renderer.programs, library.root, settle_s=settle_s,
-                                     use_watchdog=use_watchdog) if watch else None
+        self.shaders = (
+            ShaderWatcher(self.renderer.programs, library.root, settle_s=settle_s, use_watchdog=use_watchdog)
+            if watch
+            else None
+        )
         self.panel = PanelModel(self.scene, presets=lambda: self.presets.value)
         self._file_camera = self.scene.camera.world_matrix.copy()
         self.orbit = OrbitCamera.from_camera_node(self.scene.camera, self.scene.world_bounds())
         self.inspector = Inspector(ctx)
         self.result: FrameResult | None = None
         self.render_error: str | None = None
-        self.frames = 0              # frames rendered successfully
+        self.frames = 0  # frames rendered successfully
         self.failed_frames = 0
-        self.log: deque[tuple[float, str, str]] = deque(maxlen=8)    # (time, level, text) for the overlay
+        self.log: deque[tuple[float, str, str]] = deque(maxlen=8)  # (time, level, text) for the overlay
         self._seen_panel_version = -1
         self._dirty = True
 
@@ -107,7 +117,7 @@ class ViewerCore:
 
     def set_sss_model(self, model: str | None) -> str | None:
         """None: each material's own model; else one of SSS_MODELS for every material."""
-        self.settings = dataclasses.replace(self.settings, sss_model=model)   # validated again
+        self.settings = dataclasses.replace(self.settings, sss_model=model)  # validated again
         self.note("info", f"SSS model: {model or 'per material'}")
         self.invalidate()
         return model
@@ -118,7 +128,7 @@ class ViewerCore:
 
     def set_technique(self, technique: str) -> str:
         """How subsurface scattering is rendered (app.render.settings.TECHNIQUES)."""
-        self.settings = dataclasses.replace(self.settings, technique=technique)   # validated again
+        self.settings = dataclasses.replace(self.settings, technique=technique)  # validated again
         self.note("info", f"SSS technique: {technique}")
         self.invalidate()
         return technique
@@ -166,7 +176,7 @@ class ViewerCore:
             cache.pop(key).release()
         self.panel.set_scene(scene)
         cam = scene.camera.world_matrix.copy()
-        if not np.allclose(cam, self._file_camera):   # the file's camera moved: follow it
+        if not np.allclose(cam, self._file_camera):  # the file's camera moved: follow it
             self.orbit = OrbitCamera.from_camera_node(scene.camera, scene.world_bounds())
         self._file_camera = cam
         self.note("info", f"scene reloaded: {scene.source}")

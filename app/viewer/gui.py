@@ -3,6 +3,7 @@
 Only drawing lives here: which widget a parameter gets, clamping and applying edits are in
 ``panel.py`` (PanelModel), so this module stays a thin translation of its state into widgets.
 """
+
 from __future__ import annotations
 
 import math
@@ -27,16 +28,21 @@ class Gui:
     def __init__(self, core: ViewerCore):
         self.core = core
         self.show_panel = True
-        self._text: dict[str, str] = {}     # texture path fields being typed
+        self._text: dict[str, str] = {}  # texture path fields being typed
 
     # -- overlay: timings, errors, messages ---------------------------------------------------
     def overlay(self, ui_fps: float) -> None:
         core = self.core
         imgui.set_next_window_pos(imgui.ImVec2(6, 6), imgui.Cond_.always)
         imgui.set_next_window_bg_alpha(0.55)
-        flags = (imgui.WindowFlags_.no_decoration | imgui.WindowFlags_.always_auto_resize
-                 | imgui.WindowFlags_.no_saved_settings | imgui.WindowFlags_.no_focus_on_appearing
-                 | imgui.WindowFlags_.no_nav | imgui.WindowFlags_.no_move)
+        flags = (
+            imgui.WindowFlags_.no_decoration
+            | imgui.WindowFlags_.always_auto_resize
+            | imgui.WindowFlags_.no_saved_settings
+            | imgui.WindowFlags_.no_focus_on_appearing
+            | imgui.WindowFlags_.no_nav
+            | imgui.WindowFlags_.no_move
+        )
         imgui.begin("overlay", None, flags)
         res = core.result
         if res is not None:
@@ -48,8 +54,11 @@ class Gui:
                 imgui.text(f"  {p.name:<16} {p.cpu_ms:7.2f} ms{gpu}")
         name, _ = core.current_target()
         s = core.settings
-        imgui.text_colored(GREY, f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'} ({s.technique})"
-                                 f"  ui {ui_fps:4.0f} fps")
+        imgui.text_colored(
+            GREY,
+            f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'} ({s.technique})"
+            f"  ui {ui_fps:4.0f} fps",
+        )
         errors = core.errors()
         if errors:
             width = imgui.get_io().display_size.x
@@ -165,8 +174,9 @@ class Gui:
             elif w.widget == "drag_float3":
                 speed = max((w.range[1] - w.range[0]) * 1e-4, 1e-3)
                 flags = imgui.SliderFlags_.logarithmic if w.logarithmic else 0
-                ch, v = imgui.drag_float3(label, [float(x) for x in w.value], speed, w.range[0], w.range[1],
-                                          "%.3f", flags)
+                ch, v = imgui.drag_float3(
+                    label, [float(x) for x in w.value], speed, w.range[0], w.range[1], "%.3f", flags
+                )
             elif w.widget == "combo":
                 ch, v = False, w.value
                 if imgui.begin_combo(label, str(w.value)):
@@ -210,5 +220,5 @@ class Gui:
     def _try(self, fn, *args) -> None:
         try:
             fn(*args)
-        except ValueError as exc:   # shown in red in the panel and overlay (panel.error)
+        except ValueError as exc:  # shown in red in the panel and overlay (panel.error)
             self.core.panel.error = str(exc)

@@ -13,6 +13,7 @@ texture is shown follows from its format:
 
 Offset and scale start from the target's own value range (``auto_range``), and can be changed.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -122,7 +123,7 @@ def fit_viewport(tex_size: tuple[int, int], win_size: tuple[int, int]) -> tuple[
 class View:
     offset: float = 0.0
     scale: float = 1.0
-    auto: bool = True        # not yet ranged: range it when first shown
+    auto: bool = True  # not yet ranged: range it when first shown
 
 
 class Inspector:
@@ -137,8 +138,9 @@ class Inspector:
         self.vao = ctx.vertex_array(self.prog, [(self.vbo, "2f", "in_pos")])
         # a sampler object overrides the texture's own state (e.g. a shadow map's comparison
         # mode) without changing what the renderer set on it
-        self.sampler = ctx.sampler(filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False,
-                                   compare_func="")
+        self.sampler = ctx.sampler(
+            filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False, compare_func=""
+        )
         self._fbo = None
 
     # -- choosing ----------------------------------------------------------------------------
@@ -194,7 +196,7 @@ class Inspector:
             self.prog["u_offset"].value = float(view.offset)
             self.vao.render(moderngl.TRIANGLES)
         finally:
-            self.sampler.clear(0)   # the renderer's passes rely on the textures' own state
+            self.sampler.clear(0)  # the renderer's passes rely on the textures' own state
         return True
 
     def render_image(self, texture, view: View) -> np.ndarray:

@@ -12,12 +12,14 @@ Principled BSDF takes them: ``subsurface_color`` is the medium's diffuse surface
 its artist radius ``R = 4 pi l`` in mm (``Medium.artist_radius_mm``; Cycles' convention, see
 ``scene/optics/media.py``).
 """
+
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -46,14 +48,15 @@ class Widget:
     choices: tuple[str, ...] = ()
     unit: str = ""
     doc: str = ""
-    logarithmic: bool = False   # sliders over ranges spanning decades (e.g. radius 0-1000 mm)
+    logarithmic: bool = False  # sliders over ranges spanning decades (e.g. radius 0-1000 mm)
 
 
 def widget_for(param: Param, value: Any = None) -> Widget:
     kind = WIDGETS.get(param.kind)
     if kind is None:
-        raise ValueError(f"parameter {param.name!r}: no panel widget for kind {param.kind!r} "
-                         f"(known kinds: {', '.join(WIDGETS)})")
+        raise ValueError(
+            f"parameter {param.name!r}: no panel widget for kind {param.kind!r} (known kinds: {', '.join(WIDGETS)})"
+        )
     value = param.default if value is None and param.kind != "texture" else value
     rng = tuple(float(x) for x in param.range) if param.range is not None else None
     log = bool(rng and rng[0] >= 0 and rng[1] >= 1000 * max(rng[0], 1e-3))
@@ -116,11 +119,11 @@ class PanelModel:
     the key light. ``version`` increases whenever something that affects the image changed."""
 
     scene: Scene
-    presets: Callable[[], dict] | None = None      # name -> Medium (the viewer's last good set)
+    presets: Callable[[], dict] | None = None  # name -> Medium (the viewer's last good set)
     selected: Node | None = None
     version: int = 0
-    error: str | None = None                        # last rejected edit, shown in the panel
-    applied_presets: dict[int, str] = field(default_factory=dict)   # id(material) -> preset name
+    error: str | None = None  # last rejected edit, shown in the panel
+    applied_presets: dict[int, str] = field(default_factory=dict)  # id(material) -> preset name
 
     def __post_init__(self) -> None:
         self.set_scene(self.scene)
@@ -143,8 +146,15 @@ class PanelModel:
         rows = []
 
         def visit(node: Node, depth: int) -> None:
-            kind = ("mesh" if isinstance(node, MeshNode) else "light" if isinstance(node, LightNode)
-                    else "camera" if isinstance(node, CameraNode) else "group")
+            kind = (
+                "mesh"
+                if isinstance(node, MeshNode)
+                else "light"
+                if isinstance(node, LightNode)
+                else "camera"
+                if isinstance(node, CameraNode)
+                else "group"
+            )
             rows.append(TreeRow(node, depth, f"{node.name} ({kind})"))
             for c in node.children:
                 visit(c, depth + 1)
@@ -154,7 +164,7 @@ class PanelModel:
         return rows
 
     def select(self, name: str) -> Node:
-        node = self.scene.find(name)   # KeyError names the scene and node
+        node = self.scene.find(name)  # KeyError names the scene and node
         self.selected = node
         return node
 
@@ -188,7 +198,7 @@ class PanelModel:
             raise ValueError(self.error) from None
         self.error = None
         if name in ("subsurface_color", "subsurface_radius"):
-            self.applied_presets.pop(id(m), None)   # hand edits detach the preset
+            self.applied_presets.pop(id(m), None)  # hand edits detach the preset
         self.version += 1
         return m.values[name]
 

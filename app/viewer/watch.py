@@ -8,13 +8,15 @@ size) signatures, so changes are seen even where watchdog delivers no event. A r
 for any reason (bad TOML, unknown key, missing mesh, truncated file...) keeps the last good
 value and records an error that names the file; a later good save recovers.
 """
+
 from __future__ import annotations
 
 import logging
 import threading
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable, Generic, TypeVar
+from typing import Generic, TypeVar
 
 log = logging.getLogger("skinlab.view")
 T = TypeVar("T")
@@ -70,7 +72,7 @@ class FileWatcher:
         class Handler(FileSystemEventHandler):
             def on_any_event(self, event):
                 if event.event_type not in CHANGE_EVENTS or event.is_directory:
-                    return   # reading a file (as a reload does) emits "opened"/"closed_no_write"
+                    return  # reading a file (as a reload does) emits "opened"/"closed_no_write"
                 for attr in ("src_path", "dest_path"):
                     p = getattr(event, attr, None)
                     if p:
@@ -119,12 +121,19 @@ class Reloadable(Generic[T]):
     failed reloads. ``load()`` returns the value; ``files(value)`` names the files it came from
     (watched from then on)."""
 
-    def __init__(self, name: str, load: Callable[[], T], files: Callable[[T], set[Path]],
-                 settle_s: float = 0.1, watch: bool = True, use_watchdog: bool = True):
+    def __init__(
+        self,
+        name: str,
+        load: Callable[[], T],
+        files: Callable[[T], set[Path]],
+        settle_s: float = 0.1,
+        watch: bool = True,
+        use_watchdog: bool = True,
+    ):
         self.name = name
         self._load = load
         self._files = files
-        self.value: T = load()          # the first load must succeed (the caller reports its error)
+        self.value: T = load()  # the first load must succeed (the caller reports its error)
         self.error: str | None = None
         self.reloads = 0
         self.failures = 0
@@ -162,6 +171,7 @@ class Reloadable(Generic[T]):
 
 # -- what the viewer watches ------------------------------------------------------------------------
 
+
 def scene_files(scene) -> set[Path]:
     """The scene file and the files it references: meshes and material textures."""
     files = {Path(scene.source)} if scene.source else set()
@@ -195,11 +205,10 @@ def load_presets() -> dict:
         raise ValueError(f"{media.PRESET_FILE}: cannot read presets: {msg}") from None
     finally:
         if cache_clear is not None:
-            cache_clear()   # a broken file must not stay cached for other users
+            cache_clear()  # a broken file must not stay cached for other users
 
 
 def preset_reloader(settle_s: float = 0.1, watch: bool = True, use_watchdog: bool = True) -> Reloadable:
     from scene.optics.media import PRESET_FILE
 
-    return Reloadable(f"presets {PRESET_FILE}", load_presets, lambda _v: {PRESET_FILE}, settle_s, watch,
-                      use_watchdog)
+    return Reloadable(f"presets {PRESET_FILE}", load_presets, lambda _v: {PRESET_FILE}, settle_s, watch, use_watchdog)

@@ -10,6 +10,7 @@ The loop renders a new frame only when something changed (camera, parameters, si
 reload), or every iteration with ``continuous`` / ``frames``; between frames it redraws the UI
 and sleeps, so an idle window costs little CPU on llvmpipe.
 """
+
 from __future__ import annotations
 
 import logging
@@ -35,8 +36,10 @@ def _select_pyopengl_platform() -> None:
     if "OpenGL" in sys.modules:
         current = os.environ.get("PYOPENGL_PLATFORM")
         if want and current != want:
-            raise ViewerError(f"PyOpenGL was already loaded for platform {current!r}; the viewer needs {want!r} "
-                              f"(start it in its own process: skinlab view)")
+            raise ViewerError(
+                f"PyOpenGL was already loaded for platform {current!r}; the viewer needs {want!r} "
+                f"(start it in its own process: skinlab view)"
+            )
         return
     if want:
         os.environ["PYOPENGL_PLATFORM"] = want
@@ -45,36 +48,52 @@ def _select_pyopengl_platform() -> None:
 
 
 class ViewerWindow:
-    def __init__(self, scene_path=None, size=(960, 720), watch: bool = True, screenshot_dir="out/screenshots",
-                 shader_root=None, shadow_size: int = 2048, tsd_size: int | None = None, settle_s: float = 0.05,
-                 continuous: bool = False, show_ui: bool = True):
+    def __init__(
+        self,
+        scene_path=None,
+        size=(960, 720),
+        watch: bool = True,
+        screenshot_dir="out/screenshots",
+        shader_root=None,
+        shadow_size: int = 2048,
+        tsd_size: int | None = None,
+        settle_s: float = 0.05,
+        continuous: bool = False,
+        show_ui: bool = True,
+    ):
         if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
-            raise ViewerError("no X display (DISPLAY is not set); on a machine without a screen run it under "
-                              "Xvfb, e.g. `xvfb-run -a skinlab view`")
+            raise ViewerError(
+                "no X display (DISPLAY is not set); on a machine without a screen run it under "
+                "Xvfb, e.g. `xvfb-run -a skinlab view`"
+            )
         _select_pyopengl_platform()
         import moderngl
         import pyglet
 
-        pyglet.options.dpi_scaling = "stretch"   # window and mouse in logical units, as imgui expects
+        pyglet.options.dpi_scaling = "stretch"  # window and mouse in logical units, as imgui expects
         w, h = size
         try:
-            config = pyglet.gl.Config(double_buffer=True, depth_size=24, major_version=3, minor_version=3,
-                                      forward_compatible=True)
+            config = pyglet.gl.Config(
+                double_buffer=True, depth_size=24, major_version=3, minor_version=3, forward_compatible=True
+            )
             self.window = pyglet.window.Window(w, h, caption="Skinlab", resizable=True, vsync=False, config=config)
-        except Exception as exc:   # NoSuchDisplayException, NoSuchConfigException, ...
-            raise ViewerError(f"cannot open a window with an OpenGL 3.3 core context on display "
-                              f"{os.environ.get('DISPLAY')!r}: {exc}") from None
+        except Exception as exc:  # NoSuchDisplayException, NoSuchConfigException, ...
+            raise ViewerError(
+                f"cannot open a window with an OpenGL 3.3 core context on display {os.environ.get('DISPLAY')!r}: {exc}"
+            ) from None
         self.window.switch_to()
         self.ctx = moderngl.create_context(require=330)
         from app.gl.context import describe
+
         from .core import ViewerCore
 
         fw, fh = self.window.get_framebuffer_size()
         extra = {} if tsd_size is None else {"tsd_size": tsd_size}
         settings = RenderSettings(max(fw, 1), max(fh, 1), shadow_size=shadow_size, **extra)
         try:
-            self.core = ViewerCore(self.ctx, scene_path, settings, watch=watch, shader_root=shader_root,
-                                   settle_s=settle_s)
+            self.core = ViewerCore(
+                self.ctx, scene_path, settings, watch=watch, shader_root=shader_root, settle_s=settle_s
+            )
         except BaseException:
             self.window.close()
             raise
@@ -83,7 +102,7 @@ class ViewerWindow:
         self.continuous = continuous
         self.closed = False
         self._init_imgui(show_ui)
-        self.window.push_handlers(self)            # ours first, imgui's on top (it never consumes events)
+        self.window.push_handlers(self)  # ours first, imgui's on top (it never consumes events)
         if self.imgui_impl is not None:
             self.imgui_impl._attach_callbacks(self.window)
         self._ui_times: list[float] = []
@@ -97,7 +116,7 @@ class ViewerWindow:
 
         self.imgui = imgui
         imgui.create_context()
-        imgui.get_io().set_ini_filename(None)        # no imgui.ini in the working folder
+        imgui.get_io().set_ini_filename(None)  # no imgui.ini in the working folder
         self.imgui_impl = pyglet_backend.create_renderer(self.window, attach_callbacks=False)
         self.gui = Gui(self.core)
         self.gui.show_panel = show_ui
@@ -110,7 +129,7 @@ class ViewerWindow:
     # -- pyglet events -------------------------------------------------------------------------
     def on_close(self):
         self.closed = True
-        return True   # EVENT_HANDLED: the loop releases GL objects first, then closes the window
+        return True  # EVENT_HANDLED: the loop releases GL objects first, then closes the window
 
     def on_resize(self, width, height):
         fw, fh = self.window.get_framebuffer_size()
@@ -209,7 +228,7 @@ class ViewerWindow:
                 self.gui.overlay(len(self._ui_times))
                 self.gui.panel()
             imgui.render()
-            _ = self.ctx.error   # drop moderngl's stale GL error flag: PyOpenGL checks glGetError after each call
+            _ = self.ctx.error  # drop moderngl's stale GL error flag: PyOpenGL checks glGetError after each call
             self.imgui_impl.render(imgui.get_draw_data())
             self.window.flip()
         return rendered
@@ -224,7 +243,7 @@ class ViewerWindow:
                 if frames is not None and attempts >= frames:
                     break
                 if not rendered and not self.continuous:
-                    time.sleep(1 / 60)   # idle: keep the UI responsive without spinning
+                    time.sleep(1 / 60)  # idle: keep the UI responsive without spinning
             if frames is not None:
                 if self.core.render_error:
                     raise ValueError(f"the last frame failed: {self.core.render_error}")

@@ -4,6 +4,7 @@ Every profile is evaluated in optical units (mean free path l = 1/sigma_t' = 1) 
 scaled back as R(r) = R_opt(r / l) / l^2. A mean free path below MIN_MFP_MM means no scattering
 (profile 0) and x beyond PROFILE_MAX_OPTICAL_R gives 0, so nothing becomes inf or NaN.
 """
+
 from __future__ import annotations
 
 import numpy as np

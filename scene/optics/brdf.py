@@ -2,6 +2,7 @@
 
 Same names, same clamps as the GLSL; arrays broadcast. Vectors have shape (..., 3).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -84,8 +85,10 @@ def half_vector(n, v, l):
 
 
 def principled_brdf_cos(n, v, l, base, roughness, metallic, specular):
-    n, v, l, base = (np.broadcast_to(_f(x), np.broadcast_shapes(np.shape(n), np.shape(v), np.shape(l), np.shape(base)))
-                     for x in (n, v, l, base))
+    n, v, l, base = (
+        np.broadcast_to(_f(x), np.broadcast_shapes(np.shape(n), np.shape(v), np.shape(l), np.shape(base)))
+        for x in (n, v, l, base)
+    )
     NoL = _dot(n, l)
     h = half_vector(n, v, l)
     NoV = _dot(n, v)

@@ -9,13 +9,13 @@ max(r, BURLEY_R0_EPS d), the analytic value at the rim of a disc of radius ~1e-3
 finite; the energy inside that disc is underestimated by about 2.5e-4 A). l < MIN_MFP_MM is "no
 scattering": 0.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 from ._profile_util import f64, optical, radial
-from .constants import (BURLEY_R0_EPS, BURLEY_TRUNCATE, BURLEY_TRUNCATE_CDF, MIN_MFP_MM,
-                        PI, PROFILE_MAX_OPTICAL_R)
+from .constants import BURLEY_R0_EPS, BURLEY_TRUNCATE, BURLEY_TRUNCATE_CDF, MIN_MFP_MM, PI, PROFILE_MAX_OPTICAL_R
 
 SCALING_VARIANTS = ("diffuse", "searchlight", "dmfp")
 
@@ -70,6 +70,7 @@ def burley_sample_golubev(xi, d):
 
 
 # --- Blender (Cycles / EEVEE) conventions -------------------------------------------------------
+
 
 def blender_radius_to_mfp(radius):
     """User radius R -> mean free path l = R / (4 pi) (Cycles closure set-up; FACTS.md)."""

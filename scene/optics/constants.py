@@ -3,6 +3,7 @@
 `GLSL_CONSTANTS` is turned into the virtual include file ``skinlab/constants.glsl`` by
 :func:`glsl_header`; shaders never spell these numbers themselves.
 """
+
 from __future__ import annotations
 
 import math
@@ -65,11 +66,11 @@ def glsl_header() -> str:
 # Mean free paths (mm) below this are "no scattering": every profile returns 0 (the delta at r = 0
 # is the renderer's plain diffuse term). Keeps 1/l^2 far from fp32 overflow. A power of two so
 # that fp32 and float64 agree on which side of it a value lies.
-MIN_MFP_MM = 2.0 ** -20
+MIN_MFP_MM = 2.0**-20
 # Burley-type profiles diverge like 1/r at r = 0. They are evaluated at max(r, BURLEY_R0_EPS d):
 # the analytic value at the rim of a disc of radius 1e-3 d (continuous; finite at r = 0; the energy
 # inside that disc is underestimated by about A * BURLEY_R0_EPS / 4, i.e. 2.5e-4 A).
-BURLEY_R0_EPS = 2.0 ** -10
+BURLEY_R0_EPS = 2.0**-10
 # Blender (Cycles/EEVEE) Burley: truncation radius in units of d and the CDF there.
 BURLEY_TRUNCATE = 16.0
 BURLEY_TRUNCATE_CDF = 1.0 - 0.25 * math.exp(-16.0) - 0.75 * math.exp(-16.0 / 3.0)
@@ -79,7 +80,7 @@ PROFILE_MAX_OPTICAL_R = 1.0e6
 # Photon beam diffusion: depth samples per evaluation (pbrt-v4 bssrdf.cpp uses 100).
 PBD_SAMPLES = 100
 # Jensen 2001 / Egan & Hilgeman 1979 diffuse Fresnel reflectance fits (eta >= 1 and eta < 1).
-FDR_GT1 = (-1.440, 0.710, 0.668, 0.0636)      # c0/eta^2 + c1/eta + c2 + c3 eta
+FDR_GT1 = (-1.440, 0.710, 0.668, 0.0636)  # c0/eta^2 + c1/eta + c2 + c3 eta
 FDR_LT1 = (-0.4399, 0.7099, -0.3319, 0.0636)  # c0 + c1/eta + c2/eta^2 + c3/eta^3
 # The eta fits above and below are only meaningful over a limited range (Egan's eta < 1 fit
 # diverges below ~0.4; the pbrt moment fits make 1 - 2 FM1 negative above ~2.8): diffusion
@@ -87,29 +88,41 @@ FDR_LT1 = (-0.4399, 0.7099, -0.3319, 0.0636)  # c0 + c1/eta + c2/eta^2 + c3/eta^
 DIFFUSION_ETA_MIN = 0.5
 DIFFUSION_ETA_MAX = 2.5
 # pbrt-v4 FresnelMoment1/2 polynomial fits (util/scattering.cpp).
-FM1_LT1 = (0.45966, -1.73965, 3.37668, -3.904945, 2.49277, -0.68441)      # powers eta^0..5
-FM1_GE1 = (-4.61686, 11.1136, -10.4646, 5.11455, -1.27198, 0.12746)       # powers eta^0..5
-FM2_LT1 = (0.27614, -0.87350, 1.12077, -0.65095, 0.07883, 0.04860)        # powers eta^0..5
-FM2_GE1 = (-547.033, 458.843, -218.725, 45.3087,                          # eta^0, eta^-1..-3
-           404.557, -189.519, 54.9327, -9.00603, 0.63942)                 # eta^1..5
+FM1_LT1 = (0.45966, -1.73965, 3.37668, -3.904945, 2.49277, -0.68441)  # powers eta^0..5
+FM1_GE1 = (-4.61686, 11.1136, -10.4646, 5.11455, -1.27198, 0.12746)  # powers eta^0..5
+FM2_LT1 = (0.27614, -0.87350, 1.12077, -0.65095, 0.07883, 0.04860)  # powers eta^0..5
+FM2_GE1 = (
+    -547.033,
+    458.843,
+    -218.725,
+    45.3087,  # eta^0, eta^-1..-3
+    404.557,
+    -189.519,
+    54.9327,
+    -9.00603,
+    0.63942,
+)  # eta^1..5
+
+
 def _fm_reference(eta: float, which: int) -> float:
     """pbrt-v4 FresnelMoment1 (which = 1) / FresnelMoment2 (which = 2) in float64."""
     if which == 1:
         c = FM1_LT1 if eta < 1.0 else FM1_GE1
-        return sum(ck * eta ** k for k, ck in enumerate(c))
+        return sum(ck * eta**k for k, ck in enumerate(c))
     if eta < 1.0:
-        return sum(ck * eta ** k for k, ck in enumerate(FM2_LT1))
+        return sum(ck * eta**k for k, ck in enumerate(FM2_LT1))
     c = FM2_GE1
-    return (c[0] + c[1] / eta + c[2] / eta ** 2 + c[3] / eta ** 3
-            + sum(c[4 + k] * eta ** (k + 1) for k in range(5)))
+    return c[0] + c[1] / eta + c[2] / eta**2 + c[3] / eta**3 + sum(c[4 + k] * eta ** (k + 1) for k in range(5))
 
 
 def _chebyshev_fit(fn, lo: float, hi: float, n: int = 14) -> tuple[float, ...]:
     """Chebyshev coefficients of fn on [lo, hi] (interpolation at n Chebyshev nodes)."""
     nodes = [math.cos(math.pi * (j + 0.5) / n) for j in range(n)]
     vals = [fn(lo + (hi - lo) * 0.5 * (t + 1.0)) for t in nodes]
-    return tuple((2.0 if k else 1.0) / n * sum(v * math.cos(math.pi * k * (j + 0.5) / n) for j, v in enumerate(vals))
-                 for k in range(n))
+    return tuple(
+        (2.0 if k else 1.0) / n * sum(v * math.cos(math.pi * k * (j + 0.5) / n) for j, v in enumerate(vals))
+        for k in range(n)
+    )
 
 
 # The pbrt moment polynomials cancel badly in fp32 (FM2 for eta >= 1 sums terms of +-500 to
@@ -132,33 +145,37 @@ SKIN6_WEIGHTS = (
     (0.078, 0.0, 0.0),
 )
 
-GLSL_CONSTANTS.update({
-    "MIN_MFP_MM": MIN_MFP_MM,
-    "BURLEY_R0_EPS": BURLEY_R0_EPS,
-    "BURLEY_TRUNCATE": BURLEY_TRUNCATE,
-    "BURLEY_TRUNCATE_CDF": BURLEY_TRUNCATE_CDF,
-    "PBD_SAMPLES": float(PBD_SAMPLES),
-    "PROFILE_MAX_OPTICAL_R": PROFILE_MAX_OPTICAL_R,
-    "DIFFUSION_ETA_MIN": DIFFUSION_ETA_MIN,
-    "DIFFUSION_ETA_MAX": DIFFUSION_ETA_MAX,
-    **{f"FDR_GT1_{i}": v for i, v in enumerate(FDR_GT1)},
-    **{f"FDR_LT1_{i}": v for i, v in enumerate(FDR_LT1)},
-    **{f"FM1_CHEB_LT1_{i}": v for i, v in enumerate(FM1_CHEB_LT1)},
-    **{f"FM1_CHEB_GE1_{i}": v for i, v in enumerate(FM1_CHEB_GE1)},
-    **{f"FM2_CHEB_LT1_{i}": v for i, v in enumerate(FM2_CHEB_LT1)},
-    **{f"FM2_CHEB_GE1_{i}": v for i, v in enumerate(FM2_CHEB_GE1)},
-    **{f"SKIN6_VAR_{i}": v for i, v in enumerate(SKIN6_VARIANCES)},
-    **{f"SKIN6_W{c}_{i}": w[j] for j, c in enumerate("RGB") for i, w in enumerate(SKIN6_WEIGHTS)},
-})
+GLSL_CONSTANTS.update(
+    {
+        "MIN_MFP_MM": MIN_MFP_MM,
+        "BURLEY_R0_EPS": BURLEY_R0_EPS,
+        "BURLEY_TRUNCATE": BURLEY_TRUNCATE,
+        "BURLEY_TRUNCATE_CDF": BURLEY_TRUNCATE_CDF,
+        "PBD_SAMPLES": float(PBD_SAMPLES),
+        "PROFILE_MAX_OPTICAL_R": PROFILE_MAX_OPTICAL_R,
+        "DIFFUSION_ETA_MIN": DIFFUSION_ETA_MIN,
+        "DIFFUSION_ETA_MAX": DIFFUSION_ETA_MAX,
+        **{f"FDR_GT1_{i}": v for i, v in enumerate(FDR_GT1)},
+        **{f"FDR_LT1_{i}": v for i, v in enumerate(FDR_LT1)},
+        **{f"FM1_CHEB_LT1_{i}": v for i, v in enumerate(FM1_CHEB_LT1)},
+        **{f"FM1_CHEB_GE1_{i}": v for i, v in enumerate(FM1_CHEB_GE1)},
+        **{f"FM2_CHEB_LT1_{i}": v for i, v in enumerate(FM2_CHEB_LT1)},
+        **{f"FM2_CHEB_GE1_{i}": v for i, v in enumerate(FM2_CHEB_GE1)},
+        **{f"SKIN6_VAR_{i}": v for i, v in enumerate(SKIN6_VARIANCES)},
+        **{f"SKIN6_W{c}_{i}": w[j] for j, c in enumerate("RGB") for i, w in enumerate(SKIN6_WEIGHTS)},
+    }
+)
 
 # ---------------------------------------------------------------------------------------------
 # Texture-space diffusion (d'Eon & Luebke 2007; scene/optics/tsd.py, shaders/passes/tsd_*.frag)
-TSD_TAP_RANGE = 3.0            # blur taps span +-3 sigma
-TSD_MIN_MM_PER_TEXEL = 1e-6    # zero-area triangles (infinite stretch) clamp to this
-TSD_MAX_STEP_TEXELS = 4096.0   # one sigma never spans more texels than this (finite for any stretch)
-COVERAGE_EPS = 1e-6            # premultiplied coverage below this is "no surface"
-GLSL_CONSTANTS.update({
-    "TSD_MIN_MM_PER_TEXEL": TSD_MIN_MM_PER_TEXEL,
-    "TSD_MAX_STEP_TEXELS": TSD_MAX_STEP_TEXELS,
-    "COVERAGE_EPS": COVERAGE_EPS,
-})
+TSD_TAP_RANGE = 3.0  # blur taps span +-3 sigma
+TSD_MIN_MM_PER_TEXEL = 1e-6  # zero-area triangles (infinite stretch) clamp to this
+TSD_MAX_STEP_TEXELS = 4096.0  # one sigma never spans more texels than this (finite for any stretch)
+COVERAGE_EPS = 1e-6  # premultiplied coverage below this is "no surface"
+GLSL_CONSTANTS.update(
+    {
+        "TSD_MIN_MM_PER_TEXEL": TSD_MIN_MM_PER_TEXEL,
+        "TSD_MAX_STEP_TEXELS": TSD_MAX_STEP_TEXELS,
+        "COVERAGE_EPS": COVERAGE_EPS,
+    }
+)

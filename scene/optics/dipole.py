@@ -7,12 +7,14 @@ albedo), mfp = l = 1/sigma_t' in mm, eta = relative index of refraction (clamped
 the F_dr fit, see fresnel.clamp_eta). In optical units (sigma_t' = 1):
 
     z_r = 1,  D = 1/3,  A = (1 + F_dr)/(1 - F_dr),  z_v = z_r + 4 A D,  sigma_tr = sqrt(3 (1 - alpha))
-    R_d(x) = alpha/(4 pi) [z_r (sigma_tr + 1/d_r) e^{-sigma_tr d_r}/d_r^2 + z_v (sigma_tr + 1/d_v) e^{-sigma_tr d_v}/d_v^2]
+    R_d(x) = alpha/(4 pi) [z_r (sigma_tr + 1/d_r) e^{-sigma_tr d_r}/d_r^2
+                         + z_v (sigma_tr + 1/d_v) e^{-sigma_tr d_v}/d_v^2]
 
 with d_r = sqrt(x^2 + z_r^2), d_v = sqrt(x^2 + z_v^2): the paper's (sigma_tr d + 1) e^{..}/d^3 written
 as (sigma_tr + 1/d) e^{..}/d^2 so that d -> inf gives 0 * finite, not inf * 0. R(r) = R_d(r/l)/l^2.
 r = 0 is finite analytically (d_r = z_r); no clamp is needed.
 """
+
 from __future__ import annotations
 
 import numpy as np

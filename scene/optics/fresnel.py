@@ -6,6 +6,7 @@ Conventions (as pbrt-v4 util/scattering.h ``FrDielectric``): ``eta`` is the rela
 n_medium / n_outside. ``cos_i > 0`` means light arriving from outside; ``cos_i < 0`` means light
 inside the medium heading out (the ratio is inverted). Total internal reflection gives 1.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -92,5 +93,9 @@ def fresnel_moment2(eta):
     eta = clamp_eta(eta)
     ie = 1.0 / eta
     c = FM2_GE1
-    ge = c[0] + ie * (c[1] + ie * (c[2] + ie * c[3])) + eta * (c[4] + eta * (c[5] + eta * (c[6] + eta * (c[7] + eta * c[8]))))
+    ge = (
+        c[0]
+        + ie * (c[1] + ie * (c[2] + ie * c[3]))
+        + eta * (c[4] + eta * (c[5] + eta * (c[6] + eta * (c[7] + eta * c[8]))))
+    )
     return np.where(eta < 1.0, _poly(FM2_LT1, eta), ge)

@@ -6,10 +6,11 @@ non-negative weights. Float64 twin of shaders/lib/profiles_gaussians.glsl.
     G(v, r) = e^{-r^2/(2v)} / (2 pi v)    (integrates to 1 over the plane; G(v1) * G(v2) = G(v1 + v2))
     R(r) = sum_k w_k G(v_k, r)            (total reflectance = sum_k w_k per channel)
 """
+
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 from scipy.optimize import minimize, nnls
@@ -17,7 +18,7 @@ from scipy.optimize import minimize, nnls
 from ._profile_util import f64
 from .constants import PI, SKIN6_VARIANCES, SKIN6_WEIGHTS
 
-MIN_VARIANCE_MM2 = 1e-12   # narrower Gaussians are deltas: "no scattering", value 0
+MIN_VARIANCE_MM2 = 1e-12  # narrower Gaussians are deltas: "no scattering", value 0
 
 
 def gaussian(v, r):
@@ -48,9 +49,9 @@ def deon_skin_profile(r, albedo=(1.0, 1.0, 1.0)):
 
 @dataclass(frozen=True)
 class GaussianFit:
-    variances_mm2: np.ndarray   # (K,), ascending, shared by all channels
-    weights: np.ndarray         # (K, C) non-negative
-    rel_error: np.ndarray       # (C,) ||r (R - fit)||_2 / ||r R||_2 on the fit grid
+    variances_mm2: np.ndarray  # (K,), ascending, shared by all channels
+    weights: np.ndarray  # (K, C) non-negative
+    rel_error: np.ndarray  # (C,) ||r (R - fit)||_2 / ||r R||_2 on the fit grid
     r_max_mm: float
 
     def profile(self, r):
@@ -61,8 +62,9 @@ def _energy_radius(profile_fn, fraction):
     """Smallest radius holding `fraction` of every channel's energy (int R 2 pi r dr)."""
     r = np.geomspace(1e-5, 1e4, 2000)
     f = np.maximum(f64(profile_fn(r)).reshape(len(r), -1), 0.0) * 2 * PI * r[:, None] ** 2
-    cum = np.concatenate([np.zeros((1, f.shape[1])),
-                          np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(np.log(r))[:, None], axis=0)])
+    cum = np.concatenate(
+        [np.zeros((1, f.shape[1])), np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(np.log(r))[:, None], axis=0)]
+    )
     tot = cum[-1]
     if not np.all(np.isfinite(tot)) or np.all(tot <= 0):
         raise ValueError("profile_fn: profile has no finite positive energy to fit")
@@ -79,9 +81,16 @@ def _solve(basis, target):
     return w, res
 
 
-def fit_gaussians(profile_fn: Callable[[np.ndarray], np.ndarray], K: int = 6, *, r_max: float | None = None,
-                  n_r: int = 400, energy_fraction: float = 0.999, optimise: str = "free",
-                  variances: np.ndarray | None = None) -> GaussianFit:
+def fit_gaussians(
+    profile_fn: Callable[[np.ndarray], np.ndarray],
+    K: int = 6,
+    *,
+    r_max: float | None = None,
+    n_r: int = 400,
+    energy_fraction: float = 0.999,
+    optimise: str = "free",
+    variances: np.ndarray | None = None,
+) -> GaussianFit:
     """Fit R(r) (``profile_fn(r_mm) -> (N, C)`` in 1/mm^2) by K Gaussians with shared variances.
 
     Least squares on r R(r) (d'Eon & Luebke's criterion) over a uniform grid on [0, r_max]
@@ -103,7 +112,7 @@ def fit_gaussians(profile_fn: Callable[[np.ndarray], np.ndarray], K: int = 6, *,
     # midpoints: avoid evaluating singular profiles (Burley) exactly at r = 0
     r = (np.arange(n_r) + 0.5) * (r_max / n_r)
     target = f64(profile_fn(r)).reshape(n_r, -1) * r[:, None]
-    norms = np.sqrt(np.sum(target ** 2, axis=0))
+    norms = np.sqrt(np.sum(target**2, axis=0))
     norms = np.where(norms > 0, norms, 1.0)
 
     def solve(logv):
@@ -124,14 +133,20 @@ def fit_gaussians(profile_fn: Callable[[np.ndarray], np.ndarray], K: int = 6, *,
         # geometric series spanning (r_max/200)^2 .. (r_max/2)^2 initially
         def geo(p):
             return p[0] + np.arange(K) * p[1]
+
         lo, hi = np.log((r_max / 200.0) ** 2), np.log((r_max / 2.0) ** 2)
         p0 = np.array([lo, (hi - lo) / max(K - 1, 1)])
-        pr = minimize(lambda p: cost(geo(p)), p0, method="Nelder-Mead",
-                      options={"xatol": 1e-4, "fatol": 1e-12, "maxiter": 400})
+        pr = minimize(
+            lambda p: cost(geo(p)), p0, method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-12, "maxiter": 400}
+        )
         best = geo(pr.x)
         if optimise == "free" and K > 1:
-            fr = minimize(cost, best, method="Nelder-Mead",
-                          options={"xatol": 1e-4, "fatol": 1e-14, "maxiter": 300 * K, "adaptive": True})
+            fr = minimize(
+                cost,
+                best,
+                method="Nelder-Mead",
+                options={"xatol": 1e-4, "fatol": 1e-14, "maxiter": 300 * K, "adaptive": True},
+            )
             if fr.fun < cost(best):
                 best = fr.x
     v, w, rel = solve(best)

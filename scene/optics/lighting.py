@@ -1,4 +1,5 @@
 """NumPy twins of shaders/lib/lighting.glsl."""
+
 from __future__ import annotations
 
 import numpy as np

@@ -17,6 +17,7 @@ That form has finite limits everywhere (l = 0: no scattering; alpha = 1: no abso
 Presets: the twelve measured materials of Jensen et al. 2001 Table 1, read from
 assets/presets/jensen2001_table1.csv (1/mm).
 """
+
 from __future__ import annotations
 
 import csv
@@ -75,19 +76,24 @@ def check_eta(eta) -> float:
 
 # --- conversions -------------------------------------------------------------------------------
 
+
 def coefficients_to_albedo_mfp(sigma_s, sigma_a):
     """(sigma_s', sigma_a) in 1/mm -> (alpha, mfp_mm). sigma_t' = 0 has no profile: ValueError."""
     s = _nonneg(sigma_s, "sigma_s")
     a = _nonneg(sigma_a, "sigma_a")
     t = s + a
     if np.any(t <= 0):
-        raise ValueError(f"sigma_s + sigma_a: must be > 0 in every channel (got sigma_s={s.tolist()}, "
-                         f"sigma_a={a.tolist()}); a medium that neither scatters nor absorbs has no profile")
+        raise ValueError(
+            f"sigma_s + sigma_a: must be > 0 in every channel (got sigma_s={s.tolist()}, "
+            f"sigma_a={a.tolist()}); a medium that neither scatters nor absorbs has no profile"
+        )
     with np.errstate(over="ignore"):
         mfp = 1.0 / t
     if not np.all(np.isfinite(mfp)):
-        raise ValueError(f"sigma_s + sigma_a: {t.tolist()} 1/mm is too small; its mean free path 1/sigma_t "
-                         f"overflows (need sigma_s + sigma_a > {1.0 / np.finfo(np.float64).max:.3g} 1/mm)")
+        raise ValueError(
+            f"sigma_s + sigma_a: {t.tolist()} 1/mm is too small; its mean free path 1/sigma_t "
+            f"overflows (need sigma_s + sigma_a > {1.0 / np.finfo(np.float64).max:.3g} 1/mm)"
+        )
     return s / t, mfp
 
 
@@ -133,7 +139,7 @@ def _pbd_table(eta: float):
     i = np.arange(n)
     a = (1.0 - np.exp(-8.0 * i / (n - 1))) / (1.0 - np.exp(-8.0))
     a[-1] = 1.0
-    r = np.concatenate([pbd_total(a[k:k + 64], eta) for k in range(0, n, 64)])
+    r = np.concatenate([pbd_total(a[k : k + 64], eta) for k in range(0, n, 64)])
     return a, np.maximum.accumulate(r)
 
 
@@ -177,6 +183,7 @@ def invert_surface_albedo(A, eta, method: str = "pbd"):
 
 
 # --- the medium ----------------------------------------------------------------------------------
+
 
 @dataclass(frozen=True)
 class Medium:
@@ -249,7 +256,7 @@ class Medium:
     def surface_albedo(self, method: str = "pbd") -> np.ndarray:
         return surface_albedo(self.alpha, self.eta, method)
 
-    def scaled(self, k: float) -> "Medium":
+    def scaled(self, k: float) -> Medium:
         """Same medium with every length multiplied by k (scene-scale changes)."""
         return Medium(self.alpha, tuple(self.mfp_arr * float(k)), self.eta, self.name)
 

@@ -22,6 +22,7 @@ Each photon exits at most once, so its contribution x_i to a bin (or to the tota
 Deterministic for a seed: photons are generated in fixed-size batches, batch k from
 SeedSequence(seed).spawn(...)[k], independent of the number of worker processes.
 """
+
 from __future__ import annotations
 
 import sys
@@ -41,12 +42,12 @@ class MCResult:
     """Radial reflectance profile in mean-free-path units (per unit area, per entering photon)."""
 
     r_edges: np.ndarray
-    R: np.ndarray          # (B,) per unit area (1/mfp^2)
-    R_se: np.ndarray       # (B,) standard error of R
-    total: float           # total diffuse reflectance (all exits, also beyond the last edge)
+    R: np.ndarray  # (B,) per unit area (1/mfp^2)
+    R_se: np.ndarray  # (B,) standard error of R
+    total: float  # total diffuse reflectance (all exits, also beyond the last edge)
     total_se: float
     photons: int
-    capped: float          # weight per photon dropped at max_steps (upper bias bound of total)
+    capped: float  # weight per photon dropped at max_steps (upper bias bound of total)
     params: dict = field(default_factory=dict)
 
     @property
@@ -57,7 +58,7 @@ class MCResult:
 
     def scaled(self, mfp_mm: float):
         """(r_edges_mm, R_per_mm2, R_se_per_mm2) for a medium with mean free path mfp_mm."""
-        return self.r_edges * mfp_mm, self.R / mfp_mm ** 2, self.R_se / mfp_mm ** 2
+        return self.r_edges * mfp_mm, self.R / mfp_mm**2, self.R_se / mfp_mm**2
 
 
 def _check(albedo, eta, g, incidence, photons):
@@ -102,8 +103,7 @@ def _scatter(rng, ux, uy, uz, g):
 
 
 def _run_batch(args):
-    (seed_seq, n, albedo, eta, g, incidence, entry_fresnel, edges, max_steps,
-     roulette_below, roulette_p) = args
+    (seed_seq, n, albedo, eta, g, incidence, entry_fresnel, edges, max_steps, roulette_below, roulette_p) = args
     rng = np.random.default_rng(seed_seq)
     nb = len(edges) - 1
     s1 = np.zeros(nb)
@@ -134,7 +134,7 @@ def _run_batch(args):
             io = np.nonzero(out)[0]
             t = z[io] / -uz[io]
             xe, ye = x[io] + t * ux[io], y[io] + t * uy[io]
-            F = fresnel_dielectric(uz[io], eta)          # uz < 0: inside -> outside
+            F = fresnel_dielectric(uz[io], eta)  # uz < 0: inside -> outside
             leave = rng.random(len(io)) >= F
             il = io[leave]
             wl = w[il]
@@ -144,7 +144,7 @@ def _run_batch(args):
             s1 += np.bincount(b[inb], wl[inb], nb)
             s2 += np.bincount(b[inb], wl[inb] ** 2, nb)
             t1 += wl.sum()
-            t2 += (wl ** 2).sum()
+            t2 += (wl**2).sum()
             ir = io[~leave]
             x[ir], y[ir], z[ir] = xe[~leave], ye[~leave], 0.0
             uz[ir] = -uz[ir]
@@ -173,10 +173,21 @@ def _run_batch(args):
     return s1, s2, t1, t2, capped
 
 
-def simulate(albedo: float, eta: float = 1.0, g: float = 0.0, incidence: str = "normal",
-             photons: int = 100_000, seed: int = 0, r_edges=None, max_steps: int = 100_000,
-             entry_fresnel: bool = False, roulette_below: float = 1e-3, roulette_p: float = 0.1,
-             progress: bool = True, workers: int = 1) -> MCResult:
+def simulate(
+    albedo: float,
+    eta: float = 1.0,
+    g: float = 0.0,
+    incidence: str = "normal",
+    photons: int = 100_000,
+    seed: int = 0,
+    r_edges=None,
+    max_steps: int = 100_000,
+    entry_fresnel: bool = False,
+    roulette_below: float = 1e-3,
+    roulette_p: float = 0.1,
+    progress: bool = True,
+    workers: int = 1,
+) -> MCResult:
     """Run the random walk; see the module docstring. ``workers`` > 1 uses processes (same result)."""
     albedo, eta, g = float(albedo), float(eta), float(g)
     _check(albedo, eta, g, incidence, photons)
@@ -186,12 +197,20 @@ def simulate(albedo: float, eta: float = 1.0, g: float = 0.0, incidence: str = "
         raise ValueError("r_edges: need an increasing sequence of at least 2 radii >= 0")
     sizes = [BATCH] * (photons // BATCH) + ([photons % BATCH] if photons % BATCH else [])
     seqs = np.random.SeedSequence(int(seed)).spawn(len(sizes))
-    jobs = [(sq, n, albedo, eta, g, incidence, entry_fresnel, edges, int(max_steps), roulette_below, roulette_p)
-            for sq, n in zip(seqs, sizes)]
+    jobs = [
+        (sq, n, albedo, eta, g, incidence, entry_fresnel, edges, int(max_steps), roulette_below, roulette_p)
+        for sq, n in zip(seqs, sizes)
+    ]
     from tqdm import tqdm
 
-    bar = tqdm(total=photons, unit="photon", unit_scale=True, file=sys.stderr, disable=not progress,
-               desc=f"MC albedo={albedo:g}")
+    bar = tqdm(
+        total=photons,
+        unit="photon",
+        unit_scale=True,
+        file=sys.stderr,
+        disable=not progress,
+        desc=f"MC albedo={albedo:g}",
+    )
     s1 = np.zeros(len(edges) - 1)
     s2 = np.zeros_like(s1)
     t1 = t2 = capped = 0.0
@@ -199,23 +218,46 @@ def simulate(albedo: float, eta: float = 1.0, g: float = 0.0, incidence: str = "
         with ProcessPoolExecutor(workers) as ex:
             results = ex.map(_run_batch, jobs)
             for (a, b, c, d, e), n in zip(results, sizes):
-                s1 += a; s2 += b; t1 += c; t2 += d; capped += e
+                s1 += a
+                s2 += b
+                t1 += c
+                t2 += d
+                capped += e
                 bar.update(n)
     else:
         for job, n in zip(jobs, sizes):
             a, b, c, d, e = _run_batch(job)
-            s1 += a; s2 += b; t1 += c; t2 += d; capped += e
+            s1 += a
+            s2 += b
+            t1 += c
+            t2 += d
+            capped += e
             bar.update(n)
     bar.close()
     N = photons
     area = np.pi * (edges[1:] ** 2 - edges[:-1] ** 2)
     mean = s1 / N
-    var = np.maximum(s2 / N - mean ** 2, 0.0) / (N - 1)
+    var = np.maximum(s2 / N - mean**2, 0.0) / (N - 1)
     tmean = t1 / N
-    tvar = max(t2 / N - tmean ** 2, 0.0) / (N - 1)
-    return MCResult(edges, mean / area, np.sqrt(var) / area, tmean, float(np.sqrt(tvar)), N, capped / N,
-                    dict(albedo=albedo, eta=eta, g=g, incidence=incidence, seed=int(seed),
-                         max_steps=int(max_steps), entry_fresnel=bool(entry_fresnel)))
+    tvar = max(t2 / N - tmean**2, 0.0) / (N - 1)
+    return MCResult(
+        edges,
+        mean / area,
+        np.sqrt(var) / area,
+        tmean,
+        float(np.sqrt(tvar)),
+        N,
+        capped / N,
+        dict(
+            albedo=albedo,
+            eta=eta,
+            g=g,
+            incidence=incidence,
+            seed=int(seed),
+            max_steps=int(max_steps),
+            entry_fresnel=bool(entry_fresnel),
+        ),
+    )
 
 
 def chandrasekhar_h(albedo: float, mu, n: int = 200) -> np.ndarray:

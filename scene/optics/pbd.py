@@ -18,6 +18,7 @@ fp32 conditioning: phi_D is a difference of nearly equal terms when r >> z; it i
 e^{-s d_r}/d_r * (-expm1(-(s delta + log1p(delta/d_r)))) with delta = d_v - d_r =
 (z_v^2 - z_r^2)/(d_r + d_v) computed without cancellation. r = 0 is finite (z_r >= z_0 > 0).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -36,15 +37,15 @@ def pbd_ms_profile(r, alpha, mfp, eta):
     fm1, fm2 = fresnel_moment1(eta), fresnel_moment2(eta)
     Dg = (2.0 - alpha) / 3.0
     s = np.sqrt((1.0 - alpha) / Dg)
-    ze_abs = 2.0 * Dg * (1.0 + 3.0 * fm2) / (1.0 - 2.0 * fm1)   # z_e = -ze_abs
+    ze_abs = 2.0 * Dg * (1.0 + 3.0 * fm2) / (1.0 - 2.0 * fm1)  # z_e = -ze_abs
     c_phi = 0.25 * (1.0 - 2.0 * fm1)
     c_e = 0.5 * (1.0 - 3.0 * fm2)
     zr = depth_samples().reshape(1, 1, -1)
     x3, s3, Dg3, ze3 = x[..., None], s[..., None], Dg[..., None], ze_abs[..., None]
-    zv_abs = zr + 2.0 * ze3                      # |z_v|; z_v = -|z_v|
+    zv_abs = zr + 2.0 * ze3  # |z_v|; z_v = -|z_v|
     dr = np.sqrt(x3 * x3 + zr * zr)
     dv = np.sqrt(x3 * x3 + zv_abs * zv_abs)
-    delta = 2.0 * ze3 * (2.0 * zr + 2.0 * ze3) / (dr + dv)   # (z_v^2 - z_r^2)/(d_r + d_v)
+    delta = 2.0 * ze3 * (2.0 * zr + 2.0 * ze3) / (dr + dv)  # (z_v^2 - z_r^2)/(d_r + d_v)
     er = np.exp(-s3 * dr)
     ev = np.exp(-s3 * dv)
     phi = er / dr * (-np.expm1(-(s3 * delta + np.log1p(delta / dr)))) / (4.0 * PI * Dg3)
@@ -67,7 +68,7 @@ def radial_integral(profile_opt, x_min=1e-5, x_max=2e3, n=600):
 
     ``profile_opt(x) -> (N, C)``. Used for total reflectances of profiles without a closed form."""
     x = np.geomspace(x_min, x_max, n)
-    f = profile_opt(x) * 2.0 * PI * x[:, None] * x[:, None]   # integrand in d(ln x)
+    f = profile_opt(x) * 2.0 * PI * x[:, None] * x[:, None]  # integrand in d(ln x)
     inner = profile_opt(np.array([0.0]))[0] * PI * x_min * x_min
     return inner + np.trapezoid(f, np.log(x), axis=0)
 

@@ -19,11 +19,12 @@ Names:
                    shape: ignores the mean free path except that l < MIN_MFP_MM gives 0).
   "pbd"            photon beam diffusion, multiple + single scattering (pbrt-v4).
 """
+
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Callable
 
 import numpy as np
 
@@ -40,8 +41,8 @@ from .single_scattering import single_scatter_profile
 class ProfileModel:
     name: str
     description: str
-    evaluate: Callable[[np.ndarray, Medium], np.ndarray]   # (r_mm (N,), medium) -> (N, 3) 1/mm^2
-    total: Callable[[Medium], np.ndarray]                   # medium -> (3,)
+    evaluate: Callable[[np.ndarray, Medium], np.ndarray]  # (r_mm (N,), medium) -> (N, 3) 1/mm^2
+    total: Callable[[Medium], np.ndarray]  # medium -> (3,)
 
 
 def _r(r):
@@ -58,7 +59,7 @@ def _numeric_total(fn, m: Medium):
         if m.mfp_mm[c] <= 0:
             continue
         one = Medium(m.alpha, (1.0, 1.0, 1.0), m.eta)
-        out[c] = radial_integral(lambda x: fn(x, one)[:, c:c + 1])[0]
+        out[c] = radial_integral(lambda x, one=one, c=c: fn(x, one)[:, c : c + 1])[0]
     return out
 
 
@@ -90,26 +91,49 @@ def _A(m: Medium):
 
 
 _MODELS = [
-    ProfileModel("none", "no subsurface transport (delta at r = 0)",
-                 lambda r, m: np.zeros((len(r), 3)), _A),
-    ProfileModel("dipole", "Jensen et al. 2001 dipole",
-                 lambda r, m: dipole_profile(r, m.alpha_arr, m.mfp_arr, m.eta),
-                 lambda m: dipole_total(m.alpha_arr, m.eta)),
-    ProfileModel("dipole+ss", "Jensen 2001 dipole + single scattering",
-                 lambda r, m: dipole_profile(r, m.alpha_arr, m.mfp_arr, m.eta)
-                 + single_scatter_profile(r, m.alpha_arr, m.mfp_arr, m.eta),
-                 lambda m: dipole_total(m.alpha_arr, m.eta)
-                 + _numeric_total(lambda x, u: single_scatter_profile(x, u.alpha_arr, u.mfp_arr, u.eta), m)),
-    ProfileModel("burley", "Christensen-Burley 2015, searchlight s(A)",
-                 lambda r, m: burley_profile(r, _A(m), m.mfp_arr, "searchlight"), _A),
-    ProfileModel("blender-burley", "Blender Burley (R = 4 pi l, diffuse s(A), truncated at 16 d)",
-                 lambda r, m: blender_burley_profile(r, _A(m), mfp_to_radius(m.mfp_mm)), _A),
+    ProfileModel("none", "no subsurface transport (delta at r = 0)", lambda r, m: np.zeros((len(r), 3)), _A),
+    ProfileModel(
+        "dipole",
+        "Jensen et al. 2001 dipole",
+        lambda r, m: dipole_profile(r, m.alpha_arr, m.mfp_arr, m.eta),
+        lambda m: dipole_total(m.alpha_arr, m.eta),
+    ),
+    ProfileModel(
+        "dipole+ss",
+        "Jensen 2001 dipole + single scattering",
+        lambda r, m: (
+            dipole_profile(r, m.alpha_arr, m.mfp_arr, m.eta) + single_scatter_profile(r, m.alpha_arr, m.mfp_arr, m.eta)
+        ),
+        lambda m: (
+            dipole_total(m.alpha_arr, m.eta)
+            + _numeric_total(lambda x, u: single_scatter_profile(x, u.alpha_arr, u.mfp_arr, u.eta), m)
+        ),
+    ),
+    ProfileModel(
+        "burley",
+        "Christensen-Burley 2015, searchlight s(A)",
+        lambda r, m: burley_profile(r, _A(m), m.mfp_arr, "searchlight"),
+        _A,
+    ),
+    ProfileModel(
+        "blender-burley",
+        "Blender Burley (R = 4 pi l, diffuse s(A), truncated at 16 d)",
+        lambda r, m: blender_burley_profile(r, _A(m), mfp_to_radius(m.mfp_mm)),
+        _A,
+    ),
     ProfileModel("gaussians", "6 shared-variance Gaussians fitted to PBD", _gauss_eval, _gauss_total),
-    ProfileModel("deon-skin", "d'Eon & Luebke 2007 skin Gaussians x surface albedo",
-                 lambda r, m: deon_skin_profile(r, _A(m) * (m.mfp_arr >= MIN_MFP_MM)), _A),
-    ProfileModel("pbd", "photon beam diffusion (Habel 2013 / pbrt-v4), MS + SS",
-                 lambda r, m: pbd_profile(r, m.alpha_arr, m.mfp_arr, m.eta),
-                 lambda m: np.where(m.mfp_arr > 0, pbd_total(m.alpha_arr, m.eta), 0.0)),
+    ProfileModel(
+        "deon-skin",
+        "d'Eon & Luebke 2007 skin Gaussians x surface albedo",
+        lambda r, m: deon_skin_profile(r, _A(m) * (m.mfp_arr >= MIN_MFP_MM)),
+        _A,
+    ),
+    ProfileModel(
+        "pbd",
+        "photon beam diffusion (Habel 2013 / pbrt-v4), MS + SS",
+        lambda r, m: pbd_profile(r, m.alpha_arr, m.mfp_arr, m.eta),
+        lambda m: np.where(m.mfp_arr > 0, pbd_total(m.alpha_arr, m.eta), 0.0),
+    ),
 ]
 PROFILE_MODELS: dict[str, ProfileModel] = {p.name: p for p in _MODELS}
 

@@ -2,6 +2,7 @@
 clamp-to-edge addressing and compare function '<=' (the result of each tap is exactly 0 or 1,
 so the twin is exact). The renderer samples with LINEAR compare filtering, whose bilinear weights
 are implementation precision (llvmpipe uses 8-bit weights); those are not part of the twin."""
+
 from __future__ import annotations
 
 import numpy as np

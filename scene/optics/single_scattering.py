@@ -17,6 +17,7 @@ Directions: w_i, w_o point away from the surface (like the BRDF code). The scatt
 between the propagation direction of the refracted incident light T_i and the propagation direction
 of the light leaving towards w_o, i.e. -T_o (T_o = refraction of -w_o into the medium).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -54,8 +55,9 @@ def single_scatter_brdf(n, wi, wo, alpha, eta, g):
     ti = -wi / eta[..., None] + ((ci / eta - cti)[..., None]) * n
     to = -wo / eta[..., None] + ((co / eta - cto)[..., None]) * n
     cos_s = np.clip(-_dot(ti, to), -1.0, 1.0)
-    ft = (1.0 - fresnel_from_cosines(np.clip(ci, 0, 1), cti, 1.0, eta)) * \
-         (1.0 - fresnel_from_cosines(np.clip(co, 0, 1), cto, 1.0, eta))
+    ft = (1.0 - fresnel_from_cosines(np.clip(ci, 0, 1), cti, 1.0, eta)) * (
+        1.0 - fresnel_from_cosines(np.clip(co, 0, 1), cto, 1.0, eta)
+    )
     denom = np.maximum(cti + cto, 1e-4)
     val = ft * hg_phase(cos_s, g) / denom
     val = np.where((ci > 0) & (co > 0), val, 0.0)

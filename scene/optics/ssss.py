@@ -11,6 +11,7 @@ Sample offsets follow Jimenez's presets: denser near the centre, x_i = range t_i
 in [-1, 1], range = 3 sigma of the widest Gaussian. Weights: the kernel's mass over each sample's
 cell, normalised per channel to sum to 1.
 """
+
 from __future__ import annotations
 
 import math
@@ -55,5 +56,7 @@ def separable_edge_response(x_mm, offsets, weights):
     """Fraction of a half-plane's light (lit for x < 0) at distance x past a straight edge after the
     1-D kernel along x (the perpendicular pass leaves a straight edge unchanged)."""
     x = np.atleast_1d(np.asarray(x_mm, np.float64))
-    return np.stack([(weights[None, :, c] * ((x[:, None] - offsets[None, :]) < 0)).sum(axis=1)
-                     for c in range(weights.shape[1])], axis=1)
+    return np.stack(
+        [(weights[None, :, c] * ((x[:, None] - offsets[None, :]) < 0)).sum(axis=1) for c in range(weights.shape[1])],
+        axis=1,
+    )

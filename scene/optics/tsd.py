@@ -22,6 +22,7 @@ light, the colour comes from the albedo (pre-/post-scatter texturing), so a cons
 keeps its mean. Gaussians below NEGLIGIBLE_WEIGHT in every channel are dropped; Gaussians narrower
 than a texel cannot be resolved by the texture and join the identity weight I.
 """
+
 from __future__ import annotations
 
 import math
@@ -30,16 +31,24 @@ from functools import lru_cache
 
 import numpy as np
 
-from .constants import (COVERAGE_EPS, MIN_MFP_MM, SKIN6_VARIANCES, SKIN6_WEIGHTS, SPECULAR_F0_SCALE, TSD_MAX_STEP_TEXELS,
-                        TSD_MIN_MM_PER_TEXEL, TSD_TAP_RANGE)
+from .constants import (
+    COVERAGE_EPS,
+    MIN_MFP_MM,
+    SKIN6_VARIANCES,
+    SKIN6_WEIGHTS,
+    SPECULAR_F0_SCALE,
+    TSD_MAX_STEP_TEXELS,
+    TSD_MIN_MM_PER_TEXEL,
+    TSD_TAP_RANGE,
+)
 from .gaussians import fit_gaussians
 from .media import Medium
 from .profiles import get_profile
 
-TSD_MIN_TAPS = 7               # d'Eon & Luebke's 7-tap kernel is the smallest
+TSD_MIN_TAPS = 7  # d'Eon & Luebke's 7-tap kernel is the smallest
 TSD_MAX_TAPS = 31
-TSD_SUBTEXEL_SIGMA = 0.35      # a Gaussian whose sigma is below this many texels is the identity
-NEGLIGIBLE_WEIGHT = 1e-3       # a Gaussian below this weight in every channel is skipped
+TSD_SUBTEXEL_SIGMA = 0.35  # a Gaussian whose sigma is below this many texels is the identity
+NEGLIGIBLE_WEIGHT = 1e-3  # a Gaussian below this weight in every channel is skipped
 MAX_TSD_LEVELS = 6
 
 # The radius the d'Eon & Luebke skin Gaussians correspond to (the default skin radius, mm): the
@@ -47,8 +56,13 @@ MAX_TSD_LEVELS = 6
 SKIN6_RADIUS_MM = (3.67, 1.37, 0.68)
 
 # material sss_model -> profile registry name used for the Gaussian fit
-MODEL_PROFILES = {"dipole": "dipole", "burley": "burley", "blender-burley": "blender-burley",
-                  "pbd": "pbd", "gaussians": "deon-skin"}
+MODEL_PROFILES = {
+    "dipole": "dipole",
+    "burley": "burley",
+    "blender-burley": "blender-burley",
+    "pbd": "pbd",
+    "gaussians": "deon-skin",
+}
 
 
 def eta_from_specular(specular: float) -> float:
@@ -62,25 +76,28 @@ def eta_from_specular(specular: float) -> float:
 def material_medium(values) -> Medium:
     """The homogeneous medium of a principled material: subsurface_color is the surface albedo,
     subsurface_radius the artist radius per channel (Blender's convention, l = R / 4 pi)."""
-    return Medium.from_artist_radius(values["subsurface_color"], values["subsurface_radius"],
-                                     eta=eta_from_specular(values["specular"]))
+    return Medium.from_artist_radius(
+        values["subsurface_color"], values["subsurface_radius"], eta=eta_from_specular(values["specular"])
+    )
 
 
 @dataclass(frozen=True)
 class ProfileFit:
     model: str
-    variances_mm2: np.ndarray     # (K,)
-    weights: np.ndarray           # (K, 3) normalised: identity + sum = 1 per channel
-    identity: np.ndarray          # (3,) weight of the unblurred irradiance (channels with no scattering)
-    rel_error: np.ndarray         # (3,) the fit's relative L2 error on r R(r)
+    variances_mm2: np.ndarray  # (K,)
+    weights: np.ndarray  # (K, 3) normalised: identity + sum = 1 per channel
+    identity: np.ndarray  # (3,) weight of the unblurred irradiance (channels with no scattering)
+    rel_error: np.ndarray  # (3,) the fit's relative L2 error on r R(r)
 
 
 @lru_cache(maxsize=128)
 def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
     """K shared-variance Gaussians for `model` (a material sss_model) and `medium`, normalised."""
     if model not in MODEL_PROFILES:
-        raise ValueError(f"sss_model: texture-space diffusion has no profile for {model!r}; "
-                         f"expected one of {', '.join(MODEL_PROFILES)}")
+        raise ValueError(
+            f"sss_model: texture-space diffusion has no profile for {model!r}; "
+            f"expected one of {', '.join(MODEL_PROFILES)}"
+        )
     if not (isinstance(K, int) and 1 <= K <= MAX_TSD_LEVELS):
         raise ValueError(f"tsd_gaussians: expected an integer in [1, {MAX_TSD_LEVELS}], got {K!r}")
     # channels that scatter at all (mean free paths below MIN_MFP_MM are "no scattering" for every
@@ -89,9 +106,9 @@ def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
     if model == "gaussians":
         radius = np.where(scatter, medium.artist_radius_mm, 0.0)
         scale = float(radius[scatter].mean() / np.mean(SKIN6_RADIUS_MM)) if scatter.any() else 0.0
-        v_all = np.asarray(SKIN6_VARIANCES) * scale ** 2
-        w_all = np.asarray(SKIN6_WEIGHTS, dtype=np.float64).reshape(-1, 3)   # (6, 3)
-        if K < len(v_all):   # keep the K widest-weighted Gaussians
+        v_all = np.asarray(SKIN6_VARIANCES) * scale**2
+        w_all = np.asarray(SKIN6_WEIGHTS, dtype=np.float64).reshape(-1, 3)  # (6, 3)
+        if K < len(v_all):  # keep the K widest-weighted Gaussians
             keep = np.sort(np.argsort(-w_all.sum(axis=1))[:K])
             v_all, w_all = v_all[keep], w_all[keep]
         v, w, err = v_all, w_all, np.zeros(3)
@@ -112,18 +129,18 @@ def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
 
 @dataclass(frozen=True)
 class BlurStep:
-    level: int                    # index into the kept levels
-    variance_mm2: float           # the level's total variance v_k
-    sigma_mm: float               # sqrt(v_k - v_{k-1}): this step's blur
+    level: int  # index into the kept levels
+    variance_mm2: float  # the level's total variance v_k
+    sigma_mm: float  # sqrt(v_k - v_{k-1}): this step's blur
     taps: int
-    weight: tuple                 # (3,) W_k
+    weight: tuple  # (3,) W_k
 
 
 @dataclass(frozen=True)
 class DiffusionKernel:
-    steps: tuple                  # BlurStep per kept level, ascending variance
-    identity: np.ndarray          # (3,) weight of the unblurred irradiance
-    skipped: tuple = field(default=())   # (what, why) for the plan
+    steps: tuple  # BlurStep per kept level, ascending variance
+    identity: np.ndarray  # (3,) weight of the unblurred irradiance
+    skipped: tuple = field(default=())  # (what, why) for the plan
     fit: ProfileFit | None = None
 
     @property
@@ -156,8 +173,9 @@ def blur_taps(n: int) -> tuple[np.ndarray, np.ndarray]:
     return t, w / w.sum()
 
 
-def design_kernel(fit: ProfileFit, mm_per_texel_p10: float, mm_per_texel_p50: float,
-                  taps: int | None = None) -> DiffusionKernel:
+def design_kernel(
+    fit: ProfileFit, mm_per_texel_p10: float, mm_per_texel_p50: float, taps: int | None = None
+) -> DiffusionKernel:
     """Blur chain for `fit` on a texture whose (area-weighted) 10th / 50th percentile of millimetres
     per texel are given: drop negligible Gaussians, fold sub-texel ones into the identity, choose taps
     from each step's width in texels (at the 10th percentile, where the kernel is widest in texels)
@@ -170,13 +188,18 @@ def design_kernel(fit: ProfileFit, mm_per_texel_p10: float, mm_per_texel_p50: fl
     for k, v in enumerate(fit.variances_mm2):
         w = fit.weights[k]
         if np.all(w < NEGLIGIBLE_WEIGHT):
-            skipped.append((f"gaussian {k} (v={v:.3g} mm2)", f"weight {w.max():.1e} < {NEGLIGIBLE_WEIGHT:g} "
-                                                             "in every channel"))
+            skipped.append(
+                (f"gaussian {k} (v={v:.3g} mm2)", f"weight {w.max():.1e} < {NEGLIGIBLE_WEIGHT:g} in every channel")
+            )
             continue
         if math.sqrt(max(v, 0.0)) / p50 < TSD_SUBTEXEL_SIGMA:
-            skipped.append((f"gaussian {k} (v={v:.3g} mm2)",
-                            f"sigma {math.sqrt(max(v, 0)):.3g} mm < {TSD_SUBTEXEL_SIGMA} texel ({p50:.3g} mm per "
-                            "texel, median): joins the unblurred term"))
+            skipped.append(
+                (
+                    f"gaussian {k} (v={v:.3g} mm2)",
+                    f"sigma {math.sqrt(max(v, 0)):.3g} mm < {TSD_SUBTEXEL_SIGMA} texel ({p50:.3g} mm per "
+                    "texel, median): joins the unblurred term",
+                )
+            )
             ident += w
             continue
         kept_v.append(float(v))
@@ -198,8 +221,8 @@ def design_kernel(fit: ProfileFit, mm_per_texel_p10: float, mm_per_texel_p50: fl
 # -- NumPy reference twin of the GPU passes ------------------------------------------------------------
 # Arrays are (rows = v, columns = u, channels), row 0 at v = 0 (as the GPU texture is read back).
 
-def blur_axis_reference(src: np.ndarray, mm_per_texel: np.ndarray, sigma_mm: float, taps: int,
-                        axis: str) -> np.ndarray:
+
+def blur_axis_reference(src: np.ndarray, mm_per_texel: np.ndarray, sigma_mm: float, taps: int, axis: str) -> np.ndarray:
     """One 1-D pass of shaders/passes/tsd_blur.frag: src (H, W, 4) premultiplied, mm_per_texel
     (H, W, 2) (u, v); axis 'u' (columns) or 'v' (rows). float32 arithmetic like the shader."""
     src = np.asarray(src, np.float32)
@@ -250,13 +273,15 @@ def gather_reference(irradiance, levels, kernel: DiffusionKernel) -> np.ndarray:
     return out
 
 
-def exact_profile_convolution(irradiance: np.ndarray, mm_per_texel: tuple[float, float], profile_fn,
-                              radius_mm: float | None = None) -> np.ndarray:
+def exact_profile_convolution(
+    irradiance: np.ndarray, mm_per_texel: tuple[float, float], profile_fn, radius_mm: float | None = None
+) -> np.ndarray:
     """Brute-force convolution of an irradiance texture (uniform stretch mm_per_texel = (u, v)) with
     a radial profile normalised to sum 1 per channel over the texel grid (profile_fn(r_mm) -> (N, 3)).
     The kernel is evaluated at texel centres with 4x4 supersampling; normalised convolution by coverage.
     For the reference comparisons (fit error); O(texels x kernel) — use small textures."""
     from scipy.signal import fftconvolve
+
     irr = np.asarray(irradiance, np.float64)
     mu, mv = float(mm_per_texel[0]), float(mm_per_texel[1])
     if radius_mm is None:
@@ -264,7 +289,7 @@ def exact_profile_convolution(irradiance: np.ndarray, mm_per_texel: tuple[float,
     nu, nv = int(math.ceil(radius_mm / mu)), int(math.ceil(radius_mm / mv))
     ss = 4
     off = (np.arange(ss) + 0.5) / ss - 0.5
-    ys, xs = np.mgrid[-nv:nv + 1, -nu:nu + 1]
+    ys, xs = np.mgrid[-nv : nv + 1, -nu : nu + 1]
     # the radial profile tabulated once (log-spaced; some profiles cost ~0.1 ms per radius) and
     # interpolated at the 4x4 sub-samples of every kernel texel
     r_tab = np.concatenate([[0.0], np.geomspace(1e-6, max(2.0 * radius_mm, 1e-3), 4000)])
@@ -308,7 +333,7 @@ def edge_response(x_mm: np.ndarray, fit_or_profile, kind: str = "gaussians") -> 
     R_tab = np.asarray(fn(r_tab), np.float64).reshape(len(r_tab), -1)
     rr = np.hypot(d[:, None], ys[None, :])
     prof = np.stack([np.interp(rr, r_tab, R_tab[:, c]) for c in range(R_tab.shape[1])], axis=-1)
-    line = 2.0 * np.trapezoid(prof, ys, axis=1)                 # (nd, C)
+    line = 2.0 * np.trapezoid(prof, ys, axis=1)  # (nd, C)
     seg = 0.5 * (line[1:] + line[:-1]) * np.diff(d)[:, None]
     tail = np.concatenate([np.cumsum(seg[::-1], axis=0)[::-1], np.zeros((1, line.shape[1]))])  # int_d^inf
     half = tail[0]
@@ -320,6 +345,7 @@ def edge_response(x_mm: np.ndarray, fit_or_profile, kind: str = "gaussians") -> 
 
 
 # -- Fresnel factors of the specular layer (twins of shaders/lib/subsurface.glsl) ------------------------
+
 
 def fresnel_transmission(f0, c):
     """1 - Schlick F: the fraction of light entering at incidence cosine c."""
@@ -359,6 +385,7 @@ def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float = 
     if not scatter.any():
         return 1e-3, np.zeros((n, 3)), np.ones((n, 3))
     from .gaussians import _energy_radius
+
     r_max = _energy_radius(fn, energy)
     r = np.linspace(0.0, r_max, n)
     # fine quadrature of the cumulative energy (the profile may be singular at 0: Burley ~ 1/r)
@@ -389,8 +416,8 @@ def dilate_reference(img: np.ndarray, rings: int) -> np.ndarray:
         n = np.zeros((H, W), np.float32)
         for dy in (-1, 0, 1):
             for dx in (-1, 0, 1):
-                s += pad[1 + dy:1 + dy + H, 1 + dx:1 + dx + W]
-                n += pc[1 + dy:1 + dy + H, 1 + dx:1 + dx + W]
+                s += pad[1 + dy : 1 + dy + H, 1 + dx : 1 + dx + W]
+                n += pc[1 + dy : 1 + dy + H, 1 + dx : 1 + dx + W]
         fill = np.where(n[..., None] > 0, s / np.maximum(n, 1)[..., None], 0.0)
         cur = np.where(cov[..., None], cur, fill).astype(np.float32)
     return cur
@@ -402,5 +429,5 @@ def thickness_transmittance(d_mm, kernel: DiffusionKernel) -> np.ndarray:
     d = np.atleast_1d(np.asarray(d_mm, np.float64))
     out = np.zeros((len(d), 3))
     for s in kernel.steps:
-        out += np.exp(-d[:, None] ** 2 / (2.0 * max(s.variance_mm2, 1e-12))) * np.asarray(s.weight)[None, :]
+        out += np.exp(-(d[:, None] ** 2) / (2.0 * max(s.variance_mm2, 1e-12))) * np.asarray(s.weight)[None, :]
     return out

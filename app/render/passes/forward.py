@@ -1,4 +1,5 @@
 """Forward shading of every visible mesh into an HDR target with depth."""
+
 from __future__ import annotations
 
 import moderngl
@@ -24,7 +25,7 @@ class ForwardPass:
             ctx = self.r.ctx
             color = ctx.texture(size, 4, dtype="f4")
             depth = ctx.depth_texture(size)
-            depth.compare_func = ""          # sampled as plain depth (screen-space SSS)
+            depth.compare_func = ""  # sampled as plain depth (screen-space SSS)
             diffuse = ctx.texture(size, 4, dtype="f4") if split else None
             for x in (color, diffuse):
                 if x is not None:
@@ -43,8 +44,11 @@ class ForwardPass:
         ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
         lights = p.params["lights"]
         nmax = frame.settings.max_lights
-        per_frame = {"u_view_proj": frame.view_proj, "u_camera_pos": frame.camera_pos,
-                     "u_ambient": frame.scene.environment.ambient}
+        per_frame = {
+            "u_view_proj": frame.view_proj,
+            "u_camera_pos": frame.camera_pos,
+            "u_ambient": frame.scene.environment.ambient,
+        }
         bind_shadow_maps(self.r, frame)
         for node in frame.scene.mesh_nodes():
             tsd = frame.tsd.get(id(node))
@@ -66,7 +70,7 @@ class ForwardPass:
                 bind_tsd(prog, tsd)
             if tinted is not None:
                 set_uniform(prog, "u_sss_tint", tinted[1])
-            if ssss is not None:   # (sss_model overrides change no uniform: the node's own values apply)
+            if ssss is not None:  # (sss_model overrides change no uniform: the node's own values apply)
                 set_uniform(prog, "u_ssss_enabled", float(node.uid in ssss.scattering))
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         frame.targets["hdr_color"] = color
@@ -75,7 +79,7 @@ class ForwardPass:
             frame.targets["ssss_diffuse"] = diffuse
 
 
-TSD_UNITS = 7   # irradiance at 7, levels at 8..13 (material maps 0..4, shadow maps 5, 6)
+TSD_UNITS = 7  # irradiance at 7, levels at 8..13 (material maps 0..4, shadow maps 5, 6)
 
 
 def bind_tsd(prog, tsd) -> None:

@@ -1,4 +1,5 @@
 """Shadow maps: depth from a light, fitted to the scene's bounding sphere."""
+
 from __future__ import annotations
 
 import moderngl
@@ -23,8 +24,10 @@ def light_view_proj(light: LightNode, lo: np.ndarray, hi: np.ndarray) -> np.ndar
     pos = light.world_position
     dist = float(np.linalg.norm(centre - pos))
     if dist <= radius * 1.01:
-        raise ValueError(f"light {light.name!r}: a shadow-casting point light must be outside the scene's "
-                         f"bounding sphere (distance {dist:.3g} <= radius {radius:.3g})")
+        raise ValueError(
+            f"light {light.name!r}: a shadow-casting point light must be outside the scene's "
+            f"bounding sphere (distance {dist:.3g} <= radius {radius:.3g})"
+        )
     fov = 2 * np.arcsin(radius / dist)
     view = np.linalg.inv(tf.compose(pos, tf.look_at_rotation(pos, centre), np.ones(3)))
     return tf.perspective(fov, 1.0, max(dist - radius, 1e-4), dist + radius) @ view
@@ -64,13 +67,14 @@ class ShadowPass:
         tex, fbo, dist = self.target(slot, p.resolution[0], distance)
         lo, hi = frame.scene.world_bounds()
         vp = light_view_proj(light, lo, hi)
-        prog = self.r.programs.get("passes/shadow.vert", "passes/shadow.frag",
-                                   {"SHADOW_DISTANCE": 1} if distance else None)
+        prog = self.r.programs.get(
+            "passes/shadow.vert", "passes/shadow.frag", {"SHADOW_DISTANCE": 1} if distance else None
+        )
         eye = np.append(light.direction, 0.0) if light.kind == "directional" else np.append(light.world_position, 1.0)
         set_uniforms(prog, {"u_light_eye": eye})
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        if dist is not None:   # "no surface": as far as it gets
+        if dist is not None:  # "no surface": as far as it gets
             fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.CULL_FACE)

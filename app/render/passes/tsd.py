@@ -8,6 +8,7 @@
 The kernel (variances, weights, taps) comes from scene/optics/tsd.py, which also holds the NumPy
 twin of the blur and gather. The gather is the forward pass's TSD_LEVELS variant.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -18,10 +19,9 @@ import numpy as np
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
-from scene.optics.tsd import (MAX_TSD_LEVELS, BlurStep, DiffusionKernel, blur_taps, exact_profile_lut,
-                              material_medium)
+from scene.optics.tsd import MAX_TSD_LEVELS, BlurStep, DiffusionKernel, blur_taps, exact_profile_lut, material_medium
 
-MAX_TAPS = 31   # shaders/passes/tsd_blur.frag
+MAX_TAPS = 31  # shaders/passes/tsd_blur.frag
 
 
 def _texture(ctx, size: int) -> moderngl.Texture:
@@ -34,6 +34,7 @@ def _texture(ctx, size: int) -> moderngl.Texture:
 @dataclass
 class TsdNodeTargets:
     """The GPU textures of one subsurface mesh node (float32 RGBA, premultiplied by coverage)."""
+
     size: int
     irradiance: moderngl.Texture
     scratch: moderngl.Texture
@@ -63,6 +64,7 @@ class TsdNodeTargets:
 @dataclass
 class TsdFrameNode:
     """What the gather needs for one node this frame."""
+
     targets: TsdNodeTargets
     kernel: DiffusionKernel
     material: object
@@ -169,8 +171,9 @@ class TsdIrradiancePass:
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
         bind_shadow_maps(self.r, frame)
         set_light_uniforms(prog, frame, lights, shadow_lights, nmax)
-        set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient,
-                            "u_tsd_mix": p.params["mix"]})
+        set_uniforms(
+            prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": p.params["mix"]}
+        )
         self.r.resources.bind_material(prog, mat)
         if translucency:
             for slot in (0, 1):
@@ -227,8 +230,8 @@ class TsdBlurPass:
         frame.targets[f"tsd_level{step.level}[{node.name}]"] = dst
 
 
-EXACT_INNER_HALF = 24     # brute force: texels summed one by one within 24 texels of the centre...
-EXACT_RING_RATIO = 1.15   # ...then annuli r -> 1.15 r out to r_max, cells read from the mip pyramid
+EXACT_INNER_HALF = 24  # brute force: texels summed one by one within 24 texels of the centre...
+EXACT_RING_RATIO = 1.15  # ...then annuli r -> 1.15 r out to r_max, cells read from the mip pyramid
 UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.zeros(3))
 
 
@@ -263,10 +266,19 @@ class TsdExactPass:
         lut, r_max = self.lut(p.params["model"], material_medium(p.params["material"].values))
         dst = t.level(ctx, 0)
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_exact.frag")
-        set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_lut": 2, "u_rmax_mm": r_max,
-                            "u_inner_half": EXACT_INNER_HALF, "u_ring_ratio": EXACT_RING_RATIO})
-        t.irradiance.build_mipmaps()          # box-filtered far field (textureLod); the gather keeps
-        t.irradiance.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)   # sampling level 0
+        set_uniforms(
+            prog,
+            {
+                "u_src": 0,
+                "u_stretch": 1,
+                "u_lut": 2,
+                "u_rmax_mm": r_max,
+                "u_inner_half": EXACT_INNER_HALF,
+                "u_ring_ratio": EXACT_RING_RATIO,
+            },
+        )
+        t.irradiance.build_mipmaps()  # box-filtered far field (textureLod); the gather keeps
+        t.irradiance.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)  # sampling level 0
         t.irradiance.use(0)
         t.stretch.use(1)
         lut.use(2)
