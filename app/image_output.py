@@ -1,4 +1,7 @@
-"""Write images atomically: PNG (8-bit sRGB, for people) or EXR (float linear, for numbers).
+"""Write images atomically: PNG (8-bit sRGB, for people) or EXR (32-bit float linear, for numbers).
+
+EXR is written as full float, not half: half overflows to +Inf above 65504, which a bright light
+(intensity 1e6) reaches, and radiance is data that must not be silently changed.
 
 Each file is written to a temporary name beside the target and renamed into place, so a
 crash never leaves a half-written image.
@@ -22,11 +25,33 @@ def image_format(path: str | Path) -> str:
     return FORMATS[ext]
 
 
+def check_output_path(path: str | Path, option: str = "") -> Path:
+    """Fail before any work if ``path`` cannot become an image file: a supported extension, not an
+    existing folder, and no regular file where a parent folder must be. ``option`` (e.g. "--out")
+    prefixes the message."""
+    path = Path(path)
+    label = f"{option}: " if option else ""
+    if path.is_dir():
+        raise ValueError(f"{label}{path}: is a folder; give a file name such as {path / 'render.png'}")
+    try:
+        image_format(path)
+    except ValueError as exc:
+        raise ValueError(f"{label}{exc}") from None
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"{label}{path}: {parent} is a file, not a folder")
+            if not os.access(parent, os.W_OK):
+                raise ValueError(f"{label}{path}: folder {parent} is not writable")
+            break
+    return path
+
+
 def write_image(path: str | Path, pixels: np.ndarray) -> Path:
-    """uint8 (H, W, C) -> PNG; float32 (H, W, C) -> half-float EXR. Rows top first."""
+    """uint8 (H, W, C) -> PNG; float (H, W, C) -> 32-bit float EXR. Rows top first."""
     import OpenImageIO as oiio
 
-    path = Path(path)
+    path = check_output_path(path)
     fmt = image_format(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     pixels = np.ascontiguousarray(pixels)
@@ -37,7 +62,7 @@ def write_image(path: str | Path, pixels: np.ndarray) -> Path:
         spec = oiio.ImageSpec(w, h, c, "uint8")
     else:
         pixels = pixels.astype(np.float32)
-        spec = oiio.ImageSpec(w, h, c, "half")
+        spec = oiio.ImageSpec(w, h, c, "float")
         spec.attribute("compression", "zip")
     if c == 4:
         spec.channelnames = ("R", "G", "B", "A")

@@ -65,9 +65,11 @@ class Param:
         if self.kind == "texture":
             if value is None or value == "":
                 return None
+            if not isinstance(value, str | Path):
+                raise ValueError(f"{label}: expected a file path (string), got {value!r}")
             return Path(value)
         if self.kind == "choice":
-            if value not in self.choices:
+            if not isinstance(value, str) or value not in self.choices:
                 raise ValueError(f"{label}: expected one of {', '.join(self.choices)}; got {value!r}")
             return value
         arr = self._numbers(value, label)

@@ -42,12 +42,12 @@ def register(sub) -> None:
 def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
     """Render once and write each output (PNG from the tone-mapped image, EXR linear)."""
     from app.gl.context import create_headless_context
-    from app.image_output import image_format, write_image
+    from app.image_output import check_output_path, image_format, write_image
     from app.render.renderer import Renderer
     from scene.scenefile import load_scene
 
     for o in outputs:
-        image_format(o)  # fail before rendering
+        check_output_path(o, "--out")  # fail before rendering
     scene = load_scene(scene_path)
     ctx = create_headless_context()
     renderer = Renderer(ctx)
