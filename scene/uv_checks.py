@@ -55,6 +55,7 @@ class UVReport:
     #                                 world-area weighted; nan when no triangle has finite values and positive area
     texels: int = 1024
     grid: int = 512
+    zero_area_uv_surface: float = 0.0  # fraction of the mesh's world area in zero-UV-area triangles
 
     def warnings(self) -> list[str]:
         """Human-readable problems, each naming the mesh; empty when the layout is clean."""
@@ -71,7 +72,8 @@ class UVReport:
             return out
         if self.zero_area_uv:
             out.append(
-                f"{where}: {self.zero_area_uv} of {self.triangles} triangles have (near-)zero UV area; they are "
+                f"{where}: {self.zero_area_uv} of {self.triangles} triangles "
+                f"({100 * self.zero_area_uv_surface:.2g} % of its surface) have (near-)zero UV area; they are "
                 f"not rasterised in UV space, so their surface gets no irradiance"
             )
         if self.zero_area_world:
@@ -178,6 +180,7 @@ def analyse_uvs(
         uv_coverage=covered / float(grid * grid),
         mm_per_texel=mm,
         mm_per_texel_percentiles=pct,
+        zero_area_uv_surface=float(world_area[uv_zero].sum() / world_area.sum()) if world_area.sum() > 0 else 0.0,
         texels=int(texels),
         grid=int(grid),
     )

@@ -134,7 +134,8 @@ def run(args) -> int:
         out = strict_json(out, "", nulls)
         if nulls:  # JSON has no Infinity or NaN: such numbers are null, and this says where and why
             notes["null"] = (
-                f"{', '.join(nulls)}: not finite (a mean free path of 0 mm gives infinite coefficients), written as null"
+                f"{', '.join(nulls)}: not finite (a mean free path of 0 mm gives infinite coefficients), "
+                "written as null"
             )
         if notes:
             out["notes"] = notes

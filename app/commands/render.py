@@ -1,4 +1,4 @@
-"""`skinlab render [SCENE] --out PATH --size WxH [--json] [--explain]`."""
+"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--json] [--explain]`."""
 
 from __future__ import annotations
 
@@ -9,13 +9,46 @@ from pathlib import Path
 from app.render.settings import TECHNIQUES, RenderSettings, parse_size
 from scene.materials import SSS_MODELS
 
+# which --technique reads each technique option (the rest ignore it: a warning says so)
+TECHNIQUE_OPTIONS = {
+    "taps": ("--taps", ("tsd",)),
+    "ssss_taps": ("--ssss-taps", ("ssss",)),
+    "tsd_size": ("--tsd-size", ("tsd", "exact")),
+    "gaussians": ("--gaussians", ("tsd", "ssss")),
+}
+
 
 def register(sub) -> None:
     p = sub.add_parser("render", help="render a scene headless to PNG or EXR")
-    p.add_argument("scene", nargs="?", help="scene file (TOML); default: the Lee Perry-Smith head")
-    p.add_argument("--out", default="out/render.png", help="output image: .png (tone mapped) or .exr (linear)")
-    p.add_argument("--size", default="640x640", help="WIDTHxHEIGHT (default 640x640)")
-    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
+    p.add_argument(
+        "scene",
+        nargs="?",
+        help="scene file (TOML) or a mesh file (.glb .gltf .obj .ply .stl .off: default camera, two lights "
+        "and a plain grey material); default: the Lee Perry-Smith head",
+    )
+    p.add_argument(
+        "--out",
+        default="out/render.png",
+        help="output image: .png (tone mapped, 8-bit sRGB) or .exr (linear radiance, 32-bit float, with alpha) "
+        "(default out/render.png)",
+    )
+    p.add_argument("--size", default="640x640", help="image size WIDTHxHEIGHT in pixels (default 640x640)")
+    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)")
+    p.add_argument(
+        "--exposure",
+        type=float,
+        default=None,
+        help="linear multiplier on radiance before tone mapping, > 0 (default: the scene's [environment] exposure, "
+        "1.0 if unset); EXR output is radiance, unaffected",
+    )
+    p.add_argument(
+        "--camera-orbit",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="swing the scene's camera DEG degrees about the vertical axis through the meshes' centre "
+        "(positive: the camera moves to its right; default 0)",
+    )
     p.add_argument(
         "--sss",
         choices=SSS_MODELS,
@@ -30,17 +63,39 @@ def register(sub) -> None:
         "with the exact profile (slow reference); ssss: screen-space separable SSS; tint: the "
         "per-pixel profile tint baseline",
     )
-    p.add_argument("--taps", type=int, default=None, help="texture-space blur taps (odd, 7-31; default: from width)")
-    p.add_argument("--ssss-taps", type=int, default=17, help="screen-space SSS kernel samples (11, 17, 25)")
-    p.add_argument("--tsd-size", type=int, default=None, help="texture-space diffusion texels per side (default 512)")
-    p.add_argument("--gaussians", type=int, default=None, help="Gaussians fitted to the profile, 1-6 (default 6)")
-    p.add_argument("--json", action="store_true", help="print timings and output paths as JSON")
+    p.add_argument(
+        "--taps",
+        type=int,
+        default=None,
+        help="(tsd) texture-space blur taps per pass, odd 7-31 (default: from each blur's width in texels)",
+    )
+    p.add_argument(
+        "--ssss-taps",
+        type=int,
+        default=None,
+        help=f"(ssss) screen-space kernel samples, odd 3-63 (default {RenderSettings.ssss_taps}; "
+        "Jimenez's presets are 11, 17 and 25)",
+    )
+    p.add_argument(
+        "--tsd-size",
+        type=int,
+        default=None,
+        help=f"(tsd, exact) irradiance texels per side, 16-8192 (default {RenderSettings.tsd_size})",
+    )
+    p.add_argument(
+        "--gaussians",
+        type=int,
+        default=None,
+        help=f"(tsd, ssss) Gaussians fitted to the profile, 1-6 (default {RenderSettings.tsd_gaussians})",
+    )
+    p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
     p.set_defaults(func=run)
 
 
-def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
-    """Render once and write each output (PNG from the tone-mapped image, EXR linear)."""
+def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, prepare=None):
+    """Render once and write each output (PNG from the tone-mapped image, EXR linear).
+    ``prepare(scene)`` may adjust the loaded scene (camera, exposure) before rendering."""
     from app.gl.context import create_headless_context
     from app.image_output import check_output_path, image_format, write_image
     from app.render.renderer import Renderer
@@ -49,6 +104,8 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
     for o in outputs:
         check_output_path(o, "--out")  # fail before rendering
     scene = load_scene(scene_path)
+    if prepare is not None:
+        prepare(scene)
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     renderer.render(scene, settings, readback=False)  # warm-up: compiles and uploads are not frame time
@@ -60,12 +117,26 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
     return scene, result, written, ctx
 
 
+def ignored_options(args) -> list[str]:
+    """Warnings for technique options given with a technique that does not read them."""
+    out = []
+    for attr, (flag, techniques) in TECHNIQUE_OPTIONS.items():
+        if getattr(args, attr) is not None and args.technique not in techniques:
+            out.append(
+                f"{flag} applies only to --technique {' or '.join(techniques)}; "
+                f"ignored with --technique {args.technique}"
+            )
+    return out
+
+
 def settings_from_args(args, w: int, h: int) -> RenderSettings:
     extra = {}
     if args.tsd_size is not None:
         extra["tsd_size"] = args.tsd_size
     if args.gaussians is not None:
         extra["tsd_gaussians"] = args.gaussians
+    if args.ssss_taps is not None:
+        extra["ssss_taps"] = args.ssss_taps
     return RenderSettings(
         w,
         h,
@@ -73,7 +144,6 @@ def settings_from_args(args, w: int, h: int) -> RenderSettings:
         sss_model=args.sss,
         technique=args.technique,
         tsd_taps=args.taps,
-        ssss_taps=args.ssss_taps,
         **extra,
     )
 
@@ -81,11 +151,23 @@ def settings_from_args(args, w: int, h: int) -> RenderSettings:
 def run(args) -> int:
     w, h = parse_size(args.size)
     settings = settings_from_args(args, w, h)
-    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings)
-    for warning in result.plan.warnings:
+    if args.exposure is not None and not (args.exposure > 0 and args.exposure < float("inf")):
+        raise ValueError(f"--exposure: expected a finite multiplier > 0, got {args.exposure}")
+    if args.camera_orbit != args.camera_orbit or abs(args.camera_orbit) == float("inf"):
+        raise ValueError(f"--camera-orbit: expected a finite angle in degrees, got {args.camera_orbit}")
+    warnings = ignored_options(args)
+
+    def prepare(scene):
+        if args.exposure is not None:
+            scene.environment.exposure = args.exposure
+        if args.camera_orbit:
+            scene.orbit_camera(args.camera_orbit)
+
+    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare)
+    for warning in warnings + result.plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
-    if args.explain:
-        print(result.plan.explain(), file=sys.stderr if args.json else sys.stdout)
+    if args.explain:  # the warnings were printed above, once
+        print(result.plan.explain(warnings=False), file=sys.stderr if args.json else sys.stdout)
     if args.json:
         from app.gl.context import describe
 
@@ -98,6 +180,7 @@ def run(args) -> int:
                     "gl": describe(ctx),
                     "timings": result.timings.as_dict(),
                     "plan": result.plan.as_dict(),
+                    "warnings": warnings + result.plan.warnings,
                 },
                 indent=2,
             )
@@ -105,6 +188,5 @@ def run(args) -> int:
     else:
         for path in written:
             print(f"wrote {path}")
-        for p in result.timings.passes:
-            print(f"  {p.name:<18} {p.cpu_ms:8.2f} ms")
+        print(result.timings.table())
     return 0
