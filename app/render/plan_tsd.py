@@ -103,6 +103,8 @@ def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
     for w in rep.warnings():
         if w not in plan.warnings:
             plan.warnings.append(w)
+    for n in rep.notes():
+        plan.skipped.append((f"uv[{mesh.name}] slivers", n))
     pct = rep.mm_per_texel_percentiles
     p10 = float(np.nanmin(pct["p10"])) if pct else math.nan
     p50 = float(np.nanmean(pct["p50"])) if pct else math.nan
