@@ -46,6 +46,7 @@ cast_shadow = true
 from __future__ import annotations
 
 import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +64,89 @@ DEFAULT_SCENE = ASSETS / "scenes" / "head.toml"
 
 class SceneFileError(ValueError):
     pass
+
+
+@dataclass(frozen=True)
+class Key:
+    """One scene-file key: its TOML type, default, range or unit, and meaning (docs/scenes.md)."""
+
+    name: str
+    type: str
+    default: str
+    doc: str
+
+
+# Every key of every table, declared once: validation rejects anything else and docs/scenes.md is
+# generated from this (scene/scene_docs.py). Material parameters come from scene.materials.
+SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
+    "[scene]": (
+        Key("name", "string", "the file's stem", "shown in the viewer's title and output names"),
+        Key(
+            "mm_per_unit",
+            "number > 0",
+            "1.0",
+            "millimetres per scene unit: the physical scale that subsurface_radius (mm) is measured against",
+        ),
+    ),
+    "[environment]": (
+        Key("ambient", "3 numbers >= 0", "[0.03, 0.03, 0.035]", "uniform ambient radiance, linear RGB"),
+        Key("exposure", "number > 0", "1.0", "linear multiplier on radiance before tone mapping (PNG only)"),
+    ),
+    "[camera]": (
+        Key("position", "3 numbers", "[0, 0, 10]", "eye position, scene units"),
+        Key("target", "3 numbers", "[0, 0, 0]", "point looked at; must differ from position"),
+        Key("up", "3 numbers", "[0, 1, 0]", "up direction (non-zero)"),
+        Key("yfov_deg", "number in (0, 179]", "30", "vertical field of view, degrees"),
+        Key("znear", "number > 0", "0.1", "near clipping distance, scene units"),
+        Key("zfar", "number > znear", "1000", "far clipping distance, scene units"),
+    ),
+    "[materials.NAME]": (
+        Key(
+            "preset",
+            "string",
+            "none",
+            "a Jensen et al. 2001 medium (assets/presets/): sets base_color, subsurface_color, subsurface_radius, "
+            "subsurface = 1 and specular first; the table's other keys then override",
+        ),
+    ),
+    "[[meshes]]": (
+        Key("file", "string (required)", "-", "mesh file (.glb .gltf .obj .ply .stl .off), relative to the scene file"),
+        Key("name", "string", "the file's stem", "name of the node that holds the file's nodes"),
+        Key("material", "string", "a default material", "name of a [materials.NAME] table"),
+        Key("overrides", "table", "{}", "material parameters for this mesh only, e.g. { roughness = 0.4 }"),
+        Key("nodes", "table of tables", "{}", "per node of the file, by name: material, overrides, visible"),
+        Key("translation", "3 numbers", "[0, 0, 0]", "scene units"),
+        Key("rotation", "4 numbers", "[0, 0, 0, 1]", "quaternion x, y, z, w (not with rotation_deg)"),
+        Key("rotation_deg", "3 numbers", "[0, 0, 0]", "Euler angles about X, Y, Z in degrees (not with rotation)"),
+        Key("scale", "1 or 3 numbers, non-zero", "1", "scale factor(s)"),
+        Key("visible", "boolean", "true", "false hides the mesh and all its nodes"),
+        Key("flip_v", "boolean", "false", "v -> 1 - v: for files whose UV origin is the image's top-left"),
+        Key(
+            "generate_uvs",
+            "boolean",
+            "false",
+            "make an xatlas UV atlas where the file has none (cached by mesh content in ~/.cache/skinlab)",
+        ),
+    ),
+    "[meshes.nodes.NAME]": (
+        Key("material", "string", "the mesh's material", "name of a [materials.NAME] table"),
+        Key("overrides", "table", "{}", "material parameters for this node (on top of the mesh's overrides)"),
+        Key("visible", "boolean", "true", "false hides this node"),
+    ),
+    "[[lights]]": (
+        Key("name", "string", "lightN", "the viewer's key light is the one named 'key'"),
+        Key("type", "string", '"directional"', '"directional" (uses direction) or "point" (uses position)'),
+        Key("direction", "3 numbers, non-zero", "[0, 0, -1]", "the way a directional light travels"),
+        Key("position", "3 numbers", "(required for point)", "a point light's position, scene units"),
+        Key("color", "1 or 3 numbers >= 0", "[1, 1, 1]", "linear RGB"),
+        Key("intensity", "number >= 0", "1.0", "irradiance (directional) or intensity (point) multiplier on color"),
+        Key("cast_shadow", "boolean", "false", "render a shadow map (at most 2 lights; needed for translucency)"),
+    ),
+}
+
+
+def _keys(section: str) -> set[str]:
+    return {k.name for k in SCENE_FILE_KEYS[section]}
 
 
 # -- typed reads: every wrong type or value names its key ------------------------------------------
@@ -247,14 +331,14 @@ def _build(path: Path, data: dict) -> Scene:
     base = path.parent
     _known("top level", data, {"scene", "environment", "camera", "materials", "meshes", "lights"})
     sc = _table("[scene]", data.get("scene", {}))
-    _known("[scene]", sc, {"name", "mm_per_unit"})
+    _known("[scene]", sc, _keys("[scene]"))
     name = _str("[scene].name", sc["name"]) if "name" in sc else path.stem
     mm = _num("[scene].mm_per_unit", sc["mm_per_unit"], 0.0, lo_open=True) if "mm_per_unit" in sc else 1.0
     scene = Scene(name, mm)
     scene.source = path
 
     env = _table("[environment]", data.get("environment", {}))
-    _known("[environment]", env, {"ambient", "exposure"})
+    _known("[environment]", env, _keys("[environment]"))
     if "ambient" in env:
         scene.environment.ambient = _vec("[environment].ambient", env["ambient"], lo=0.0)
     if "exposure" in env:
@@ -296,24 +380,7 @@ def _build(path: Path, data: dict) -> Scene:
 
     for i, entry in enumerate(_tables("[meshes]", data.get("meshes", []))):
         where = f"[[meshes]] #{i + 1}"
-        _known(
-            where,
-            entry,
-            {
-                "name",
-                "file",
-                "material",
-                "overrides",
-                "nodes",
-                "translation",
-                "rotation",
-                "rotation_deg",
-                "scale",
-                "visible",
-                "flip_v",
-                "generate_uvs",
-            },
-        )
+        _known(where, entry, _keys("[[meshes]]"))
         if "file" not in entry:
             raise SceneFileError(f"{where}: missing 'file'")
         mpath = Path(_str(f"{where}.file", entry["file"]))
@@ -346,7 +413,7 @@ def _build(path: Path, data: dict) -> Scene:
         for ln in loaded:
             nwhere = f"{where}.nodes.{ln.name}"
             cfg = node_cfg.get(ln.name, {})
-            _known(nwhere, cfg, {"material", "overrides", "visible"})
+            _known(nwhere, cfg, _keys("[meshes.nodes.NAME]"))
             if ln.mesh is not None:
                 mat = default_mat
                 if "material" in cfg or "overrides" in cfg:
@@ -365,7 +432,7 @@ def _build(path: Path, data: dict) -> Scene:
 
     for i, entry in enumerate(_tables("[lights]", data.get("lights", []))):
         where = f"[[lights]] #{i + 1}"
-        _known(where, entry, {"name", "type", "direction", "position", "color", "intensity", "cast_shadow"})
+        _known(where, entry, _keys("[[lights]]"))
         kind = _str(f"{where}.type", entry.get("type", "directional"))
         if kind not in LightNode.KINDS:
             raise SceneFileError(f"{where}.type: expected one of {', '.join(LightNode.KINDS)}, got {kind!r}")
@@ -393,7 +460,7 @@ def _build(path: Path, data: dict) -> Scene:
 
     if "camera" in data:
         cam = _table("[camera]", data["camera"])
-        _known("[camera]", cam, {"position", "target", "up", "yfov_deg", "znear", "zfar"})
+        _known("[camera]", cam, _keys("[camera]"))
         znear = _num("[camera].znear", cam.get("znear", 0.1), 0.0, lo_open=True)
         zfar = _num("[camera].zfar", cam.get("zfar", 1000.0), 0.0, lo_open=True)
         if zfar <= znear:
