@@ -61,7 +61,8 @@ _BLENDER_ROWS = (
     ),
     (
         "Subsurface Method: Random Walk",
-        'no random walk in real time: `"pbd"` (photon beam diffusion) is the closest fit to a path-traced medium',
+        'no random walk in real time: `"pbd"` (photon beam diffusion) has the smallest profile error against '
+        "our Monte Carlo random walk (docs/accuracy.md)",
     ),
     ("Subsurface IOR, Anisotropy", "not modelled: the index comes from `specular`, the phase function is isotropic"),
     ("Roughness, Metallic", "`roughness`, `metallic` (same meaning)"),
