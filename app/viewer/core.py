@@ -38,6 +38,24 @@ def next_sss_model(current: str | None, step: int = 1) -> str | None:
     return SSS_CYCLE[(i + step) % len(SSS_CYCLE)]
 
 
+# T cycles these; the exact reference (seconds per frame on a slow GPU) only from the panel's combo
+CYCLE_TECHNIQUES = tuple(t for t in TECHNIQUES if t != "exact")
+SLOW_TECHNIQUES = {"exact": "the brute-force reference: a frame may take seconds"}
+
+
+def next_technique(current: str, step: int = 1) -> str:
+    """The technique T (shift+T) switches to: the cycle skips the slow exact reference."""
+    if current not in CYCLE_TECHNIQUES:
+        return CYCLE_TECHNIQUES[0 if step > 0 else -1]
+    i = CYCLE_TECHNIQUES.index(current)
+    return CYCLE_TECHNIQUES[(i + step) % len(CYCLE_TECHNIQUES)]
+
+
+def window_title(scene) -> str:
+    source = getattr(scene, "source", None)
+    return f"Skinlab - {scene.name}" + (f" ({Path(source).name})" if source else "")
+
+
 class ViewerCore:
     def __init__(
         self,
@@ -78,6 +96,11 @@ class ViewerCore:
     @property
     def scene(self):
         return self.scene_src.value
+
+    @property
+    def title(self) -> str:
+        """The window title: Skinlab, the scene's name and its file (follows scene reloads)."""
+        return window_title(self.scene)
 
     def note(self, level: str, text: str) -> None:
         self.log.append((time.monotonic(), level, text))
@@ -123,13 +146,14 @@ class ViewerCore:
         return model
 
     def cycle_technique(self, step: int = 1) -> str:
-        i = TECHNIQUES.index(self.settings.technique)
-        return self.set_technique(TECHNIQUES[(i + step) % len(TECHNIQUES)])
+        """T: the next technique of CYCLE_TECHNIQUES (the exact reference is chosen in the panel)."""
+        return self.set_technique(next_technique(self.settings.technique, step))
 
     def set_technique(self, technique: str) -> str:
         """How subsurface scattering is rendered (app.render.settings.TECHNIQUES)."""
         self.settings = dataclasses.replace(self.settings, technique=technique)  # validated again
-        self.note("info", f"SSS technique: {technique}")
+        slow = SLOW_TECHNIQUES.get(technique)
+        self.note("warning" if slow else "info", f"SSS technique: {technique}" + (f" ({slow})" if slow else ""))
         self.invalidate()
         return technique
 

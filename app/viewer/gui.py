@@ -15,9 +15,15 @@ from imgui_bundle import imgui
 from app.render.settings import TECHNIQUES
 from scene.materials import SSS_MODELS
 
-from .core import ViewerCore
+from .core import SLOW_TECHNIQUES, ViewerCore
 from .inspector import display_mode
-from .panel import angles_from_direction, direction_from_angles
+from .panel import (
+    angles_from_direction,
+    direction_from_angles,
+    sss_override_note,
+    texture_text,
+    widget_label,
+)
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 GREY = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
@@ -29,6 +35,16 @@ class Gui:
         self.core = core
         self.show_panel = True
         self._text: dict[str, str] = {}  # texture path fields being typed
+        self.panel_rect: tuple[float, float, float, float] | None = None  # x, y (from the top), w, h
+
+    def over_panel(self, x: float, y_from_top: float) -> bool:
+        """Whether a point (window coordinates, y down) lies on the panel as last drawn. The window
+        asks this for wheel events, which can arrive before Dear ImGui's next frame knows where the
+        mouse is (so want_capture_mouse alone lets a slow frame's scroll zoom the camera too)."""
+        if not self.show_panel or self.panel_rect is None:
+            return False
+        px, py, pw, ph = self.panel_rect
+        return px <= x <= px + pw and py <= y_from_top <= py + ph
 
     # -- overlay: timings, errors, messages ---------------------------------------------------
     def overlay(self, ui_fps: float) -> None:
@@ -81,6 +97,8 @@ class Gui:
         imgui.set_next_window_pos(imgui.ImVec2(io.display_size.x - w - 6, 6), imgui.Cond_.first_use_ever)
         imgui.set_next_window_size(imgui.ImVec2(w, io.display_size.y * 0.9), imgui.Cond_.first_use_ever)
         expanded, _ = imgui.begin("Skinlab (H hides)", None)
+        pos, size = imgui.get_window_pos(), imgui.get_window_size()
+        self.panel_rect = (pos.x, pos.y, size.x, size.y)
         if expanded:
             self._render_section()
             self._inspector_section()
@@ -103,8 +121,9 @@ class Gui:
             imgui.end_combo()
         cur = core.settings.technique
         if imgui.begin_combo("technique (T)", cur):
-            for o in TECHNIQUES:
-                clicked, _ = imgui.selectable(o, o == cur)
+            for o in TECHNIQUES:  # T skips the slow ones; here they are, marked
+                text = f"{o}  ({SLOW_TECHNIQUES[o]})" if o in SLOW_TECHNIQUES else o
+                clicked, _ = imgui.selectable(text, o == cur)
                 if clicked:
                     core.set_technique(o)
             imgui.end_combo()
@@ -165,12 +184,23 @@ class Gui:
                 if clicked:
                     self._try(panel.apply_preset, n)
             imgui.end_combo()
-        for w in panel.widgets():
-            label = f"{w.param}{' (' + w.unit + ')' if w.unit else ''}"
+        note = sss_override_note(m, self.core.settings.sss_model)
+        if note:
+            imgui.push_text_wrap_pos(0.0)
+            imgui.text_colored(YELLOW, note)
+            imgui.pop_text_wrap_pos()
+        widgets = panel.widgets()
+        # widgets leave room for the longest label, so no label is cut off at the panel's edge
+        label_w = max((imgui.calc_text_size(widget_label(w)).x for w in widgets), default=0.0)
+        imgui.push_item_width(-(label_w + imgui.get_style().item_inner_spacing.x + 4.0))
+        for w in widgets:
+            label = widget_label(w)
+            if w.param == "sss_model" and note:
+                label = f"{w.param} (M overrides)"
             if w.widget == "slider_float":
                 ch, v = imgui.slider_float(label, float(w.value), w.range[0], w.range[1])
-            elif w.widget == "color_edit3":
-                ch, v = imgui.color_edit3(label, [float(x) for x in w.value])
+            elif w.widget == "color_edit3":  # linear values 0-1, as in the scene file
+                ch, v = imgui.color_edit3(label, [float(x) for x in w.value], imgui.ColorEditFlags_.float)
             elif w.widget == "drag_float3":
                 speed = max((w.range[1] - w.range[0]) * 1e-4, 1e-3)
                 flags = imgui.SliderFlags_.logarithmic if w.logarithmic else 0
@@ -187,7 +217,7 @@ class Gui:
                     imgui.end_combo()
             elif w.widget == "file_path":
                 key = f"{id(m)}:{w.param}"
-                text = self._text.get(key, "" if w.value is None else str(w.value))
+                text = self._text.get(key, texture_text(w.value))
                 ch_text, text = imgui.input_text(label, text, imgui.InputTextFlags_.enter_returns_true)
                 self._text[key] = text
                 ch, v = ch_text, text
@@ -195,10 +225,14 @@ class Gui:
                     self._text.pop(key, None)
             else:  # widget_for() only returns the kinds above
                 raise ValueError(f"parameter {w.param}: no drawing code for widget {w.widget!r}")
-            if imgui.is_item_hovered() and w.doc:
-                imgui.set_tooltip(w.doc)
+            if imgui.is_item_hovered() and (w.doc or w.widget == "file_path"):
+                tip = w.doc
+                if w.widget == "file_path":
+                    tip += f"\n{w.value or 'no map'}\n(a name alone: next to the current map)"
+                imgui.set_tooltip(tip)
             if ch:
                 self._try(panel.edit, w.param, v)
+        imgui.pop_item_width()
         if panel.error:
             imgui.push_text_wrap_pos(0.0)
             imgui.text_colored(RED, panel.error)
