@@ -15,13 +15,18 @@ from app.render.settings import RenderSettings, parse_size
 
 
 def register(sub) -> None:
+    from app.bench.accuracy import SWEEPS  # the sweeps' numbers are the help's defaults
+
     p = sub.add_parser("bench", help="benchmarks (timings are printed, never asserted)")
     bsub = p.add_subparsers(dest="bench", metavar="BENCH")
     bsub.required = True
     peer = bsub.add_parser("peer", help="Skinlab vs pyrender on the same head, size and EGL context kind")
-    peer.add_argument("--size", default="512x512")
-    peer.add_argument("--frames", type=int, default=30, help="timed frames per renderer (after warm-up)")
-    peer.add_argument("--json", action="store_true")
+    peer.add_argument("--size", default="512x512", help="frame size WIDTHxHEIGHT in pixels (default 512x512)")
+    peer.add_argument(
+        "--frames", type=int, default=30, help="timed frames per renderer, after 2 warm-up frames (default 30)"
+    )
+    peer.add_argument("--json", action="store_true", help="print the result as JSON")
+    peer.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     peer.set_defaults(func=run_peer_bench)
     rel = bsub.add_parser(
         "reload",
@@ -40,8 +45,8 @@ def register(sub) -> None:
         default=0.05,
         help="ShaderWatcher settle time in seconds (default 0.05, as skinlab view)",
     )
-    rel.add_argument("--shadow-size", type=int, default=512)
-    rel.add_argument("--tsd-size", type=int, default=256)
+    rel.add_argument("--shadow-size", type=int, default=512, help="shadow map texels per side (default 512)")
+    rel.add_argument("--tsd-size", type=int, default=256, help="texture-space diffusion texels per side (default 256)")
     rel.add_argument(
         "--mode",
         choices=("on-demand", "continuous"),
@@ -49,8 +54,10 @@ def register(sub) -> None:
         help="on-demand: the viewer's default loop (idle polls at 60 Hz, a frame only after a "
         "change); continuous: a frame every iteration (as with skinlab view --continuous)",
     )
-    rel.add_argument("--timeout", type=float, default=20.0, help="give up on one edit after this many seconds")
-    rel.add_argument("--json", action="store_true")
+    rel.add_argument(
+        "--timeout", type=float, default=20.0, help="give up on one edit after this many seconds (default 20)"
+    )
+    rel.add_argument("--json", action="store_true", help="print the result as JSON (every sample)")
     rel.set_defaults(func=run_reload_bench)
     acc = bsub.add_parser(
         "accuracy",
@@ -64,21 +71,35 @@ def register(sub) -> None:
     )
     acc.add_argument("--quick", action="store_true", help="a subset at 160x160 (a few minutes at most on 2 cores)")
     acc.add_argument("--tiny", action="store_true", help=argparse.SUPPRESS)  # tests: 4 settings, head, 64x64
-    acc.add_argument("--size", default=None, help="WIDTHxHEIGHT (default 640x640; --quick 160x160)")
+    full, quick = SWEEPS["full"], SWEEPS["quick"]
+    acc.add_argument(
+        "--size",
+        default=None,
+        help=f"WIDTHxHEIGHT (default {full.size[0]}x{full.size[1]}; --quick {quick.size[0]}x{quick.size[1]})",
+    )
     acc.add_argument(
         "--scenes",
         default=None,
         help="comma-separated: head, bunny (skim milk), bunny-marble, ... or .toml paths (default head,bunny)",
     )
-    acc.add_argument("--frames", type=int, default=None, help="timed frames per setting (default 10; --quick 5)")
     acc.add_argument(
-        "--photons", type=int, default=None, help="Monte Carlo photons per channel (default 200000; --quick 20000)"
+        "--frames",
+        type=int,
+        default=None,
+        help=f"timed frames per setting (default {full.frames}; --quick {quick.frames})",
+    )
+    acc.add_argument(
+        "--photons",
+        type=int,
+        default=None,
+        help=f"Monte Carlo photons per channel (default {full.photons}; --quick {quick.photons})",
     )
     acc.add_argument(
         "--exact-size",
         type=int,
         default=None,
-        help="irradiance texels per side of the exact reference (default 1024; --quick 256)",
+        help=f"irradiance texels per side of the exact reference (default {full.exact_size}; "
+        f"--quick {quick.exact_size})",
     )
     acc.add_argument("--no-peer", action="store_true", help="skip the pyrender comparison")
     acc.add_argument("--no-images", action="store_true", help="do not write images/SCENE-SETTING.png")
@@ -86,7 +107,7 @@ def register(sub) -> None:
     acc.set_defaults(func=run_accuracy_bench)
 
 
-def peer_bench(size=(512, 512), frames: int = 30) -> dict:
+def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False) -> dict:
     """Median frame times, both including the colour+depth read-back (pyrender always reads back).
     ``skinlab_ms`` is the plain-PBR frame (sss_model none, like pyrender's: no subsurface scattering);
     ``skinlab_default_ms`` the frame with the default RenderSettings (the head's skin scatters, so
@@ -107,24 +128,37 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
     r = Renderer(ctx)
     r.timer.sync = False  # no glFinish between passes: whole frames are timed here
 
-    def timed(settings):
+    import sys
+
+    from tqdm import tqdm
+
+    # frames (with 2 warm-ups) of two Skinlab settings, then pyrender's in one subprocess (one step)
+    bar = tqdm(total=2 * (frames + 2) + 1, desc="bench peer", unit="frame", file=sys.stderr, disable=not progress)
+
+    def timed(settings, what):
+        bar.set_postfix_str(what)
         r.render(scene, settings)
         r.render(scene, settings)
+        bar.update(2)
         out = []
         for _ in range(frames):
             t0 = time.perf_counter()
             r.render(scene, settings, readback=("ldr", "depth"))  # what pyrender reads back
             out.append((time.perf_counter() - t0) * 1e3)
+            bar.update()
         return out
 
     try:
-        ours = timed(RenderSettings(w, h, sss_model="none"))
-        ours_default = timed(RenderSettings(w, h))
+        ours = timed(RenderSettings(w, h, sss_model="none"), "skinlab plain PBR")
+        ours_default = timed(RenderSettings(w, h), "skinlab default")
     finally:
         r.release()
+    bar.set_postfix_str("pyrender (subprocess)")
     cam = scene.camera
     meshes = [(str(n.mesh.source), n.world_matrix) for n in scene.mesh_nodes()]
     peer = run_peer(meshes, cam.world_matrix, cam.yfov, cam.znear, cam.zfar, size, frames=frames)
+    bar.update()
+    bar.close()
     theirs = list(map(float, peer["times"]))
     mo, mt = statistics.median(ours), statistics.median(theirs)
     md = statistics.median(ours_default)
@@ -141,7 +175,7 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
 
 
 def run_peer_bench(args) -> int:
-    res = peer_bench(parse_size(args.size), args.frames)
+    res = peer_bench(parse_size(args.size), args.frames, progress=not args.no_progress)
     if args.json:
         print(json.dumps(res, indent=2))
     else:
