@@ -116,3 +116,55 @@ def test_written_images_have_ordinary_permissions(tmp_path):
     finally:
         os.umask(old)
     assert stat.S_IMODE(p.stat().st_mode) == 0o644
+
+
+def test_exr_keeps_radiance_above_the_half_float_range(tmp_path):
+    """A light of intensity 1e6 gives radiance above 65504: the EXR must hold it, not +Inf."""
+    from app.image_output import read_image, write_image
+
+    px = np.zeros((2, 3, 4), np.float32)
+    px[0, 0, :3] = [1e6, 7e4, 0.125]
+    px[..., 3] = 1
+    back = read_image(write_image(tmp_path / "x.exr", px))
+    assert back.dtype == np.float32 and np.isfinite(back).all()
+    assert np.array_equal(back, px)
+
+
+def test_render_a_mesh_file_with_camera_exposure_and_technique_warnings(tmp_path):
+    obj = tmp_path / "quad.obj"
+    obj.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n")
+    outs = {}
+    for name, extra in (("a", []), ("b", ["--exposure", "3", "--camera-orbit", "30"])):
+        out = tmp_path / f"{name}.exr"
+        p = skinlab("render", str(obj), "--out", str(out), "--size", "32x32", "--ssss-taps", "11", *extra)
+        assert p.returncode == 0, p.stderr
+        assert "warning: --ssss-taps applies only to --technique ssss; ignored with --technique tsd" in p.stderr
+        assert p.stderr.count("warning:") == 1
+        assert "frame (total)" in p.stdout and "forward" in p.stdout
+        from app.image_output import read_image
+
+        outs[name] = read_image(out)
+    a, b = outs["a"], outs["b"]
+    assert 0.05 < a[..., 3].mean() < 0.95  # the default camera frames the quad
+    assert 0.02 < b[..., 3].mean() < a[..., 3].mean() - 0.02  # seen 30 degrees off its normal: narrower
+
+
+def test_gallery_contact_sheet_tiles_and_labels():
+    from app.commands.demo import contact_sheet
+
+    tiles = [(np.full((10, 12, 4), 40 * i, np.uint8), f"t{i}") for i in range(5)]
+    tiles[0][0][..., 3] = 0  # a tile's alpha does not make the sheet transparent
+    label = 8
+    sheet = contact_sheet(tiles, columns=3, label_px=label)
+    assert sheet.shape == (2 * (10 + label), 3 * 12, 4) and sheet.dtype == np.uint8
+    assert (sheet[..., 3] == 255).all()
+    for i in range(5):
+        x, y = (i % 3) * 12, (i // 3) * (10 + label)
+        assert (sheet[y : y + 10, x : x + 12, :3] == 40 * i).all()
+    strip = sheet[10 : 10 + label, 0:12, :3]
+    assert strip.max() > 150  # the label is drawn in the strip below its tile
+    assert (sheet[18:28, 24:, :3] == (20, 20, 22)).all()  # the empty sixth cell is background
+    import pytest
+
+    with pytest.raises(ValueError, match="tile 'x' is 5x5, expected 12x10"):
+        contact_sheet([tiles[0], (np.zeros((5, 5, 4), np.uint8), "x")])
