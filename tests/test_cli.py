@@ -154,7 +154,7 @@ def test_gallery_contact_sheet_tiles_and_labels():
 
     tiles = [(np.full((10, 12, 4), 40 * i, np.uint8), f"t{i}") for i in range(5)]
     tiles[0][0][..., 3] = 0  # a tile's alpha does not make the sheet transparent
-    label = 8
+    label = 16
     sheet = contact_sheet(tiles, columns=3, label_px=label)
     assert sheet.shape == (2 * (10 + label), 3 * 12, 4) and sheet.dtype == np.uint8
     assert (sheet[..., 3] == 255).all()
@@ -163,7 +163,7 @@ def test_gallery_contact_sheet_tiles_and_labels():
         assert (sheet[y : y + 10, x : x + 12, :3] == 40 * i).all()
     strip = sheet[10 : 10 + label, 0:12, :3]
     assert strip.max() > 150  # the label is drawn in the strip below its tile
-    assert (sheet[18:28, 24:, :3] == (20, 20, 22)).all()  # the empty sixth cell is background
+    assert (sheet[10 + label : 20 + label, 24:, :3] == (20, 20, 22)).all()  # the empty sixth cell is background
     import pytest
 
     with pytest.raises(ValueError, match="tile 'x' is 5x5, expected 12x10"):
