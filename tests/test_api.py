@@ -61,3 +61,18 @@ def test_orbit_keeps_distance_to_the_centre_and_moves_to_the_right():
     assert np.dot(p1 - p0, right0) > 0  # positive degrees: the camera moves to its right
     scene.orbit_camera(-20)
     assert np.allclose(scene.camera.world_position, p0)
+
+
+def test_the_readme_example_runs(tmp_path, monkeypatch):
+    """The Python block of README.md, at a small size, from the repository root."""
+    import re
+
+    root = ASSETS.parent
+    (code,) = re.findall(r"```python\n(.*?)```", (root / "README.md").read_text(), re.S)
+    assert "640, 480" in code
+    monkeypatch.chdir(root)
+    ns: dict = {}
+    exec(code.replace("640, 480", "40, 30").replace("print(", "str("), ns)
+    frame = ns["frame"]
+    assert frame.ldr.shape == (30, 40, 4) and frame.hdr.shape == (30, 40, 4) and frame.depth.shape == (30, 40)
+    assert ns["scene"].mesh_nodes()[0].material["roughness"] == 0.3

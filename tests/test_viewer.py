@@ -610,3 +610,14 @@ def test_wheel_over_the_panel_is_decided_by_where_the_panel_was_drawn():
     assert not gui.over_panel(599, 100) and not gui.over_panel(700, 507)
     gui.show_panel = False
     assert not gui.over_panel(700, 100)
+
+
+def test_viewer_opens_a_mesh_file_directly(ctx, tmp_path):
+    obj = tmp_path / "quad.obj"
+    obj.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n")
+    c = ViewerCore(ctx, obj, RenderSettings(32, 32, **SMALL), watch=False)
+    try:
+        assert c.render() and c.errors() == [] and c.title == "Skinlab - quad (quad.obj)"
+        assert c.panel.material is not None and c.panel.key_light().name == "key"
+    finally:
+        c.close()
