@@ -168,3 +168,18 @@ def test_gallery_contact_sheet_tiles_and_labels():
 
     with pytest.raises(ValueError, match="tile 'x' is 5x5, expected 12x10"):
         contact_sheet([tiles[0], (np.zeros((5, 5, 4), np.uint8), "x")])
+
+
+def test_timing_table_is_aligned_with_a_total():
+    from app.render.timing import FrameTimings, PassTime
+
+    t = FrameTimings([PassTime("shadow[key]", 1.5, 2.0), PassTime("tsd_irradiance[LeePerrySmith]", None, 10.25)])
+    lines = t.table().splitlines()
+    assert "GPU timer queries" in lines[0]
+    body = lines[1:]
+    assert len({len(l) for l in body}) == 1  # every row the same width: aligned columns
+    assert body[-1].split()[-2:] == ["12.25", "n/a"]  # cpu total; no gpu total when a pass has none
+    assert "frame (total)" in body[-1]
+    t2 = FrameTimings([PassTime("a", 1.0, 2.0), PassTime("b", 3.0, 4.0)], software_gl=True)
+    assert t2.table().splitlines()[-1].split()[-2:] == ["6.00", "4.00"]
+    assert "CPU, synchronised" in t2.table()

@@ -63,11 +63,9 @@ class Gui:
         res = core.result
         if res is not None:
             t = res.timings
-            clock = t.as_dict()["clock"]
-            imgui.text(f"frame {t.frame_ms:7.2f} ms ({clock}), render call {res.cpu_ms:.1f} ms")
-            for p in t.passes:
-                gpu = f"  gpu {p.gpu_ms:6.2f}" if p.gpu_ms is not None else ""
-                imgui.text(f"  {p.name:<16} {p.cpu_ms:7.2f} ms{gpu}")
+            imgui.text(f"frame {t.frame_ms:7.2f} ms, render call {res.cpu_ms:.1f} ms")
+            for line in t.table().splitlines():  # the same table as skinlab render and demo print
+                imgui.text(line)
         name, _ = core.current_target()
         s = core.settings
         imgui.text_colored(
@@ -78,7 +76,7 @@ class Gui:
         errors = core.errors()
         if errors:
             width = imgui.get_io().display_size.x
-            imgui.push_text_wrap_pos(max(width - 360.0 if self.show_panel else width - 20.0, 200.0))
+            imgui.push_text_wrap_pos(max(width - 460.0 if self.show_panel else width - 20.0, 200.0))
             for e in errors:
                 imgui.text_colored(RED, e)
             imgui.pop_text_wrap_pos()
@@ -93,7 +91,7 @@ class Gui:
         if not self.show_panel:
             return
         io = imgui.get_io()
-        w = min(340.0, io.display_size.x * 0.5)
+        w = min(440.0, io.display_size.x * 0.5)  # room for a label and three number fields
         imgui.set_next_window_pos(imgui.ImVec2(io.display_size.x - w - 6, 6), imgui.Cond_.first_use_ever)
         imgui.set_next_window_size(imgui.ImVec2(w, io.display_size.y * 0.9), imgui.Cond_.first_use_ever)
         expanded, _ = imgui.begin("Skinlab (H hides)", None)
