@@ -183,3 +183,23 @@ def test_timing_table_is_aligned_with_a_total():
     t2 = FrameTimings([PassTime("a", 1.0, 2.0), PassTime("b", 3.0, 4.0)], software_gl=True)
     assert t2.table().splitlines()[-1].split()[-2:] == ["6.00", "4.00"]
     assert "CPU, synchronised" in t2.table()
+
+
+def test_bench_peer_shows_progress(monkeypatch, capsys):
+    """bench peer reports its frames on a progress bar (pyrender's side stubbed: it has its own test)."""
+    from app.bench import pyrender_peer
+    from app.commands.bench import peer_bench
+
+    calls = []
+
+    def fake_peer(meshes, pose, yfov, znear, zfar, size, frames=0, timeout=600):
+        calls.append(frames)
+        return {"times": [1.0] * frames}
+
+    monkeypatch.setattr(pyrender_peer, "run_peer", fake_peer)
+    res = peer_bench((16, 16), frames=1, progress=True)
+    err = capsys.readouterr().err
+    assert calls == [1] and res["pyrender_ms"] == 1.0
+    assert "bench peer" in err and "7/7" in err  # 2 x (2 warm-up + 1 timed) + pyrender
+    peer_bench((16, 16), frames=1, progress=False)
+    assert "bench peer" not in capsys.readouterr().err
