@@ -15,6 +15,7 @@ from app.commands import COMMAND_MODULES
 
 EXIT_BAD_INPUT = 2
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for `cmd | head`
+EXIT_INTERRUPTED = 130  # 128 + SIGINT
 
 
 class UserError(Exception):
@@ -73,6 +74,9 @@ def main(argv: list[str] | None = None) -> int:
         return code
     except BrokenPipeError:
         return _quiet_broken_pipe()
+    except KeyboardInterrupt:  # Ctrl-C: files are written to a temporary name first, so nothing is half-written
+        print(f"skinlab {args.command}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except (UserError, ContextError, ShaderError, ValueError, FileNotFoundError, OSError) as exc:
         if os.environ.get("SKINLAB_DEBUG"):
             raise  # SKINLAB_DEBUG=1 shows the traceback behind the one-line message

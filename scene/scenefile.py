@@ -1,4 +1,5 @@
-"""Scene files (TOML, read with tomllib).
+"""Scene files (TOML, read with tomllib). Every key with its type, default and meaning is in
+docs/scenes.md, generated from SCENE_FILE_KEYS below and the material declarations.
 
 ```toml
 [scene]

@@ -197,3 +197,14 @@ def test_closed_pipe_ends_quietly():
     )
     assert p.stdout.startswith('{"medium"') and len(p.stdout) == 100
     assert "Traceback" not in p.stderr and "BrokenPipe" not in p.stderr, p.stderr
+
+
+def test_ctrl_c_is_one_line_not_a_traceback(monkeypatch, capsys):
+    import app.commands.mc as mc
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(mc, "run", interrupted)
+    assert main(["mc", "--albedo", "0.5"]) == 130
+    assert capsys.readouterr().err == "skinlab mc: interrupted\n"
