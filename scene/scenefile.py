@@ -210,11 +210,16 @@ def _num(where: str, value: Any, lo: float | None = None, hi: float | None = Non
     v = float(value)
     if (lo is not None and (v <= lo if lo_open else v < lo)) or (hi is not None and v > hi):
         raise SceneFileError(f"{where}: expected a number in {rng}, got {_show(value)}")
+    if abs(v) > MAX_MAGNITUDE:
+        raise SceneFileError(f"{where}: expected a number of magnitude at most {MAX_MAGNITUDE:g}, got {_show(value)}")
     return v
 
 
+MAX_MAGNITUDE = 1e12  # coordinates, scales, colours: larger ones overflow float32 products (NaN pixels)
+
+
 def _vec(where: str, value: Any, n: int = 3, lo: float | None = None) -> np.ndarray:
-    """n finite numbers (a single number fills all n), each >= lo if given."""
+    """n finite numbers (a single number fills all n) of magnitude <= MAX_MAGNITUDE, each >= lo if given."""
     items = value if isinstance(value, list) else [value]
     if not all(_is_number(v) for v in items):
         raise SceneFileError(f"{where}: expected {n} numbers, got {_kind(value)} {_show(value)}")
@@ -225,6 +230,8 @@ def _vec(where: str, value: Any, n: int = 3, lo: float | None = None) -> np.ndar
         raise SceneFileError(f"{where}: expected {n} finite numbers, got {_show(value)}")
     if lo is not None and (a < lo).any():
         raise SceneFileError(f"{where}: expected numbers >= {lo}, got {_show(value)}")
+    if (np.abs(a) > MAX_MAGNITUDE).any():
+        raise SceneFileError(f"{where}: expected numbers of magnitude at most {MAX_MAGNITUDE:g}, got {_show(value)}")
     return a
 
 
