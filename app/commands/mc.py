@@ -51,6 +51,8 @@ def register(sub) -> None:
 def run(args) -> int:
     from scene.optics.montecarlo import simulate
 
+    if args.seed < 0:
+        raise ValueError(f"--seed: expected an integer >= 0, got {args.seed}")
     if args.workers < 0:
         raise ValueError(f"--workers: expected an integer >= 1 (or 0: one per core), got {args.workers}")
     if args.max_steps < 1:

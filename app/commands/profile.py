@@ -8,6 +8,7 @@ import json
 
 import numpy as np
 
+MAX_LENGTH_MM = 1e6  # a kilometre of mean free path: beyond it the profiles underflow to nothing
 DEFAULT_R = "0,0.01,0.02,0.05,0.1,0.2,0.5,1,2,5,10"
 
 
@@ -20,6 +21,8 @@ def _triple(text: str, name: str):
         vals *= 3
     if len(vals) != 3:
         raise ValueError(f"{name}: expected 1 or 3 comma-separated values, got {len(vals)}")
+    if name in ("mfp", "radius") and any(abs(v) > MAX_LENGTH_MM for v in vals if np.isfinite(v)):
+        raise ValueError(f"{name}: expected lengths of at most {MAX_LENGTH_MM:g} mm, got {text!r}")
     return vals
 
 
@@ -97,6 +100,8 @@ def medium_from_args(args):
 def run(args) -> int:
     from scene.optics.profiles import PROFILE_MODELS, evaluate_profile, profile_names, total_reflectance
 
+    if args.seed < 0:
+        raise ValueError(f"--seed: expected an integer >= 0, got {args.seed}")
     m = medium_from_args(args)
     r = _radii(args.r)
     names = profile_names() if args.model == "all" else [args.model]
