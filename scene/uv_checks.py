@@ -65,9 +65,9 @@ class UVReport:
         """Harmless findings worth a line in an explanation: zero-UV-area slivers below the warning share."""
         if self.has_uvs and self.zero_area_uv and self.zero_area_uv_surface < ZERO_UV_SURFACE_WARN:
             return [
-                f"{self.zero_area_uv} of {self.triangles} triangles ({100 * self.zero_area_uv_surface:.2g} % of the "
-                f"surface) have (near-)zero UV area and get no irradiance; under the "
-                f"{100 * ZERO_UV_SURFACE_WARN:g} % that would be visible"
+                f"{self.zero_area_uv} of {self.triangles} triangles have (near-)zero UV area: not rasterised, no "
+                f"irradiance; {100 * self.zero_area_uv_surface:.2g} % of the surface, under the "
+                f"{100 * ZERO_UV_SURFACE_WARN:g} % that would be visible (so no warning)"
             ]
         return []
 
