@@ -203,3 +203,22 @@ def test_bench_peer_shows_progress(monkeypatch, capsys):
     assert "bench peer" in err and "7/7" in err  # 2 x (2 warm-up + 1 timed) + pyrender
     peer_bench((16, 16), frames=1, progress=False)
     assert "bench peer" not in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_demo_gallery_writes_images_markdown_and_contact_sheet(tmp_path, capsys):
+    from app.cli import main
+    from app.image_output import read_image
+
+    assert main(["demo", "--out", str(tmp_path), "--size", "24x24", "--gallery"]) == 0
+    out, err = capsys.readouterr()
+    g = tmp_path / "gallery"
+    pngs = sorted(p.name for p in g.glob("*.png"))
+    assert len(pngs) == 10 and "gallery.png" in pngs and "head-burley.png" in pngs and "bunny-ketchup.png" in pngs
+    sheet = read_image(g / "gallery.png")
+    assert sheet.shape == (3 * (24 + 18), 3 * 24, 4)
+    md = (g / "gallery.md").read_text()
+    assert "![contact sheet](gallery.png)" in md and md.count("| ![") == 9
+    assert "gallery: 100%" in err and "9/9" in err  # the progress bar
+    assert "frame (total)" in out and str((g / "gallery.png").resolve()) in out
+    assert not [p for p in tmp_path.rglob(".*")]  # nothing half-written
