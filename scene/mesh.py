@@ -77,6 +77,21 @@ class Mesh:
         generate_atlas(self)
 
 
+_ATLASED: dict[int, Mesh] = {}
+
+
+def with_atlas(mesh: Mesh) -> Mesh:
+    """``mesh`` if it has UVs, else a copy of it with an xatlas atlas (one per source mesh and
+    process). The source is left alone: meshes from scene.loaders are shared through its cache."""
+    if mesh.uvs is not None:
+        return mesh
+    if mesh.uid not in _ATLASED:
+        copy = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, None, None, mesh.source)
+        generate_atlas(copy)
+        _ATLASED[mesh.uid] = copy
+    return _ATLASED[mesh.uid]
+
+
 def vertex_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """Area-weighted vertex normals; degenerate vertices get +Z rather than NaN."""
     p = positions.astype(np.float64)

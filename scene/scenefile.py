@@ -57,7 +57,7 @@ from . import transform as tf
 from .graph import CameraNode, LightNode, MeshNode, Node, Scene
 from .loaders import SUPPORTED, LoadedNode, load_mesh_file
 from .materials import Material
-from .mesh import Mesh
+from .mesh import Mesh, with_atlas
 
 ASSETS = Path(__file__).resolve().parents[1] / "assets"
 DEFAULT_SCENE = ASSETS / "scenes" / "head.toml"
@@ -414,9 +414,7 @@ def _build(path: Path, data: dict) -> Scene:
         if _bool(f"{where}.flip_v", entry.get("flip_v", False)):
             loaded = [LoadedNode(ln.name, ln.parent, ln.matrix, flip_v(ln.mesh)) for ln in loaded]
         if _bool(f"{where}.generate_uvs", entry.get("generate_uvs", False)):  # an xatlas atlas where none
-            for ln in loaded:
-                if ln.mesh is not None:
-                    ln.mesh.ensure_uvs(f"{where}: generate_uvs", generate=True)
+            loaded = [LoadedNode(ln.name, ln.parent, ln.matrix, ln.mesh and with_atlas(ln.mesh)) for ln in loaded]
         created: dict[str, Node] = {}
         for ln in loaded:
             nwhere = f"{where}.nodes.{ln.name}"

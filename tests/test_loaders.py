@@ -134,3 +134,18 @@ def test_atlas_is_cached_by_mesh_content(tmp_path, monkeypatch, capsys):
     generate_atlas(third)
     assert "generating a UV atlas" in capsys.readouterr().err
     assert np.array_equal(third.uvs, first.uvs)
+
+
+def test_generated_atlases_leave_the_loader_cache_alone(tmp_path):
+    """generate_uvs (and texture-space diffusion on a mesh without UVs) give the scene an atlased
+    copy: loading the file again still gives the mesh as the file has it."""
+    from scene.scenefile import load_scene
+
+    scene_file = tmp_path / "s.toml"
+    scene_file.write_text(f'[[meshes]]\nfile = "{ASSETS / "stanford-bunny" / "bunny.ply"}"\ngenerate_uvs = true\n')
+    (node,) = load_scene(scene_file).mesh_nodes()
+    assert node.mesh.uvs is not None
+    (again,) = load_mesh_file(ASSETS / "stanford-bunny" / "bunny.ply")
+    assert again.mesh.uvs is None and again.mesh is not node.mesh
+    (node2,) = load_scene(scene_file).mesh_nodes()
+    assert node2.mesh is node.mesh  # one atlas per source mesh and process

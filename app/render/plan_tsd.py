@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from scene.mesh import with_atlas
 from scene.optics.tsd import design_kernel, material_medium, profile_fit
 from scene.uv_checks import analyse_uvs
 
@@ -97,7 +98,7 @@ def plan_tsd_node(node, settings, scene, plan) -> TsdNodePlan | None:
             "diffusion generated an atlas with xatlas (set generate_uvs = true in the scene "
             "file to do it at load time)"
         )
-        mesh.ensure_uvs("texture-space diffusion needs UVs", generate=True)
+        node.mesh = mesh = with_atlas(mesh)  # a copy: the loader's cached mesh stays as the file has it
     size = settings.tsd_size
     rep = uv_report(node, scene.mm_per_unit, size)
     for w in rep.warnings():
