@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from app.render.settings import RenderSettings
+from app.render.techniques.tsd import TsdSettings
 from app.viewer.camera import PITCH_LIMIT, OrbitCamera
 from app.viewer.core import SSS_CYCLE, ViewerCore, next_sss_model
 from app.viewer.inspector import FINAL, Inspector, View, auto_range, display_mode, fit_viewport, target_names
@@ -31,7 +32,7 @@ from scene.materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
 from scene.scenefile import ASSETS, DEFAULT_SCENE
 
 ROOT = Path(__file__).resolve().parents[1]
-SMALL = dict(shadow_size=256, tsd_size=64)
+SMALL = dict(shadow_size=256, technique=TsdSettings(size=64))
 
 
 # -- Xvfb ----------------------------------------------------------------------------------------
@@ -466,11 +467,21 @@ def test_core_settings_follow_size_and_sss_cycle(core):
     assert seen == [None, *SSS_MODELS, None]
     assert next_sss_model("pbd") is None and next_sss_model(None, -1) == "pbd"
     # T cycles the technique; the frame plan follows (screen-space SSS has its blur pass)
-    assert c.settings.technique == "tsd"
+    assert c.settings.technique_name == "tsd"
     assert c.cycle_technique() == "exact" and c.cycle_technique() == "ssss" and c.dirty
     c.render()
     assert {"ssss_diffuse", "ssss_blurred"} <= set(c.targets())
     assert c.cycle_technique(-1) == "exact"
+    # the panel edits the current technique's own settings; each technique keeps its own
+    assert c.set_technique("tsd") == "tsd" and c.settings.technique.size == 64
+    assert c.set_technique_option("gaussians", 3) == 3 and c.settings.technique.gaussians == 3
+    with pytest.raises(ValueError, match=r"tsd setting gaussians: expected an integer in \[1, 6\], got 9"):
+        c.set_technique_option("gaussians", 9)
+    with pytest.raises(ValueError, match="tsd setting 'taps_x': unknown"):
+        c.set_technique_option("taps_x", 9)
+    c.set_technique("ssss")
+    c.set_technique("tsd")
+    assert c.settings.technique.gaussians == 3 and c.settings.technique.size == 64
 
 
 def test_core_shows_shader_errors_and_keeps_rendering(core):

@@ -23,18 +23,18 @@ texture-space convolution, which is the image reference):
   (and the tint, which does not spread light) scores exactly 1; a perfect profile 0. The edge
   response is what a shadow boundary shows on screen, it accepts a delta (identity weight), a
   Gaussian sum and a tabulated radial profile alike, and it integrates the MC noise away.
-  For "tsd" the technique's profile is the Gaussian kernel the frame actually used (after the
-  planner folded sub-texel Gaussians into the unblurred term; no blur pass at all = a delta), for
-  "exact" the material's model profile, for "none"/"tint" a delta (the tint shifts colour but moves
-  no light), for "ssss" the frame's 1-D screen-space kernel (scene/optics/ssss.py
-  separable_edge_response; an edge along a screen axis, the separable kernel's best case).
+  Each technique gives its own edge response from the frame plan it rendered
+  (``Technique.edge_response``, app/render/techniques/<name>/): for "tsd" the Gaussian kernel the
+  frame actually used (after the planner folded sub-texel Gaussians into the unblurred term; no
+  blur pass at all = a delta), for "exact" the material's model profile, for "none"/"tint" a delta
+  (the tint shifts colour but moves no light), for "ssss" the frame's 1-D screen-space kernel
+  (scene/optics/ssss.py separable_edge_response; an edge along a screen axis, the separable
+  kernel's best case).
   ``profile_err_model`` is the same measure against the material's own model profile instead of
   Monte Carlo: the technique's approximation error alone, without the model's.
 
-A technique the renderer does not implement yet either raises (recorded as an ``error`` row; the
-sweep goes on) or is silently rendered as texture-space diffusion: every non-tsd setting is
-compared with the tsd frame of the same settings, and an identical image is recorded as
-``ignored``. Without a working exact reference the most accurate tsd setting (largest irradiance
+A setting that fails to render is recorded as an ``error`` row and the sweep goes on. Without a
+working exact reference the most accurate tsd setting (largest irradiance
 texture, largest K) stands in as a *proxy* reference, named in the ``reference`` column.
 """
 
@@ -49,10 +49,12 @@ import statistics
 import sys
 import tempfile
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from scene.optics.edges import model_edge, scattering_channels, step, step_edge
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 SCENE_ALIASES = {"head": None, "bunny": ASSETS / "bunny-skimmilk.toml"}
@@ -188,51 +190,45 @@ SWEEPS = {"full": FULL, "quick": QUICK, "tiny": TINY}
 
 @dataclass(frozen=True)
 class Setting:
-    technique: str  # ledger technique: none | tint | tsd | ssss | exact
+    """One ledger row's setting: a registered technique and the ledger columns its settings fill
+    (the technique's LedgerStyle.columns maps them to its settings fields)."""
+
+    technique: str  # a registered technique: none | tint | tsd | ssss | exact | ...
     K: int | None = None
     tsd_size: int | None = None
     taps: int | None = None  # tsd taps; None = auto (only meaningful for tsd)
     ssss_taps: int | None = None
 
+    def _style(self):
+        from app.render.registry import get_technique
+
+        return get_technique(self.technique).ledger
+
     @property
     def label(self) -> str:
-        if self.technique == "tsd":
-            return f"tsd K{self.K} {self.tsd_size} {self.taps or 'auto'}"
-        if self.technique == "ssss":
-            return f"ssss {self.ssss_taps}"
-        if self.technique == "exact":
-            return f"exact {self.tsd_size}"
-        return self.technique
+        style = self._style()
+        if not style.label:
+            return self.technique
+        return style.label.format(**{c: ("auto" if v is None else v) for c, v in self._columns().items()})
+
+    def _columns(self) -> dict:
+        return {c: getattr(self, c) for c in self._style().columns}
 
     def render_settings(self, sweep: Sweep, size=None):
         from app.render.settings import RenderSettings
 
         w, h = size or sweep.size
-        base = dict(width=w, height=h, shadow_size=sweep.shadow_size)
-        if self.technique == "none":
-            return RenderSettings(**base, sss_model="none")
-        # tint and ssss do not use the irradiance texture: tsd_size = the sweep's K-sweep size only
-        # keeps the comparison frame (a renderer that ignores the technique draws tsd) affordable
-        if self.technique == "tint":
-            return RenderSettings(**base, technique="tint", tsd_size=sweep.k_size)
-        if self.technique == "tsd":
-            return RenderSettings(
-                **base, technique="tsd", tsd_size=self.tsd_size, tsd_gaussians=self.K, tsd_taps=self.taps
-            )
-        if self.technique == "ssss":
-            return RenderSettings(**base, technique="ssss", ssss_taps=self.ssss_taps, tsd_size=sweep.k_size)
-        if self.technique == "exact":
-            return RenderSettings(**base, technique="exact", tsd_size=self.tsd_size)
-        raise ValueError(f"unknown ledger technique {self.technique!r}")
+        cols = self._style().columns
+        opts = {f: getattr(self, c) for c, f in cols.items() if getattr(self, c) is not None}
+        return RenderSettings.for_technique(self.technique, w, h, shadow_size=sweep.shadow_size, **opts)
 
     def cells(self) -> dict:
         """The parameter columns; empty where the parameter does not apply to the technique."""
-        return {
-            "K": self.K if self.technique == "tsd" else "",
-            "tsd_size": self.tsd_size if self.technique in ("tsd", "exact") else "",
-            "taps": (self.taps or "auto") if self.technique == "tsd" else "",
-            "ssss_taps": self.ssss_taps if self.technique == "ssss" else "",
-        }
+        own = self._columns()
+        return {c: ("auto" if own[c] is None else own[c]) if c in own else "" for c in SETTING_COLUMNS}
+
+
+SETTING_COLUMNS = ("K", "tsd_size", "taps", "ssss_taps")
 
 
 def sweep_settings(sweep: Sweep) -> list[Setting]:
@@ -380,19 +376,9 @@ def _edge_grid(mfp: float) -> np.ndarray:
     return np.concatenate([-pos[::-1], [0.0], pos])
 
 
-def _step(x: np.ndarray) -> np.ndarray:
-    return np.where(x < 0, 1.0, np.where(x == 0, 0.5, 0.0))
-
-
-def _scattering(medium) -> np.ndarray:
-    from scene.optics.constants import MIN_MFP_MM
-
-    return (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
-
-
 def _reference(medium, edge_of_channel, photons: int = 0) -> ProfileReference:
     """Edge responses of a reference per scattering channel: edge_of_channel(c, x_mm) -> (N,)."""
-    scatter = _scattering(medium)
+    scatter = scattering_channels(medium)
     xs, es, dens = [], [], []
     for c in range(3):
         if not scatter[c]:
@@ -400,7 +386,7 @@ def _reference(medium, edge_of_channel, photons: int = 0) -> ProfileReference:
             continue
         x = _edge_grid(float(medium.mfp_arr[c]))
         e = np.asarray(edge_of_channel(c, x), np.float64)
-        xs.append(x), es.append(e), dens.append(float(np.trapezoid(np.abs(_step(x) - e), x)))
+        xs.append(x), es.append(e), dens.append(float(np.trapezoid(np.abs(step(x) - e), x)))
     return ProfileReference(medium, scatter, xs, es, dens, photons)
 
 
@@ -422,7 +408,7 @@ def profile_reference(medium, photons: int, cache_dir: Path | None) -> ProfileRe
 
 def model_reference(model: str, medium) -> ProfileReference | None:
     """The edge responses of the material's exact model profile (what the techniques approximate)."""
-    fn = technique_edge_fn("exact", model, medium)
+    fn = model_edge(model, medium)
     if fn is None:
         return None
     return _reference(medium, lambda c, x: fn(x)[:, c])
@@ -440,34 +426,14 @@ def edge_error(ref: ProfileReference, edge_fn) -> float:
     return float(np.mean(errs)) if errs else math.nan
 
 
-def technique_edge_fn(technique: str, model: str, medium, kernel=None, ssss=None):
-    """The technique's edge response x_mm -> (N, 3), or None where the ledger has no profile for it.
-    ``kernel``: the tsd DiffusionKernel the frame used; ``ssss``: (offsets_mm, weights) of the
-    screen-space kernel the frame used."""
-    from scene.optics.profiles import get_profile
-    from scene.optics.tsd import MODEL_PROFILES, edge_response
+def edge_response(technique: str, model: str, medium, plan):
+    """The edge response x_mm -> (N, 3) of a registered technique as the frame `plan` rendered a
+    material of `model` (none: no scattering, a step), or None where the technique has none."""
+    from app.render.registry import get_technique
 
-    if technique in ("none", "tint") or model == "none":
-        return lambda x: np.repeat(_step(np.asarray(x))[:, None], 3, axis=1)
-    if technique == "tsd":
-        if kernel is None:
-            return None
-        return lambda x: edge_response(x, kernel, "gaussians")
-    if technique == "ssss":
-        if ssss is None:
-            return None
-        from scene.optics.ssss import separable_edge_response
-
-        offsets, weights = ssss
-        return lambda x: separable_edge_response(x, np.asarray(offsets), np.asarray(weights))
-    if technique == "exact":
-        if model not in MODEL_PROFILES:
-            return None
-        scatter = _scattering(medium)
-        prof = get_profile(MODEL_PROFILES[model])
-        fn = lambda r: prof.evaluate(np.asarray(r, np.float64), medium) * scatter[None, :]
-        return lambda x: edge_response(x, fn, "profile")
-    return None
+    if model == "none":
+        return step_edge
+    return get_technique(technique).edge_response(model, medium, plan)
 
 
 def fit_kernel(model: str, medium, K: int):
@@ -484,17 +450,6 @@ def _clock(timings) -> str:
     if not timings.software_gl and timings.passes and all(p.gpu_ms is not None for p in timings.passes):
         return "gpu-timer"
     return "cpu-synchronised"
-
-
-def _subsurface_node(scene, renderer):
-    """The first mesh node whose frame used texture-space diffusion, with its kernel."""
-    frame = getattr(renderer, "last_frame", None)
-    tsd = getattr(frame, "tsd", None) or {}
-    for n in scene.mesh_nodes():
-        t = tsd.get(id(n))
-        if t is not None and getattr(t, "kernel", None) is not None:
-            return n, t.kernel
-    return None, None
 
 
 def measure_setting(renderer, scene, rs, warmup: int, frames: int, budget_s: float) -> dict:
@@ -539,17 +494,8 @@ def measure_setting(renderer, scene, rs, warmup: int, frames: int, budget_s: flo
         "ldr": final.ldr,
         "plan": final.plan.names(),
         "kinds": [p.kind for p in final.plan.passes],
-        "ssss": _ssss_kernel(final.plan),
+        "frame_plan": final.plan,
     }
-
-
-def _ssss_kernel(plan):
-    """(offsets_mm, weights) of the frame's screen-space kernel, or None."""
-    for p in plan.passes:
-        k = p.params.get("ssss") if p.kind == "ssss_blur" else None
-        if k is not None and getattr(k, "offsets_mm", None) is not None:
-            return np.asarray(k.offsets_mm), np.asarray(k.weights)
-    return None
 
 
 # -- the run ---------------------------------------------------------------------------------------------
@@ -580,8 +526,9 @@ def run_sweep(
     from tqdm import tqdm
 
     from app.gl.context import create_headless_context, describe
-    from app.render.plan_tsd import effective_material
+    from app.render.registry import get_technique
     from app.render.renderer import Renderer
+    from app.render.scattering import effective_material
     from scene.optics.tsd import material_medium
     from scene.scenefile import load_scene
 
@@ -624,7 +571,6 @@ def run_sweep(
                     base_mat = None
             hdrs: dict[Setting, np.ndarray] = {}
             scene_rows: dict[Setting, dict] = {}
-            tsd_images: dict = {}
             for st in settings:
                 bar.set_postfix_str(f"{label}: {st.label}")
                 row = {
@@ -639,20 +585,14 @@ def run_sweep(
                 }
                 try:
                     rs = st.render_settings(sweep)
-                    row["model"] = effective_material(base_node, rs)["sss_model"] if base_node is not None else ""
+                    row["model"] = (
+                        effective_material(base_node, rs)["sss_model"]
+                        if base_node is not None and get_technique(st.technique).scatters
+                        else "none"
+                        if base_node is not None
+                        else ""
+                    )
                     m = measure_setting(renderer, scene, rs, sweep.warmup, sweep.frames, sweep.budget_s)
-                    _, kernel = _subsurface_node(scene, renderer)
-                    if st.technique in ("exact", "tint", "ssss"):
-                        # a technique the renderer does not know yet may be rendered as tsd: compare
-                        twin = replace(rs, technique="tsd")
-                        key = (twin.tsd_size, twin.tsd_gaussians, twin.tsd_taps)
-                        if key not in tsd_images:
-                            tsd_images[key] = renderer.render(scene, twin, readback=("hdr",)).hdr
-                        if np.array_equal(tsd_images[key], m["hdr"]):
-                            row["status"] = "ignored"
-                            row["error"] = (
-                                f"the renderer drew technique {st.technique!r} exactly as 'tsd' (not implemented yet?)"
-                            )
                     row.update(
                         {
                             k: m[k]
@@ -677,10 +617,7 @@ def run_sweep(
                         write_image(out / "images" / f"{label}-{safe}.png", m["ldr"])
                     # profile error against Monte Carlo and against the material's own model profile
                     if base_mat is not None:
-                        tech = "none" if row["model"] == "none" else st.technique
-                        if tech in ("tsd", "exact") and not {"tsd_blur", "tsd_exact"} & set(m["kinds"]):
-                            tech = "none"  # every Gaussian folded into the unblurred term: plain diffuse
-                        fn = technique_edge_fn(tech, row["model"], base_medium, kernel, m["ssss"])
+                        fn = edge_response(st.technique, row["model"], base_medium, m["frame_plan"])
                         row["profile_err_mc"] = edge_error(pref, fn) if fn is not None else math.nan
                         row["profile_err_model"] = (
                             edge_error(mref, fn) if (fn is not None and mref is not None) else math.nan

@@ -227,7 +227,9 @@ def reload_bench(
     if not 0.0 <= settle_s <= 10.0:
         raise ValueError(f"--settle: expected seconds in [0, 10], got {settle_s}")
     w, h = size
-    settings = RenderSettings(w, h, shadow_size=shadow_size, tsd_size=tsd_size)
+    from app.render.techniques.tsd import TsdSettings
+
+    settings = RenderSettings(w, h, shadow_size=shadow_size, technique=TsdSettings(size=tsd_size))
     ctx = create_headless_context()
     scene = load_scene(None)
     with tempfile.TemporaryDirectory(prefix="skinlab-reload-") as tmp:

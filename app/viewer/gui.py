@@ -12,7 +12,7 @@ import time
 import numpy as np
 from imgui_bundle import imgui
 
-from app.render.settings import TECHNIQUES
+from app.render.registry import techniques
 from scene.materials import SSS_MODELS
 
 from .core import ViewerCore
@@ -56,7 +56,7 @@ class Gui:
         s = core.settings
         imgui.text_colored(
             GREY,
-            f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'} ({s.technique})"
+            f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'} ({s.technique_name})"
             f"  ui {ui_fps:4.0f} fps",
         )
         errors = core.errors()
@@ -101,15 +101,48 @@ class Gui:
                 if clicked:
                     core.set_sss_model(None if o == "per material" else o)
             imgui.end_combo()
-        cur = core.settings.technique
+        cur = core.settings.technique_name
         if imgui.begin_combo("technique (T)", cur):
-            for o in TECHNIQUES:
-                clicked, _ = imgui.selectable(o, o == cur)
+            for t in techniques():
+                clicked, _ = imgui.selectable(t.name, t.name == cur)
+                if imgui.is_item_hovered():
+                    imgui.set_tooltip(t.description)
                 if clicked:
-                    core.set_technique(o)
+                    core.set_technique(t.name)
             imgui.end_combo()
+        self._technique_options()
         if imgui.button("Reset camera (R)"):
             core.reset_camera()
+
+    def _technique_options(self) -> None:
+        """One widget per field of the current technique's settings (from its declaration)."""
+        core = self.core
+        st = core.settings.technique
+        for name, o in st.options().items():
+            v = getattr(st, name)
+            label = f"{name}##{st.technique}"
+            if o.kind == "bool":
+                changed, new = imgui.checkbox(label, bool(v))
+            elif o.kind == "int" and o.none:
+                auto = v is None
+                changed, auto_new = imgui.checkbox(f"{name}: {o.none}##{st.technique}", auto)
+                new = None if auto_new else (v if v is not None else int(o.range[0]))
+                if not auto_new:
+                    c2, new = imgui.slider_int(label, int(new), int(o.range[0]), int(o.range[1]))
+                    changed = changed or c2
+            elif o.kind == "int":
+                changed, new = imgui.slider_int(label, int(v), int(o.range[0]), int(o.range[1]))
+            else:
+                changed, new = imgui.slider_float(label, float(v), float(o.range[0]), float(o.range[1]))
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(o.help(st.defaults()[name]))
+            if changed:
+                if o.odd and isinstance(new, int) and new % 2 == 0:
+                    new += 1 if new < o.range[1] else -1
+                try:
+                    core.set_technique_option(name, new)
+                except ValueError as exc:
+                    core.note("error", str(exc))
 
     def _inspector_section(self) -> None:
         core = self.core

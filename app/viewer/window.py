@@ -56,7 +56,7 @@ class ViewerWindow:
         screenshot_dir="out/screenshots",
         shader_root=None,
         shadow_size: int = 2048,
-        tsd_size: int | None = None,
+        technique="tsd",
         settle_s: float = 0.05,
         continuous: bool = False,
         show_ui: bool = True,
@@ -88,8 +88,7 @@ class ViewerWindow:
         from .core import ViewerCore
 
         fw, fh = self.window.get_framebuffer_size()
-        extra = {} if tsd_size is None else {"tsd_size": tsd_size}
-        settings = RenderSettings(max(fw, 1), max(fh, 1), shadow_size=shadow_size, **extra)
+        settings = RenderSettings(max(fw, 1), max(fh, 1), shadow_size=shadow_size, technique=technique)
         try:
             self.core = ViewerCore(
                 self.ctx, scene_path, settings, watch=watch, shader_root=shader_root, settle_s=settle_s

@@ -4,13 +4,21 @@ horizontally then vertically with the profile's 1-D kernel (scene/optics/ssss.py
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
 
+from .plan import SsssPlan
+
 MAX_SSSS_TAPS = 63  # shaders/passes/ssss_blur.frag
+
+
+@dataclass
+class SsssBlurParams:
+    ssss: SsssPlan
 
 
 class SsssBlurPass:
@@ -33,7 +41,7 @@ class SsssBlurPass:
         return t
 
     def run(self, frame, p) -> None:
-        ctx, plan = self.r.ctx, p.params["ssss"]
+        ctx, plan = self.r.ctx, p.params.ssss
         w, h = p.resolution
         tmp, blurred, out = self.targets((w, h))
         ftmp, fblur, fout = self._fbos
