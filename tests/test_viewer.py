@@ -363,7 +363,7 @@ def test_preset_file_reload(tmp_path, monkeypatch):
     csv = tmp_path / "presets.csv"
     csv.write_text(media.PRESET_FILE.read_text())
     monkeypatch.setattr(media, "PRESET_FILE", csv)
-    media._load_presets.cache_clear()
+    media.forget_presets()
     src = preset_reloader(settle_s=0.05)
     try:
         from scene.scenefile import load_scene
@@ -383,7 +383,7 @@ def test_preset_file_reload(tmp_path, monkeypatch):
     finally:
         src.stop()
         monkeypatch.undo()
-        media._load_presets.cache_clear()
+        media.forget_presets()
 
 
 # -- inspector and core (headless EGL) ----------------------------------------------------------------------
