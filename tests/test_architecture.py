@@ -301,3 +301,18 @@ def test_texture_units_are_handed_out_once_per_sampler(ctx):
     with pytest.raises(RuntimeError, match="u_b needs unit 1, but the GL offers 1"):
         small.bind(prog, "u_b", b)
 
+
+def test_citations_resolve_inside_the_repo():
+    """Every docs/references.md#section a comment points to exists; no comment points outside the repo."""
+    sections = set(re.findall(r"^## ([\w-]+)$", (ROOT / "docs" / "references.md").read_text(), re.M))
+    cited = set()
+    for d in ("app", "scene", "shaders", "docs", "assets"):
+        for f in (ROOT / d).rglob("*"):
+            if f.suffix not in (".py", ".glsl", ".frag", ".vert", ".md", ".csv", ".toml"):
+                continue
+            text = f.read_text(encoding="utf-8", errors="replace")
+            assert "shared/reference" not in text and "FACTS.md" not in text, f
+            for anchor in re.findall(r"references\.md#([\w-]+)", text):
+                assert anchor in sections, (f, anchor)
+                cited.add(anchor)
+    assert len(cited) >= 8, cited

@@ -2,7 +2,8 @@
 everything drawn, Dear ImGui (imgui-bundle's pyglet backend) for the overlay and the panel.
 
 Mouse: left drag orbits around the camera target, right or middle drag (or shift + left) pans,
-the wheel zooms. Keys: R reset camera, M / shift+M cycle the SSS model, P or Tab / shift+P
+the wheel zooms. Keys: R reset camera, M / shift+M cycle the SSS model, T / shift+T cycle the
+subsurface technique (the registry's order, app/render/registry.py), P or Tab / shift+P
 cycle the inspected target, [ and ] halve/double its display scale, N auto-ranges it,
 S saves a PNG screenshot, shift+S an EXR, H hides the panel, Esc quits.
 
