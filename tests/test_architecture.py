@@ -72,6 +72,16 @@ def render_help(capsys) -> str:
     return " ".join(capsys.readouterr().out.split())
 
 
+def test_worked_example_is_measured_by_the_ledger(lambert):
+    from app.bench import sweep
+
+    row = next(s for s in sweep.sweep_settings(sweep.QUICK) if s.technique == "lambert")
+    assert row.label == "lambert" and row.cells() == {"K": "", "tsd_size": "", "taps": "", "ssss_taps": ""}
+    st = row.render_settings(sweep.QUICK)
+    assert st.technique_name == "lambert" and st.technique.strength == 1.0 and st.size == sweep.QUICK.size
+    assert "lambert" not in {s.technique for s in sweep.sweep_settings(sweep.TINY)}  # the tests' sweep
+
+
 def test_worked_example_gets_cli_options_from_its_declaration(lambert, capsys):
     from app.cli import build_parser
     from app.commands.render import settings_from_args
@@ -104,6 +114,21 @@ def test_registry_refuses_clashes():
     with pytest.raises(ValueError, match="render setting technique: expected one of tsd, exact, ssss, tint, none"):
         registry.get_technique("fog")
     assert registry.technique_names()[:5] == ["tsd", "exact", "ssss", "tint", "none"]
+
+
+def test_every_registered_pass_and_settings_class_keeps_the_interfaces():
+    import inspect
+
+    from app.render.options import TechniqueSettings
+
+    for t in registry.techniques():
+        assert t.description and "\n" not in t.description, t.name
+        assert issubclass(t.settings_type, TechniqueSettings) and t.settings_type.technique == t.name
+        t.settings_type()  # the defaults are valid
+        for kind, cls in t.passes.items():
+            # the RenderPass protocol (app/render/technique.py): made with the renderer, run per planned pass
+            assert list(inspect.signature(cls.run).parameters) == ["self", "frame", "p"], (t.name, kind)
+            assert list(inspect.signature(cls.__init__).parameters) == ["self", "renderer"], (t.name, kind)
 
 
 def test_core_modules_never_name_a_technique():

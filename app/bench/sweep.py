@@ -28,6 +28,7 @@ class Sweep:
     peer_frames: int
     scenes: tuple[str, ...] = ("head", "bunny")
     extra: tuple = ()  # extra settings (tiny sweep)
+    every_technique: bool = True  # also a default-settings row for each registered technique not swept above
 
 
 FULL = Sweep(
@@ -79,6 +80,7 @@ TINY = Sweep(
     photons=4_000,
     peer_frames=1,
     scenes=("head",),
+    every_technique=False,
 )
 SWEEPS = {"full": FULL, "quick": QUICK, "tiny": TINY}
 
@@ -137,6 +139,10 @@ def sweep_settings(sweep: Sweep) -> list[Setting]:
     # the exact convolution at the smaller swept sizes: the irradiance texture's own resolution error
     out += [Setting("exact", tsd_size=s) for s in sweep.sizes if s < sweep.exact_size]
     out += list(sweep.extra)
+    if sweep.every_technique:  # a newly registered technique is measured without editing the sweep
+        from app.render.registry import technique_names
+
+        out += [Setting(name) for name in technique_names() if name not in {s.technique for s in out}]
     seen, uniq = set(), []
     for s in out:
         if s not in seen:

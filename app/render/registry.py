@@ -34,10 +34,14 @@ def _load_builtins() -> None:
     if _loaded:
         return
     _loaded = True
-    for name in BUILTIN_PACKAGES:
-        t = importlib.import_module(name).TECHNIQUE
-        if t.name not in _registry:
-            register(t)
+    try:
+        for name in BUILTIN_PACKAGES:
+            t = importlib.import_module(name).TECHNIQUE
+            if t.name not in _registry:
+                register(t)
+    except BaseException:
+        _loaded = False  # the next look-up tries again (and reports the same error)
+        raise
 
 
 def register(technique: Technique) -> Technique:

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from .options import TechniqueSettings
-from .registry import get_technique
+from .registry import DEFAULT_TECHNIQUE, get_technique
 
 
 @dataclass
@@ -24,7 +24,7 @@ class RenderSettings:
     # None: each material's own sss_model; else one of scene.materials.SSS_MODELS for every material
     sss_model: str | None = None
     # how subsurface scattering is rendered: a registered technique (app/render/registry.py)
-    technique: TechniqueSettings | str = "tsd"
+    technique: TechniqueSettings | str = DEFAULT_TECHNIQUE
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):

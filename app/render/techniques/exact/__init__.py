@@ -12,7 +12,7 @@ from app.render.options import TechniqueSettings, option
 from app.render.technique import LedgerStyle, PlanContext, Technique, TechniquePlan
 from app.render.techniques.tsd import PASSES as TSD_PASSES
 from app.render.techniques.tsd.forward import TsdForward
-from app.render.techniques.tsd.passes import TsdStore
+from app.render.techniques.tsd.passes import STATE_KEY, TsdStore
 from app.render.techniques.tsd.plan import TsdExactParams, plan_tsd
 from scene.optics.edges import model_edge, step_edge
 
@@ -38,7 +38,7 @@ class ExactTechnique(Technique):
     description = "brute-force texture-space convolution with the exact profile (the slow image reference)"
     settings_type = ExactSettings
     passes = {**TSD_PASSES, "tsd_exact": TsdExactPass}
-    state = ("tsd", TsdStore)
+    state = (STATE_KEY, TsdStore)  # texture-space diffusion's per-mesh textures, shared
     ledger = LedgerStyle("*", "black", {"tsd_size": "size"}, "exact {tsd_size}")
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:

@@ -13,7 +13,7 @@ from app.render.technique import LedgerStyle, PlanContext, Technique, TechniqueP
 from scene.optics.edges import gaussians_edge, step_edge
 
 from .forward import TsdForward
-from .passes import MAX_TAPS, TsdBlurPass, TsdDilatePass, TsdIrradiancePass, TsdStore, TsdStretchPass
+from .passes import MAX_TAPS, STATE_KEY, TsdBlurPass, TsdDilatePass, TsdIrradiancePass, TsdStore, TsdStretchPass
 from .plan import TsdBlurParams, TsdIrradianceParams, plan_tsd
 
 PASSES = {
@@ -51,7 +51,7 @@ class TsdTechnique(Technique):
     description = "texture-space diffusion with the Gaussian fit (d'Eon & Luebke 2007; the default)"
     settings_type = TsdSettings
     passes = PASSES
-    state = ("tsd", TsdStore)
+    state = (STATE_KEY, TsdStore)
     ledger = LedgerStyle(
         "o", "tab:blue", {"K": "gaussians", "tsd_size": "size", "taps": "taps"}, "tsd K{K} {tsd_size} {taps}"
     )
