@@ -8,14 +8,23 @@ import moderngl
 from app.gl.uniforms import set_uniform
 
 MIN_UNITS = 16  # GL 3.3 guarantees 16 fragment texture image units
+_LIMITS: dict[int, int] = {}  # id(context) -> its unit count (ctx.info queries the driver every time)
+
+
+def unit_limit(ctx: moderngl.Context | None) -> int:
+    if ctx is None:
+        return MIN_UNITS
+    n = _LIMITS.get(id(ctx))
+    if n is None:
+        n = _LIMITS[id(ctx)] = int(ctx.info.get("GL_MAX_TEXTURE_IMAGE_UNITS", MIN_UNITS))
+    return n
 
 
 class TextureUnits:
     """Units 0, 1, 2, ... in the order samplers are bound; one allocator per program use."""
 
     def __init__(self, ctx: moderngl.Context | None = None):
-        limit = ctx.info.get("GL_MAX_TEXTURE_IMAGE_UNITS", MIN_UNITS) if ctx is not None else MIN_UNITS
-        self.limit = int(limit)
+        self.limit = unit_limit(ctx)
         self.bound: dict[str, int] = {}  # sampler uniform -> unit
 
     def bind(self, prog: moderngl.Program, sampler: str, texture) -> int:
