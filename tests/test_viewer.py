@@ -553,3 +553,24 @@ def test_core_reloads_a_changed_texture_file(ctx, tmp_path):
         assert dark < bright - 10  # the renderer's cached texture was replaced
     finally:
         c.close()
+
+
+def test_technique_settings_widgets_come_from_the_declaration():
+    from app.render.techniques.ssss import SsssSettings
+    from app.viewer.panel import technique_value, technique_widgets
+
+    st = TsdSettings(size=64)
+    ws = {w.param: w for w in technique_widgets(st)}
+    assert list(ws) == list(TsdSettings.options())  # one widget per declared setting, in order
+    assert ws["size"].widget == "slider_int" and ws["size"].range == (16.0, 8192.0) and ws["size"].value == 64
+    assert ws["taps"].widget == "slider_int_or_auto" and ws["taps"].value is None
+    assert ws["albedo_mix"].widget == "slider_float" and ws["translucency"].widget == "checkbox"
+    assert "irradiance texels per side" in ws["size"].doc and "default: 512" in ws["size"].doc
+    # values from a widget are made valid: clamped, rounded, odd where the setting wants odd
+    assert technique_value(st, "size", 1e9) == 8192 and technique_value(st, "size", 3.4) == 16
+    assert technique_value(st, "taps", 8) == 9 and technique_value(st, "taps", 31.6) == 31
+    assert technique_value(st, "taps", None) is None and technique_value(st, "albedo_mix", -1) == 0.0
+    assert technique_value(SsssSettings(), "taps", 64) == 63
+    for name, w in ws.items():  # and every such value is accepted by the settings class
+        v = technique_value(st, name, w.range[1] if w.range else w.value)
+        assert getattr(st.replace(**{name: v}), name) == v

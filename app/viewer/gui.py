@@ -17,7 +17,7 @@ from scene.materials import SSS_MODELS
 
 from .core import ViewerCore
 from .inspector import display_mode
-from .panel import angles_from_direction, direction_from_angles
+from .panel import angles_from_direction, direction_from_angles, technique_value, technique_widgets
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 GREY = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
@@ -115,32 +115,30 @@ class Gui:
             core.reset_camera()
 
     def _technique_options(self) -> None:
-        """One widget per field of the current technique's settings (from its declaration)."""
+        """The current technique's settings (panel.technique_widgets: from its declaration)."""
         core = self.core
         st = core.settings.technique
-        for name, o in st.options().items():
-            v = getattr(st, name)
-            label = f"{name}##{st.technique}"
-            if o.kind == "bool":
-                changed, new = imgui.checkbox(label, bool(v))
-            elif o.kind == "int" and o.none:
-                auto = v is None
-                changed, auto_new = imgui.checkbox(f"{name}: {o.none}##{st.technique}", auto)
-                new = None if auto_new else (v if v is not None else int(o.range[0]))
-                if not auto_new:
-                    c2, new = imgui.slider_int(label, int(new), int(o.range[0]), int(o.range[1]))
-                    changed = changed or c2
-            elif o.kind == "int":
-                changed, new = imgui.slider_int(label, int(v), int(o.range[0]), int(o.range[1]))
+        for w in technique_widgets(st):
+            label = f"{w.param}##{st.technique}"
+            new = w.value
+            if w.widget.endswith("_or_auto"):
+                changed, auto = imgui.checkbox(f"{w.param} automatic##{st.technique}", w.value is None)
+                new = None if auto else (w.value if w.value is not None else w.range[0])
             else:
-                changed, new = imgui.slider_float(label, float(v), float(o.range[0]), float(o.range[1]))
+                changed = False
+            if new is not None:
+                if w.widget.startswith("checkbox"):
+                    c, new = imgui.checkbox(label, bool(new))
+                elif w.widget.startswith("slider_int"):
+                    c, new = imgui.slider_int(label, int(new), int(w.range[0]), int(w.range[1]))
+                else:
+                    c, new = imgui.slider_float(label, float(new), float(w.range[0]), float(w.range[1]))
+                changed = changed or c
             if imgui.is_item_hovered():
-                imgui.set_tooltip(o.help(st.defaults()[name]))
+                imgui.set_tooltip(w.doc)
             if changed:
-                if o.odd and isinstance(new, int) and new % 2 == 0:
-                    new += 1 if new < o.range[1] else -1
                 try:
-                    core.set_technique_option(name, new)
+                    core.set_technique_option(w.param, technique_value(st, w.param, new))
                 except ValueError as exc:
                     core.note("error", str(exc))
 
