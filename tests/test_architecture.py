@@ -131,6 +131,25 @@ def test_every_registered_pass_and_settings_class_keeps_the_interfaces():
             assert list(inspect.signature(cls.__init__).parameters) == ["self", "renderer"], (t.name, kind)
 
 
+def test_release_frees_every_pass_and_state_and_the_renderer_stays_usable(ctx):
+    from app.render.renderer import Renderer
+
+    r = Renderer(ctx)
+    scene = slab_scene(occluder=True)
+    r.render(scene, RenderSettings.for_technique("exact", 16, 16, shadow_size=64, size=64), readback=False)
+    first = r.render(scene, RenderSettings.for_technique("ssss", 16, 16, shadow_size=64)).hdr
+    assert {"ssss_blur", "tsd_exact", "shadow", "forward"} <= set(r.passes) and r.states
+    made = dict(r.last_frame.targets)  # shadow map, forward targets, the screen-space blur's, tone mapping
+    assert {"shadow_map0", "hdr_color", "ssss_blurred", "ldr_color", "depth"} <= set(made)
+    r.release()
+    assert r.states == {} and r.programs.entries == {} and r.passes["shadow"].maps == {}
+    alive = [name for name, tex in made.items() if "InvalidObject" not in type(tex.mglo).__name__]
+    assert alive == [], alive
+    again = r.render(scene, RenderSettings.for_technique("ssss", 16, 16, shadow_size=64)).hdr
+    np.testing.assert_array_equal(again, first)
+    r.release()
+
+
 def test_core_modules_never_name_a_technique():
     """plan.py, renderer.py, the forward pass and shader, the CLI's render options, the viewer and the
     ledger's run loop loop over the registry."""

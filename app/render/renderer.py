@@ -145,6 +145,18 @@ class Renderer:
         return hdr, ldr, depth
 
     def release(self) -> None:
+        """Release every GPU object the renderer made; it stays usable (all are made again on demand)."""
+        for p in self.passes.values():
+            release = getattr(p, "release", None)
+            if release is not None:
+                release()
+        for vao in self._fs_vaos.values():
+            vao.release()
+        self._fs_vaos.clear()
+        for t in (self._dummy_shadow, self._dummy_texture):
+            if t is not None:
+                t.release()
+        self._dummy_shadow = self._dummy_texture = None
         self.programs.release()
         self.resources.release()
         for st in self.states.values():

@@ -46,7 +46,8 @@ HOOK_INCLUDE = "skinlab/sss_hook.glsl"  # the include name forward.frag uses for
 
 
 class RenderPass(Protocol):
-    """A pass kind's implementation: made once per renderer, run for each planned pass of its kind."""
+    """A pass kind's implementation: made once per renderer, run for each planned pass of its kind.
+    A pass holding GPU objects of its own also has ``release()``, called by Renderer.release."""
 
     def __init__(self, renderer) -> None: ...
 

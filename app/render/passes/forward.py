@@ -38,6 +38,13 @@ class ForwardPass:
             t = self._targets = (color, depth, fbo, extra)
         return t
 
+    def release(self) -> None:
+        if self._targets is not None:
+            color, depth, fbo, extra = self._targets
+            for x in (fbo, color, depth, *extra):
+                x.release()
+            self._targets = None
+
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
         prm: ForwardParams = p.params

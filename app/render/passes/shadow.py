@@ -61,6 +61,13 @@ class ShadowPass:
             t = self.maps[slot] = (tex, fbo, dist)
         return t
 
+    def release(self) -> None:
+        for tex, fbo, dist in self.maps.values():
+            for x in (fbo, tex, dist):
+                if x is not None:
+                    x.release()
+        self.maps.clear()
+
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
         prm: ShadowParams = p.params

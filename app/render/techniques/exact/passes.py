@@ -40,6 +40,11 @@ class TsdExactPass:
             hit = self._luts[key] = (tex, r_max)
         return hit
 
+    def release(self) -> None:
+        for t, _ in self._luts.values():
+            t.release()
+        self._luts.clear()
+
     def run(self, frame, p) -> None:
         prm: TsdExactParams = p.params
         ctx, node, size = self.r.ctx, prm.node, prm.size

@@ -29,9 +29,7 @@ class SsssBlurPass:
     def targets(self, size):
         t = self._targets
         if t is None or t[0].size != tuple(size):
-            if t is not None:
-                for x in t:
-                    x.release()
+            self.release()
             ctx = self.r.ctx
             texs = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]  # tmp, blurred, composite
             for x in texs:
@@ -39,6 +37,12 @@ class SsssBlurPass:
             self._fbos = [ctx.framebuffer([x]) for x in texs]
             t = self._targets = tuple(texs)
         return t
+
+    def release(self) -> None:
+        if self._targets is not None:
+            for x in (*self._fbos, *self._targets):
+                x.release()
+            self._targets, self._fbos = None, []
 
     def run(self, frame, p) -> None:
         ctx, plan = self.r.ctx, p.params.ssss
