@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from app.render.settings import RenderSettings
+from app.render.techniques.tsd import TsdSettings
 from app.viewer.camera import PITCH_LIMIT, OrbitCamera
 from app.viewer.core import SSS_CYCLE, ViewerCore, next_sss_model
 from app.viewer.inspector import FINAL, Inspector, View, auto_range, display_mode, fit_viewport, target_names
@@ -31,7 +32,7 @@ from scene.materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
 from scene.scenefile import ASSETS, DEFAULT_SCENE
 
 ROOT = Path(__file__).resolve().parents[1]
-SMALL = dict(shadow_size=256, tsd_size=64)
+SMALL = dict(shadow_size=256, technique=TsdSettings(size=64))
 
 
 # -- Xvfb ----------------------------------------------------------------------------------------
@@ -362,7 +363,7 @@ def test_preset_file_reload(tmp_path, monkeypatch):
     csv = tmp_path / "presets.csv"
     csv.write_text(media.PRESET_FILE.read_text())
     monkeypatch.setattr(media, "PRESET_FILE", csv)
-    media._load_presets.cache_clear()
+    media.forget_presets()
     src = preset_reloader(settle_s=0.05)
     try:
         from scene.scenefile import load_scene
@@ -382,7 +383,7 @@ def test_preset_file_reload(tmp_path, monkeypatch):
     finally:
         src.stop()
         monkeypatch.undo()
-        media._load_presets.cache_clear()
+        media.forget_presets()
 
 
 # -- inspector and core (headless EGL) ----------------------------------------------------------------------
@@ -466,14 +467,23 @@ def test_core_settings_follow_size_and_sss_cycle(core):
     assert seen == [None, *SSS_MODELS, None]
     assert next_sss_model("pbd") is None and next_sss_model(None, -1) == "pbd"
     # T cycles the technique; the frame plan follows (screen-space SSS has its blur pass)
-    assert c.settings.technique == "tsd"
+    assert c.settings.technique_name == "tsd"
     assert c.cycle_technique() == "ssss" and c.dirty  # T skips the slow exact reference
     c.render()
     assert {"ssss_diffuse", "ssss_blurred"} <= set(c.targets())
     assert c.cycle_technique(-1) == "tsd"
     assert c.set_technique("exact") == "exact"  # from the panel; the overlay says it is slow
     assert "a frame may take seconds" in c.log[-1][2] and c.log[-1][1] == "warning"
+    # the panel edits the current technique's own settings; each technique keeps its own
+    assert c.set_technique("tsd") == "tsd" and c.settings.technique.size == 64
+    assert c.set_technique_option("gaussians", 3) == 3 and c.settings.technique.gaussians == 3
+    with pytest.raises(ValueError, match=r"tsd setting gaussians: expected an integer in \[1, 6\], got 9"):
+        c.set_technique_option("gaussians", 9)
+    with pytest.raises(ValueError, match="tsd setting 'taps_x': unknown"):
+        c.set_technique_option("taps_x", 9)
+    c.set_technique("ssss")
     c.set_technique("tsd")
+    assert c.settings.technique.gaussians == 3 and c.settings.technique.size == 64
 
 
 def test_core_shows_shader_errors_and_keeps_rendering(core):
@@ -547,6 +557,27 @@ def test_core_reloads_a_changed_texture_file(ctx, tmp_path):
         c.close()
 
 
+def test_technique_settings_widgets_come_from_the_declaration():
+    from app.render.techniques.ssss import SsssSettings
+    from app.viewer.panel import technique_value, technique_widgets
+
+    st = TsdSettings(size=64)
+    ws = {w.param: w for w in technique_widgets(st)}
+    assert list(ws) == list(TsdSettings.options())  # one widget per declared setting, in order
+    assert ws["size"].widget == "slider_int" and ws["size"].range == (16.0, 8192.0) and ws["size"].value == 64
+    assert ws["taps"].widget == "slider_int_or_auto" and ws["taps"].value is None
+    assert ws["albedo_mix"].widget == "slider_float" and ws["translucency"].widget == "checkbox"
+    assert "irradiance texels per side" in ws["size"].doc and "default: 512" in ws["size"].doc
+    # values from a widget are made valid: clamped, rounded, odd where the setting wants odd
+    assert technique_value(st, "size", 1e9) == 8192 and technique_value(st, "size", 3.4) == 16
+    assert technique_value(st, "taps", 8) == 9 and technique_value(st, "taps", 31.6) == 31
+    assert technique_value(st, "taps", None) is None and technique_value(st, "albedo_mix", -1) == 0.0
+    assert technique_value(SsssSettings(), "taps", 64) == 63
+    for name, w in ws.items():  # and every such value is accepted by the settings class
+        v = technique_value(st, name, w.range[1] if w.range else w.value)
+        assert getattr(st.replace(**{name: v}), name) == v
+
+
 def test_panel_labels_texture_fields_and_m_override_note(tmp_path):
     from app.viewer.panel import resolve_texture_input, sss_override_note, texture_text, widget_label
     from scene.materials import Material
@@ -584,19 +615,21 @@ def test_panel_texture_edit_by_file_name_resolves_next_to_the_current_map(tmp_pa
         panel.edit("normal_map", "missing.png")
 
 
-def test_technique_cycle_skips_the_slow_exact_reference_and_title_names_the_scene():
-    from app.render.settings import TECHNIQUES
-    from app.viewer.core import CYCLE_TECHNIQUES, next_technique, window_title
+def test_technique_cycle_skips_slow_techniques_and_title_names_the_scene():
+    from app.render.registry import get_technique, technique_names
+    from app.viewer.core import cycle_techniques, next_technique, window_title
     from scene.scenefile import load_scene
 
-    assert "exact" not in CYCLE_TECHNIQUES and set(CYCLE_TECHNIQUES) | {"exact"} == set(TECHNIQUES)
+    cycle = cycle_techniques()
+    assert get_technique("exact").slow and "exact" not in cycle
+    assert set(cycle) == {n for n in technique_names() if not get_technique(n).slow} and "tsd" in cycle
     seen, t = [], "tsd"
-    for _ in range(len(CYCLE_TECHNIQUES)):
+    for _ in range(len(cycle)):
         t = next_technique(t)
         seen.append(t)
-    assert "exact" not in seen and seen[-1] == "tsd"
-    assert next_technique("exact") == CYCLE_TECHNIQUES[0]
-    assert next_technique("tsd", -1) == CYCLE_TECHNIQUES[-1]
+    assert "exact" not in seen and seen[-1] == "tsd" and sorted(seen) == sorted(cycle)
+    assert next_technique("exact") == cycle[0]
+    assert next_technique("tsd", -1) == cycle[cycle.index("tsd") - 1]
     assert window_title(load_scene()) == "Skinlab - head (head.toml)"
 
 

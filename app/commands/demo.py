@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from app.atomic_write import write_text_atomic
 from app.render.settings import RenderSettings, parse_size
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets" / "scenes"
@@ -93,9 +94,7 @@ def gallery(folder: Path, w: int, h: int, progress: bool = True) -> list[Path]:
         *rows,
         "",
     ]
-    tmp = folder / ".gallery.md.tmp"
-    tmp.write_text("\n".join(md))
-    tmp.replace(folder / "gallery.md")
+    write_text_atomic(folder / "gallery.md", "\n".join(md))
     return written
 
 

@@ -1,4 +1,5 @@
-"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--json] [--explain]`."""
+"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--technique NAME] [--json] [--explain]`: the
+technique options come from the registered techniques (app/commands/technique_options.py)."""
 
 from __future__ import annotations
 
@@ -6,16 +7,9 @@ import json
 import sys
 from pathlib import Path
 
-from app.render.settings import TECHNIQUES, RenderSettings, parse_size
+from app.commands.technique_options import add_technique_options, technique_from_args
+from app.render.settings import RenderSettings, parse_size
 from scene.materials import SSS_MODELS
-
-# which --technique reads each technique option (the rest ignore it: a warning says so)
-TECHNIQUE_OPTIONS = {
-    "taps": ("--taps", ("tsd",)),
-    "ssss_taps": ("--ssss-taps", ("ssss",)),
-    "tsd_size": ("--tsd-size", ("tsd", "exact")),
-    "gaussians": ("--gaussians", ("tsd", "ssss")),
-}
 
 
 def register(sub) -> None:
@@ -55,39 +49,7 @@ def register(sub) -> None:
         default=None,
         help="subsurface model for every material (default: each material's own sss_model)",
     )
-    p.add_argument(
-        "--technique",
-        choices=TECHNIQUES,
-        default="tsd",
-        help="tsd: texture-space diffusion (default); exact: brute-force texture-space convolution "
-        "with the exact profile (slow reference); ssss: screen-space separable SSS; tint: the "
-        "per-pixel profile tint baseline",
-    )
-    p.add_argument(
-        "--taps",
-        type=int,
-        default=None,
-        help="(tsd) texture-space blur taps per pass, odd 7-31 (default: from each blur's width in texels)",
-    )
-    p.add_argument(
-        "--ssss-taps",
-        type=int,
-        default=None,
-        help=f"(ssss) screen-space kernel samples, odd 3-63 (default {RenderSettings.ssss_taps}; "
-        "Jimenez's presets are 11, 17 and 25)",
-    )
-    p.add_argument(
-        "--tsd-size",
-        type=int,
-        default=None,
-        help=f"(tsd, exact) irradiance texels per side, 16-8192 (default {RenderSettings.tsd_size})",
-    )
-    p.add_argument(
-        "--gaussians",
-        type=int,
-        default=None,
-        help=f"(tsd, ssss) Gaussians fitted to the profile, 1-6 (default {RenderSettings.tsd_gaussians})",
-    )
+    add_technique_options(p)  # an option of another technique than --technique is an error naming it
     p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
     p.set_defaults(func=run)
@@ -117,35 +79,8 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, p
     return scene, result, written, ctx
 
 
-def ignored_options(args) -> list[str]:
-    """Warnings for technique options given with a technique that does not read them."""
-    out = []
-    for attr, (flag, techniques) in TECHNIQUE_OPTIONS.items():
-        if getattr(args, attr) is not None and args.technique not in techniques:
-            out.append(
-                f"{flag} applies only to --technique {' or '.join(techniques)}; "
-                f"ignored with --technique {args.technique}"
-            )
-    return out
-
-
 def settings_from_args(args, w: int, h: int) -> RenderSettings:
-    extra = {}
-    if args.tsd_size is not None:
-        extra["tsd_size"] = args.tsd_size
-    if args.gaussians is not None:
-        extra["tsd_gaussians"] = args.gaussians
-    if args.ssss_taps is not None:
-        extra["ssss_taps"] = args.ssss_taps
-    return RenderSettings(
-        w,
-        h,
-        shadow_size=args.shadow_size,
-        sss_model=args.sss,
-        technique=args.technique,
-        tsd_taps=args.taps,
-        **extra,
-    )
+    return RenderSettings(w, h, shadow_size=args.shadow_size, sss_model=args.sss, technique=technique_from_args(args))
 
 
 def run(args) -> int:
@@ -155,7 +90,6 @@ def run(args) -> int:
         raise ValueError(f"--exposure: expected a finite multiplier > 0, got {args.exposure}")
     if args.camera_orbit != args.camera_orbit or abs(args.camera_orbit) == float("inf"):
         raise ValueError(f"--camera-orbit: expected a finite angle in degrees, got {args.camera_orbit}")
-    warnings = ignored_options(args)
 
     def prepare(scene):
         if args.exposure is not None:
@@ -164,7 +98,7 @@ def run(args) -> int:
             scene.orbit_camera(args.camera_orbit)
 
     scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare)
-    for warning in warnings + result.plan.warnings:
+    for warning in result.plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     if args.explain:  # the warnings were printed above, once
         print(result.plan.explain(warnings=False), file=sys.stderr if args.json else sys.stdout)
@@ -180,7 +114,7 @@ def run(args) -> int:
                     "gl": describe(ctx),
                     "timings": result.timings.as_dict(),
                     "plan": result.plan.as_dict(),
-                    "warnings": warnings + result.plan.warnings,
+                    "warnings": result.plan.warnings,
                 },
                 indent=2,
             )

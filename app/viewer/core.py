@@ -18,8 +18,9 @@ import numpy as np
 
 from app.gl.hot_reload import ShaderWatcher
 from app.gl.shader_source import ShaderLibrary
+from app.render.registry import get_technique, techniques
 from app.render.renderer import FrameResult, Renderer
-from app.render.settings import TECHNIQUES, RenderSettings
+from app.render.settings import RenderSettings
 from scene.materials import SSS_MODELS
 
 from .camera import OrbitCamera
@@ -38,17 +39,18 @@ def next_sss_model(current: str | None, step: int = 1) -> str | None:
     return SSS_CYCLE[(i + step) % len(SSS_CYCLE)]
 
 
-# T cycles these; the exact reference (seconds per frame on a slow GPU) only from the panel's combo
-CYCLE_TECHNIQUES = tuple(t for t in TECHNIQUES if t != "exact")
-SLOW_TECHNIQUES = {"exact": "the brute-force reference: a frame may take seconds"}
+def cycle_techniques() -> list[str]:
+    """The registered techniques T goes through: all but the slow ones (Technique.slow: image
+    references taking seconds per frame), which the panel's technique list offers, marked."""
+    return [t.name for t in techniques() if not t.slow]
 
 
 def next_technique(current: str, step: int = 1) -> str:
-    """The technique T (shift+T) switches to: the cycle skips the slow exact reference."""
-    if current not in CYCLE_TECHNIQUES:
-        return CYCLE_TECHNIQUES[0 if step > 0 else -1]
-    i = CYCLE_TECHNIQUES.index(current)
-    return CYCLE_TECHNIQUES[(i + step) % len(CYCLE_TECHNIQUES)]
+    """The technique T (shift+T) switches to; the cycle skips slow techniques."""
+    names = cycle_techniques()
+    if current not in names:
+        return names[0 if step > 0 else -1]
+    return names[(names.index(current) + step) % len(names)]
 
 
 def window_title(scene) -> str:
@@ -69,6 +71,7 @@ class ViewerCore:
     ):
         self.ctx = ctx
         self.settings = settings or RenderSettings()
+        self._technique_settings: dict = {}  # technique name -> its settings when last left
         library = ShaderLibrary(root=Path(shader_root)) if shader_root else ShaderLibrary()
         if not library.root.is_dir():
             raise FileNotFoundError(f"--shader-dir: no such folder: {library.root}")
@@ -146,16 +149,32 @@ class ViewerCore:
         return model
 
     def cycle_technique(self, step: int = 1) -> str:
-        """T: the next technique of CYCLE_TECHNIQUES (the exact reference is chosen in the panel)."""
-        return self.set_technique(next_technique(self.settings.technique, step))
+        """T: the next registered technique, skipping slow ones (chosen in the panel instead)."""
+        return self.set_technique(next_technique(self.settings.technique_name, step))
 
     def set_technique(self, technique: str) -> str:
-        """How subsurface scattering is rendered (app.render.settings.TECHNIQUES)."""
-        self.settings = dataclasses.replace(self.settings, technique=technique)  # validated again
-        slow = SLOW_TECHNIQUES.get(technique)
+        """How subsurface scattering is rendered (a registered technique, app/render/registry.py);
+        each technique keeps the settings it had when the viewer last left it. A slow one is noted
+        as a warning (the overlay shows it in yellow)."""
+        slow = get_technique(technique).slow  # a clear error for an unknown name
+        self._technique_settings[self.settings.technique_name] = self.settings.technique
+        chosen = self._technique_settings.get(technique, technique)
+        self.settings = dataclasses.replace(self.settings, technique=chosen)  # validated again
         self.note("warning" if slow else "info", f"SSS technique: {technique}" + (f" ({slow})" if slow else ""))
         self.invalidate()
         return technique
+
+    def set_technique_option(self, name: str, value) -> object:
+        """Change one setting of the current technique (checked against its declaration)."""
+        opts = self.settings.technique.options()
+        if name not in opts:
+            raise ValueError(
+                f"{self.settings.technique_name} setting {name!r}: unknown; its settings: {', '.join(opts) or 'none'}"
+            )
+        self.settings = dataclasses.replace(self.settings, technique=self.settings.technique.replace(**{name: value}))
+        self.note("info", f"{self.settings.technique_name} {name}: {getattr(self.settings.technique, name)}")
+        self.invalidate()
+        return getattr(self.settings.technique, name)
 
     def reset_camera(self) -> None:
         self.orbit.reset()

@@ -1,0 +1,74 @@
+"""Skinlab against pyrender on the same head, size and EGL context kind (`skinlab bench peer`)."""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+
+from tqdm import tqdm
+
+from app.render.settings import RenderSettings
+
+
+def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False) -> dict:
+    """Median frame times, both including the colour+depth read-back (pyrender always reads back).
+    ``skinlab_ms`` is the plain-PBR frame (sss_model none, like pyrender's: no subsurface scattering);
+    ``skinlab_default_ms`` the frame with the default RenderSettings (the head's skin scatters, so
+    texture-space diffusion runs)."""
+    from app.bench.pyrender_peer import run_peer
+    from app.gl.context import create_headless_context, describe
+    from app.render.renderer import Renderer
+    from scene.scenefile import load_scene
+
+    if frames < 1:
+        raise ValueError(f"--frames: expected >= 1, got {frames}")
+    scene = load_scene(None)
+    # plain PBR on both sides: no shadow map (pyrender's directional light casts none by default)
+    for light in scene.lights():
+        light.cast_shadow = False
+    w, h = size
+    ctx = create_headless_context()
+    r = Renderer(ctx)
+    r.timer.sync = False  # no glFinish between passes: whole frames are timed here
+
+    # frames (with 2 warm-ups) of two Skinlab settings, then pyrender's in one subprocess (one step)
+    bar = tqdm(total=2 * (frames + 2) + 1, desc="bench peer", unit="frame", file=sys.stderr, disable=not progress)
+
+    def timed(settings, what):
+        bar.set_postfix_str(what)
+        r.render(scene, settings)
+        r.render(scene, settings)
+        bar.update(2)
+        out = []
+        for _ in range(frames):
+            t0 = time.perf_counter()
+            r.render(scene, settings, readback=("ldr", "depth"))  # what pyrender reads back
+            out.append((time.perf_counter() - t0) * 1e3)
+            bar.update()
+        return out
+
+    try:
+        ours = timed(RenderSettings(w, h, sss_model="none"), "skinlab plain PBR")
+        ours_default = timed(RenderSettings(w, h), "skinlab default")
+    finally:
+        r.release()
+    bar.set_postfix_str("pyrender (subprocess)")
+    cam = scene.camera
+    meshes = [(str(n.mesh.source), n.world_matrix) for n in scene.mesh_nodes()]
+    peer = run_peer(meshes, cam.world_matrix, cam.yfov, cam.znear, cam.zfar, size, frames=frames)
+    bar.update()
+    bar.close()
+    theirs = list(map(float, peer["times"]))
+    mo, mt = statistics.median(ours), statistics.median(theirs)
+    md = statistics.median(ours_default)
+    return {
+        "size": [w, h],
+        "frames": frames,
+        "gl": describe(ctx),
+        "skinlab_ms": mo,
+        "pyrender_ms": mt,
+        "ratio_skinlab_over_pyrender": mo / mt,
+        "skinlab_default_ms": md,
+        "ratio_default_over_pyrender": md / mt,
+    }
