@@ -5,14 +5,16 @@
     scene = load("assets/scenes/head.toml")          # or load("model.obj"): default camera and lights
     scene.find("head").visible = True                # the scene graph is plain Python (scene/graph.py)
     with Skinlab() as lab:                            # one headless GL context (EGL), reused per render
-        frame = lab.render(scene, 640, 480, technique="tsd", exposure=1.5, camera_orbit=30)
+        frame = lab.render(scene, 640, 480, technique="tsd", size=256, exposure=1.5, camera_orbit=30)
     frame.ldr    # (480, 640, 4) uint8, tone mapped sRGB, row 0 at the top (what a PNG holds)
     frame.hdr    # (480, 640, 4) float32 linear radiance, alpha = coverage
     frame.depth  # (480, 640) float32 distance along the view axis in scene units, inf = background
     print(frame.timings.table())
 
 ``render(...)`` takes the fields of :class:`app.render.settings.RenderSettings` as keywords
-(``technique``, ``sss_model``, ``tsd_size``, ``shadow_size``, ...), plus ``exposure`` (a linear
+(``technique``, ``sss_model``, ``shadow_size``, ...) and the chosen technique's own settings
+(``size=256`` for tsd's irradiance texels; `skinlab render --help` lists them per technique; an
+unknown one is an error naming it), plus ``exposure`` (a linear
 multiplier, as ``[environment] exposure``) and ``camera_orbit`` (degrees about the vertical axis
 through the meshes' centre, as ``skinlab render --camera-orbit``); both apply to this render only.
 Materials are edited with ``node.material.update({"roughness": 0.3})``, which validates each
@@ -24,6 +26,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from app.render.registry import DEFAULT_TECHNIQUE
 from app.render.renderer import FrameResult, Renderer
 from app.render.settings import RenderSettings
 from scene.graph import Scene
@@ -62,7 +65,11 @@ class Skinlab:
         ``warm_up`` renders once first, so that timings exclude shader compiles and uploads."""
         if not isinstance(scene, Scene):
             scene = load_scene(scene)
-        st = RenderSettings(width, height, **settings)
+        technique = settings.pop("technique", None)
+        if technique is None or isinstance(technique, str):  # a name and keywords for its settings
+            st = RenderSettings.for_technique(technique or DEFAULT_TECHNIQUE, width, height, **settings)
+        else:  # a technique's settings object
+            st = RenderSettings(width, height, technique=technique, **settings)
         if exposure is not None and not (0 < exposure < float("inf")):
             raise ValueError(f"exposure: expected a finite multiplier > 0, got {exposure}")
         saved_exposure, saved_camera = scene.environment.exposure, None

@@ -32,6 +32,11 @@ def test_render_head_to_numpy_with_exposure_and_orbit_restored(lab):
         lab.render(scene, 8, 8, exposure=0)
     with pytest.raises(ValueError, match="technique"):
         lab.render(scene, 8, 8, technique="magic")
+    # the technique's own settings by keyword
+    small = lab.render(scene, 24, 24, technique="tsd", size=256, shadow_size=256)
+    assert {p.resolution for p in small.plan.passes if p.name.startswith("tsd_irradiance")} == {(256, 256)}
+    with pytest.raises(ValueError, match="render setting taps: not a setting of technique 'tint'"):
+        lab.render(scene, 8, 8, technique="tint", taps=9)
 
 
 def test_a_mesh_file_opens_with_default_camera_lights_and_material(lab, tmp_path):
