@@ -26,7 +26,7 @@ FIT_GAUSSIANS = 6
 @dataclass(frozen=True)
 class ExactSettings(TechniqueSettings):
     technique = "exact"
-    size: int = option(512, "irradiance texels per side", "int", range=(16, 8192))
+    size: int = option(512, "irradiance texels per side", "int", range=(16, 8192), unit="texels")
     albedo_mix: float = option(
         0.5, "pre-/post-scatter texturing: albedo^mix before the convolution", "float", range=(0, 1)
     )
