@@ -1,0 +1,101 @@
+"""Tiny path-traced references (Mitsuba 3, scalar_rgb): the physics of the exported medium against
+Chandrasekhar's exact albedo, the framing against Skinlab's own frame, and the cache."""
+
+import math
+
+import numpy as np
+import pytest
+from tsd_scenes import skin
+
+from app.truth.compare import image_error, object_mask
+from app.truth.reference import ReferenceRequest, render_reference
+from scene.graph import CameraNode, LightNode, MeshNode, Scene
+from scene.materials import Material
+from scene.optics.montecarlo import exact_albedo_isotropic
+from scene.optics.tsd import material_medium
+from scene.primitives import box_mesh
+
+pytest.importorskip("mitsuba")
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("SKINLAB_CACHE", str(tmp_path / "cache"))
+
+
+def sky_slab(color) -> Scene:
+    """A slab many mean free paths wide and deep (mfp 1 mm, index-matched) under a uniform sky of
+    radiance 1, seen straight from above through a narrow camera."""
+    s = Scene("sky-slab", 1.0)
+    s.environment.ambient = np.ones(3)
+    mat = skin(radius=(4 * math.pi,) * 3, color=color, specular=0.0)
+    s.add(MeshNode("slab", box_mesh((400.0, 400.0, 200.0)), mat, translation=(0.0, 0.0, -100.0)))
+    cam = CameraNode("cam", yfov=math.radians(2.0), znear=100.0, zfar=3000.0)
+    cam.look_at((0.0, 0.0, 1000.0), (0.0, 0.0, 0.0))
+    s.add(cam)
+    return s
+
+
+def test_index_matched_slab_reflects_chandrasekhars_albedo():
+    """Under a uniform sky the radiance leaving toward the normal equals, by reciprocity, the
+    albedo for normal incidence: 1 - H(1) sqrt(1 - alpha) for an isotropic semi-infinite medium."""
+    s = sky_slab((0.2, 0.5, 0.8))
+    alpha = material_medium(s.find("slab").material.values).alpha_arr
+    ref = render_reference(s, ReferenceRequest(8, 8, spp=256, passes=2), progress=False)
+    got = ref.image[..., :3].reshape(-1, 3).mean(0)
+    want = np.array([exact_albedo_isotropic(a, 1.0) for a in alpha])
+    # standard error of the 64-pixel mean from the spread between the halves of the passes
+    se = np.abs(ref.half_a - ref.half_b)[..., :3].reshape(-1, 3).mean(0) / 2
+    assert np.all(np.abs(got - want) < 0.01 + 4 * se), (got, want, se)
+    assert np.all(ref.image[..., 3] > 0.99)
+
+
+def test_framing_matches_skinlabs_frame(renderer):
+    """An asymmetric object at a non-square size covers the same pixels in both renderers."""
+    s = Scene("ell", 1.0)
+    grey = Material("grey", {"base_color": (0.5, 0.5, 0.5)})
+    s.add(MeshNode("bar", box_mesh((4.0, 1.0, 1.0)), grey, translation=(1.5, 0.0, 0.0)))
+    s.add(MeshNode("post", box_mesh((1.0, 3.0, 1.0)), grey, translation=(0.0, 2.0, 0.0)))
+    key = LightNode("key", "directional")
+    s.add(key)
+    cam = CameraNode("cam", yfov=math.radians(50), znear=0.5, zfar=100)
+    cam.look_at((2.0, 2.0, 8.0), (1.0, 1.0, 0.0))
+    s.add(cam)
+    from app.render.settings import RenderSettings
+
+    w, h = 80, 56
+    ref = render_reference(s, ReferenceRequest(w, h, spp=8, passes=2), progress=False)
+    mine = renderer.render(s, RenderSettings(w, h, sss_model="none")).hdr
+    a, b = object_mask(ref.image), mine[..., 3] > 0.5
+    assert (a & b).sum() / (a | b).sum() > 0.93
+    # the disagreement is at the silhouette only: no pixel deep inside either mask differs
+    inner = a & np.roll(a, 1, 0) & np.roll(a, -1, 0) & np.roll(a, 1, 1) & np.roll(a, -1, 1)
+    assert b[inner].all()
+
+
+def test_reference_is_cached_by_content():
+    s = sky_slab((0.3, 0.3, 0.3))
+    req = ReferenceRequest(4, 4, spp=8, passes=2)
+    first = render_reference(s, req, progress=False)
+    again = render_reference(s, req, progress=False)
+    assert not first.cached and again.cached and again.key == first.key
+    assert np.array_equal(first.image, again.image)
+    assert set(first.meta["noise_floor"]) >= {"rel_l1", "rel_l1_block", "energy"}
+    other = render_reference(s, ReferenceRequest(4, 4, spp=8, passes=2, seed=1), progress=False)
+    assert not other.cached and other.key != first.key
+
+
+def test_error_measures_on_known_images():
+    ref = np.zeros((8, 8, 4), np.float32)
+    ref[2:6, 2:6] = (1.0, 1.0, 1.0, 1.0)
+    img = ref.copy()
+    img[2:4, 2:6, :3] = 1.5  # half the object 50 % too bright
+    e = image_error(img, ref)
+    assert e["rel_l1"] == pytest.approx(0.25) and e["pixels"] == 16
+    assert e["energy"] == pytest.approx([0.25, 0.25, 0.25])
+    noisy = ref.copy()
+    noisy[2:6, 2:6, :3] += np.array([[0.2, -0.2] * 2, [-0.2, 0.2] * 2] * 2)[..., None]
+    n = image_error(noisy, ref)
+    assert n["rel_l1"] == pytest.approx(0.2) and n["rel_l1_block"] == pytest.approx(0.0, abs=1e-6)
+    with pytest.raises(ValueError, match="differ"):
+        image_error(img[:4], ref)
