@@ -20,7 +20,7 @@ pytest.importorskip("mitsuba")
 
 @pytest.fixture(autouse=True)
 def _cache(tmp_path, monkeypatch):
-    monkeypatch.setenv("SKINLAB_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path / "cache"))
 
 
 def sky_slab(color) -> Scene:

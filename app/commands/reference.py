@@ -17,7 +17,7 @@ def register(sub) -> None:
         "become homogeneous media with the medium Skinlab derives from them, inside their boundary (none at index "
         "1, a rough dielectric otherwise). Renders in independent passes and reports the noise floor (relative L1 "
         "between the halves of the passes, per pixel and on 4x4 blocks). Cached by content in "
-        "$SKINLAB_CACHE/reference (default ~/.cache/skinlab/reference). See docs/ground-truth.md.",
+        "$SKINLAB_CACHE_DIR/reference (default ~/.cache/skinlab/reference). See docs/ground-truth.md.",
     )
     p.add_argument("scene", nargs="?", help="scene file (TOML); default: the Lee Perry-Smith head")
     p.add_argument(

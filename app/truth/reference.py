@@ -7,7 +7,7 @@ bar counts samples).
 
 Results are cached by a hash of everything that affects them: the exported description (world-space
 geometry, media, BSDFs, baked textures, lights, camera, size), samples, passes, seed, variant,
-integrator settings and the Mitsuba version. The cache lives in ``$SKINLAB_CACHE/reference`` (default
+integrator settings and the Mitsuba version. The cache lives in ``$SKINLAB_CACHE_DIR/reference`` (default
 ``~/.cache/skinlab/reference``): ``<key>.npz`` (mean and the two half means, float32) beside
 ``<key>.json`` (how it was made), each written to a temporary name and renamed.
 """
@@ -85,7 +85,10 @@ class Reference:
 
 
 def cache_dir() -> Path:
-    base = os.environ.get("SKINLAB_CACHE") or Path.home() / ".cache" / "skinlab"
+    """$SKINLAB_CACHE_DIR/reference, else $XDG_CACHE_HOME/skinlab/reference, else ~/.cache/skinlab/reference."""
+    base = os.environ.get("SKINLAB_CACHE_DIR")
+    if not base:
+        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "skinlab"
     return Path(base) / "reference"
 
 
@@ -123,7 +126,8 @@ def reference_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_ver
     return h.hexdigest()[:24]
 
 
-def _atomic_write(path: Path, write) -> None:
+def atomic_write(path: Path, write) -> None:
+    """write(tmp_path) fills a temporary file beside `path`, which is then renamed into place."""
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     os.close(fd)
@@ -156,8 +160,8 @@ def _store(ref: Reference) -> None:
         with open(tmp, "wb") as fh:
             np.savez_compressed(fh, image=ref.image, half_a=ref.half_a, half_b=ref.half_b)
 
-    _atomic_write(d / f"{ref.key}.npz", npz)
-    _atomic_write(d / f"{ref.key}.json", lambda tmp: Path(tmp).write_text(json.dumps(ref.meta, indent=1)))
+    atomic_write(d / f"{ref.key}.npz", npz)
+    atomic_write(d / f"{ref.key}.json", lambda tmp: Path(tmp).write_text(json.dumps(ref.meta, indent=1)))
 
 
 def chunk_plan(spp: int, passes: int) -> list[tuple[int, int]]:
