@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from tsd_scenes import skin
 
+from app.bench.truth_ledger import REFERENCE_SCENES
 from app.truth.compare import image_error, object_mask
 from app.truth.reference import ReferenceRequest, render_reference
 from scene.graph import CameraNode, LightNode, MeshNode, Scene
@@ -99,3 +100,36 @@ def test_error_measures_on_known_images():
     assert n["rel_l1"] == pytest.approx(0.2) and n["rel_l1_block"] == pytest.approx(0.0, abs=1e-6)
     with pytest.raises(ValueError, match="differ"):
         image_error(img[:4], ref)
+
+
+def test_reference_command_writes_exr_png_and_reports_its_noise(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    from app.image_output import read_image
+
+    out = tmp_path / "ref" / "slab.exr"
+    scene = REFERENCE_SCENES / "slab-edge-skin1.toml"
+    r = subprocess.run(
+        [sys.executable, "-m", "app.cli", "reference", str(scene), "--out", str(out), "--size", "12x8",
+         "--spp", "4", "--passes", "2", "--json"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    assert res["noise_floor"]["pixels"] > 0 and res["spp"] == 4 and not res["cached"]
+    img = read_image(out)
+    assert img.shape == (8, 12, 4) and np.isfinite(img).all() and img[..., 3].min() > 0.99
+    assert out.with_suffix(".png").is_file()
+    assert not [p for p in out.parent.iterdir() if p.name.startswith(".")]  # no temporary left
+
+
+def test_missing_mitsuba_says_how_to_install(monkeypatch):
+    import sys
+
+    from app.truth.reference import ReferenceUnavailable, set_variant
+
+    monkeypatch.setitem(sys.modules, "mitsuba", None)
+    with pytest.raises(ReferenceUnavailable, match="pip install"):
+        set_variant("scalar_rgb")
