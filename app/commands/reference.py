@@ -13,11 +13,12 @@ def register(sub) -> None:
     p = sub.add_parser(
         "reference",
         help="path-trace a scene volumetrically with Mitsuba 3 (the ground truth the ledger measures against)",
-        description="Path-traces the scene with Mitsuba 3's volumetric path tracer (volpath): subsurface materials "
-        "become homogeneous media with the medium Skinlab derives from them, inside their boundary (none at index "
-        "1, a rough dielectric otherwise). Renders in independent passes and reports the noise floor (relative L1 "
-        "between the halves of the passes, per pixel and on 4x4 blocks). Cached by content in "
-        "$SKINLAB_CACHE_DIR/reference (default ~/.cache/skinlab/reference). See docs/ground-truth.md.",
+        description="Path-traces the scene with Mitsuba 3's volumetric path tracer with spectral MIS "
+        "(volpathmis): subsurface materials become homogeneous media with the medium Skinlab derives from "
+        "them, inside their boundary (none at index 1, a rough dielectric otherwise). Renders in independent "
+        "passes and reports the noise floor (relative L1 between the halves of the passes, per pixel and on "
+        "4x4 blocks). Cached by content in $SKINLAB_CACHE_DIR/reference (default ~/.cache/skinlab/reference). "
+        "See docs/ground-truth.md.",
     )
     p.add_argument("scene", nargs="?", help="scene file (TOML); default: the Lee Perry-Smith head")
     p.add_argument(

@@ -30,7 +30,7 @@ from scene.graph import Scene
 from .compare import image_error, object_mask
 from .export import ReferenceDescription, describe
 
-EXPORT_VERSION = 1  # bump when the exporter changes what a scene renders as
+EXPORT_VERSION = 2  # bump when the exporter changes what a scene renders as
 CHUNK_SPP = 32
 VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
 INSTALL_HINT = "install it with `.venv/bin/pip install 'mitsuba>=3.5'` (make setup does: the 'truth' extra)"
