@@ -54,8 +54,22 @@ from pathlib import Path
 
 import numpy as np
 
+from app.bench.truth_ledger import (
+    REFERENCE_SCENES,
+    TRUTH_COLUMNS,
+    TruthSpec,
+    error_map_sheet,
+    load_truth,
+    reference_scene_names,
+    truth_errors,
+    truth_markdown,
+    write_error_map,
+)
+from app.truth.compare import relative_difference
+
 ASSETS = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 SCENE_ALIASES = {"head": None, "bunny": ASSETS / "bunny-skimmilk.toml"}
+REFERENCE_SCENE_NAMES = tuple(reference_scene_names())
 LUM_FRACTION = 0.05  # lit pixels: reference luminance above 5 % of its 99th percentile
 REC709 = np.array([0.2126, 0.7152, 0.0722])
 EDGE_RANGE_MFP = 50.0  # the edge-response integral spans +-50 mean free paths per channel
@@ -89,6 +103,7 @@ CSV_COLUMNS = [
     "profile_err_mc",
     "profile_err_model",
     "reference",
+    *TRUTH_COLUMNS,
     "status",
     "error",
     "passes_ms",
@@ -107,6 +122,7 @@ NUMERIC_COLUMNS = [
     "image_rel_l1_same_size",
     "profile_err_mc",
     "profile_err_model",
+    *TRUTH_COLUMNS,
 ]
 
 
@@ -131,6 +147,8 @@ class Sweep:
     peer_frames: int
     scenes: tuple[str, ...] = ("head", "bunny")
     extra: tuple = ()  # extra settings (tiny sweep)
+    # the path-traced truth: reference size and samples (app/bench/truth_ledger.py); None: not measured
+    truth: TruthSpec | None = None
 
 
 FULL = Sweep(
@@ -148,6 +166,8 @@ FULL = Sweep(
     budget_s=25.0,
     photons=200_000,
     peer_frames=30,
+    scenes=REFERENCE_SCENE_NAMES,
+    truth=TruthSpec((192, 192), 1024),
 )
 QUICK = Sweep(
     "quick",
@@ -164,6 +184,8 @@ QUICK = Sweep(
     budget_s=2.0,
     photons=20_000,
     peer_frames=5,
+    scenes=("head-skin1-matched", "bunny-skimmilk", "slab-edge-skin1"),
+    truth=TruthSpec((96, 96), 256),
 )
 # for the tests: four settings on the head at 64x64
 TINY = Sweep(
@@ -181,7 +203,8 @@ TINY = Sweep(
     budget_s=0.5,
     photons=4_000,
     peer_frames=1,
-    scenes=("head",),
+    scenes=("head-skin1-matched",),
+    truth=TruthSpec((32, 32), 16, passes=2),
 )
 SWEEPS = {"full": FULL, "quick": QUICK, "tiny": TINY}
 
@@ -254,6 +277,29 @@ def sweep_settings(sweep: Sweep) -> list[Setting]:
     return uniq
 
 
+def sheet_settings(settings: list[Setting]) -> list[Setting]:
+    """One setting per technique for the error-map contact sheet: the default-like one (tsd at
+    RenderSettings' K and size with automatic taps, ssss at its default taps) where swept, else the
+    technique's first; the exact reference at its largest size."""
+    from app.render.settings import RenderSettings
+
+    d = RenderSettings()
+    prefer = {
+        "tsd": Setting("tsd", K=d.tsd_gaussians, tsd_size=d.tsd_size),
+        "ssss": Setting("ssss", ssss_taps=d.ssss_taps),
+    }
+    out = []
+    for tech in ("none", "tint", "tsd", "ssss", "exact"):
+        cands = [s for s in settings if s.technique == tech]
+        if not cands:
+            continue
+        if tech == "exact":
+            out.append(max(cands, key=lambda s: s.tsd_size))
+        else:
+            out.append(prefer[tech] if prefer.get(tech) in cands else cands[0])
+    return out
+
+
 def proxy_reference(settings: list[Setting]) -> Setting | None:
     """The most accurate tsd setting: largest irradiance texture, then largest K, auto taps first."""
     tsd = [s for s in settings if s.technique == "tsd"]
@@ -266,13 +312,14 @@ def resolve_scene(name: str):
     """'head', 'bunny' (skim milk), 'bunny-marble'... (assets/scenes/NAME.toml) or a path to a scene file."""
     if name in SCENE_ALIASES:
         return SCENE_ALIASES[name]
-    p = ASSETS / f"{name}.toml"
-    if p.is_file():
-        return p
+    for folder in (REFERENCE_SCENES, ASSETS):
+        p = folder / f"{name}.toml"
+        if p.is_file():
+            return p
     p = Path(name)
     if p.suffix == ".toml" and p.is_file():
         return p
-    known = ", ".join(list(SCENE_ALIASES) + sorted(x.stem for x in ASSETS.glob("*.toml")))
+    known = ", ".join(list(SCENE_ALIASES) + sorted(x.stem for x in ASSETS.glob("*.toml")) + list(REFERENCE_SCENE_NAMES))
     raise ValueError(f"--scenes: unknown scene {name!r}; expected one of {known} or a .toml path")
 
 
@@ -575,8 +622,11 @@ def run_sweep(
     progress: bool = True,
     images: bool = True,
     command: str | None = None,
+    references: bool = False,
 ) -> dict:
-    """Run the whole ledger and write DIR/ledger.csv, ledger.md, ledger.json, pareto.png and cost.png."""
+    """Run the whole ledger and write DIR/ledger.csv, ledger.md, ledger.json, pareto.png and cost.png;
+    with the sweep's truth, error_maps/ and error_maps.png. references: path-trace the references
+    that are not cached yet (else a scene without a cached reference has no truth columns)."""
     from tqdm import tqdm
 
     from app.gl.context import create_headless_context, describe
@@ -596,6 +646,8 @@ def run_sweep(
     gl = describe(ctx)
     renderer = Renderer(ctx)
     rows: list[dict] = []
+    truth_notes: dict[str, str] = {}
+    sheet: dict[str, dict[str, np.ndarray]] = {}
     bar = tqdm(
         total=len(settings) * len(scenes),
         file=sys.stderr,
@@ -622,6 +674,18 @@ def run_sweep(
                 except Exception as exc:
                     print(f"profile references for {label} failed: {_first_line(exc)}", file=sys.stderr)
                     base_mat = None
+            truth = None
+            if sweep.truth is not None:
+                bar.set_postfix_str(f"{label}: path-traced reference")
+                try:
+                    truth = load_truth(scene, sweep.truth, render=references, progress=progress)
+                except Exception as exc:
+                    truth_notes[label] = f"the path-traced reference failed: {_first_line(exc)}"
+                if truth is None and label not in truth_notes:
+                    truth_notes[label] = (
+                        "no cached path-traced reference at "
+                        f"{sweep.truth.size[0]}x{sweep.truth.size[1]}, {sweep.truth.spp} spp: run with --references"
+                    )
             hdrs: dict[Setting, np.ndarray] = {}
             scene_rows: dict[Setting, dict] = {}
             tsd_images: dict = {}
@@ -670,6 +734,15 @@ def run_sweep(
                     )
                     row["passes"] = m["passes"]
                     hdrs[st] = m["hdr"]
+                    if truth is not None:
+                        # an untimed frame at the reference's size, compared with the truth
+                        small = renderer.render(scene, st.render_settings(sweep, truth.image.shape[1::-1]),
+                                                readback=("hdr",)).hdr  # fmt: skip
+                        row.update(truth_errors(small, truth))
+                        safe = st.label.replace(" ", "-")
+                        write_error_map(out / "error_maps" / f"{label}-{safe}.png", small, truth)
+                        if st in sheet_settings(settings):
+                            sheet.setdefault(label, {})[st.label] = relative_difference(small, truth.image)
                     if images:
                         from app.image_output import write_image
 
@@ -716,6 +789,12 @@ def run_sweep(
         bar.close()
         renderer.release()
     sweep_s = time.perf_counter() - t_start
+    if sheet:
+        error_map_sheet(
+            sheet,
+            out / "error_maps.png",
+            "signed relative difference against the path-traced truth (red: brighter, blue: darker)",
+        )
     peer_res = None
     if peer:
         try:
@@ -735,6 +814,14 @@ def run_sweep(
         "budget_s": sweep.budget_s,
         "photons": sweep.photons,
         "scenes": [scene_label(s) for s in scenes],
+        "truth": None
+        if sweep.truth is None
+        else {
+            "size": list(sweep.truth.size),
+            "spp": sweep.truth.spp,
+            "passes": sweep.truth.passes,
+            "missing": truth_notes,
+        },
         "sweep_s": sweep_s,
         "total_s": time.perf_counter() - t_start,
         "peer": peer_res,
@@ -781,23 +868,37 @@ def csv_text(rows: list[dict]) -> str:
     return buf.getvalue()
 
 
-def usable(r: dict) -> bool:
-    return (
-        r.get("status") == "ok"
-        and np.isfinite(r.get("frame_ms_median", math.nan))
-        and np.isfinite(r.get("image_rel_l1", math.nan))
-    )
+TRUTH_KEY = "truth_rel_l1_block"  # the first error axis where the path-traced truth was measured
+ERROR_LABELS = {
+    TRUTH_KEY: "error vs path-traced truth (rel-L1, 4x4 blocks)",
+    "image_rel_l1": "image rel-L1 vs exact convolution",
+}
 
 
-def pareto_front(rows: list[dict]) -> list[dict]:
-    """Rows not dominated in (frame_ms_median, image_rel_l1): sorted by time, each strictly more
-    accurate than every cheaper one."""
-    pts = sorted((r for r in rows if usable(r)), key=lambda r: (r["frame_ms_median"], r["image_rel_l1"]))
+def _finite(v) -> bool:
+    return isinstance(v, (int, float, np.floating)) and bool(np.isfinite(v))
+
+
+def usable(r: dict, key: str = "image_rel_l1") -> bool:
+    return r.get("status") == "ok" and _finite(r.get("frame_ms_median", math.nan)) and _finite(r.get(key, math.nan))
+
+
+def error_key(rows: list[dict]) -> str:
+    """The truth where every scene of `rows` has it, else the exact convolution."""
+    scenes = set(r["scene"] for r in rows)
+    with_truth = {r["scene"] for r in rows if usable(r, TRUTH_KEY)}
+    return TRUTH_KEY if scenes and with_truth == scenes else "image_rel_l1"
+
+
+def pareto_front(rows: list[dict], key: str = "image_rel_l1") -> list[dict]:
+    """Rows not dominated in (frame_ms_median, key): sorted by time, each strictly more accurate
+    than every cheaper one."""
+    pts = sorted((r for r in rows if usable(r, key)), key=lambda r: (r["frame_ms_median"], r[key]))
     front, best = [], math.inf
     for r in pts:
-        if r["image_rel_l1"] < best:
+        if r[key] < best:
             front.append(r)
-            best = r["image_rel_l1"]
+            best = r[key]
     return front
 
 
@@ -855,25 +956,33 @@ def slopes(series: dict) -> dict:
     return res
 
 
-def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS) -> list[dict]:
-    """For each error threshold: the cheapest setting whose image rel-L1 is within it in every scene
-    (cost: mean over scenes of the median frame time), overall and among tsd settings only."""
+def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS, key: str = "image_rel_l1") -> list[dict]:
+    """For each error budget tau: the cheapest setting (cost: mean over scenes of the median frame
+    time) within it in every scene, overall and among tsd settings only. Against the exact
+    convolution the budget is absolute (error <= tau); against the truth, where every setting keeps
+    the error the techniques share, it is relative to the best setting of each scene (error <= the
+    scene's smallest error + tau)."""
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     by_label: dict[str, dict] = {}
     for r in rows:
         by_label.setdefault(r["setting"], {})[r["scene"]] = r
+    floor = {s: 0.0 for s in scenes}
+    if key == TRUTH_KEY:
+        for s in scenes:
+            errs = [r[key] for r in rows if r["scene"] == s and usable(r, key)]
+            floor[s] = min(errs) if errs else math.inf
     out = []
     for tau in thresholds:
         ok = []
         for labl, per in by_label.items():
-            if len(per) != len(scenes) or not all(usable(r) and r["image_rel_l1"] <= tau for r in per.values()):
+            if len(per) != len(scenes) or not all(usable(r, key) and r[key] <= floor[s] + tau for s, r in per.items()):
                 continue
             cost = float(np.mean([r["frame_ms_median"] for r in per.values()]))
             ok.append((cost, labl, per))
         ok.sort(key=lambda t: t[0])
         best = ok[0] if ok else None
         best_tsd = next((t for t in ok if next(iter(t[2].values()))["technique"] == "tsd"), None)
-        out.append({"threshold": tau, "best": best, "best_tsd": best_tsd})
+        out.append({"threshold": tau, "best": best, "best_tsd": best_tsd, "key": key, "floor": floor})
     return out
 
 
@@ -908,8 +1017,11 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         "size (the fit/blur error without the texture-resolution error). "
         "profile error: relative L1 of the edge response against the Monte Carlo random walk, "
         "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1); `vs model`: the same against the "
-        "material's own model profile (the technique's approximation alone).",
+        "material's own model profile (the technique's approximation alone). `truth 4x4` / `truth px`: "
+        "relative L1 against the path-traced truth on 4x4 blocks / per pixel, beside the truth's noise floor "
+        "(4x4) and the largest per-channel energy difference.",
         "",
+        *truth_markdown(rows, meta),
     ]
     for scene in dict.fromkeys(r["scene"] for r in rows):
         srows = [r for r in rows if r["scene"] == scene]
@@ -944,9 +1056,10 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         L.append(
             "| setting | technique | model | K | tsd size | taps | ssss taps | blur levels | frames | "
             "frame ms median | p10 | p90 | tsd ms | image rel-L1 | image max | image p95 | rel-L1 vs exact same size | "
-            "profile err vs MC | profile err vs model | status |"
+            "profile err vs MC | profile err vs model | truth 4x4 | truth px | truth noise 4x4 | truth energy | "
+            "status |"
         )
-        L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+        L.append("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
         for r in srows:
             status = r["status"] + (f": {r['error']}" if r.get("error") else "")
             pct = lambda v: "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100 * v:.2f} %"
@@ -973,6 +1086,10 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
                         pct(r.get("image_rel_l1_same_size")),
                         pct(r.get("profile_err_mc")),
                         pct(r.get("profile_err_model")),
+                        pct(r.get("truth_rel_l1_block")),
+                        pct(r.get("truth_rel_l1")),
+                        pct(r.get("truth_noise_block")),
+                        pct(r.get("truth_energy")),
                         status.replace("|", "/"),
                     ]
                 )
@@ -981,11 +1098,10 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         L.append("")
         fr = fronts.get(scene, [])
         if fr:
+            key = error_key(rows)
             L.append(
-                "Pareto front (time, image rel-L1): "
-                + " -> ".join(
-                    f"`{r['setting']}` ({r['frame_ms_median']:.1f} ms, {100 * r['image_rel_l1']:.2f} %)" for r in fr
-                )
+                f"Pareto front (time, {ERROR_LABELS[key]}): "
+                + " -> ".join(f"`{r['setting']}` ({r['frame_ms_median']:.1f} ms, {100 * r[key]:.2f} %)" for r in fr)
             )
             L.append("")
     L += [
@@ -1036,14 +1152,20 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
             )
         L.append(f"| pyrender | {p['pyrender_ms']:.2f} | 1 |")
     L.append("")
+    key = recs[0]["key"] if recs else "image_rel_l1"
+    rule = (
+        "whose error against the path-traced truth (4x4 blocks) is within tau of the scene's best setting in "
+        "*every* scene (every technique keeps the error they share, so the budget is relative to the best)"
+        if key == TRUTH_KEY
+        else "whose image rel-L1 against the reference is <= tau in *every* scene; the reference itself "
+        "qualifies trivially"
+    )
     L += [
         "## Recommended defaults",
         "",
-        "Rule: for each image-error budget tau, the cheapest setting (mean over the scenes of its median "
-        "frame time) whose image rel-L1 against the reference is <= tau in *every* scene; the reference "
-        "itself qualifies trivially. `tsd only` restricts this to texture-space diffusion settings "
-        "(what RenderSettings' tsd_size / tsd_gaussians / tsd_taps defaults choose among). A setting "
-        "must have been measured in every scene.",
+        f"Rule: for each error budget tau, the cheapest setting (mean over the scenes of its median frame time) "
+        f"{rule}. `tsd only` restricts this to texture-space diffusion settings (what RenderSettings' tsd_size / "
+        "tsd_gaussians / tsd_taps defaults choose among). A setting must have been measured in every scene.",
         "",
         "| budget tau | cheapest setting | mean ms | errors per scene "
         "| cheapest tsd setting | mean ms | errors per scene |",
@@ -1058,7 +1180,7 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
             return [
                 f"`{labl}`",
                 f"{cost:.1f}",
-                ", ".join(f"{s} {100 * r['image_rel_l1']:.2f} %" for s, r in per.items()),
+                ", ".join(f"{s} {100 * r[key]:.2f} %" for s, r in per.items()),
             ]
 
         L.append(f"| {100 * rec['threshold']:g} % | " + " | ".join(cell(rec["best"]) + cell(rec["best_tsd"])) + " |")
@@ -1076,9 +1198,10 @@ def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
     from app.bench.ledger_plots import cost_plot, pareto_plot
 
     out = Path(out)
+    key = error_key(rows)
     fronts = {}
     for scene in dict.fromkeys(r["scene"] for r in rows):
-        fronts[scene] = pareto_front([r for r in rows if r["scene"] == scene])
+        fronts[scene] = pareto_front([r for r in rows if r["scene"] == scene], key)
     k_sizes = [r["tsd_size"] for r in rows if r["technique"] == "tsd"]
     # the K sweep's size: the size with the most distinct K
     k_size = None
@@ -1090,9 +1213,9 @@ def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
         k_size = max(counts, key=lambda s: (len(counts[s]), s)) if counts else None
     series = cost_series(rows, {"k_size": k_size})
     sl = slopes(series)
-    recs = recommendations(rows)
+    recs = recommendations(rows, key=key)
     write_text_atomic(out / "ledger.csv", csv_text(rows))
-    pareto_plot(rows, fronts, out / "pareto.png")
+    pareto_plot(rows, fronts, out / "pareto.png", key=key, label=ERROR_LABELS[key])
     cost_plot(series, sl, out / "cost.png")
     md = markdown(rows, meta, sl, recs, fronts)
     write_text_atomic(out / "ledger.md", md)
@@ -1122,13 +1245,18 @@ def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
         "slopes": {s: {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()} for s, d in sl.items()},
         "pareto": {s: [r["setting"] for r in f] for s, f in fronts.items()},
         "recommendations": rec_json,
+        "error_axis": key,
     }
     write_text_atomic(out / "ledger.json", json.dumps(clean(doc), indent=1))
+    names = ["ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png"]
+    if (out / "error_maps.png").is_file() and key == TRUTH_KEY:
+        names.append("error_maps.png")
     return {
         "rows": rows,
         "meta": meta,
         "slopes": sl,
         "recommendations": recs,
         "fronts": fronts,
-        "files": [str(out / n) for n in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png")],
+        "error_axis": key,
+        "files": [str(out / n) for n in names],
     }

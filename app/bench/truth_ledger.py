@@ -121,3 +121,53 @@ def error_map_sheet(maps: dict[str, dict[str, np.ndarray]], path: Path, title: s
     finally:
         plt.close(fig)
     return Path(path)
+
+
+def _pct(v) -> str:
+    return "" if v is None or not isinstance(v, (int, float)) or not math.isfinite(v) else f"{100 * v:.1f} %"
+
+
+def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
+    """The ledger's section against the truth: a table of settings x scenes (error on 4x4 blocks,
+    the reference's noise floor beside it), what is missing, and the error maps."""
+    t = meta.get("truth")
+    if not t:
+        return []
+    L = [
+        "## Against the path-traced truth",
+        "",
+        f"Each setting rendered once more at {t['size'][0]}x{t['size'][1]} (untimed) and compared with the scene "
+        f"path-traced by Mitsuba 3 (volpathmis, {t['spp']} spp in {t['passes']} passes; `skinlab reference`, "
+        "docs/ground-truth.md): relative L1 of linear radiance over the object on 4x4-pixel blocks (per pixel in "
+        "the per-scene tables). `noise` is the reference's own noise floor: the same measure between the halves "
+        "of its passes (the full reference is about half as noisy); differences below it are not resolved.",
+        "",
+    ]
+    for scene, why in (t.get("missing") or {}).items():
+        L.append(f"- **{scene}**: {why}")
+    scenes = [s for s in dict.fromkeys(r["scene"] for r in rows) if s not in (t.get("missing") or {})]
+    if not scenes:
+        return [*L, ""]
+    noise = {
+        s: next((r.get("truth_noise_block") for r in rows if r["scene"] == s and r.get("truth_noise_block")), None)
+        for s in scenes
+    }
+    L.append("| setting | " + " | ".join(f"{s} (noise {_pct(noise[s])})" for s in scenes) + " | mean ms |")
+    L.append("|---|" + "---|" * (len(scenes) + 1))
+    by_label: dict[str, dict] = {}
+    for r in rows:
+        by_label.setdefault(r["setting"], {})[r["scene"]] = r
+    for labl, per in by_label.items():
+        cells = [_pct(per[s].get("truth_rel_l1_block")) if s in per else "" for s in scenes]
+        ms = [per[s].get("frame_ms_median") for s in scenes if s in per]
+        ms = [m for m in ms if isinstance(m, (int, float)) and math.isfinite(m)]
+        mean_ms = f"{sum(ms) / len(ms):.1f}" if ms else ""
+        L.append(f"| {labl} | " + " | ".join(cells) + f" | {mean_ms} |")
+    L += [
+        "",
+        "Error maps: `error_maps/SCENE-SETTING.png` for every setting, `error_maps.png` for one setting per "
+        "technique: (frame - truth) / truth of luminance on 4x4 blocks, red brighter, blue darker, full colour "
+        "at +-50 %.",
+        "",
+    ]
+    return L
