@@ -136,3 +136,20 @@ def test_missing_mitsuba_says_how_to_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "mitsuba", None)
     with pytest.raises(ReferenceUnavailable, match="pip install"):
         set_variant("scalar_rgb")
+
+
+def test_error_map_signs_and_dark_blocks():
+    from app.truth.compare import error_map_rgb, relative_difference
+
+    ref = np.zeros((8, 8, 4), np.float32)
+    ref[..., 3] = 1.0
+    ref[:4, :, :3] = 1.0  # a lit top half, a black bottom half
+    img = ref.copy()
+    img[:4, :4, :3] = 1.2  # 20 % brighter at the top left
+    img[:4, 4:, :3] = 0.9  # 10 % darker at the top right
+    img[4:, :, :3] = 0.05  # light where the truth has none: not a relative difference
+    d = relative_difference(img, ref)
+    assert np.allclose(d[:4, :4], 0.2) and np.allclose(d[:4, 4:], -0.1) and np.isnan(d[4:]).all()
+    rgb = error_map_rgb(d)
+    assert rgb[0, 0, 0] > rgb[0, 0, 2] and rgb[0, 7, 2] > rgb[0, 7, 0]  # red brighter, blue darker
+    assert (rgb[7, 7] == (40, 40, 40)).all()

@@ -20,6 +20,7 @@ import numpy as np
 BLOCK = 4
 COVERAGE = 0.5
 MAP_SCALE = 0.5  # error maps: full colour at +-50 % relative difference
+MAP_DARK = 0.01  # blocks darker than this fraction of the brightest (99th percentile) block are not judged
 REC709 = np.array([0.2126, 0.7152, 0.0722])
 
 
@@ -62,14 +63,16 @@ def image_error(img: np.ndarray, ref: np.ndarray, mask: np.ndarray | None = None
 
 def relative_difference(img: np.ndarray, ref: np.ndarray, block: int = BLOCK) -> np.ndarray:
     """Signed (img - ref) / ref of luminance per block x block tile, expanded back to pixels (NaN
-    outside the object)."""
+    outside the object and where the truth's block is darker than MAP_DARK of its 99th percentile
+    block: a relative difference of almost nothing says nothing)."""
     _check(img, ref)
     m = object_mask(ref)
     li = np.where(m, img[..., :3] @ REC709, 0.0)
     lr = np.where(m, ref[..., :3] @ REC709, 0.0)
     bi, br, bm = block_sums(li, block), block_sums(lr, block), block_sums(m.astype(np.float64), block)
+    lit = br > MAP_DARK * (np.percentile(br[bm > 0], 99) if (bm > 0).any() else 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        d = np.where((bm > 0) & (br > 0), (bi - br) / br, np.nan)
+        d = np.where((bm > 0) & (br > 0) & lit, (bi - br) / br, np.nan)
     out = np.full(m.shape, np.nan)
     h2, w2 = d.shape[0] * block, d.shape[1] * block
     out[:h2, :w2] = np.repeat(np.repeat(d, block, axis=0), block, axis=1)
@@ -78,7 +81,7 @@ def relative_difference(img: np.ndarray, ref: np.ndarray, block: int = BLOCK) ->
 
 def error_map_rgb(diff: np.ndarray, scale: float = MAP_SCALE) -> np.ndarray:
     """uint8 RGB: red where the image is brighter than the truth, blue where darker (full colour at
-    +-scale), white where equal, dark grey outside the object."""
+    +-scale), white where equal, dark grey outside the object or where the truth is too dark."""
     import matplotlib
 
     cmap = matplotlib.colormaps["RdBu_r"]
