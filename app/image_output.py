@@ -1,16 +1,16 @@
 """Write images atomically: PNG (8-bit sRGB, for people) or EXR (float linear, for numbers).
 
-Each file is written to a temporary name beside the target and renamed into place, so a
-crash never leaves a half-written image.
+Each file is written to a temporary name beside the target and renamed into place
+(app/atomic_write.py), so a crash never leaves a half-written image.
 """
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
+
+from app.atomic_write import atomic_path
 
 FORMATS = {".png": "png", ".exr": "exr"}
 
@@ -42,23 +42,14 @@ def write_image(path: str | Path, pixels: np.ndarray) -> Path:
     if c == 4:
         spec.channelnames = ("R", "G", "B", "A")
         spec.alpha_channel = 3
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        out = oiio.ImageOutput.create(tmp)
-        if out is None or not out.open(tmp, spec):
+    with atomic_path(path) as tmp:
+        out = oiio.ImageOutput.create(str(tmp))
+        if out is None or not out.open(str(tmp), spec):
             raise OSError(f"{path}: cannot open for writing: {oiio.geterror()}")
         ok = out.write_image(pixels)
         out.close()
         if not ok:
             raise OSError(f"{path}: write failed: {oiio.geterror()}")
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600 files; outputs get ordinary permissions
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path
 
 

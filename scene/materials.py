@@ -3,7 +3,12 @@
 A :class:`Param` has a name, a kind, a default and a valid range. Kinds:
 - ``float`` / ``color`` / ``vec3``: plain values, uploaded as uniforms ``u_<name>``;
 - ``texture``: a file path; when set it selects a shader variant (``HAS_<NAME>``) and binds a sampler;
-- ``choice``: an option that changes shader code (e.g. the SSS model): a define ``<NAME>_<OPTION>``.
+- ``choice``: an option the renderer reads on the CPU (the SSS model picks the profile a technique
+  plans with); it is no uniform and no define.
+
+The GLSL declarations of the uniforms and samplers come from the same declaration: the virtual
+include ``skinlab/material.glsl`` (:func:`glsl_material_uniforms`), so a renamed parameter is a
+compile error in the shaders that use it, not a uniform silently left at zero.
 """
 
 from __future__ import annotations
@@ -155,18 +160,10 @@ class Material:
             if p.kind == "texture" and self.values[p.name] is not None
         }
 
-    def defines(self, kinds: tuple[str, ...] = ("texture",)) -> dict[str, str]:
-        """Shader-variant defines: ``HAS_<MAP>`` for set maps and ``<CHOICE>_<OPTION>`` for choices.
-        A pass asks only for the kinds its code depends on, so unrelated settings share a program."""
-        d = {}
-        for p in self.params:
-            if p.kind not in kinds:
-                continue
-            if p.kind == "texture" and self.values[p.name] is not None:
-                d[p.define] = "1"
-            elif p.kind == "choice":
-                d[f"{p.name.upper()}_{self.values[p.name].upper().replace('-', '_')}"] = "1"
-        return d
+    def defines(self) -> dict[str, str]:
+        """Shader-variant defines: ``HAS_<MAP>`` for the maps that are set (plain values are uniforms,
+        so materials that differ only in values share a program)."""
+        return {p.define: "1" for p in self.params if p.kind == "texture" and self.values[p.name] is not None}
 
     @property
     def has_subsurface(self) -> bool:
@@ -175,6 +172,23 @@ class Material:
             and self.values["sss_model"] != "none"
             and max(self.values["subsurface_radius"]) > 0
         )
+
+
+_GLSL_TYPES = {"float": "float", "color": "vec3", "vec3": "vec3"}
+
+
+def glsl_material_uniforms(params: tuple[Param, ...] = PRINCIPLED_PARAMS) -> str:
+    """The material uniform and sampler declarations (the virtual include ``skinlab/material.glsl``):
+    ``uniform <type> u_<name>;`` per plain value and ``uniform sampler2D u_<map>;`` inside
+    ``#ifdef HAS_<MAP>`` per texture. Choices are read on the CPU and declare nothing."""
+    lines = ["// generated from scene/materials.py (PRINCIPLED_PARAMS): the material's uniforms"]
+    for p in params:
+        if p.kind in _GLSL_TYPES:
+            unit = f" ({p.unit})" if p.unit else ""
+            lines.append(f"uniform {_GLSL_TYPES[p.kind]} {p.uniform};" + (f"  // {p.doc}{unit}" if p.doc else ""))
+        elif p.kind == "texture":
+            lines += [f"#ifdef {p.define}", f"uniform sampler2D {p.uniform};  // {p.doc}", "#endif"]
+    return "\n".join(lines) + "\n"
 
 
 def medium_values(medium) -> dict[str, Any]:

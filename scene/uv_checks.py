@@ -1,7 +1,7 @@
 """UV-layout checks for texture-space diffusion (d'Eon & Luebke 2007).
 
 Texture-space diffusion renders each mesh's irradiance into a square UV texture of
-``texels`` x ``texels`` texels (``RenderSettings.tsd_size``) and blurs it there with kernels measured
+``texels`` x ``texels`` texels (``TsdSettings.size``) and blurs it there with kernels measured
 in millimetres. That only works when the UV layout is a faithful, non-overlapping map of the
 surface, and the blur needs to know how many millimetres one texel spans. ``analyse_uvs``
 measures both, in pure NumPy:

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from app.bench import accuracy as acc
+from scene.optics import edges
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -136,7 +137,7 @@ def test_failing_setting_is_an_error_row_and_the_sweep_goes_on(ctx, tmp_path):
     sweep = replace(acc.TINY, ks=(6,), extra=(bad,), frames=1, warmup=1)
     res = acc.run_sweep(sweep, tmp_path, peer=False, progress=False, images=False)
     rows = {r["setting"]: r for r in res["rows"]}
-    assert rows[bad.label]["status"] == "error" and "ssss_taps" in rows[bad.label]["error"]
+    assert rows[bad.label]["status"] == "error" and "ssss setting taps" in rows[bad.label]["error"]
     assert rows["none"]["status"] == "ok" and rows[bad.label] is res["rows"][-1]
     _, csv_rows = read_rows(tmp_path / "ledger.csv")
     assert len(csv_rows) == len(acc.sweep_settings(sweep)) and math.isnan(float(csv_rows[-1]["frame_ms_median"]))
@@ -207,12 +208,34 @@ def test_edge_error_scores_a_step_one_and_the_reference_zero():
 
     medium = Medium.from_artist_radius((0.8, 0.55, 0.45), (3.67, 1.37, 0.68), eta=1.4)
     ref = acc.model_reference("burley", medium)
-    exact = acc.technique_edge_fn("exact", "burley", medium)
-    assert acc.edge_error(ref, exact) == pytest.approx(0.0, abs=1e-12)
-    assert acc.edge_error(ref, acc.technique_edge_fn("none", "none", medium)) == pytest.approx(1.0)
-    fit6 = acc.edge_error(ref, acc.technique_edge_fn("tsd", "burley", medium, acc.fit_kernel("burley", medium, 6)))
-    fit1 = acc.edge_error(ref, acc.technique_edge_fn("tsd", "burley", medium, acc.fit_kernel("burley", medium, 1)))
+    assert acc.edge_error(ref, edges.model_edge("burley", medium)) == pytest.approx(0.0, abs=1e-12)
+    assert acc.edge_error(ref, edges.step_edge) == pytest.approx(1.0)
+    fit6 = acc.edge_error(ref, edges.gaussians_edge(acc.fit_kernel("burley", medium, 6)))
+    fit1 = acc.edge_error(ref, edges.gaussians_edge(acc.fit_kernel("burley", medium, 1)))
     assert 0.0 < fit6 < fit1 < 1.0
+
+
+def test_each_technique_gives_its_edge_response_from_the_frame_plan(renderer):
+    """The ledger asks the technique (registry) for its edge response as the frame rendered it."""
+    from tsd_scenes import skin, slab_scene
+
+    from app.render.settings import RenderSettings
+    from scene.optics.tsd import material_medium
+
+    scene = slab_scene(material=skin("burley"))
+    medium = material_medium(scene.find("slab").material.values)
+    ref = acc.model_reference("burley", medium)
+    errs = {}
+    for t in ("none", "tint", "tsd", "exact", "ssss"):
+        own = {"size": 64} if t in ("tsd", "exact") else {}  # texels: the plan is what counts here
+        plan = renderer.render(
+            scene, RenderSettings.for_technique(t, 32, 32, shadow_size=64, **own), readback=False
+        ).plan
+        errs[t] = acc.edge_error(ref, acc.edge_response(t, "burley", medium, plan))
+        assert acc.edge_error(ref, acc.edge_response(t, "none", medium, plan)) == pytest.approx(1.0)
+    assert errs["none"] == pytest.approx(1.0) and errs["tint"] == pytest.approx(1.0)  # no light moves
+    assert errs["exact"] == pytest.approx(0.0, abs=1e-12)
+    assert 0.0 < errs["tsd"] < 0.5 and 0.0 < errs["ssss"] < 1.0, errs
 
 
 def test_accuracy_registered_beside_peer_and_reload():

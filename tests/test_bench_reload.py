@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from app.commands.bench import bench_edit, reload_bench
+from app.bench.reload import bench_edit, reload_bench
 
 ROOT = Path(__file__).resolve().parents[1]
 FAST = dict(size=(32, 32), shadow_size=64, tsd_size=16)

@@ -79,8 +79,14 @@ def test_render_sss_override(tmp_path):
         (["render", "--out", "x.jpg"], "x.jpg: unsupported image extension '.jpg'; expected .png or .exr"),
         (["render", "missing.toml"], "scene file not found: missing.toml"),
         (["render", "--size", "12"], "--size: expected WIDTHxHEIGHT"),
-        (["render", "--size", "8x8", "--tsd-size", "3"], "tsd_size: expected an integer in [16, 8192], got 3"),
-        (["render", "--size", "8x8", "--gaussians", "9"], "tsd_gaussians: expected an integer in [1, 6], got 9"),
+        (["render", "--size", "8x8", "--tsd-size", "3"], "--tsd-size: expected an integer in [16, 8192], got 3"),
+        (["render", "--size", "8x8", "--gaussians", "9"], "--tsd-gaussians: expected an integer in [1, 6], got 9"),
+        (["render", "--size", "8x8", "--tsd-taps", "x"], "--tsd-taps: expected an odd integer in [7, 31]"),
+        (
+            ["render", "--size", "8x8", "--technique", "ssss", "--ssss-taps", "4"],
+            "--ssss-taps: expected an odd integer in [3, 63], got 4",
+        ),
+        (["render", "--size", "8x8", "--ssss-taps", "11"], "--ssss-taps: a setting of technique ssss, but --technique"),
     ],
 )
 def test_bad_input_is_one_clear_line(args, message):

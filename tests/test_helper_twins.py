@@ -81,7 +81,7 @@ def test_dipole_and_depth_helpers(glsl):
     z, d, s = grid([1.0, 2.3], [1.0, 1.5, 10.0, 1e3, 1e6, 1e30], [0.0, 1e-3, 0.5, 1.7])
     d3, s3 = np.stack([d] * 3, 1), np.stack([s] * 3, 1)
     gpu = glsl.evaluate("lib/profiles_dipole.glsl", "dipole_pole(z, d, s)", {"z": z, "d": d3, "s": s3}, 3)
-    assert_close_fp32(gpu, dipole._pole(z[:, None], d3, s3), what="dipole_pole")
+    assert_close_fp32(gpu, dipole.dipole_pole(z[:, None], d3, s3), what="dipole_pole")
 
     i = np.arange(len(ss.depth_samples()), dtype=np.float64)
     gpu = glsl.evaluate("lib/profiles_common.glsl", "depth_sample(int(i))", {"i": i})[:, 0]

@@ -6,6 +6,7 @@ from head_probe import landmarks, project, redness
 
 from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
+from app.render.techniques.tsd import TsdSettings
 from scene import scenefile
 from scene.scenefile import load_scene
 
@@ -20,7 +21,7 @@ def renderer(ctx):
 @pytest.fixture(scope="module")
 def head_frames(renderer):
     s = load_scene()
-    settings = RenderSettings(*SIZE, shadow_size=512, tsd_size=256)
+    settings = RenderSettings(*SIZE, shadow_size=512, technique=TsdSettings(size=256))
     return s, renderer.render(s, settings), renderer.render(s, settings)
 
 
@@ -43,7 +44,7 @@ def test_lips_are_where_the_lips_are(renderer, head_frames):
     wrong = load_scene()
     (head,) = wrong.mesh_nodes()
     head.mesh = scenefile.flip_v(head.mesh)  # flipping twice undoes the scene file's flip_v
-    w = renderer.render(wrong, RenderSettings(*SIZE, shadow_size=512, tsd_size=256))
+    w = renderer.render(wrong, RenderSettings(*SIZE, shadow_size=512, technique=TsdSettings(size=256)))
     assert not redness(w.hdr, px["lips"]) > 1.25 * redness(w.hdr, px["cheek"])
 
 

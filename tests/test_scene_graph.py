@@ -62,7 +62,6 @@ def test_material_declaration_drives_uniforms_defines_and_validation():
     assert u["u_roughness"] == 0.3 and u["u_subsurface_radius"] == (1.0, 0.2, 0.1)
     assert "u_base_color_map" not in u and m.textures()["u_base_color_map"][1] == "srgb"
     assert m.defines() == {"HAS_BASE_COLOR_MAP": "1"}
-    assert m.defines(("choice",)) == {"SSS_MODEL_BURLEY": "1"}
     with pytest.raises(ValueError, match=r"material 'skin': roughness: value 1.5 outside the valid range \[0.0, 1.0\]"):
         m.update({"roughness": 1.5})
     with pytest.raises(ValueError, match="subsurface_radius: value .* outside .* mm"):

@@ -5,8 +5,11 @@ import numpy as np
 import pytest
 from tsd_scenes import exact_profile, pixel_x, skin, slab_scene
 
-from app.render.passes.tsd import read_texture
 from app.render.settings import RenderSettings
+from app.render.techniques.exact import ExactSettings
+from app.render.techniques.ssss import SsssSettings
+from app.render.techniques.tsd import TsdSettings
+from app.render.techniques.tsd.passes import frame_nodes, read_texture
 from scene.optics import ssss, tsd
 
 
@@ -19,10 +22,10 @@ def edge_row(res, n):
 def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer, model):
     n = 192
     scene = slab_scene(occluder=True, material=skin(model))
-    res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, tsd_size=n, technique="exact"))
+    res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, technique=ExactSettings(size=n)))
     assert [p.kind for p in res.plan.passes].count("tsd_exact") == 1
     assert "tsd_blur" not in [p.kind for p in res.plan.passes]
-    t = renderer.last_frame.tsd[id(scene.find("slab"))]
+    t = frame_nodes(renderer.last_frame)[scene.find("slab").uid]
     medium = tsd.material_medium(t.material.values)
     row, lit = edge_row(res, n)
     x_mm = pixel_x(n, 1.0) * scene.mm_per_unit
@@ -47,10 +50,10 @@ def test_screen_space_sss_follows_its_separable_kernel(renderer):
     n = 160
     scene = slab_scene(occluder=True, material=skin("burley"))
     for taps in (11, 25):
-        st = RenderSettings(n, n, shadow_size=4096, technique="ssss", ssss_taps=taps)
+        st = RenderSettings(n, n, shadow_size=4096, technique=SsssSettings(taps=taps))
         res = renderer.render(scene, st)
         assert [p.kind for p in res.plan.passes] == ["shadow", "forward", "ssss_blur", "tonemap"]
-        plan = res.plan.passes[2].params["ssss"]
+        plan = res.plan.passes[2].params.ssss
         assert len(plan.offsets_mm) == taps
         row, lit = edge_row(res, n)
         x_mm = pixel_x(n, 1.0) * scene.mm_per_unit
@@ -77,7 +80,7 @@ def test_screen_space_sss_does_not_bleed_across_depth_discontinuities(renderer):
     near_mat = skin("burley", base=(1.0, 1.0, 1.0))
     scene.add(MeshNode("near", near, near_mat))
     scene.lights()[0].intensity = 1.0
-    st = RenderSettings(96, 96, shadow_size=512, technique="ssss", ssss_taps=25)
+    st = RenderSettings(96, 96, shadow_size=512, technique=SsssSettings(taps=25))
     a = renderer.render(scene, st).hdr
     scene.find("slab").visible = False
     b = renderer.render(scene, st).hdr
@@ -88,10 +91,10 @@ def test_screen_space_sss_does_not_bleed_across_depth_discontinuities(renderer):
 
 def test_tint_baseline_is_the_profile_colour_without_blur(renderer):
     scene = slab_scene(material=skin("burley"))
-    st = RenderSettings(48, 48, tsd_size=64)
+    st = RenderSettings(48, 48, technique=TsdSettings(size=64))
     tsd_img = renderer.render(scene, st).hdr[24, 24, :3]
     res = renderer.render(scene, RenderSettings(48, 48, technique="tint"))
     assert [p.kind for p in res.plan.passes] == ["forward", "tonemap"]
-    tint = res.plan.passes[0].params["tint"][scene.find("slab").uid][1]
+    tint = res.plan.passes[0].params.hook.tints[scene.find("slab").uid][1]
     np.testing.assert_allclose(res.hdr[24, 24, :3], tsd_img * tint, rtol=1e-3)
     assert tint.max() == 1.0 and tint.min() < 1.0

@@ -5,14 +5,15 @@ import pytest
 from tsd_scenes import exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 from app.gl.glsl_eval import assert_close_fp32
-from app.render.passes.tsd import read_texture
 from app.render.settings import RenderSettings
+from app.render.techniques.tsd import TsdSettings
+from app.render.techniques.tsd.passes import frame_nodes, read_texture, store
 from scene.mesh import Mesh
 from scene.optics import tsd
 
 
 def tsd_node(renderer, scene, name="slab"):
-    return renderer.last_frame.tsd[id(scene.find(name))]
+    return frame_nodes(renderer.last_frame)[scene.find(name).uid]
 
 
 def test_subsurface_glsl_twins(glsl):
@@ -31,7 +32,7 @@ def test_dilation_pass_matches_its_twin(renderer):
     """passes/tsd_dilate.frag against dilate_reference on a texture with islands, holes and edges."""
     from types import SimpleNamespace
 
-    from app.render.passes.tsd import _dilate
+    from app.render.techniques.tsd.passes import dilate
 
     rng = np.random.default_rng(5)
     n = 32
@@ -40,15 +41,15 @@ def test_dilation_pass_matches_its_twin(renderer):
     mask[10:20, 4:12] = True
     img[mask, :3] = rng.uniform(0.1, 2.0, (mask.sum(), 3))
     img[mask, 3] = 1.0
-    t = renderer.tsd.targets(SimpleNamespace(uid=-1), n)
+    t = store(renderer).targets(SimpleNamespace(uid=-1), n)
     t.stretch.write(img.tobytes())
-    _dilate(renderer, t, t.stretch, 4)
+    dilate(renderer, t, t.stretch, 4)
     gpu = read_texture(t.stretch)
     ref = tsd.dilate_reference(img, 4)
     np.testing.assert_allclose(gpu, ref, rtol=1e-5, atol=1e-6)
     assert (ref[..., 3] > 0).sum() > mask.sum()  # it did grow
     np.testing.assert_array_equal(gpu[mask], img[mask])  # covered texels are untouched
-    renderer.tsd.nodes.pop(-1).release()
+    store(renderer).nodes.pop(-1).release()
 
 
 def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
@@ -62,7 +63,7 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
         uvs=np.array([[0, 0], [1, 0], [1, 1], [0, 1]], np.float32),
     )
     scene = slab_scene(occluder=True, mesh=mesh)
-    renderer.render(scene, RenderSettings(64, 64, shadow_size=1024, tsd_size=128), readback=False)
+    renderer.render(scene, RenderSettings(64, 64, shadow_size=1024, technique=TsdSettings(size=128)), readback=False)
     t = tsd_node(renderer, scene)
     irr, stretch = read_texture(t.targets.irradiance), read_texture(t.targets.stretch)
     assert np.ptp(stretch[..., 0]) > 0.05 * stretch[..., 0].mean()  # the stretch does vary
@@ -74,7 +75,7 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
     # the fit's error: the same irradiance convolved with the exact profile (rectangle slab, uniform
     # stretch, so the brute-force reference applies)
     scene = slab_scene(occluder=True)
-    renderer.render(scene, RenderSettings(64, 64, shadow_size=1024, tsd_size=128), readback=False)
+    renderer.render(scene, RenderSettings(64, 64, shadow_size=1024, technique=TsdSettings(size=128)), readback=False)
     t = tsd_node(renderer, scene)
     irr, stretch = read_texture(t.targets.irradiance), read_texture(t.targets.stretch)
     # the stretch pass: a 40 mm square on 128 texels is 0.3125 mm per texel along u and v
@@ -95,7 +96,7 @@ def test_shadow_edge_follows_the_profile_edge_response(renderer, model):
     exact profile over the lit half-plane within 2 % (absolute, of the lit level) at every pixel."""
     n = 192
     scene = slab_scene(occluder=True, material=skin(model))
-    res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, tsd_size=n))
+    res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, technique=TsdSettings(size=n)))
     t = tsd_node(renderer, scene)
     row = res.hdr[n // 2, :, :3].astype(np.float64)
     lit = row[-8:].mean(axis=0)
@@ -114,7 +115,7 @@ def test_constant_irradiance_keeps_its_mean(renderer):
     """Energy: with uniform light, every blurred level equals the irradiance (the kernel sums to 1;
     the colour is the albedo's), and the image is the same as with a tiny radius."""
     scene = slab_scene(material=skin("burley", base=(0.7, 0.5, 0.4)))
-    res = renderer.render(scene, RenderSettings(64, 64, tsd_size=128))
+    res = renderer.render(scene, RenderSettings(64, 64, technique=TsdSettings(size=128)))
     t = tsd_node(renderer, scene)
     irr = tsd.unpremultiply(read_texture(t.targets.irradiance))
     for k in range(t.kernel.levels):
@@ -135,7 +136,7 @@ def test_scale_invariance(renderer):
     millimetres; doubling the radius with it (the issue's "halving" would quarter radius / size)
     leaves the image unchanged, as does describing the same scene with half the coordinates and
     twice the mm per unit."""
-    st = RenderSettings(96, 96, shadow_size=2048, tsd_size=128)
+    st = RenderSettings(96, 96, shadow_size=2048, technique=TsdSettings(size=128))
     a = renderer.render(slab_scene(occluder=True, mm_per_unit=20.0, material=skin(radius=(8.0, 4.0, 2.0))), st).hdr
     b = renderer.render(slab_scene(occluder=True, mm_per_unit=40.0, material=skin(radius=(16.0, 8.0, 4.0))), st).hdr
     np.testing.assert_allclose(a, b, atol=2e-4 * a.max())
@@ -168,7 +169,7 @@ def test_uv_seam_does_not_darken(renderer):
         uvs=uv,
     )
     scene = slab_scene(mesh=mesh, material=skin(radius=(20.0, 10.0, 5.0)))
-    res = renderer.render(scene, RenderSettings(96, 96, tsd_size=128))
+    res = renderer.render(scene, RenderSettings(96, 96, technique=TsdSettings(size=128)))
     img = res.hdr[..., :3]
     core = img[20:76, 20:76]
     ref = img[48, 24]
@@ -191,7 +192,7 @@ def test_translucency_through_thin_parts(renderer):
         s.add(MeshNode("back", back, Material("back", {"specular": 0.0})))
         return s
 
-    st = RenderSettings(48, 48, shadow_size=1024, tsd_size=64)
+    st = RenderSettings(48, 48, shadow_size=1024, technique=TsdSettings(size=64))
     thin = renderer.render(sheet(0.5 / 20.0), st)  # 0.5 mm
     thick = renderer.render(sheet(20.0 / 20.0), st)  # 20 mm
     none = renderer.render(sheet(0.5 / 20.0, shadow=False), st)
@@ -200,7 +201,7 @@ def test_translucency_through_thin_parts(renderer):
     # the irradiance texel is the light through 0.5 mm: e x cos x (1 - F) x sum_k W_k e^{-d^2/2v_k}
     st_thin = sheet(0.5 / 20.0)
     renderer.render(st_thin, st, readback=False)
-    t = renderer.last_frame.tsd[id(st_thin.find("slab"))]
+    t = frame_nodes(renderer.last_frame)[st_thin.find("slab").uid]
     irr = tsd.unpremultiply(read_texture(t.targets.irradiance))[32, 32]
     np.testing.assert_allclose(irr, tsd.thickness_transmittance(0.5, t.kernel)[0], rtol=1e-3)
     assert thick.hdr[24, 24, 0] < 0.05 * c[0]

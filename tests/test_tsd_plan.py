@@ -7,12 +7,14 @@ import pytest
 from tsd_scenes import quad_mesh, skin, slab_scene
 
 from app.render.settings import RenderSettings
+from app.render.techniques.tsd import TsdSettings
+from app.render.techniques.tsd.passes import store
 from scene.materials import Material
 from scene.mesh import Mesh
 from scene.optics import tsd
 from scene.scenefile import load_scene
 
-ST = RenderSettings(48, 48, shadow_size=256, tsd_size=64)
+ST = RenderSettings(48, 48, shadow_size=256, technique=TsdSettings(size=64))
 
 
 def kinds(plan):
@@ -30,10 +32,11 @@ def test_no_scattering_material_means_no_texture_space_passes(renderer):
         assert not any(k.startswith("tsd") for k in kinds(res.plan)), mat.values
         assert np.isfinite(res.hdr).all() and res.hdr[24, 24, :3].max() > 0
     # and settings override per render: --sss none / --sss dipole
-    res = renderer.render(slab_scene(), RenderSettings(48, 48, tsd_size=64, sss_model="none"))
+    res = renderer.render(slab_scene(), RenderSettings(48, 48, sss_model="none", technique=TsdSettings(size=64)))
     assert kinds(res.plan) == ["forward", "tonemap"]
     res = renderer.render(
-        slab_scene(material=skin(model="none")), RenderSettings(48, 48, tsd_size=64, sss_model="dipole")
+        slab_scene(material=skin(model="none")),
+        RenderSettings(48, 48, sss_model="dipole", technique=TsdSettings(size=64)),
     )
     assert "tsd_irradiance" in kinds(res.plan) and "scatters (dipole)" in res.plan.explain()
 
@@ -43,14 +46,14 @@ def test_stretch_map_is_recomputed_only_when_geometry_changes(renderer):
     node = scene.find("slab")
     first = renderer.render(scene, ST)
     assert "tsd_stretch" in kinds(first.plan)
-    n = renderer.tsd.stretch_updates
+    n = store(renderer).stretch_updates
     second = renderer.render(scene, ST)
-    assert "tsd_stretch" not in kinds(second.plan) and renderer.tsd.stretch_updates == n
+    assert "tsd_stretch" not in kinds(second.plan) and store(renderer).stretch_updates == n
     assert any("stretch map reused" in why for _, why in second.plan.skipped)
     node.mesh.positions = node.mesh.positions * np.float32(2.0)  # the geometry changes...
     node.mesh.version += 1
     third = renderer.render(scene, ST)
-    assert "tsd_stretch" in kinds(third.plan) and renderer.tsd.stretch_updates == n + 1
+    assert "tsd_stretch" in kinds(third.plan) and store(renderer).stretch_updates == n + 1
     scene.mm_per_unit *= 2  # ...or the scene scale
     assert "tsd_stretch" in kinds(renderer.render(scene, ST).plan)
     node.scale = (1.0, 3.0, 1.0)  # ...or the node's transform
@@ -60,11 +63,11 @@ def test_stretch_map_is_recomputed_only_when_geometry_changes(renderer):
 def test_texture_space_targets_are_released_when_no_longer_used(renderer):
     a, b = slab_scene(), slab_scene()
     renderer.render(a, ST, readback=False)
-    assert a.find("slab").uid in renderer.tsd.nodes
+    assert a.find("slab").uid in store(renderer).nodes
     renderer.render(b, ST, readback=False)  # another scene (a reload, say)
-    assert set(renderer.tsd.nodes) == {b.find("slab").uid}
-    renderer.render(b, RenderSettings(48, 48, tsd_size=64, sss_model="none"), readback=False)
-    assert renderer.tsd.nodes == {}
+    assert set(store(renderer).nodes) == {b.find("slab").uid}
+    renderer.render(b, RenderSettings(48, 48, sss_model="none", technique=TsdSettings(size=64)), readback=False)
+    assert store(renderer).nodes == {}
 
 
 def test_negligible_and_subtexel_gaussians_are_skipped():
@@ -96,7 +99,7 @@ def test_tap_count_follows_kernel_width():
 
 def test_shader_variant_matches_the_levels_used(renderer):
     res = renderer.render(slab_scene(), ST)
-    n = next(p for p in res.plan.passes if p.kind == "tsd_irradiance").params["kernel"].levels
+    n = next(p for p in res.plan.passes if p.kind == "tsd_irradiance").params.kernel.levels
     keys = [k for k in renderer.programs.entries if "passes/forward.frag" in str(k)]
     assert any(f"('TSD_LEVELS', '{n}')" in str(k) for k in keys), keys
 
@@ -121,7 +124,7 @@ def test_overlapping_uvs_and_zero_area_triangles_warn_but_render_finite(renderer
     text = " ".join(res.plan.warnings)
     assert "overlap" in text and "zero world area" in text, res.plan.warnings
     assert np.isfinite(res.hdr).all()
-    from app.render.passes.tsd import read_texture
+    from app.render.techniques.tsd.passes import read_texture
 
     for name, tex in renderer.last_frame.targets.items():
         if name.startswith("tsd"):
@@ -165,8 +168,10 @@ def test_unknown_model_and_bad_settings_are_clear_errors():
         tsd.profile_fit("fog", m, 4)
     with pytest.raises(ValueError, match="render setting sss_model: expected one of"):
         RenderSettings(sss_model="fog")
-    with pytest.raises(ValueError, match="tsd_gaussians"):
-        RenderSettings(tsd_gaussians=0)
+    with pytest.raises(ValueError, match=r"tsd setting gaussians: expected an integer in \[1, 6\], got 0"):
+        TsdSettings(gaussians=0)
+    with pytest.raises(ValueError, match="render setting technique: expected one of tsd, exact, ssss, tint, none"):
+        RenderSettings(technique="fog")
 
 
 def test_bunny_preset_scene_generates_uvs_and_scatters(renderer, tmp_path):
@@ -174,7 +179,7 @@ def test_bunny_preset_scene_generates_uvs_and_scatters(renderer, tmp_path):
     (node,) = scene.mesh_nodes()
     assert node.mesh.uvs is not None  # generate_uvs = true
     assert node.material["subsurface_radius"][0] > 10  # skim milk scatters far (Jensen 2001)
-    res = renderer.render(scene, RenderSettings(64, 64, shadow_size=256, tsd_size=128))
+    res = renderer.render(scene, RenderSettings(64, 64, shadow_size=256, technique=TsdSettings(size=128)))
     assert "tsd_irradiance" in kinds(res.plan) and np.isfinite(res.hdr).all()
     cover = res.hdr[..., 3] > 0
     assert 0.1 < cover.mean() < 0.9 and res.hdr[cover, :3].mean() > 0.05

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from app.render.settings import RenderSettings
+from app.render.techniques.tsd import TsdSettings
 from app.viewer.camera import PITCH_LIMIT, OrbitCamera
 from app.viewer.core import SSS_CYCLE, ViewerCore, next_sss_model
 from app.viewer.inspector import FINAL, Inspector, View, auto_range, display_mode, fit_viewport, target_names
@@ -31,7 +32,7 @@ from scene.materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
 from scene.scenefile import ASSETS, DEFAULT_SCENE
 
 ROOT = Path(__file__).resolve().parents[1]
-SMALL = dict(shadow_size=256, tsd_size=64)
+SMALL = dict(shadow_size=256, technique=TsdSettings(size=64))
 
 
 # -- Xvfb ----------------------------------------------------------------------------------------
@@ -362,7 +363,7 @@ def test_preset_file_reload(tmp_path, monkeypatch):
     csv = tmp_path / "presets.csv"
     csv.write_text(media.PRESET_FILE.read_text())
     monkeypatch.setattr(media, "PRESET_FILE", csv)
-    media._load_presets.cache_clear()
+    media.forget_presets()
     src = preset_reloader(settle_s=0.05)
     try:
         from scene.scenefile import load_scene
@@ -382,7 +383,7 @@ def test_preset_file_reload(tmp_path, monkeypatch):
     finally:
         src.stop()
         monkeypatch.undo()
-        media._load_presets.cache_clear()
+        media.forget_presets()
 
 
 # -- inspector and core (headless EGL) ----------------------------------------------------------------------
@@ -466,11 +467,21 @@ def test_core_settings_follow_size_and_sss_cycle(core):
     assert seen == [None, *SSS_MODELS, None]
     assert next_sss_model("pbd") is None and next_sss_model(None, -1) == "pbd"
     # T cycles the technique; the frame plan follows (screen-space SSS has its blur pass)
-    assert c.settings.technique == "tsd"
+    assert c.settings.technique_name == "tsd"
     assert c.cycle_technique() == "exact" and c.cycle_technique() == "ssss" and c.dirty
     c.render()
     assert {"ssss_diffuse", "ssss_blurred"} <= set(c.targets())
     assert c.cycle_technique(-1) == "exact"
+    # the panel edits the current technique's own settings; each technique keeps its own
+    assert c.set_technique("tsd") == "tsd" and c.settings.technique.size == 64
+    assert c.set_technique_option("gaussians", 3) == 3 and c.settings.technique.gaussians == 3
+    with pytest.raises(ValueError, match=r"tsd setting gaussians: expected an integer in \[1, 6\], got 9"):
+        c.set_technique_option("gaussians", 9)
+    with pytest.raises(ValueError, match="tsd setting 'taps_x': unknown"):
+        c.set_technique_option("taps_x", 9)
+    c.set_technique("ssss")
+    c.set_technique("tsd")
+    assert c.settings.technique.gaussians == 3 and c.settings.technique.size == 64
 
 
 def test_core_shows_shader_errors_and_keeps_rendering(core):
@@ -542,3 +553,24 @@ def test_core_reloads_a_changed_texture_file(ctx, tmp_path):
         assert dark < bright - 10  # the renderer's cached texture was replaced
     finally:
         c.close()
+
+
+def test_technique_settings_widgets_come_from_the_declaration():
+    from app.render.techniques.ssss import SsssSettings
+    from app.viewer.panel import technique_value, technique_widgets
+
+    st = TsdSettings(size=64)
+    ws = {w.param: w for w in technique_widgets(st)}
+    assert list(ws) == list(TsdSettings.options())  # one widget per declared setting, in order
+    assert ws["size"].widget == "slider_int" and ws["size"].range == (16.0, 8192.0) and ws["size"].value == 64
+    assert ws["taps"].widget == "slider_int_or_auto" and ws["taps"].value is None
+    assert ws["albedo_mix"].widget == "slider_float" and ws["translucency"].widget == "checkbox"
+    assert "irradiance texels per side" in ws["size"].doc and "default: 512" in ws["size"].doc
+    # values from a widget are made valid: clamped, rounded, odd where the setting wants odd
+    assert technique_value(st, "size", 1e9) == 8192 and technique_value(st, "size", 3.4) == 16
+    assert technique_value(st, "taps", 8) == 9 and technique_value(st, "taps", 31.6) == 31
+    assert technique_value(st, "taps", None) is None and technique_value(st, "albedo_mix", -1) == 0.0
+    assert technique_value(SsssSettings(), "taps", 64) == 63
+    for name, w in ws.items():  # and every such value is accepted by the settings class
+        v = technique_value(st, name, w.range[1] if w.range else w.value)
+        assert getattr(st.replace(**{name: v}), name) == v

@@ -95,7 +95,9 @@ def main(argv=None):
     a = p.parse_args(argv)
     text = markdown(measure(a.photons, a.eta, a.seed, not a.no_progress), a.photons, a.eta, a.seed)
     if a.out:
-        Path(a.out).write_text(text)
+        from app.atomic_write import write_text_atomic
+
+        write_text_atomic(a.out, text)
     else:
         print(text)
     return 0

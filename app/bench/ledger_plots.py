@@ -10,8 +10,10 @@ from pathlib import Path
 
 import numpy as np
 
-MARKERS = {"exact": "*", "tsd": "o", "ssss": "s", "tint": "^", "none": "X"}
-COLOURS = {"exact": "black", "tsd": "tab:blue", "ssss": "tab:orange", "tint": "tab:green", "none": "tab:red"}
+from app.atomic_write import write_bytes_atomic
+from app.render.registry import techniques
+
+from .ledger_analysis import usable
 
 
 def _floor(pts, key: str = "image_rel_l1") -> float:
@@ -29,11 +31,9 @@ def _figure_bytes(fig) -> bytes:
 def _save(fig, path: Path) -> Path:
     import matplotlib.pyplot as plt
 
-    from app.bench.accuracy import _atomic_bytes
-
     data = _figure_bytes(fig)
     plt.close(fig)
-    return _atomic_bytes(path, data)
+    return write_bytes_atomic(path, data)
 
 
 def _plt():
@@ -48,25 +48,23 @@ def _plt():
 def pareto_plot(
     rows: list[dict], fronts: dict, path: Path, key: str = "image_rel_l1", label: str = "image rel-L1"
 ) -> Path:
-    from app.bench.accuracy import usable
-
     plt = _plt()
     scenes = list(dict.fromkeys(r["scene"] for r in rows)) or ["(none)"]
     fig, axes = plt.subplots(1, len(scenes), figsize=(6.4 * len(scenes), 4.8), squeeze=False)
     for ax, scene in zip(axes[0], scenes):
         pts = [r for r in rows if r["scene"] == scene and usable(r, key)]
         floor = _floor(pts, key)
-        for tech in MARKERS:
-            sel = [r for r in pts if r["technique"] == tech]
+        for t in techniques():  # each technique's marker and colour from its LedgerStyle
+            sel = [r for r in pts if r["technique"] == t.name]
             if not sel:
                 continue
             ax.scatter(
                 [r["frame_ms_median"] for r in sel],
                 [max(r[key], floor) for r in sel],
-                marker=MARKERS[tech],
-                c=COLOURS[tech],
-                s=70 if tech == "exact" else 40,
-                label=tech,
+                marker=t.ledger.marker,
+                c=t.ledger.colour,
+                s=70 if t.ledger.marker == "*" else 40,
+                label=t.name,
                 edgecolors="none",
                 zorder=3,
             )

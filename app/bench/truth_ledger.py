@@ -94,7 +94,7 @@ def error_map_sheet(maps: dict[str, dict[str, np.ndarray]], path: Path, title: s
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from app.truth.reference import atomic_write
+    from app.atomic_write import atomic_path
 
     scenes = list(maps)
     cols = list(dict.fromkeys(c for s in scenes for c in maps[s]))
@@ -117,7 +117,8 @@ def error_map_sheet(maps: dict[str, dict[str, np.ndarray]], path: Path, title: s
     if title:
         fig.suptitle(title, fontsize=9)
     try:
-        atomic_write(Path(path), lambda tmp: fig.savefig(tmp, format="png", dpi=90))
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, format="png", dpi=90)
     finally:
         plt.close(fig)
     return Path(path)

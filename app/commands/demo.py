@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from app.atomic_write import write_text_atomic
 from app.render.settings import RenderSettings, parse_size
 
 ASSETS = Path(__file__).resolve().parents[2] / "assets" / "scenes"
@@ -79,7 +80,5 @@ def gallery(folder: Path, w: int, h: int) -> list[Path]:
         *rows,
         "",
     ]
-    tmp = folder / ".gallery.md.tmp"
-    tmp.write_text("\n".join(md))
-    tmp.replace(folder / "gallery.md")
+    write_text_atomic(folder / "gallery.md", "\n".join(md))
     return written

@@ -5,8 +5,11 @@ against the Monte Carlo reference."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
+
+from app.atomic_write import atomic_path
 
 DEFAULT_R = "0,0.01,0.02,0.05,0.1,0.2,0.5,1,2,5,10"
 
@@ -160,5 +163,6 @@ def plot_models(m, path, photons, seed=0):
         ax.grid(True, which="both", alpha=0.25)
     axes[0].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format=Path(path).suffix.lstrip(".") or "png")
     plt.close(fig)

@@ -1,4 +1,5 @@
-"""`skinlab render [SCENE] --out PATH --size WxH [--json] [--explain]`."""
+"""`skinlab render [SCENE] --out PATH --size WxH [--technique NAME] [--json] [--explain]`: the
+technique options come from the registered techniques (app/commands/technique_options.py)."""
 
 from __future__ import annotations
 
@@ -6,7 +7,8 @@ import json
 import sys
 from pathlib import Path
 
-from app.render.settings import TECHNIQUES, RenderSettings, parse_size
+from app.commands.technique_options import add_technique_options, technique_from_args
+from app.render.settings import RenderSettings, parse_size
 from scene.materials import SSS_MODELS
 
 
@@ -22,18 +24,7 @@ def register(sub) -> None:
         default=None,
         help="subsurface model for every material (default: each material's own sss_model)",
     )
-    p.add_argument(
-        "--technique",
-        choices=TECHNIQUES,
-        default="tsd",
-        help="tsd: texture-space diffusion (default); exact: brute-force texture-space convolution "
-        "with the exact profile (slow reference); ssss: screen-space separable SSS; tint: the "
-        "per-pixel profile tint baseline",
-    )
-    p.add_argument("--taps", type=int, default=None, help="texture-space blur taps (odd, 7-31; default: from width)")
-    p.add_argument("--ssss-taps", type=int, default=17, help="screen-space SSS kernel samples (11, 17, 25)")
-    p.add_argument("--tsd-size", type=int, default=None, help="texture-space diffusion texels per side (default 512)")
-    p.add_argument("--gaussians", type=int, default=None, help="Gaussians fitted to the profile, 1-6 (default 6)")
+    add_technique_options(p)
     p.add_argument("--json", action="store_true", help="print timings and output paths as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
     p.set_defaults(func=run)
@@ -61,21 +52,7 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
 
 
 def settings_from_args(args, w: int, h: int) -> RenderSettings:
-    extra = {}
-    if args.tsd_size is not None:
-        extra["tsd_size"] = args.tsd_size
-    if args.gaussians is not None:
-        extra["tsd_gaussians"] = args.gaussians
-    return RenderSettings(
-        w,
-        h,
-        shadow_size=args.shadow_size,
-        sss_model=args.sss,
-        technique=args.technique,
-        tsd_taps=args.taps,
-        ssss_taps=args.ssss_taps,
-        **extra,
-    )
+    return RenderSettings(w, h, shadow_size=args.shadow_size, sss_model=args.sss, technique=technique_from_args(args))
 
 
 def run(args) -> int:

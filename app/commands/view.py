@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 import sys
 
+from app.commands.technique_options import add_technique_options, technique_from_args
 from app.render.settings import RenderSettings, parse_size
 
 
@@ -16,12 +17,7 @@ def register(sub) -> None:
     p.add_argument("scene", nargs="?", help="scene file (TOML); default: the Lee Perry-Smith head")
     p.add_argument("--size", default="960x720", help="window size WIDTHxHEIGHT (default 960x720)")
     p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
-    p.add_argument(
-        "--tsd-size",
-        type=int,
-        default=RenderSettings.tsd_size,
-        help=f"texture-space diffusion texels per side (default {RenderSettings.tsd_size})",
-    )
+    add_technique_options(p)  # the technique the viewer starts with (T cycles) and its settings
     w = p.add_mutually_exclusive_group()
     w.add_argument(
         "--watch",
@@ -62,7 +58,8 @@ def run(args) -> int:
         image_format(args.screenshot)  # fail before opening a window
     if not (0.0 <= args.settle <= 10.0):
         raise ValueError(f"--settle: expected seconds in [0, 10], got {args.settle}")
-    RenderSettings(shadow_size=args.shadow_size, tsd_size=args.tsd_size)  # errors name the option's setting
+    technique = technique_from_args(args)  # errors name the option
+    RenderSettings(shadow_size=args.shadow_size, technique=technique)
     if not logging.getLogger().handlers:
         logging.basicConfig(level=logging.INFO, stream=sys.stderr, format="skinlab view: %(message)s")
     logging.getLogger("OpenGL").setLevel(logging.WARNING)  # PyOpenGL's "no OpenGL_accelerate" notice
@@ -76,7 +73,7 @@ def run(args) -> int:
         screenshot_dir=args.screenshot_dir,
         shader_root=args.shader_dir,
         shadow_size=args.shadow_size,
-        tsd_size=args.tsd_size,
+        technique=technique,
         settle_s=args.settle,
         continuous=args.continuous,
         show_ui=not args.no_ui,

@@ -21,8 +21,8 @@ def normalize_defines(defines: Mapping[str, object] | None) -> dict[str, str]:
     return out
 
 
-def _key(vs: str, fs: str, defines: Mapping[str, object] | None) -> tuple:
-    return (vs, fs, tuple(sorted(normalize_defines(defines).items())))
+def _key(vs: str, fs: str, defines: Mapping[str, object] | None, includes: Mapping[str, str] | None) -> tuple:
+    return (vs, fs, tuple(sorted(normalize_defines(defines).items())), tuple(sorted((includes or {}).items())))
 
 
 @dataclass
@@ -34,13 +34,19 @@ class ProgramEntry:
 
 
 def compile_program(
-    ctx: moderngl.Context, library: ShaderLibrary, vs: str, fs: str, defines: Mapping[str, object] | None = None
+    ctx: moderngl.Context,
+    library: ShaderLibrary,
+    vs: str,
+    fs: str,
+    defines: Mapping[str, object] | None = None,
+    includes: Mapping[str, str] | None = None,
 ) -> tuple[moderngl.Program, set[Path]]:
-    """Compile one program; on failure raise :class:`ShaderError` naming file and line."""
+    """Compile one program; on failure raise :class:`ShaderError` naming file and line. ``includes``:
+    include names resolved to other files for this program (ShaderLibrary.expand's aliases)."""
     defines = normalize_defines(defines)
     srcs: dict[str, ExpandedSource] = {
-        "vertex_shader": library.expand(vs, defines),
-        "fragment_shader": library.expand(fs, defines),
+        "vertex_shader": library.expand(vs, defines, includes),
+        "fragment_shader": library.expand(fs, defines, includes),
     }
     deps = {p for s in srcs.values() for p in s.paths if p is not None}
     try:
@@ -78,7 +84,7 @@ def _diagnose(ctx: moderngl.Context, srcs: dict[str, ExpandedSource]) -> ShaderE
 
 
 class ProgramCache:
-    """Programs keyed by (stage files, defines). ``reload`` recompiles programs whose files
+    """Programs keyed by (stage files, defines, include aliases). ``reload`` recompiles programs whose files
     changed and keeps the last good program when the new source fails."""
 
     def __init__(self, ctx: moderngl.Context, library: ShaderLibrary | None = None):
@@ -87,11 +93,17 @@ class ProgramCache:
         self.entries: dict[tuple, ProgramEntry] = {}
         self.compiles = 0
 
-    def get(self, vs: str, fs: str, defines: Mapping[str, object] | None = None) -> moderngl.Program:
-        key = _key(vs, fs, defines)
+    def get(
+        self,
+        vs: str,
+        fs: str,
+        defines: Mapping[str, object] | None = None,
+        includes: Mapping[str, str] | None = None,
+    ) -> moderngl.Program:
+        key = _key(vs, fs, defines, includes)
         entry = self.entries.get(key)
         if entry is None:
-            prog, deps = compile_program(self.ctx, self.library, vs, fs, defines)
+            prog, deps = compile_program(self.ctx, self.library, vs, fs, defines, includes)
             self.compiles += 1
             entry = self.entries[key] = ProgramEntry(prog, deps, None, 1)
         return entry.program
@@ -105,10 +117,10 @@ class ProgramCache:
         keys = list(self.entries) if changed is None else self.dependents(changed)
         errors = []
         for key in keys:
-            vs, fs, defs = key
+            vs, fs, defs, incs = key
             entry = self.entries[key]
             try:
-                prog, deps = compile_program(self.ctx, self.library, vs, fs, dict(defs))
+                prog, deps = compile_program(self.ctx, self.library, vs, fs, dict(defs), dict(incs))
             except ShaderError as exc:
                 entry.error = str(exc)
                 errors.append(exc)

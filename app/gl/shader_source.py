@@ -74,9 +74,10 @@ class ShaderLibrary:
     def __post_init__(self) -> None:
         self.root = Path(self.root)
         if not self.virtual:
+            from scene.materials import glsl_material_uniforms
             from scene.optics.constants import glsl_header
 
-            self.virtual = {"skinlab/constants.glsl": glsl_header}
+            self.virtual = {"skinlab/constants.glsl": glsl_header, "skinlab/material.glsl": glsl_material_uniforms}
 
     # -- reading -------------------------------------------------------------------------
     def display_name(self, path: Path) -> str:
@@ -103,8 +104,13 @@ class ShaderLibrary:
         raise ShaderError(f"shader file '{name}' not found{where}; looked in: " + ", ".join(str(c) for c in candidates))
 
     # -- expansion -----------------------------------------------------------------------
-    def expand(self, name: str, defines: Mapping[str, object] | None = None) -> ExpandedSource:
-        """Expand ``name`` (relative to the shader root) with ``defines`` for its variant."""
+    def expand(
+        self, name: str, defines: Mapping[str, object] | None = None, aliases: Mapping[str, str] | None = None
+    ) -> ExpandedSource:
+        """Expand ``name`` (relative to the shader root) with ``defines`` for its variant. ``aliases``
+        map an include name to a file under the root for this expansion only: the forward pass's
+        ``#include "skinlab/sss_hook.glsl"`` names the technique's hook file this way."""
+        aliases = dict(aliases or {})
         files: list[str] = []
         paths: list[Path | None] = []
         out: list[str] = []
@@ -118,6 +124,8 @@ class ShaderLibrary:
             out.append(code)
 
         def visit(fname: str, including: Path | None, include_site: tuple[int, int] | None) -> None:
+            if fname in aliases:
+                fname, including = aliases[fname], None
             text, path, shown = self._read(fname, including)
             key = str(path.resolve()) if path else shown
             if key in seen:

@@ -22,7 +22,7 @@ class Frame:
     targets: dict[str, moderngl.Texture] = field(default_factory=dict)
     shadow_matrices: dict[int, np.ndarray] = field(default_factory=dict)
     shadow_eyes: dict[int, np.ndarray] = field(default_factory=dict)  # slot -> light pos (w=1) / dir (w=0)
-    tsd: dict[int, object] = field(default_factory=dict)  # id(node) -> TsdFrameNode
+    data: dict[str, dict] = field(default_factory=dict)  # a technique's per-frame data, by its state key
 
     @property
     def view_proj(self) -> np.ndarray:

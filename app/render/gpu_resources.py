@@ -7,7 +7,7 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-from app.gl.uniforms import set_uniform, set_uniforms
+from app.gl.uniforms import set_uniforms
 from scene.mesh import Mesh
 from scene.textures import load_texture
 
@@ -96,13 +96,11 @@ class GpuResources:
             self.uploads += 1
         return tex
 
-    def bind_material(self, prog: moderngl.Program, material) -> None:
-        """The material's plain values as uniforms and its maps on texture units 0, 1, ... (the
-        units below the shadow maps' 5, 6)."""
+    def bind_material(self, prog: moderngl.Program, material, units) -> None:
+        """The material's plain values as uniforms and its maps on units from `units` (TextureUnits)."""
         set_uniforms(prog, material.uniforms())
-        for unit, (sampler, (path, cs)) in enumerate(material.textures().items()):
-            self.texture(path, cs).use(unit)
-            set_uniform(prog, sampler, unit)
+        for sampler, (path, cs) in material.textures().items():
+            units.bind(prog, sampler, self.texture(path, cs))
 
     def release(self) -> None:
         for g in self.meshes.values():

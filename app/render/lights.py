@@ -6,13 +6,14 @@ import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
 
-SHADOW_UNITS = (5, 6)  # texture units of shadow slots 0 and 1 (material maps use 0..4)
+SHADOW_SLOTS = 2  # shadow maps u_shadow0, u_shadow1 (shaders/lib/shadow.glsl)
 
 
-def bind_shadow_maps(renderer, frame) -> None:
-    for slot, unit in enumerate(SHADOW_UNITS):
+def bind_shadow_maps(renderer, frame, prog, units) -> None:
+    """Both shadow samplers on units from `units` (TextureUnits); an empty slot gets a 1x1 map."""
+    for slot in range(SHADOW_SLOTS):
         tex = frame.targets.get(f"shadow_map{slot}")
-        (tex if tex is not None else renderer.dummy_shadow_map()).use(unit)
+        units.bind(prog, f"u_shadow{slot}", tex if tex is not None else renderer.dummy_shadow_map())
 
 
 def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
@@ -26,8 +27,6 @@ def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
         {
             "u_num_lights": len(lights),
             "u_mm_per_unit": frame.scene.mm_per_unit,
-            "u_shadow0": SHADOW_UNITS[0],
-            "u_shadow1": SHADOW_UNITS[1],
         },
     )
     set_array(prog, "u_light_vec", np.array(vec).reshape(-1, 4), nmax)

@@ -13,14 +13,15 @@ from app.gl.shader_source import ShaderLibrary
 from scene.graph import Scene
 
 from .frame import Frame
+from .frame_plan import FramePlan
 from .gpu_resources import GpuResources
 from .passes.forward import ForwardPass
 from .passes.shadow import ShadowPass
-from .passes.ssss import SsssBlurPass
 from .passes.tonemap import TonemapPass
-from .passes.tsd import TsdBlurPass, TsdDilatePass, TsdExactPass, TsdIrradiancePass, TsdStore, TsdStretchPass
-from .plan import FramePlan, plan_frame
+from .plan import plan_frame
+from .registry import get_technique, pass_class
 from .settings import RenderSettings
+from .technique import RenderPass
 from .timing import FrameTimings, PassTimer
 
 
@@ -40,21 +41,17 @@ class Renderer:
         self.programs = ProgramCache(ctx, library)
         self.resources = GpuResources(ctx)
         self.timer = PassTimer(ctx)
-        self.tsd = TsdStore(ctx)
-        self.passes = {
+        # the core's passes; a technique's are made on first use (pass_for)
+        self.passes: dict[str, RenderPass] = {
             "shadow": ShadowPass(self),
-            "tsd_stretch": TsdStretchPass(self),
-            "tsd_irradiance": TsdIrradiancePass(self),
-            "tsd_dilate": TsdDilatePass(self),
-            "tsd_blur": TsdBlurPass(self),
-            "tsd_exact": TsdExactPass(self),
-            "ssss_blur": SsssBlurPass(self),
             "forward": ForwardPass(self),
             "tonemap": TonemapPass(self),
         }
+        self.states: dict[str, object] = {}  # techniques' GPU state kept across frames, by key
         self._fs_vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
         self._fs_vaos: dict[int, moderngl.VertexArray] = {}
         self._dummy_shadow = None
+        self._dummy_texture = None
         self.last_frame: Frame | None = None  # the latest frame's targets (viewer's pass inspector)
 
     # -- helpers for passes -----------------------------------------------------------
@@ -63,6 +60,28 @@ class Renderer:
         if vao is None or vao.program is not prog:
             vao = self._fs_vaos[id(prog)] = self.ctx.vertex_array(prog, [(self._fs_vbo, "2f", "in_pos")])
         vao.render(moderngl.TRIANGLES)
+
+    def state(self, key: str, factory):
+        """A technique's state kept across frames (made by factory(ctx) on first use)."""
+        st = self.states.get(key)
+        if st is None:
+            st = self.states[key] = factory(self.ctx)
+        return st
+
+    def pass_for(self, kind: str) -> RenderPass:
+        p = self.passes.get(kind)
+        if p is None:
+            cls = pass_class(kind)
+            if cls is None:
+                raise ValueError(f"frame plan: no registered pass for kind {kind!r}")
+            p = self.passes[kind] = cls(self)
+        return p
+
+    def dummy_texture(self) -> moderngl.Texture:
+        """A 1x1 float texture for a sampler with nothing to read (value 1e30: 'no surface')."""
+        if self._dummy_texture is None:
+            self._dummy_texture = self.ctx.texture((1, 1), 4, np.full(4, 1e30, np.float32).tobytes(), dtype="f4")
+        return self._dummy_texture
 
     def dummy_shadow_map(self) -> moderngl.Texture:
         if self._dummy_shadow is None:
@@ -73,7 +92,8 @@ class Renderer:
 
     # -- a frame ------------------------------------------------------------------------
     def plan(self, scene: Scene, settings: RenderSettings) -> FramePlan:
-        return plan_frame(scene, settings, self.tsd.stretch_valid)
+        t = get_technique(settings.technique_name)
+        return plan_frame(scene, settings, self.state(*t.state) if t.state is not None else None)
 
     def render(
         self, scene: Scene, settings: RenderSettings | None = None, readback: bool | tuple[str, ...] = True
@@ -86,7 +106,10 @@ class Renderer:
         if cam is None:
             raise ValueError(f"scene {scene.name!r} has no camera")
         plan = self.plan(scene, settings)
-        self.tsd.retain({p.params["node"].uid for p in plan.passes if p.kind.startswith("tsd_")})
+        for st in self.states.values():  # a technique's state keeps what this frame uses
+            begin = getattr(st, "begin_frame", None)
+            if begin is not None:
+                begin(plan)
         frame = Frame(
             scene,
             settings,
@@ -97,7 +120,7 @@ class Renderer:
         self.timer.start_frame()
         for p in plan.passes:
             with self.timer.measure(p.name):
-                self.passes[p.kind].run(frame, p)
+                self.pass_for(p.kind).run(frame, p)
         self.last_frame = frame
         wanted = ("hdr", "ldr", "depth") if readback is True else (readback or ())
         hdr, ldr, depth = self.read_targets(frame, wanted)
@@ -122,6 +145,20 @@ class Renderer:
         return hdr, ldr, depth
 
     def release(self) -> None:
+        """Release every GPU object the renderer made; it stays usable (all are made again on demand)."""
+        for p in self.passes.values():
+            release = getattr(p, "release", None)
+            if release is not None:
+                release()
+        for vao in self._fs_vaos.values():
+            vao.release()
+        self._fs_vaos.clear()
+        for t in (self._dummy_shadow, self._dummy_texture):
+            if t is not None:
+                t.release()
+        self._dummy_shadow = self._dummy_texture = None
         self.programs.release()
         self.resources.release()
-        self.tsd.release()
+        for st in self.states.values():
+            st.release()
+        self.states.clear()

@@ -2,13 +2,20 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
-TECHNIQUES = ("tsd", "exact", "ssss", "tint")
+from .options import TechniqueSettings
+from .registry import DEFAULT_TECHNIQUE, get_technique
 
 
 @dataclass
 class RenderSettings:
+    """What a render is asked to do beyond the scene. The subsurface technique and its own settings
+    are one value: ``technique`` is a technique's settings object (``TsdSettings(size=256)``), or a
+    registered name for that technique's defaults (``"ssss"``); see :meth:`for_technique`."""
+
     width: int = 640
     height: int = 640
     shadow_size: int = 2048
@@ -16,19 +23,8 @@ class RenderSettings:
     max_lights: int = 4
     # None: each material's own sss_model; else one of scene.materials.SSS_MODELS for every material
     sss_model: str | None = None
-    # how subsurface scattering is rendered (TECHNIQUES): texture-space diffusion with the Gaussian
-    # fit ("tsd", default), brute-force texture-space convolution with the exact profile ("exact",
-    # the slow image reference), screen-space separable SSS ("ssss", Jimenez et al.), or the
-    # per-pixel profile tint without convolution ("tint", the original study's baseline)
-    technique: str = "tsd"
-    tsd_taps: int | None = None  # None: from each blur's width in texels; else a fixed odd count (7..31)
-    ssss_taps: int = 17  # screen-space kernel samples: 11, 17 or 25 (Jimenez presets)
-    # texture-space diffusion defaults from the accuracy/time ledger (docs/ledger.md): the cheapest
-    # setting within 1 % image error of the exact reference on the head and the bunny
-    tsd_size: int = 512  # irradiance texels per side
-    tsd_albedo_mix: float = 0.5  # pre-/post-scatter texturing: albedo^mix before the blur
-    tsd_gaussians: int = 6  # K: Gaussians fitted to the profile
-    translucency: bool = True  # light through thin parts (needs a shadow-casting light)
+    # how subsurface scattering is rendered: a registered technique (app/render/registry.py)
+    technique: TechniqueSettings | str = DEFAULT_TECHNIQUE
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):
@@ -42,24 +38,32 @@ class RenderSettings:
                 raise ValueError(
                     f"render setting sss_model: expected one of {', '.join(SSS_MODELS)}, got {self.sss_model!r}"
                 )
-        if self.technique not in TECHNIQUES:
+        if isinstance(self.technique, str):
+            self.technique = get_technique(self.technique).settings_type()
+        elif not isinstance(self.technique, TechniqueSettings):
             raise ValueError(
-                f"render setting technique: expected one of {', '.join(TECHNIQUES)}, got {self.technique!r}"
+                "render setting technique: expected a technique name or its settings, got " + repr(self.technique)
             )
-        if self.tsd_taps is not None and (
-            not isinstance(self.tsd_taps, int) or self.tsd_taps % 2 == 0 or not 7 <= self.tsd_taps <= 31
-        ):
+
+    @classmethod
+    def for_technique(cls, technique: str, width: int = 640, height: int = 640, **kw: Any) -> RenderSettings:
+        """Settings for a technique by name; keywords are RenderSettings fields or the technique's
+        own settings (``for_technique("tsd", 64, 64, shadow_size=256, size=128)``)."""
+        st = get_technique(technique).settings_type
+        own = {f.name for f in dataclasses.fields(cls)}
+        opts = {k: v for k, v in kw.items() if k not in own}
+        unknown = set(opts) - set(st.options())
+        if unknown:
             raise ValueError(
-                f"render setting tsd_taps: expected an odd integer in [7, 31] or None, got {self.tsd_taps!r}"
+                f"render setting {sorted(unknown)[0]}: not a setting of technique {technique!r} "
+                f"(its settings: {', '.join(st.options()) or 'none'})"
             )
-        if not isinstance(self.ssss_taps, int) or self.ssss_taps % 2 == 0 or not 3 <= self.ssss_taps <= 63:
-            raise ValueError(f"render setting ssss_taps: expected an odd integer in [3, 63], got {self.ssss_taps!r}")
-        if not isinstance(self.tsd_size, int) or not 16 <= self.tsd_size <= 8192:
-            raise ValueError(f"render setting tsd_size: expected an integer in [16, 8192], got {self.tsd_size!r}")
-        if not isinstance(self.tsd_gaussians, int) or not 1 <= self.tsd_gaussians <= 6:
-            raise ValueError(f"render setting tsd_gaussians: expected an integer in [1, 6], got {self.tsd_gaussians!r}")
-        if not 0.0 <= float(self.tsd_albedo_mix) <= 1.0:
-            raise ValueError(f"render setting tsd_albedo_mix: expected a number in [0, 1], got {self.tsd_albedo_mix!r}")
+        base = {k: v for k, v in kw.items() if k in own}
+        return cls(width, height, **base, technique=st(**opts))
+
+    @property
+    def technique_name(self) -> str:
+        return self.technique.technique
 
     @property
     def size(self) -> tuple[int, int]:

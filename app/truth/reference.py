@@ -18,13 +18,13 @@ import hashlib
 import json
 import math
 import os
-import tempfile
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from app.atomic_write import atomic_path, write_text_atomic
 from scene.graph import Scene
 
 from .compare import image_error, object_mask
@@ -126,19 +126,6 @@ def reference_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_ver
     return h.hexdigest()[:24]
 
 
-def atomic_write(path: Path, write) -> None:
-    """write(tmp_path) fills a temporary file beside `path`, which is then renamed into place."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def load_cached(key: str) -> Reference | None:
     d = cache_dir()
     npz, js = d / f"{key}.npz", d / f"{key}.json"
@@ -155,13 +142,9 @@ def load_cached(key: str) -> Reference | None:
 
 def _store(ref: Reference) -> None:
     d = cache_dir()
-
-    def npz(tmp):
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, image=ref.image, half_a=ref.half_a, half_b=ref.half_b)
-
-    atomic_write(d / f"{ref.key}.npz", npz)
-    atomic_write(d / f"{ref.key}.json", lambda tmp: Path(tmp).write_text(json.dumps(ref.meta, indent=1)))
+    with atomic_path(d / f"{ref.key}.npz") as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, image=ref.image, half_a=ref.half_a, half_b=ref.half_b)
+    write_text_atomic(d / f"{ref.key}.json", json.dumps(ref.meta, indent=1))
 
 
 def chunk_plan(spp: int, passes: int) -> list[tuple[int, int]]:

@@ -18,8 +18,9 @@ import numpy as np
 
 from app.gl.hot_reload import ShaderWatcher
 from app.gl.shader_source import ShaderLibrary
+from app.render.registry import get_technique, technique_names
 from app.render.renderer import FrameResult, Renderer
-from app.render.settings import TECHNIQUES, RenderSettings
+from app.render.settings import RenderSettings
 from scene.materials import SSS_MODELS
 
 from .camera import OrbitCamera
@@ -51,6 +52,7 @@ class ViewerCore:
     ):
         self.ctx = ctx
         self.settings = settings or RenderSettings()
+        self._technique_settings: dict = {}  # technique name -> its settings when last left
         library = ShaderLibrary(root=Path(shader_root)) if shader_root else ShaderLibrary()
         if not library.root.is_dir():
             raise FileNotFoundError(f"--shader-dir: no such folder: {library.root}")
@@ -123,15 +125,32 @@ class ViewerCore:
         return model
 
     def cycle_technique(self, step: int = 1) -> str:
-        i = TECHNIQUES.index(self.settings.technique)
-        return self.set_technique(TECHNIQUES[(i + step) % len(TECHNIQUES)])
+        names = technique_names()
+        i = names.index(self.settings.technique_name)
+        return self.set_technique(names[(i + step) % len(names)])
 
     def set_technique(self, technique: str) -> str:
-        """How subsurface scattering is rendered (app.render.settings.TECHNIQUES)."""
-        self.settings = dataclasses.replace(self.settings, technique=technique)  # validated again
+        """How subsurface scattering is rendered (a registered technique, app/render/registry.py);
+        each technique keeps the settings it had when the viewer last left it."""
+        get_technique(technique)  # a clear error for an unknown name
+        self._technique_settings[self.settings.technique_name] = self.settings.technique
+        chosen = self._technique_settings.get(technique, technique)
+        self.settings = dataclasses.replace(self.settings, technique=chosen)  # validated again
         self.note("info", f"SSS technique: {technique}")
         self.invalidate()
         return technique
+
+    def set_technique_option(self, name: str, value) -> object:
+        """Change one setting of the current technique (checked against its declaration)."""
+        opts = self.settings.technique.options()
+        if name not in opts:
+            raise ValueError(
+                f"{self.settings.technique_name} setting {name!r}: unknown; its settings: {', '.join(opts) or 'none'}"
+            )
+        self.settings = dataclasses.replace(self.settings, technique=self.settings.technique.replace(**{name: value}))
+        self.note("info", f"{self.settings.technique_name} {name}: {getattr(self.settings.technique, name)}")
+        self.invalidate()
+        return getattr(self.settings.technique, name)
 
     def reset_camera(self) -> None:
         self.orbit.reset()

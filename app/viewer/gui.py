@@ -12,12 +12,12 @@ import time
 import numpy as np
 from imgui_bundle import imgui
 
-from app.render.settings import TECHNIQUES
+from app.render.registry import techniques
 from scene.materials import SSS_MODELS
 
 from .core import ViewerCore
 from .inspector import display_mode
-from .panel import angles_from_direction, direction_from_angles
+from .panel import angles_from_direction, direction_from_angles, technique_value, technique_widgets
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 GREY = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
@@ -56,7 +56,7 @@ class Gui:
         s = core.settings
         imgui.text_colored(
             GREY,
-            f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'} ({s.technique})"
+            f"{s.width}x{s.height}  target: {name}  sss: {s.sss_model or 'per material'} ({s.technique_name})"
             f"  ui {ui_fps:4.0f} fps",
         )
         errors = core.errors()
@@ -101,15 +101,46 @@ class Gui:
                 if clicked:
                     core.set_sss_model(None if o == "per material" else o)
             imgui.end_combo()
-        cur = core.settings.technique
+        cur = core.settings.technique_name
         if imgui.begin_combo("technique (T)", cur):
-            for o in TECHNIQUES:
-                clicked, _ = imgui.selectable(o, o == cur)
+            for t in techniques():
+                clicked, _ = imgui.selectable(t.name, t.name == cur)
+                if imgui.is_item_hovered():
+                    imgui.set_tooltip(t.description)
                 if clicked:
-                    core.set_technique(o)
+                    core.set_technique(t.name)
             imgui.end_combo()
+        self._technique_options()
         if imgui.button("Reset camera (R)"):
             core.reset_camera()
+
+    def _technique_options(self) -> None:
+        """The current technique's settings (panel.technique_widgets: from its declaration)."""
+        core = self.core
+        st = core.settings.technique
+        for w in technique_widgets(st):
+            label = f"{w.param}##{st.technique}"
+            new = w.value
+            if w.widget.endswith("_or_auto"):
+                changed, auto = imgui.checkbox(f"{w.param} automatic##{st.technique}", w.value is None)
+                new = None if auto else (w.value if w.value is not None else w.range[0])
+            else:
+                changed = False
+            if new is not None:
+                if w.widget.startswith("checkbox"):
+                    c, new = imgui.checkbox(label, bool(new))
+                elif w.widget.startswith("slider_int"):
+                    c, new = imgui.slider_int(label, int(new), int(w.range[0]), int(w.range[1]))
+                else:
+                    c, new = imgui.slider_float(label, float(new), float(w.range[0]), float(w.range[1]))
+                changed = changed or c
+            if imgui.is_item_hovered():
+                imgui.set_tooltip(w.doc)
+            if changed:
+                try:
+                    core.set_technique_option(w.param, technique_value(st, w.param, new))
+                except ValueError as exc:
+                    core.note("error", str(exc))
 
     def _inspector_section(self) -> None:
         core = self.core

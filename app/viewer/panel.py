@@ -268,3 +268,37 @@ class PanelModel:
         p = light.world_position
         n = np.linalg.norm(p)
         return -p / n if n else np.array([0.0, 0.0, -1.0])
+
+
+# -- the current technique's settings (app/render/options.py declarations) --------------------------------
+
+# Option.kind -> widget kind; an option that may be None (automatic) gets "<kind>_or_auto"
+TECHNIQUE_WIDGETS = {"bool": "checkbox", "int": "slider_int", "float": "slider_float"}
+
+
+def technique_widgets(settings) -> list[Widget]:
+    """One widget per field of a technique's settings, from its declaration (range, meaning, default)."""
+    defaults = settings.defaults()
+    out = []
+    for name, o in settings.options().items():
+        kind = TECHNIQUE_WIDGETS[o.kind] + ("_or_auto" if o.none else "")
+        rng = tuple(float(x) for x in o.range) if o.range is not None else None
+        out.append(Widget(name, kind, getattr(settings, name), rng, unit=o.unit, doc=o.help(defaults[name])))
+    return out
+
+
+def technique_value(settings, name: str, value: Any) -> Any:
+    """A widget's value made valid for the field: numbers clamped into the declared range, integers
+    rounded (odd counts to the nearest odd one inside the range); None (automatic) and booleans as given."""
+    o = settings.options()[name]
+    if value is None or o.kind == "bool":
+        return value
+    v = float(value)
+    if o.range is not None:
+        v = min(max(v, o.range[0]), o.range[1])
+    if o.kind == "float":
+        return v
+    n = int(round(v))
+    if o.odd and n % 2 == 0:
+        n = n + 1 if o.range is None or n + 1 <= o.range[1] else n - 1
+    return n

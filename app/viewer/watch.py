@@ -195,17 +195,14 @@ def load_presets() -> dict:
     """name -> Medium from the presets file, read afresh (errors name the file)."""
     from scene.optics import media
 
-    cache_clear = getattr(media._load_presets, "cache_clear", None)
-    if cache_clear is not None:
-        cache_clear()
+    media.forget_presets()
     try:
         return {n: media.preset(n) for n in media.preset_names()}
     except Exception as exc:
         msg = str(exc).strip() or exc.__class__.__name__
         raise ValueError(f"{media.PRESET_FILE}: cannot read presets: {msg}") from None
     finally:
-        if cache_clear is not None:
-            cache_clear()  # a broken file must not stay cached for other users
+        media.forget_presets()  # a broken file must not stay cached for other users
 
 
 def preset_reloader(settle_s: float = 0.1, watch: bool = True, use_watchdog: bool = True) -> Reloadable:

@@ -2,7 +2,8 @@
 everything drawn, Dear ImGui (imgui-bundle's pyglet backend) for the overlay and the panel.
 
 Mouse: left drag orbits around the camera target, right or middle drag (or shift + left) pans,
-the wheel zooms. Keys: R reset camera, M / shift+M cycle the SSS model, P or Tab / shift+P
+the wheel zooms. Keys: R reset camera, M / shift+M cycle the SSS model, T / shift+T cycle the
+subsurface technique (the registry's order, app/render/registry.py), P or Tab / shift+P
 cycle the inspected target, [ and ] halve/double its display scale, N auto-ranges it,
 S saves a PNG screenshot, shift+S an EXR, H hides the panel, Esc quits.
 
@@ -56,7 +57,7 @@ class ViewerWindow:
         screenshot_dir="out/screenshots",
         shader_root=None,
         shadow_size: int = 2048,
-        tsd_size: int | None = None,
+        technique="tsd",
         settle_s: float = 0.05,
         continuous: bool = False,
         show_ui: bool = True,
@@ -88,8 +89,7 @@ class ViewerWindow:
         from .core import ViewerCore
 
         fw, fh = self.window.get_framebuffer_size()
-        extra = {} if tsd_size is None else {"tsd_size": tsd_size}
-        settings = RenderSettings(max(fw, 1), max(fh, 1), shadow_size=shadow_size, **extra)
+        settings = RenderSettings(max(fw, 1), max(fh, 1), shadow_size=shadow_size, technique=technique)
         try:
             self.core = ViewerCore(
                 self.ctx, scene_path, settings, watch=watch, shader_root=shader_root, settle_s=settle_s

@@ -21,7 +21,7 @@ SCALING_VARIANTS = ("diffuse", "searchlight", "dmfp")
 
 
 def burley_s(A, variant="searchlight"):
-    """Scaling factor s(A) (Christensen & Burley 2015, section 5, eqs. 5-7 / FACTS.md).
+    """Scaling factor s(A) (Christensen & Burley 2015, section 5, eqs. 5-7; docs/references.md#christensen-burley-2015).
 
     "diffuse": diffuse surface transmission, l = mean free path: 1.9 - A + 3.5 (A - 0.8)^2
     "searchlight": perpendicular incidence, l = mean free path: 1.85 - A + 7 |A - 0.8|^3
@@ -73,7 +73,7 @@ def burley_sample_golubev(xi, d):
 
 
 def blender_radius_to_mfp(radius):
-    """User radius R -> mean free path l = R / (4 pi) (Cycles closure set-up; FACTS.md)."""
+    """User radius R -> mean free path l = R / (4 pi) (Cycles closure set-up; docs/references.md#blender-burley)."""
     return f64(radius) / (4.0 * PI)
 
 

@@ -1,4 +1,5 @@
-"""NumPy twins of shaders/lib/color.glsl: sRGB transfer (IEC 61966-2-1), ACES fit (Narkowicz 2015)."""
+"""NumPy twins of shaders/lib/color.glsl: sRGB transfer (IEC 61966-2-1), ACES fit (Narkowicz 2015);
+docs/references.md#aces-srgb."""
 
 from __future__ import annotations
 

@@ -60,8 +60,8 @@ def glsl_header() -> str:
 
 # ---------------------------------------------------------------------------------------------
 # Diffusion profiles (issue 3). Appended as a block so the dict order above is unchanged.
-# Sources: shared/reference/FACTS.md; Jensen et al. 2001; Christensen & Burley 2015; pbrt-v4
-# src/pbrt/bssrdf.cpp + util/scattering.h (Fresnel moments); d'Eon & Luebke 2007 (GPU Gems 3, 14).
+# Sources (docs/references.md): jensen-2001, christensen-burley-2015, blender-burley, habel-2013
+# (pbrt-v4 src/pbrt/bssrdf.cpp + util/scattering.h, Fresnel moments), deon-luebke-2007 (GPU Gems 3, 14).
 # ---------------------------------------------------------------------------------------------
 # Mean free paths (mm) below this are "no scattering": every profile returns 0 (the delta at r = 0
 # is the renderer's plain diffuse term). Keeps 1/l^2 far from fp32 overflow. A power of two so

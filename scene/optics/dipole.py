@@ -1,6 +1,6 @@
 """Jensen et al. 2001 dipole diffusion profile (SIGGRAPH 2001, "A Practical Model for Subsurface
 Light Transport", eqs. 4-6 and the total diffuse reflectance of section 2.4). Float64 twin of
-shaders/lib/profiles_dipole.glsl.
+shaders/lib/profiles_dipole.glsl. Equations: docs/references.md#jensen-2001.
 
 Parameterisation shared by all profiles: alpha = sigma_s'/sigma_t' (reduced single-scattering
 albedo), mfp = l = 1/sigma_t' in mm, eta = relative index of refraction (clamped to the range of
@@ -35,7 +35,8 @@ def sigma_tr_optical(alpha):
     return np.sqrt(3.0 * np.maximum(1.0 - f64(alpha), 0.0))
 
 
-def _pole(z, d, s_tr):
+def dipole_pole(z, d, s_tr):
+    """One pole of the dipole (twin of shaders/lib/profiles_dipole.glsl dipole_pole)."""
     return z * (s_tr + 1.0 / d) * np.exp(-s_tr * d) / (d * d)
 
 
@@ -47,7 +48,7 @@ def dipole_profile(r, alpha, mfp, eta):
     zv = 1.0 + 4.0 / 3.0 * dipole_a(eta)
     dr = np.sqrt(x * x + 1.0)
     dv = np.sqrt(x * x + zv * zv)
-    out = alpha / (4.0 * PI) * (_pole(1.0, dr, s_tr) + _pole(zv, dv, s_tr)) * inv_l2
+    out = alpha / (4.0 * PI) * (dipole_pole(1.0, dr, s_tr) + dipole_pole(zv, dv, s_tr)) * inv_l2
     return np.where(valid, out, 0.0)
 
 

@@ -1,4 +1,5 @@
-"""Sums of Gaussians: d'Eon & Luebke 2007 (GPU Gems 3, ch. 14) six-Gaussian skin profile and a
+"""Sums of Gaussians: d'Eon & Luebke 2007 (GPU Gems 3, ch. 14; docs/references.md#deon-luebke-2007)
+six-Gaussian skin profile and a
 fitter that approximates any radial profile by K Gaussians with ONE set of variances shared by the
 R, G, B channels (texture-space diffusion blurs once per variance for all channels) and per-channel
 non-negative weights. Float64 twin of shaders/lib/profiles_gaussians.glsl.

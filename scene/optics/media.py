@@ -11,8 +11,9 @@ That form has finite limits everywhere (l = 0: no scattering; alpha = 1: no abso
   Monte Carlo reference, see docs/accuracy.md) or ``"dipole"`` (Jensen 2001 closed form).
 * A -> alpha: numerical inversion of that total reflectance (monotonic in alpha): bisection on the
   dipole closed form, or interpolation in a 256-albedo PBD table per eta; or ``"cycles"``, the
-  Chiang 2016 random-walk fit used by Cycles (FACTS.md), alpha = 1 - exp(A(-5.09406 + A(2.61188 - 4.31805 A))).
-* artist radius R (Blender) <-> l:  l = R/(4 pi)  (Cycles' convention; FACTS.md).
+  Chiang 2016 random-walk fit used by Cycles (docs/references.md#blender-burley),
+  alpha = 1 - exp(A(-5.09406 + A(2.61188 - 4.31805 A))).
+* artist radius R (Blender) <-> l:  l = R/(4 pi)  (Cycles' convention; docs/references.md#blender-burley).
 
 Presets: the twelve measured materials of Jensen et al. 2001 Table 1, read from
 assets/presets/jensen2001_table1.csv (1/mm).
@@ -271,6 +272,11 @@ def _load_presets() -> dict[str, Medium]:
         sa = [float(row[f"sigma_a_{c}"]) for c in "rgb"]
         out[row["material"]] = Medium.from_coefficients(ss, sa, float(row["eta"]), row["material"])
     return out
+
+
+def forget_presets() -> None:
+    """Drop the presets read so far: the next look-up reads PRESET_FILE afresh (hot reload)."""
+    _load_presets.cache_clear()
 
 
 def preset_names() -> list[str]:

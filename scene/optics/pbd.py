@@ -1,6 +1,7 @@
 """Photon beam diffusion (Habel, Christensen, Jarosz 2013, "Photon Beam Diffusion: A Hybrid
 Monte Carlo Method for Subsurface Scattering"), as implemented in pbrt-v4 src/pbrt/bssrdf.cpp
 (``BeamDiffusionMS`` / ``BeamDiffusionSS``). Float64 twin of shaders/lib/profiles_pbd.glsl.
+Equations: docs/references.md#habel-2013.
 
 Multiple scattering integrates improved dipoles (Grosjean diffusion coefficient, PBD boundary
 condition with the Fresnel moments, empirical kappa correction) over point sources at depths

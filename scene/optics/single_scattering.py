@@ -4,7 +4,7 @@ shaders/lib/profiles_single.glsl.
 
 Two forms:
 
-* :func:`single_scatter_brdf` - the BRDF-like term of Jensen 2001 (FACTS.md):
+* :func:`single_scatter_brdf` - the BRDF-like term of Jensen 2001 (docs/references.md#jensen-2001):
   f_r^(1) = alpha F p(cos_s) / (|n.T_i| + |n.T_o|), F = F_t(eta, w_i) F_t(eta, w_o), T_i and T_o
   the refracted directions. It is what a renderer adds to the dipole at a shading point.
 * :func:`single_scatter_profile` - the same physics as a *radial profile* for a normally incident

@@ -1,6 +1,6 @@
 """Screen-space separable subsurface scattering (Jimenez, Sundstedt & Gutierrez 2009; Jimenez et al.
-2015 "Separable Subsurface Scattering"): one 1-D kernel applied horizontally then vertically in
-screen space, its width in pixels from each pixel's depth. NumPy reference of the kernel used by
+2015 "Separable Subsurface Scattering"; docs/references.md#jimenez-ssss): one 1-D kernel applied horizontally then
+vertically in screen space, its width in pixels from each pixel's depth. NumPy reference of the kernel used by
 shaders/passes/ssss_blur.frag.
 
 The 1-D kernel is built from the same normalised Gaussian fit as texture-space diffusion: at offset

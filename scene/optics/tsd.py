@@ -1,5 +1,6 @@
-"""Texture-space diffusion (d'Eon & Luebke 2007, GPU Gems 3 ch. 14): the kernel design shared by the
-GPU passes (app/render/passes/tsd.py, shaders/passes/tsd_*.frag) and its NumPy reference twin.
+"""Texture-space diffusion (d'Eon & Luebke 2007, GPU Gems 3 ch. 14; docs/references.md#deon-luebke-2007):
+the kernel design shared by the GPU passes (app/render/techniques/tsd/, shaders/passes/tsd_*.frag) and
+its NumPy reference twin.
 
 The diffusion step, per channel c, of an irradiance texture E (premultiplied by albedo^mix):
 

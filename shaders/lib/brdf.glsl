@@ -1,6 +1,6 @@
 // Disney principled BRDF pieces (Burley 2012, "Physically Based Shading at Disney"):
 // Burley diffuse with retro-reflection, GGX D, height-correlated Smith G, Schlick Fresnel.
-// NumPy twin: scene/optics/brdf.py (same names, same clamps). Formulas: shared/reference/FACTS.md.
+// NumPy twin: scene/optics/brdf.py (same names, same clamps). Formulas: docs/references.md#burley-2012.
 #include "skinlab/constants.glsl"
 
 float pow5(float x) { float x2 = x * x; return x2 * x2 * x; }

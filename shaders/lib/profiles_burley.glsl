@@ -1,5 +1,5 @@
 // Christensen & Burley 2015 normalized diffusion and Blender's truncated variant with samplers.
-// See scene/optics/burley.py for the formulas; r, l, d in mm, result 1/mm^2.
+// See scene/optics/burley.py and docs/references.md#christensen-burley-2015 for the formulas; r, l, d in mm, result 1/mm^2.
 #include "lib/profiles_common.glsl"
 
 const int BURLEY_DIFFUSE = 0;      // diffuse surface transmission, l = mean free path

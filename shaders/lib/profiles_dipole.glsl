@@ -1,4 +1,4 @@
-// Jensen et al. 2001 dipole (see scene/optics/dipole.py for the formulas and conventions).
+// Jensen et al. 2001 dipole (scene/optics/dipole.py, docs/references.md#jensen-2001).
 // alpha = sigma_s'/sigma_t', mfp = 1/sigma_t' (mm), eta relative index; r in mm; result 1/mm^2.
 #include "lib/profiles_common.glsl"
 

@@ -1,5 +1,6 @@
 // Fresnel factors of the specular layer over a subsurface medium (texture-space diffusion).
-// NumPy twin: scene/optics/tsd.py (fresnel_transmission, sss_exit_weight).
+// NumPy twin: scene/optics/tsd.py (fresnel_transmission, sss_exit_weight). Sources:
+// docs/references.md#burley-2012 (Schlick), #burley-2015 (exit weight).
 #include "lib/brdf.glsl"
 
 // Fraction of light crossing the interface at incidence cosine c: 1 - Schlick F.

@@ -7,26 +7,15 @@
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/subsurface.glsl"
+#include "skinlab/material.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_tangent;
 
-uniform vec3 u_base_color;
-uniform float u_specular;
-uniform float u_normal_scale;
 uniform vec3 u_ambient;
 uniform float u_tsd_mix;
-#ifdef HAS_BASE_COLOR_MAP
-uniform sampler2D u_base_color_map;
-#endif
-#ifdef HAS_NORMAL_MAP
-uniform sampler2D u_normal_map;
-#endif
-#ifdef HAS_OCCLUSION_MAP
-uniform sampler2D u_occlusion_map;
-#endif
 #ifdef TSD_TRANSLUCENCY
 uniform sampler2D u_distance0;            // light-space distance of the first surface (scene units)
 uniform sampler2D u_distance1;

@@ -6,6 +6,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_uniforms
+from app.render.frame_plan import ShadowParams
 from scene import transform as tf
 from scene.graph import LightNode
 
@@ -60,10 +61,17 @@ class ShadowPass:
             t = self.maps[slot] = (tex, fbo, dist)
         return t
 
+    def release(self) -> None:
+        for tex, fbo, dist in self.maps.values():
+            for x in (fbo, tex, dist):
+                if x is not None:
+                    x.release()
+        self.maps.clear()
+
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
-        light, slot = p.params["light"], p.params["slot"]
-        distance = bool(p.params.get("distance"))
+        prm: ShadowParams = p.params
+        light, slot, distance = prm.light, prm.slot, prm.distance
         tex, fbo, dist = self.target(slot, p.resolution[0], distance)
         lo, hi = frame.scene.world_bounds()
         vp = light_view_proj(light, lo, hi)

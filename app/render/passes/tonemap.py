@@ -12,6 +12,12 @@ class TonemapPass:
         self.r = renderer
         self._target = None
 
+    def release(self) -> None:
+        if self._target is not None:
+            self._target[1].release()
+            self._target[0].release()
+            self._target = None
+
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
         if self._target is None or self._target[0].size != tuple(p.resolution):

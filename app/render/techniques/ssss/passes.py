@@ -4,13 +4,21 @@ horizontally then vertically with the profile's 1-D kernel (scene/optics/ssss.py
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
 
+from .plan import SsssPlan
+
 MAX_SSSS_TAPS = 63  # shaders/passes/ssss_blur.frag
+
+
+@dataclass
+class SsssBlurParams:
+    ssss: SsssPlan
 
 
 class SsssBlurPass:
@@ -21,9 +29,7 @@ class SsssBlurPass:
     def targets(self, size):
         t = self._targets
         if t is None or t[0].size != tuple(size):
-            if t is not None:
-                for x in t:
-                    x.release()
+            self.release()
             ctx = self.r.ctx
             texs = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]  # tmp, blurred, composite
             for x in texs:
@@ -32,8 +38,14 @@ class SsssBlurPass:
             t = self._targets = tuple(texs)
         return t
 
+    def release(self) -> None:
+        if self._targets is not None:
+            for x in (*self._fbos, *self._targets):
+                x.release()
+            self._targets, self._fbos = None, []
+
     def run(self, frame, p) -> None:
-        ctx, plan = self.r.ctx, p.params["ssss"]
+        ctx, plan = self.r.ctx, p.params.ssss
         w, h = p.resolution
         tmp, blurred, out = self.targets((w, h))
         ftmp, fblur, fout = self._fbos

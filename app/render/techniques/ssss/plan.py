@@ -7,10 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from app.render.scattering import scattering_material
 from scene.optics.ssss import ssss_kernel
 from scene.optics.tsd import material_medium, profile_fit
-
-from .plan_tsd import scattering_material
 
 
 @dataclass
@@ -22,7 +21,7 @@ class SsssPlan:
     scattering: set  # uids of the nodes whose diffuse is blurred
 
 
-def plan_ssss(meshes, settings, plan) -> SsssPlan | None:
+def plan_ssss(meshes, settings, plan, gaussians: int, taps: int) -> SsssPlan | None:
     chosen, uids = None, set()
     for n in meshes:
         mat = scattering_material(n, settings, plan, f"ssss[{n.name}]")
@@ -39,6 +38,6 @@ def plan_ssss(meshes, settings, plan) -> SsssPlan | None:
     if chosen is None:
         plan.skipped.append(("ssss_blur", "no visible material scatters below the surface"))
         return None
-    fit = profile_fit(chosen["sss_model"], material_medium(chosen.values), settings.tsd_gaussians)
-    offsets, weights, rng = ssss_kernel(fit, settings.ssss_taps)
+    fit = profile_fit(chosen["sss_model"], material_medium(chosen.values), gaussians)
+    offsets, weights, rng = ssss_kernel(fit, taps)
     return SsssPlan(chosen, offsets, weights, rng, uids)

@@ -6,7 +6,8 @@
   tsd_blur        one Gaussian level of the chain: separable u then v, taps in mm via the stretch map
 
 The kernel (variances, weights, taps) comes from scene/optics/tsd.py, which also holds the NumPy
-twin of the blur and gather. The gather is the forward pass's TSD_LEVELS variant.
+twin of the blur and gather. The gather is the technique's forward hook
+(shaders/techniques/tsd/forward.glsl, variant TSD_LEVELS; bound by forward.py here).
 """
 
 from __future__ import annotations
@@ -19,7 +20,12 @@ import numpy as np
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
-from scene.optics.tsd import MAX_TSD_LEVELS, BlurStep, DiffusionKernel, blur_taps, exact_profile_lut, material_medium
+from app.render.texture_units import TextureUnits
+from scene.optics.tsd import MAX_TSD_LEVELS, DiffusionKernel, blur_taps
+
+from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
+
+STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
 MAX_TAPS = 31  # shaders/passes/tsd_blur.frag
 
@@ -66,7 +72,7 @@ class TsdFrameNode:
     """What the gather needs for one node this frame."""
 
     targets: TsdNodeTargets
-    kernel: DiffusionKernel
+    kernel: DiffusionKernel  # the gather's weights (UNIT_KERNEL after the exact convolution)
     material: object
     mix: float
 
@@ -78,7 +84,8 @@ def stretch_key(node, scene, size: int) -> tuple:
 
 
 class TsdStore:
-    """Per-node TSD textures, kept across frames (stretch maps are reused while geometry is unchanged)."""
+    """Per-node TSD textures, kept across frames (stretch maps are reused while geometry is unchanged).
+    The renderer keeps one per renderer (Renderer.state) and calls begin_frame with each frame plan."""
 
     def __init__(self, ctx):
         self.ctx = ctx
@@ -102,6 +109,10 @@ class TsdStore:
             self.nodes.pop(u).release()
         return len(gone)
 
+    def begin_frame(self, plan) -> None:
+        """Keep the textures of the nodes this frame's passes use; release the rest."""
+        self.retain({p.params.node.uid for p in plan.passes if isinstance(p.params, TsdNodeParams)})
+
     def stretch_valid(self, node, scene, size: int) -> bool:
         t = self.nodes.get(node.uid)
         return t is not None and t.size == size and t.stretch_key == stretch_key(node, scene, size)
@@ -112,13 +123,23 @@ class TsdStore:
         self.nodes.clear()
 
 
+def store(renderer) -> TsdStore:
+    """The renderer's TSD store."""
+    return renderer.state(STATE_KEY, TsdStore)
+
+
+def frame_nodes(frame) -> dict:
+    """This frame's TsdFrameNode per node uid (written by the irradiance pass, read by the gather)."""
+    return frame.data.setdefault(STATE_KEY, {})
+
+
 def _uv_raster_setup(ctx, fbo, size: int) -> None:
     fbo.use()
     ctx.viewport = (0, 0, size, size)
     ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
 
 
-def _dilate(renderer, t: TsdNodeTargets, tex: moderngl.Texture, rings: int) -> None:
+def dilate(renderer, t: TsdNodeTargets, tex: moderngl.Texture, rings: int) -> None:
     """`rings` one-texel dilation steps of `tex`, ping-ponging with the scratch texture (even count
     ends in `tex`)."""
     ctx = renderer.ctx
@@ -138,17 +159,18 @@ class TsdStretchPass:
         self.r = renderer
 
     def run(self, frame, p) -> None:
-        ctx, node, size = self.r.ctx, p.params["node"], p.params["size"]
-        t = self.r.tsd.targets(node, size)
+        prm: TsdNodeParams = p.params
+        ctx, node, size = self.r.ctx, prm.node, prm.size
+        t = store(self.r).targets(node, size)
         fbo = t.fbo(ctx, t.stretch)
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_stretch.frag")
         set_uniforms(prog, {**node_uniforms(node), "u_mm_per_unit": frame.scene.mm_per_unit})
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
-        _dilate(self.r, t, t.stretch, p.params["dilate"])
+        dilate(self.r, t, t.stretch, prm.dilate)
         t.stretch_key = stretch_key(node, frame.scene, size)
-        self.r.tsd.stretch_updates += 1
+        store(self.r).stretch_updates += 1
 
 
 class TsdIrradiancePass:
@@ -156,38 +178,34 @@ class TsdIrradiancePass:
         self.r = renderer
 
     def run(self, frame, p) -> None:
-        ctx, node, size = self.r.ctx, p.params["node"], p.params["size"]
-        mat, kernel = p.params["material"], p.params["kernel"]
-        t = self.r.tsd.targets(node, size)
+        prm: TsdIrradianceParams = p.params
+        ctx, node, size, mat, kernel = self.r.ctx, prm.node, prm.size, prm.material, prm.kernel
+        t = store(self.r).targets(node, size)
         fbo = t.fbo(ctx, t.irradiance)
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
-        lights, shadow_lights = p.params["lights"], p.params["shadow_lights"]
-        translucency = p.params.get("translucency", False)
         nmax = frame.settings.max_lights
-        defines = {**mat.defines(("texture",)), "MAX_LIGHTS": nmax}
-        if translucency:
+        defines = {**mat.defines(), "MAX_LIGHTS": nmax}
+        if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
-        bind_shadow_maps(self.r, frame)
-        set_light_uniforms(prog, frame, lights, shadow_lights, nmax)
-        set_uniforms(
-            prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": p.params["mix"]}
-        )
-        self.r.resources.bind_material(prog, mat)
-        if translucency:
+        units = TextureUnits(ctx)
+        bind_shadow_maps(self.r, frame, prog, units)
+        set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
+        set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
+        self.r.resources.bind_material(prog, mat, units)
+        if prm.translucency:
             for slot in (0, 1):
                 d = frame.targets.get(f"shadow_distance{slot}")
-                if d is not None:
-                    d.use(7 + slot)
-                set_uniform(prog, f"u_distance{slot}", 7 + slot)
+                units.bind(prog, f"u_distance{slot}", d if d is not None else self.r.dummy_texture())
             eyes = np.stack([frame.shadow_eyes.get(s, np.zeros(4)) for s in (0, 1)])
             set_array(prog, "u_light_eye", eyes, 2)
             set_array(prog, "u_tsd_var", np.array([s.variance_mm2 for s in kernel.steps]), MAX_TSD_LEVELS)
             set_array(prog, "u_tsd_w", kernel.weights(), MAX_TSD_LEVELS)
             set_uniform(prog, "u_tsd_levels", kernel.levels)
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
-        frame.tsd[id(node)] = TsdFrameNode(t, kernel, mat, p.params["mix"])
+        gather = prm.gather if prm.gather is not None else kernel
+        frame_nodes(frame)[node.uid] = TsdFrameNode(t, gather, mat, prm.mix)
         frame.targets[f"tsd_irradiance_raw[{node.name}]"] = t.irradiance
 
 
@@ -196,9 +214,10 @@ class TsdDilatePass:
         self.r = renderer
 
     def run(self, frame, p) -> None:
-        node = p.params["node"]
-        t = self.r.tsd.targets(node, p.params["size"])
-        _dilate(self.r, t, t.irradiance, p.params["dilate"])
+        prm: TsdNodeParams = p.params
+        node = prm.node
+        t = store(self.r).targets(node, prm.size)
+        dilate(self.r, t, t.irradiance, prm.dilate)
         frame.targets.pop(f"tsd_irradiance_raw[{node.name}]", None)
         frame.targets[f"tsd_irradiance[{node.name}]"] = t.irradiance
         frame.targets[f"tsd_stretch[{node.name}]"] = t.stretch
@@ -209,9 +228,9 @@ class TsdBlurPass:
         self.r = renderer
 
     def run(self, frame, p) -> None:
-        ctx, node, size = self.r.ctx, p.params["node"], p.params["size"]
-        step = p.params["step"]
-        t = self.r.tsd.targets(node, size)
+        prm: TsdBlurParams = p.params
+        ctx, node, size, step = self.r.ctx, prm.node, prm.size, prm.step
+        t = store(self.r).targets(node, size)
         src = t.irradiance if step.level == 0 else t.level(ctx, step.level - 1)
         dst = t.level(ctx, step.level)
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
@@ -228,69 +247,6 @@ class TsdBlurPass:
             set_uniform(prog, "u_axis", axis)
             self.r.fullscreen(prog)
         frame.targets[f"tsd_level{step.level}[{node.name}]"] = dst
-
-
-EXACT_INNER_HALF = 24  # brute force: texels summed one by one within 24 texels of the centre...
-EXACT_RING_RATIO = 1.15  # ...then annuli r -> 1.15 r out to r_max, cells read from the mip pyramid
-UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.zeros(3))
-
-
-class TsdExactPass:
-    """Brute-force convolution with the exact profile into level 0; the gather then reads that level
-    with weight 1 (UNIT_KERNEL)."""
-
-    def __init__(self, renderer):
-        self.r = renderer
-        self._luts: dict = {}
-
-    def lut(self, model, medium):
-        key = (model, medium)
-        hit = self._luts.get(key)
-        if hit is None:
-            r_max, R, E = exact_profile_lut(model, medium)
-            data = np.zeros((2, len(R), 4), np.float32)
-            data[0, :, :3], data[1, :, :3] = R, E
-            tex = self.r.ctx.texture((len(R), 2), 4, data.tobytes(), dtype="f4")
-            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
-            tex.repeat_x = tex.repeat_y = False
-            if len(self._luts) > 32:
-                for t, _ in self._luts.values():
-                    t.release()
-                self._luts.clear()
-            hit = self._luts[key] = (tex, r_max)
-        return hit
-
-    def run(self, frame, p) -> None:
-        ctx, node, size = self.r.ctx, p.params["node"], p.params["size"]
-        t = self.r.tsd.targets(node, size)
-        lut, r_max = self.lut(p.params["model"], material_medium(p.params["material"].values))
-        dst = t.level(ctx, 0)
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_exact.frag")
-        set_uniforms(
-            prog,
-            {
-                "u_src": 0,
-                "u_stretch": 1,
-                "u_lut": 2,
-                "u_rmax_mm": r_max,
-                "u_inner_half": EXACT_INNER_HALF,
-                "u_ring_ratio": EXACT_RING_RATIO,
-            },
-        )
-        t.irradiance.build_mipmaps()  # box-filtered far field (textureLod); the gather keeps
-        t.irradiance.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)  # sampling level 0
-        t.irradiance.use(0)
-        t.stretch.use(1)
-        lut.use(2)
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-        t.fbo(ctx, dst).use()
-        ctx.viewport = (0, 0, size, size)
-        self.r.fullscreen(prog)
-        t.irradiance.filter = (moderngl.LINEAR, moderngl.LINEAR)
-        fn = frame.tsd.get(id(node))
-        if fn is not None:
-            fn.kernel = UNIT_KERNEL
-        frame.targets[f"tsd_exact[{node.name}]"] = dst
 
 
 def read_texture(tex: moderngl.Texture) -> np.ndarray:

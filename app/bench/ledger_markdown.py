@@ -1,0 +1,220 @@
+"""The ledger as Markdown (ledger.md): the measurement conditions, one table per scene, the Pareto
+fronts, the cost slopes, the pyrender peer and the recommended defaults."""
+
+from __future__ import annotations
+
+import math
+
+from .image_error import LUM_FRACTION
+from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, error_key
+from .ledger_csv import fmt_cell
+from .truth_ledger import truth_markdown
+
+
+def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: dict) -> str:
+    L = [f"# Accuracy/time ledger ({meta['sweep']} sweep)", ""]
+    L.append(f"- GL: {meta['gl']}; {meta['cpus']} CPU(s); {meta['date']}")
+    L.append(
+        f"- image {meta['size'][0]}x{meta['size'][1]}, shadow maps {meta['shadow_size']}; "
+        f"{meta['warmup']} warm-up frames, then the median (p10/p90) of up to {meta['frames']} frames "
+        f"of `render(readback=False)` per setting (fewer, at least 3, where they would take over "
+        f"{meta['budget_s']:g} s); Monte Carlo {meta['photons']:,} photons per channel"
+    )
+    clocks = sorted({r.get("clock") for r in rows if r.get("clock")})
+    L.append(
+        f"- clock: {', '.join(clocks) or 'n/a'} (cpu-synchronised: wall time with glFinish after each "
+        "pass, Mesa llvmpipe's GPU timer queries see only command submission; gpu-timer: GL timer queries)"
+    )
+    L.append(f"- sweep took {meta['sweep_s']:.1f} s, the whole run (with the pyrender peer) {meta['total_s']:.1f} s")
+    if meta.get("loadavg_start") is not None:
+        L.append(
+            f"- load average (1/5/15 min) at the start {meta['loadavg_start']}, at the end "
+            f"{meta.get('loadavg_end')}: other processes on the machine share its cores and lengthen frames"
+        )
+    if meta.get("command"):
+        L.append(f"- command: `{meta['command']}`")
+    L += [
+        "",
+        "image error: against the scene's reference image (the `reference` column) on linear HDR over "
+        f"lit surface pixels (coverage > 0, luminance > {LUM_FRACTION:.0%} of the 99th percentile); "
+        "rel-L1 = sum|img - ref| / sum ref; max/p95: per-pixel sum_c|img - ref| / sum_c ref. "
+        "`rel-L1 vs exact same size`: a tsd setting against the exact convolution at its own irradiance "
+        "size (the fit/blur error without the texture-resolution error). "
+        "profile error: relative L1 of the edge response against the Monte Carlo random walk, "
+        "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1); `vs model`: the same against the "
+        "material's own model profile (the technique's approximation alone).",
+        "`truth 4x4` / `truth px`: relative L1 against the path-traced truth on 4x4 blocks / per pixel, "
+        "beside the truth's noise floor (4x4) and the largest per-channel energy difference.",
+        "",
+        *truth_markdown(rows, meta),
+    ]
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        srows = [r for r in rows if r["scene"] == scene]
+        ref = next((r["reference"] for r in srows if r.get("reference")), "")
+        proxy = bool(ref) and not ref.startswith("exact")
+        L.append(f"## {scene}")
+        L.append("")
+        if not ref:
+            L.append(
+                "**No reference image**: neither the exact convolution nor a tsd proxy rendered; "
+                "image errors are empty."
+            )
+        elif proxy:
+            L.append(
+                f"**Proxy reference**: the exact technique did not render (see its row), so `{ref}` "
+                "stands in as the image reference; image errors are relative to it, not to the exact "
+                "profile."
+            )
+        else:
+            L.append(f"Reference image: `{ref}`.")
+        ref_size = next((r.get("tsd_size") for r in srows if r["setting"] == ref), None)
+        finer = [
+            r["setting"] for r in srows if ref_size and r.get("tsd_size") not in ("", None) and r["tsd_size"] > ref_size
+        ]
+        if finer:
+            L.append(
+                f"Settings with a finer irradiance texture than the reference's {ref_size} texels "
+                f"({', '.join(finer)}) are compared with a coarser image: their error includes the "
+                "reference's own texture-resolution error (compare the exact rows at smaller sizes)."
+            )
+        L.append("")
+        L.append(
+            "| setting | technique | model | K | tsd size | taps | ssss taps | blur levels | frames | "
+            "frame ms median | p10 | p90 | tsd ms | image rel-L1 | image max | image p95 | rel-L1 vs exact same size | "
+            "profile err vs MC | profile err vs model | truth 4x4 | truth px | truth noise 4x4 | truth energy | "
+            "status |"
+        )
+        L.append("|---" * 24 + "|")
+        for r in srows:
+            status = r["status"] + (f": {r['error']}" if r.get("error") else "")
+            pct = lambda v: "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100 * v:.2f} %"
+            L.append(
+                "| "
+                + " | ".join(
+                    [
+                        r["setting"],
+                        r["technique"],
+                        r.get("model", ""),
+                        fmt_cell(r.get("K")),
+                        fmt_cell(r.get("tsd_size")),
+                        fmt_cell(r.get("taps")),
+                        fmt_cell(r.get("ssss_taps")),
+                        fmt_cell(r.get("blur_levels", "")),
+                        fmt_cell(r.get("frames", "")),
+                        fmt_cell(r.get("frame_ms_median"), 4),
+                        fmt_cell(r.get("frame_ms_p10"), 4),
+                        fmt_cell(r.get("frame_ms_p90"), 4),
+                        fmt_cell(r.get("tsd_ms_median"), 4),
+                        pct(r.get("image_rel_l1")),
+                        pct(r.get("image_max_rel")),
+                        pct(r.get("image_p95_rel")),
+                        pct(r.get("image_rel_l1_same_size")),
+                        pct(r.get("profile_err_mc")),
+                        pct(r.get("profile_err_model")),
+                        pct(r.get("truth_rel_l1_block")),
+                        pct(r.get("truth_rel_l1")),
+                        pct(r.get("truth_noise_block")),
+                        pct(r.get("truth_energy")),
+                        status.replace("|", "/"),
+                    ]
+                )
+                + " |"
+            )
+        L.append("")
+        fr = fronts.get(scene, [])
+        if fr:
+            key = error_key(rows)
+            L.append(
+                f"Pareto front (time, {ERROR_LABELS[key]}): "
+                + " -> ".join(f"`{r['setting']}` ({r['frame_ms_median']:.1f} ms, {100 * r[key]:.2f} %)" for r in fr)
+            )
+            L.append("")
+    L += [
+        "## Cost slopes",
+        "",
+        "Least-squares slopes of log(time) against log(irradiance texels = tsd_size^2) over the size sweep "
+        "(K = max, auto taps) and against log(K) over the K sweep (auto taps; only the K for which at least "
+        "one blur pass runs: where every Gaussian folds into the unblurred term the frame is plain diffuse); "
+        "`tsd` is the sum of the "
+        "texture-space passes (stretch when it runs, irradiance, dilation, blurs). Slope 1 = linear.",
+        "",
+        "| scene | frame vs texels | tsd passes vs texels | frame vs K | tsd passes vs K "
+        "| tsd passes vs blur levels | sizes | K | blur levels per K |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for scene, s in sl.items():
+        f = lambda t: "n/a" if math.isnan(t[0]) else f"{t[0]:.3f}"
+        L.append(
+            f"| {scene} | {f(s['frame_vs_texels'])} | {f(s['tsd_vs_texels'])} | {f(s['frame_vs_K'])} | "
+            f"{f(s['tsd_vs_K'])} | {f(s['tsd_vs_levels'])} | {', '.join(map(str, s['sizes']))} | "
+            f"{', '.join(map(str, s['Ks']))} (at {s['k_size']}) | {', '.join(map(str, s['levels']))} |"
+        )
+    if not sl:
+        L.append("| (no tsd series measured) | | | | | | | | |")
+    L.append("")
+    L += ["## Peer: pyrender", ""]
+    p = meta.get("peer")
+    if p is None:
+        L.append("Not run (--no-peer).")
+    elif "error" in p:
+        L.append(f"The pyrender peer failed: {p['error']}")
+    else:
+        L.append(
+            f"`skinlab bench peer --size {p['size'][0]}x{p['size'][1]} --frames {p['frames']}` "
+            f"({p['gl']}): the head, shadows off, colour+depth read back on both sides, median of "
+            f"{p['frames']} whole frames (no glFinish between passes); pyrender's frame is plain PBR, "
+            "Skinlab's plain-PBR frame has sss_model none, its default frame the default "
+            "RenderSettings (texture-space diffusion on the skin)."
+        )
+        L.append("")
+        L.append("| renderer | ms/frame | / pyrender |")
+        L.append("|---|---|---|")
+        L.append(f"| skinlab, plain PBR | {p['skinlab_ms']:.2f} | {p['ratio_skinlab_over_pyrender']:.2f} |")
+        if p.get("skinlab_default_ms") is not None:
+            L.append(
+                f"| skinlab, default settings (tsd) | {p['skinlab_default_ms']:.2f} | "
+                f"{p['ratio_default_over_pyrender']:.2f} |"
+            )
+        L.append(f"| pyrender | {p['pyrender_ms']:.2f} | 1 |")
+    L.append("")
+    key = recs[0]["key"] if recs else "image_rel_l1"
+    rule = (
+        "whose error against the path-traced truth (4x4 blocks) is within tau of the scene's best setting in "
+        "*every* scene (every technique keeps the error they share, so the budget counts from the best)"
+        if key == TRUTH_KEY
+        else "whose image rel-L1 against the reference is <= tau in *every* scene; the reference itself "
+        "qualifies trivially"
+    )
+    L += [
+        "## Recommended defaults",
+        "",
+        f"Rule: for each error budget tau, the cheapest setting (mean over the scenes of its median frame time) "
+        f"{rule}. `tsd only` restricts this to texture-space diffusion settings that blur in every scene (what "
+        "the tsd technique's size / gaussians / taps defaults choose among; one whose Gaussians are all narrower "
+        "than a texel renders the plain frame). A setting must have been measured in every scene.",
+        "",
+        "| budget tau | cheapest setting | mean ms | errors per scene "
+        "| cheapest tsd setting | mean ms | errors per scene |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for rec in recs:
+
+        def cell(t):
+            if t is None:
+                return ["none qualifies", "", ""]
+            cost, labl, per = t
+            return [
+                f"`{labl}`",
+                f"{cost:.1f}",
+                ", ".join(f"{s} {100 * r[key]:.2f} %" for s, r in per.items()),
+            ]
+
+        L.append(f"| {100 * rec['threshold']:g} % | " + " | ".join(cell(rec["best"]) + cell(rec["best_tsd"])) + " |")
+    if any(r.get("reference") and not r["reference"].startswith("exact") for r in rows):
+        L += [
+            "",
+            "These recommendations are relative to a proxy reference (see above), not to the exact "
+            "convolution: re-run once the exact technique renders.",
+        ]
+    L.append("")
+    return "\n".join(L)

@@ -1,0 +1,62 @@
+"""Skinlab against pyrender on the same head, size and EGL context kind (`skinlab bench peer`)."""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+from app.render.settings import RenderSettings
+
+
+def peer_bench(size=(512, 512), frames: int = 30) -> dict:
+    """Median frame times, both including the colour+depth read-back (pyrender always reads back).
+    ``skinlab_ms`` is the plain-PBR frame (sss_model none, like pyrender's: no subsurface scattering);
+    ``skinlab_default_ms`` the frame with the default RenderSettings (the head's skin scatters, so
+    texture-space diffusion runs)."""
+    from app.bench.pyrender_peer import run_peer
+    from app.gl.context import create_headless_context, describe
+    from app.render.renderer import Renderer
+    from scene.scenefile import load_scene
+
+    if frames < 1:
+        raise ValueError(f"--frames: expected >= 1, got {frames}")
+    scene = load_scene(None)
+    # plain PBR on both sides: no shadow map (pyrender's directional light casts none by default)
+    for light in scene.lights():
+        light.cast_shadow = False
+    w, h = size
+    ctx = create_headless_context()
+    r = Renderer(ctx)
+    r.timer.sync = False  # no glFinish between passes: whole frames are timed here
+
+    def timed(settings):
+        r.render(scene, settings)
+        r.render(scene, settings)
+        out = []
+        for _ in range(frames):
+            t0 = time.perf_counter()
+            r.render(scene, settings, readback=("ldr", "depth"))  # what pyrender reads back
+            out.append((time.perf_counter() - t0) * 1e3)
+        return out
+
+    try:
+        ours = timed(RenderSettings(w, h, sss_model="none"))
+        ours_default = timed(RenderSettings(w, h))
+    finally:
+        r.release()
+    cam = scene.camera
+    meshes = [(str(n.mesh.source), n.world_matrix) for n in scene.mesh_nodes()]
+    peer = run_peer(meshes, cam.world_matrix, cam.yfov, cam.znear, cam.zfar, size, frames=frames)
+    theirs = list(map(float, peer["times"]))
+    mo, mt = statistics.median(ours), statistics.median(theirs)
+    md = statistics.median(ours_default)
+    return {
+        "size": [w, h],
+        "frames": frames,
+        "gl": describe(ctx),
+        "skinlab_ms": mo,
+        "pyrender_ms": mt,
+        "ratio_skinlab_over_pyrender": mo / mt,
+        "skinlab_default_ms": md,
+        "ratio_default_over_pyrender": md / mt,
+    }

@@ -1,0 +1,222 @@
+"""Planning texture-space diffusion for a frame: which meshes need it, with which Gaussian chain.
+
+A mesh node gets TSD passes only when its (effective) material scatters below the surface: a
+subsurface weight above 0, a model other than "none" and a radius above 0, and a kernel wider than a
+texel. Everything decided here is recorded in the plan (pass reasons, skipped items, warnings).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from app.render.frame_plan import PlannedPass
+from app.render.scattering import scattering_material
+from scene.optics.tsd import BlurStep, DiffusionKernel, design_kernel, material_medium, profile_fit
+from scene.uv_checks import analyse_uvs
+
+DILATE_RINGS = 4  # texels of dilation past chart borders (irradiance and stretch)
+
+
+def model_scale(world: np.ndarray) -> float:
+    return float(abs(np.linalg.det(world[:3, :3])) ** (1.0 / 3.0))
+
+
+_UV_CACHE: dict = {}
+
+
+def uv_report(node, mm_per_unit: float, size: int):
+    mesh = node.mesh
+    key = (mesh.uid, mesh.version, float(mm_per_unit), round(model_scale(node.world_matrix), 9), size)
+    r = _UV_CACHE.get(key)
+    if r is None:
+        if len(_UV_CACHE) > 64:
+            _UV_CACHE.clear()
+        r = _UV_CACHE[key] = analyse_uvs(
+            mesh, mm_per_unit, texels=size, grid=512, model_scale=model_scale(node.world_matrix)
+        )
+    return r
+
+
+@dataclass
+class TsdNodePlan:
+    node: object
+    material: object
+    kernel: DiffusionKernel
+    size: int
+
+
+# -- the passes' typed parameters ----------------------------------------------------------------------
+
+
+@dataclass
+class TsdNodeParams:
+    """What every texture-space pass of one mesh node needs."""
+
+    node: object
+    size: int  # texels per side
+    material: object  # the effective material
+    kernel: DiffusionKernel  # the Gaussian chain (and the translucency's Gaussians)
+    dilate: int = DILATE_RINGS
+
+
+@dataclass
+class TsdIrradianceParams(TsdNodeParams):
+    lights: list = field(default_factory=list)
+    shadow_lights: list = field(default_factory=list)
+    translucency: bool = False
+    mix: float = 0.5  # pre-/post-scatter texturing: albedo^mix before the blur
+    gather: DiffusionKernel | None = None  # the forward pass's gather weights (None: kernel)
+
+
+@dataclass
+class TsdBlurParams(TsdNodeParams):
+    step: BlurStep | None = None
+
+
+@dataclass
+class TsdExactParams(TsdNodeParams):
+    model: str = ""
+
+
+# the exact convolution writes level 0, which the gather reads with weight 1
+UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.zeros(3))
+
+
+def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None) -> TsdNodePlan | None:
+    """Decide TSD for one visible mesh node (PlanContext `ctx`); record skips and warnings in its plan."""
+    label = f"tsd[{node.name}]"
+    plan, scene = ctx.plan, ctx.scene
+    mat = scattering_material(node, ctx.settings, plan, label)
+    if mat is None:
+        return None
+    mesh = node.mesh
+    if mesh.uvs is None:
+        plan.warnings.append(
+            f"mesh {mesh.name!r} ({mesh.source or 'no file'}) has no UVs; texture-space "
+            "diffusion generated an atlas with xatlas (set generate_uvs = true in the scene "
+            "file to do it at load time)"
+        )
+        mesh.ensure_uvs("texture-space diffusion needs UVs", generate=True)
+    rep = uv_report(node, scene.mm_per_unit, size)
+    for w in rep.warnings():
+        if w not in plan.warnings:
+            plan.warnings.append(w)
+    pct = rep.mm_per_texel_percentiles
+    p10 = float(np.nanmin(pct["p10"])) if pct else math.nan
+    p50 = float(np.nanmean(pct["p50"])) if pct else math.nan
+    if not (np.isfinite(p10) and np.isfinite(p50) and p50 > 0):
+        plan.warnings.append(
+            f"mesh {mesh.name!r}: no triangle with a usable UV-to-surface scale; rendered without subsurface scattering"
+        )
+        plan.skipped.append((label, "no usable UV layout"))
+        return None
+    fit = profile_fit(mat["sss_model"], material_medium(mat.values), gaussians)
+    kernel = design_kernel(fit, max(p10, 1e-9), p50, taps=taps)
+    for what, why in kernel.skipped:
+        plan.skipped.append((f"{label} {what}", why))
+    if kernel.levels == 0:
+        plan.skipped.append(
+            (label, "every Gaussian of the profile is narrower than a texel or negligible; plain diffuse")
+        )
+        return None
+    return TsdNodePlan(node, mat, kernel, size)
+
+
+def plan_tsd(ctx, size: int, gaussians: int, taps: int | None, mix: float, translucency: bool, exact: bool = False):
+    """The texture-space passes of every scattering mesh (stretch, irradiance, dilation, then the
+    Gaussian blurs, or with `exact` the brute-force convolution) and whether translucency runs;
+    (passes, node plans, translucency)."""
+    plan = ctx.plan
+    nodes = [t for t in (plan_tsd_node(n, ctx, size, gaussians, taps) for n in ctx.meshes) if t is not None]
+    use_translucency = bool(nodes) and translucency and bool(ctx.shadow_lights)
+    if nodes and not use_translucency:
+        plan.skipped.append(
+            ("translucency", "disabled in the settings" if not translucency else "no shadow-casting light")
+        )
+    if not nodes:
+        plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
+    stretch_valid = ctx.state.stretch_valid if ctx.state is not None else None
+    passes = []
+    for t in nodes:
+        passes += _node_passes(t, ctx, mix, use_translucency, stretch_valid, exact)
+    return passes, nodes, use_translucency
+
+
+def _node_passes(t, ctx, mix, translucency, stretch_valid, exact) -> list[PlannedPass]:
+    node, n, k = t.node, t.size, t.kernel
+    base = dict(node=node, size=n, material=t.material, kernel=k, dilate=DILATE_RINGS)
+    res = (n, n)
+    out = []
+    if stretch_valid is not None and stretch_valid(node, ctx.scene, n):
+        ctx.plan.skipped.append(
+            (f"tsd_stretch[{node.name}]", f"geometry unchanged (mesh version {node.mesh.version}); stretch map reused")
+        )
+    else:
+        out.append(
+            PlannedPass(
+                f"tsd_stretch[{node.name}]",
+                "tsd_stretch",
+                "tsd_stretch",
+                res,
+                f"mm per texel of '{node.mesh.name}' (new or changed geometry / scale)",
+                TsdNodeParams(**base),
+            )
+        )
+    out.append(
+        PlannedPass(
+            f"tsd_irradiance[{node.name}]",
+            "tsd_irradiance",
+            "tsd_irradiance",
+            res,
+            f"material '{t.material.name}' scatters ({t.material['sss_model']}): light entering the surface in UV space"
+            + (", translucency through thin parts" if translucency else ""),
+            TsdIrradianceParams(
+                **base,
+                lights=ctx.lights,
+                shadow_lights=ctx.shadow_lights,
+                translucency=translucency,
+                mix=mix,
+                gather=UNIT_KERNEL if exact else k,
+            ),
+        )
+    )
+    out.append(
+        PlannedPass(
+            f"tsd_dilate[{node.name}]",
+            "tsd_dilate",
+            "tsd_irradiance",
+            res,
+            f"push irradiance {DILATE_RINGS} texels past UV chart borders (seams)",
+            TsdNodeParams(**base),
+        )
+    )
+    if exact:
+        out.append(
+            PlannedPass(
+                f"tsd_exact[{node.name}]",
+                "tsd_exact",
+                "tsd_level0",
+                res,
+                f"brute-force convolution with the exact {t.material['sss_model']} profile (image reference; slow "
+                "on purpose)",
+                TsdExactParams(**base, model=t.material["sss_model"]),
+            )
+        )
+        return out
+    for s in k.steps:
+        w = ", ".join(f"{x:.3f}" for x in s.weight)
+        out.append(
+            PlannedPass(
+                f"tsd_blur[{node.name}]{s.level}",
+                "tsd_blur",
+                f"tsd_level{s.level}",
+                res,
+                f"Gaussian v={s.variance_mm2:.4g} mm2 (step sigma {s.sigma_mm:.3g} mm, {s.taps} taps), "
+                f"weight RGB ({w})",
+                TsdBlurParams(**base, step=s),
+            )
+        )
+    return out

@@ -1,0 +1,64 @@
+// Subsurface hook of technique "tsd" (and "exact"): the texture-space diffusion gather (d'Eon &
+// Luebke 2007): the subsurface diffuse term is the weighted sum of the blurred irradiance levels x
+// albedo^(1-mix) (post-scatter texturing), mixed with plain Burley diffuse by u_subsurface. Variant:
+// TSD_LEVELS = n (0..6) blurred levels. Contract: app/render/technique.py.
+#include "lib/subsurface.glsl"
+
+uniform float u_tsd_mix;
+uniform vec3 u_tsd_identity;         // weight of the unblurred irradiance per channel
+uniform vec3 u_tsd_w[6];             // weight of each blurred level per channel
+uniform sampler2D u_tsd_irradiance;  // premultiplied by coverage: rgb / a
+#if TSD_LEVELS > 0
+uniform sampler2D u_tsd_level0;
+#endif
+#if TSD_LEVELS > 1
+uniform sampler2D u_tsd_level1;
+#endif
+#if TSD_LEVELS > 2
+uniform sampler2D u_tsd_level2;
+#endif
+#if TSD_LEVELS > 3
+uniform sampler2D u_tsd_level3;
+#endif
+#if TSD_LEVELS > 4
+uniform sampler2D u_tsd_level4;
+#endif
+#if TSD_LEVELS > 5
+uniform sampler2D u_tsd_level5;
+#endif
+
+vec3 unpremultiply(vec4 t) { return t.a > COVERAGE_EPS ? t.rgb / t.a : vec3(0.0); }
+
+// Diffused irradiance (still x albedo^mix) at uv: I E + sum_k W_k level_k.
+vec3 tsd_diffused(vec2 uv) {
+    vec3 d = u_tsd_identity * unpremultiply(texture(u_tsd_irradiance, uv));
+#if TSD_LEVELS > 0
+    d += u_tsd_w[0] * unpremultiply(texture(u_tsd_level0, uv));
+#endif
+#if TSD_LEVELS > 1
+    d += u_tsd_w[1] * unpremultiply(texture(u_tsd_level1, uv));
+#endif
+#if TSD_LEVELS > 2
+    d += u_tsd_w[2] * unpremultiply(texture(u_tsd_level2, uv));
+#endif
+#if TSD_LEVELS > 3
+    d += u_tsd_w[3] * unpremultiply(texture(u_tsd_level3, uv));
+#endif
+#if TSD_LEVELS > 4
+    d += u_tsd_w[4] * unpremultiply(texture(u_tsd_level4, uv));
+#endif
+#if TSD_LEVELS > 5
+    d += u_tsd_w[5] * unpremultiply(texture(u_tsd_level5, uv));
+#endif
+    return d;
+}
+
+float sss_plain_weight() { return 1.0 - u_subsurface; }
+
+void sss_add_light(vec3 e, float vis, float NoL) {}  // the irradiance pass gathered the light
+
+vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
+    // the diffused light leaving toward the viewer (1/pi: Lambertian exit)
+    vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
+    return (1.0 - u_metallic) * u_subsurface * post * tsd_diffused(uv) * (INV_PI * sss_exit_weight(abs(NoV)));
+}
