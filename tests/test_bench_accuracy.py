@@ -1,5 +1,6 @@
-"""`skinlab bench accuracy`: the ledger's files and their structure on a tiny sweep (head, 64x64,
-five settings; timings are measured, never asserted), and the pieces it is computed from."""
+"""`skinlab bench accuracy`: the ledger's files and their structure on a tiny sweep (the index-matched
+head, 64x64, five settings, a 32x32 path-traced truth; timings are measured, never asserted), and the
+pieces it is computed from."""
 
 import csv
 import json
@@ -19,11 +20,14 @@ from scene.optics import edges
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def cli(*args, timeout=180):
+HEAD = "head-skin1-matched"
+
+
+def cli(*args, timeout=180, env=None):
     return subprocess.run(
         [sys.executable, "-m", "app.cli", "bench", *args],
         cwd=ROOT,
-        env=dict(os.environ),
+        env={**os.environ, **(env or {})},
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -32,8 +36,10 @@ def cli(*args, timeout=180):
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
+    """The tiny sweep with its reference path-traced into an empty cache (--references)."""
     out = tmp_path_factory.mktemp("ledger")
-    res = cli("accuracy", "--tiny", "--out", str(out))
+    cache = tmp_path_factory.mktemp("cache")
+    res = cli("accuracy", "--tiny", "--references", "--out", str(out), env={"SKINLAB_CACHE_DIR": str(cache)})
     assert res.returncode == 0, res.stderr[-3000:]
     return out, res
 
@@ -50,7 +56,7 @@ def test_csv_structure(tiny):
     assert header == acc.CSV_COLUMNS
     settings = acc.sweep_settings(acc.TINY)
     assert [r["setting"] for r in rows] == [s.label for s in settings]  # one row per setting, in order
-    assert {r["scene"] for r in rows} == {"head"}
+    assert {r["scene"] for r in rows} == {HEAD}
     assert {r["technique"] for r in rows} == {"exact", "none", "tint", "tsd"}
     for r in rows:
         assert r["status"] in ("ok", "error", "ignored"), r
@@ -72,6 +78,12 @@ def test_csv_structure(tiny):
     assert int(by[ref]["pixels"]) > 100
     # no scattering has the profile error of a hard step: exactly 1
     assert float(by["none"]["profile_err_mc"]) == pytest.approx(1.0)
+    # every ok row is measured against the path-traced truth, with its noise floor
+    for r in rows:
+        if r["status"] == "ok":
+            e, n = float(r["truth_rel_l1_block"]), float(r["truth_noise_block"])
+            assert 0 < e < 1 and 0 < n < float(r["truth_rel_l1"]) and float(r["truth_energy"]) >= 0
+    assert len({r["truth_noise_block"] for r in rows}) == 1  # one reference per scene
 
 
 def test_markdown_json_and_figures(tiny):
@@ -79,7 +91,9 @@ def test_markdown_json_and_figures(tiny):
     md = (out / "ledger.md").read_text()
     for needle in (
         "# Accuracy/time ledger (tiny sweep)",
-        "## head",
+        f"## {HEAD}",
+        "## Against the path-traced truth",
+        "truth 4x4",
         "| setting | technique | model |",
         "## Cost slopes",
         "frame vs texels",
@@ -89,19 +103,33 @@ def test_markdown_json_and_figures(tiny):
     ):
         assert needle in md, needle
     assert md.index("## Recommended defaults") > md.index("## Cost slopes")
-    table = [line for line in md.splitlines() if line.startswith("| ") and " | head" not in line]
-    assert sum(line.startswith(f"| {s.label} |") for s in acc.sweep_settings(acc.TINY) for line in table) == 5
+    table = [line for line in md.splitlines() if line.startswith("| ") and f" | {HEAD}" not in line]
+    # each setting in the per-scene table and in the table against the truth
+    assert sum(line.startswith(f"| {s.label} |") for s in acc.sweep_settings(acc.TINY) for line in table) == 10
     doc = json.loads((out / "ledger.json").read_text())
-    assert len(doc["rows"]) == 5 and doc["meta"]["sweep"] == "tiny" and "head" in doc["pareto"]
+    assert len(doc["rows"]) == 5 and doc["meta"]["sweep"] == "tiny" and HEAD in doc["pareto"]
+    assert doc["error_axis"] == "truth_rel_l1_block" and doc["meta"]["truth"]["missing"] == {}
     from app.image_output import read_image
 
-    for name in ("pareto.png", "cost.png"):
+    for name in ("pareto.png", "cost.png", "error_maps.png"):
         img = read_image(out / name)
         assert img.ndim == 3 and img.shape[0] > 100 and img.shape[1] > 100 and img.std() > 0
-    assert len(list((out / "images").glob("head-*.png"))) == 5
+    assert len(list((out / "images").glob(f"{HEAD}-*.png"))) == 5
+    maps = sorted((out / "error_maps").glob(f"{HEAD}-*.png"))
+    assert len(maps) == 5 and all(read_image(m).shape[:2] == (32, 32) for m in maps)
     assert not [p for p in out.rglob(".*") if p.is_file()]  # no temporary files left behind
-    for name in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png"):
+    for name in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png", "error_maps.png"):
         assert str((out / name).resolve()) in res.stdout
+
+
+def test_without_a_cached_reference_the_ledger_says_how_to_make_it(ctx, tmp_path, monkeypatch):
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path / "empty-cache"))
+    sweep = replace(acc.TINY, ks=(6,), frames=1, warmup=1)
+    res = acc.run_sweep(sweep, tmp_path, peer=False, progress=False, images=False)
+    assert all(math.isnan(r.get("truth_rel_l1_block", math.nan)) for r in res["rows"])
+    assert res["error_axis"] == "image_rel_l1"  # falls back to the exact convolution
+    assert "--references" in (tmp_path / "ledger.md").read_text()
+    assert not (tmp_path / "empty-cache").exists() or not any((tmp_path / "empty-cache").rglob("*.npz"))
 
 
 def test_failing_setting_is_an_error_row_and_the_sweep_goes_on(ctx, tmp_path):
@@ -149,6 +177,14 @@ def test_pareto_front_and_recommendation_rule():
     assert recs[0.01]["best"][1] == "z"  # y fails in scene a; z is within 1 % in both
     assert recs[0.05]["best"][1] == "x"
     assert recs[0.001]["best"][1] == "ref" and recs[0.001]["best_tsd"] is None
+    # against the truth the budget counts from each scene's best setting
+    for r in rows:
+        r["truth_rel_l1_block"] = r["image_rel_l1"] + (0.12 if r["scene"] == "a" else 0.10)
+    assert acc.error_key(rows) == "truth_rel_l1_block"
+    recs = {r["threshold"]: r for r in acc.recommendations(rows, (0.01, 0.05), key="truth_rel_l1_block")}
+    assert recs[0.01]["best"][1] == "z" and recs[0.05]["best"][1] == "x"
+    front = acc.pareto_front([r for r in rows if r["scene"] == "b"], "truth_rel_l1_block")
+    assert [r["setting"] for r in front] == ["x", "y", "ref"]  # ref (0.100) beats y (0.102)
 
 
 def test_log_slope_and_image_error():

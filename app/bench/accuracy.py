@@ -55,12 +55,23 @@ from pathlib import Path
 import numpy as np
 
 from .image_error import image_error, lit_mask
-from .ledger_analysis import log_slope, pareto_front, recommendations, usable
+from .ledger_analysis import error_key, log_slope, pareto_front, recommendations, usable
 from .ledger_csv import CSV_COLUMNS, NUMERIC_COLUMNS, csv_text
 from .ledger_files import write_ledger
 from .measure import measure_setting
 from .profile_error import edge_error, edge_response, fit_kernel, model_reference, profile_reference
-from .sweep import SWEEPS, TINY, Setting, Sweep, proxy_reference, resolve_scene, scene_label, sweep_settings
+from .sweep import (
+    SWEEPS,
+    TINY,
+    Setting,
+    Sweep,
+    proxy_reference,
+    resolve_scene,
+    scene_label,
+    sheet_settings,
+    sweep_settings,
+)
+from .truth_ledger import error_map_sheet, load_truth, truth_errors, write_error_map
 
 __all__ = [  # the ledger's public names, importable from here as before the split
     "CSV_COLUMNS",
@@ -82,6 +93,7 @@ __all__ = [  # the ledger's public names, importable from here as before the spl
     "run_sweep",
     "sweep_settings",
     "usable",
+    "error_key",
     "write_ledger",
 ]
 
@@ -106,14 +118,18 @@ def run_sweep(
     progress: bool = True,
     images: bool = True,
     command: str | None = None,
+    references: bool = False,
 ) -> dict:
-    """Run the whole ledger and write DIR/ledger.csv, ledger.md, ledger.json, pareto.png and cost.png."""
+    """Run the whole ledger and write DIR/ledger.csv, ledger.md, ledger.json, pareto.png and cost.png;
+    with the sweep's truth, error_maps/ and error_maps.png. references: path-trace the references
+    that are not cached yet (else a scene without a cached reference has no truth columns)."""
     from tqdm import tqdm
 
     from app.gl.context import create_headless_context, describe
     from app.render.registry import get_technique
     from app.render.renderer import Renderer
     from app.render.scattering import effective_material
+    from app.truth.compare import relative_difference
     from scene.optics.tsd import material_medium
     from scene.scenefile import load_scene
 
@@ -128,6 +144,9 @@ def run_sweep(
     gl = describe(ctx)
     renderer = Renderer(ctx)
     rows: list[dict] = []
+    truth_notes: dict[str, str] = {}
+    sheet: dict[str, dict[str, np.ndarray]] = {}
+    on_sheet = set(sheet_settings(settings))
     bar = tqdm(
         total=len(settings) * len(scenes),
         file=sys.stderr,
@@ -154,6 +173,18 @@ def run_sweep(
                 except Exception as exc:
                     print(f"profile references for {label} failed: {_first_line(exc)}", file=sys.stderr)
                     base_mat = None
+            truth = None
+            if sweep.truth is not None:
+                bar.set_postfix_str(f"{label}: path-traced reference")
+                try:
+                    truth = load_truth(scene, sweep.truth, render=references, progress=progress)
+                except Exception as exc:
+                    truth_notes[label] = f"the path-traced reference failed: {_first_line(exc)}"
+                if truth is None and label not in truth_notes:
+                    truth_notes[label] = (
+                        "no cached path-traced reference at "
+                        f"{sweep.truth.size[0]}x{sweep.truth.size[1]}, {sweep.truth.spp} spp: run with --references"
+                    )
             hdrs: dict[Setting, np.ndarray] = {}
             scene_rows: dict[Setting, dict] = {}
             for st in settings:
@@ -195,6 +226,15 @@ def run_sweep(
                     )
                     row["passes"] = m["passes"]
                     hdrs[st] = m["hdr"]
+                    if truth is not None:
+                        # an untimed frame at the reference's size, compared with the truth
+                        small_rs = st.render_settings(sweep, truth.image.shape[1::-1])
+                        small = renderer.render(scene, small_rs, readback=("hdr",)).hdr
+                        row.update(truth_errors(small, truth))
+                        safe = st.label.replace(" ", "-")
+                        write_error_map(out / "error_maps" / f"{label}-{safe}.png", small, truth)
+                        if st in on_sheet:
+                            sheet.setdefault(label, {})[st.label] = relative_difference(small, truth.image)
                     if images:
                         from app.image_output import write_image
 
@@ -238,6 +278,12 @@ def run_sweep(
         bar.close()
         renderer.release()
     sweep_s = time.perf_counter() - t_start
+    if sheet:
+        error_map_sheet(
+            sheet,
+            out / "error_maps.png",
+            "signed relative difference against the path-traced truth (red: brighter, blue: darker)",
+        )
     peer_res = None
     if peer:
         try:
@@ -257,6 +303,14 @@ def run_sweep(
         "budget_s": sweep.budget_s,
         "photons": sweep.photons,
         "scenes": [scene_label(s) for s in scenes],
+        "truth": None
+        if sweep.truth is None
+        else {
+            "size": list(sweep.truth.size),
+            "spp": sweep.truth.spp,
+            "passes": sweep.truth.passes,
+            "missing": truth_notes,
+        },
         "sweep_s": sweep_s,
         "total_s": time.perf_counter() - t_start,
         "peer": peer_res,

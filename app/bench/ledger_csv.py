@@ -6,6 +6,8 @@ import csv
 import io
 import math
 
+from .truth_ledger import TRUTH_COLUMNS
+
 CSV_COLUMNS = [
     "scene",
     "setting",
@@ -33,6 +35,7 @@ CSV_COLUMNS = [
     "profile_err_mc",
     "profile_err_model",
     "reference",
+    *TRUTH_COLUMNS,
     "status",
     "error",
     "passes_ms",
@@ -51,6 +54,7 @@ NUMERIC_COLUMNS = [
     "image_rel_l1_same_size",
     "profile_err_mc",
     "profile_err_model",
+    *TRUTH_COLUMNS,
 ]
 
 

@@ -11,7 +11,7 @@ import numpy as np
 
 from app.atomic_write import write_text_atomic
 
-from .ledger_analysis import cost_series, pareto_front, recommendations, slopes
+from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, cost_series, error_key, pareto_front, recommendations, slopes
 from .ledger_csv import csv_text
 from .ledger_markdown import markdown
 
@@ -20,9 +20,10 @@ def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
     from app.bench.ledger_plots import cost_plot, pareto_plot
 
     out = Path(out)
+    key = error_key(rows)
     fronts = {}
     for scene in dict.fromkeys(r["scene"] for r in rows):
-        fronts[scene] = pareto_front([r for r in rows if r["scene"] == scene])
+        fronts[scene] = pareto_front([r for r in rows if r["scene"] == scene], key)
     k_sizes = [r["tsd_size"] for r in rows if r["technique"] == "tsd"]
     # the K sweep's size: the size with the most distinct K
     k_size = None
@@ -34,9 +35,9 @@ def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
         k_size = max(counts, key=lambda s: (len(counts[s]), s)) if counts else None
     series = cost_series(rows, {"k_size": k_size})
     sl = slopes(series)
-    recs = recommendations(rows)
+    recs = recommendations(rows, key=key)
     write_text_atomic(out / "ledger.csv", csv_text(rows))
-    pareto_plot(rows, fronts, out / "pareto.png")
+    pareto_plot(rows, fronts, out / "pareto.png", key=key, label=ERROR_LABELS[key])
     cost_plot(series, sl, out / "cost.png")
     md = markdown(rows, meta, sl, recs, fronts)
     write_text_atomic(out / "ledger.md", md)
@@ -66,13 +67,18 @@ def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
         "slopes": {s: {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()} for s, d in sl.items()},
         "pareto": {s: [r["setting"] for r in f] for s, f in fronts.items()},
         "recommendations": rec_json,
+        "error_axis": key,
     }
     write_text_atomic(out / "ledger.json", json.dumps(clean(doc), indent=1))
+    names = ["ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png"]
+    if key == TRUTH_KEY and (out / "error_maps.png").is_file():
+        names.append("error_maps.png")
     return {
         "rows": rows,
         "meta": meta,
         "slopes": sl,
         "recommendations": recs,
         "fronts": fronts,
-        "files": [str(out / n) for n in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png")],
+        "error_axis": key,
+        "files": [str(out / n) for n in names],
     }

@@ -16,9 +16,9 @@ from app.render.registry import techniques
 from .ledger_analysis import usable
 
 
-def _floor(pts) -> float:
+def _floor(pts, key: str = "image_rel_l1") -> float:
     """Where the reference (error 0) is drawn on the log axis: a decade below the smallest other error."""
-    nz = [r["image_rel_l1"] for r in pts if r["image_rel_l1"] > 0]
+    nz = [r[key] for r in pts if r[key] > 0]
     return 10.0 ** (math.floor(math.log10(min(nz))) - 1) if nz else 1e-5
 
 
@@ -45,20 +45,22 @@ def _plt():
     return plt
 
 
-def pareto_plot(rows: list[dict], fronts: dict, path: Path) -> Path:
+def pareto_plot(
+    rows: list[dict], fronts: dict, path: Path, key: str = "image_rel_l1", label: str = "image rel-L1"
+) -> Path:
     plt = _plt()
     scenes = list(dict.fromkeys(r["scene"] for r in rows)) or ["(none)"]
     fig, axes = plt.subplots(1, len(scenes), figsize=(6.4 * len(scenes), 4.8), squeeze=False)
     for ax, scene in zip(axes[0], scenes):
-        pts = [r for r in rows if r["scene"] == scene and usable(r)]
-        floor = _floor(pts)
+        pts = [r for r in rows if r["scene"] == scene and usable(r, key)]
+        floor = _floor(pts, key)
         for t in techniques():  # each technique's marker and colour from its LedgerStyle
             sel = [r for r in pts if r["technique"] == t.name]
             if not sel:
                 continue
             ax.scatter(
                 [r["frame_ms_median"] for r in sel],
-                [max(r["image_rel_l1"], floor) for r in sel],
+                [max(r[key], floor) for r in sel],
                 marker=t.ledger.marker,
                 c=t.ledger.colour,
                 s=70 if t.ledger.marker == "*" else 40,
@@ -69,13 +71,13 @@ def pareto_plot(rows: list[dict], fronts: dict, path: Path) -> Path:
         fr = fronts.get(scene, [])
         if fr:
             x = [r["frame_ms_median"] for r in fr]
-            y = [max(r["image_rel_l1"], floor) for r in fr]
+            y = [max(r[key], floor) for r in fr]
             ax.step(x, y, where="post", color="grey", lw=1, ls="--", zorder=2, label="Pareto front")
             ax.scatter(x, y, s=140, facecolors="none", edgecolors="grey", zorder=4)
             for r, xi, yi in zip(fr, x, y):
-                text = r["setting"] + (" (reference: 0)" if r["image_rel_l1"] == 0 else "")
+                text = r["setting"] + (" (reference: 0)" if r[key] == 0 else "")
                 ax.annotate(text, (xi, yi), textcoords="offset points", xytext=(5, 4), fontsize=7)
-        bad = [r for r in rows if r["scene"] == scene and not usable(r)]
+        bad = [r for r in rows if r["scene"] == scene and not usable(r, key)]
         if bad:
             ax.text(
                 0.01,
@@ -89,12 +91,19 @@ def pareto_plot(rows: list[dict], fronts: dict, path: Path) -> Path:
         ax.set_xscale("log")
         ax.margins(x=0.25)
         ax.xaxis.set_minor_formatter(plt.NullFormatter())
-        if pts and any(r["image_rel_l1"] > 0 for r in pts):
+        if pts and any(r[key] > 0 for r in pts):
             ax.set_yscale("log")
-        ref = next((r["reference"] for r in rows if r["scene"] == scene and r.get("reference")), "")
-        ax.set_title(f"{scene}: error vs time (reference: {ref or 'none'})", fontsize=9)
+        if key == "image_rel_l1":
+            ref = next((r["reference"] for r in rows if r["scene"] == scene and r.get("reference")), "")
+            ax.set_title(f"{scene}: error vs time (reference: {ref or 'none'})", fontsize=9)
+            ax.set_ylabel(f"{label} (the reference drawn at {floor:g})")
+        else:
+            noise = next((r.get("truth_noise_block") for r in pts if r.get("truth_noise_block") is not None), None)
+            if noise is not None and np.isfinite(noise):
+                ax.axhline(noise, color="grey", lw=0.8, ls=":", label="truth noise floor (4x4)")
+            ax.set_title(f"{scene}: error against the path-traced truth vs time", fontsize=9)
+            ax.set_ylabel(label)
         ax.set_xlabel("median frame time (ms)")
-        ax.set_ylabel(f"image rel-L1 vs reference (the reference drawn at {floor:g})")
         ax.grid(True, which="both", alpha=0.3)
         if pts:
             ax.legend(fontsize=7, loc="upper right")

@@ -6,8 +6,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from .truth_ledger import REFERENCE_SCENES, TruthSpec, reference_scene_names
+
 ASSETS = Path(__file__).resolve().parents[2] / "assets" / "scenes"
 SCENE_ALIASES = {"head": None, "bunny": ASSETS / "bunny-skimmilk.toml"}
+REFERENCE_SCENE_NAMES = tuple(reference_scene_names())
 
 
 @dataclass(frozen=True)
@@ -29,6 +32,8 @@ class Sweep:
     scenes: tuple[str, ...] = ("head", "bunny")
     extra: tuple = ()  # extra settings (tiny sweep)
     every_technique: bool = True  # also a default-settings row for each registered technique not swept above
+    # the path-traced truth: reference size and samples (app/bench/truth_ledger.py); None: not measured
+    truth: TruthSpec | None = None
 
 
 FULL = Sweep(
@@ -46,6 +51,8 @@ FULL = Sweep(
     budget_s=25.0,
     photons=200_000,
     peer_frames=30,
+    scenes=REFERENCE_SCENE_NAMES,
+    truth=TruthSpec((192, 192), 1024),
 )
 QUICK = Sweep(
     "quick",
@@ -56,14 +63,16 @@ QUICK = Sweep(
     (256, 512),
     (None, 7),
     (11, 25),
-    512,
+    256,  # the exact convolution at 512 texels took half of the quick run; the truth is the first axis now
     frames=5,
     warmup=2,
     budget_s=2.0,
     photons=20_000,
     peer_frames=5,
+    scenes=("head-skin1-matched", "bunny-skimmilk", "slab-edge-skin1"),
+    truth=TruthSpec((96, 96), 256),
 )
-# for the tests: four settings on the head at 64x64
+# for the tests: five settings on the index-matched head at 64x64, a 32x32 truth
 TINY = Sweep(
     "tiny",
     (64, 64),
@@ -79,7 +88,8 @@ TINY = Sweep(
     budget_s=0.5,
     photons=4_000,
     peer_frames=1,
-    scenes=("head",),
+    scenes=("head-skin1-matched",),
+    truth=TruthSpec((32, 32), 16, passes=2),
     every_technique=False,
 )
 SWEEPS = {"full": FULL, "quick": QUICK, "tiny": TINY}
@@ -151,6 +161,22 @@ def sweep_settings(sweep: Sweep) -> list[Setting]:
     return uniq
 
 
+def sheet_settings(settings: list[Setting]) -> list[Setting]:
+    """One setting per technique for the error-map contact sheet: the one with the technique's default
+    settings where it was swept, else the technique's first (for exact: the reference size)."""
+    from app.render.registry import get_technique
+
+    out = []
+    for tech in dict.fromkeys(s.technique for s in settings):
+        t = get_technique(tech)
+        defaults = t.settings_type()
+        cols = t.ledger.columns
+        default = Setting(tech, **{c: getattr(defaults, f) for c, f in cols.items()})
+        cands = [s for s in settings if s.technique == tech]
+        out.append(default if default in cands and tech != "exact" else cands[0])
+    return out
+
+
 def proxy_reference(settings: list[Setting]) -> Setting | None:
     """The most accurate tsd setting: largest irradiance texture, then largest K, auto taps first."""
     tsd = [s for s in settings if s.technique == "tsd"]
@@ -163,13 +189,14 @@ def resolve_scene(name: str):
     """'head', 'bunny' (skim milk), 'bunny-marble'... (assets/scenes/NAME.toml) or a path to a scene file."""
     if name in SCENE_ALIASES:
         return SCENE_ALIASES[name]
-    p = ASSETS / f"{name}.toml"
-    if p.is_file():
-        return p
+    for folder in (REFERENCE_SCENES, ASSETS):
+        p = folder / f"{name}.toml"
+        if p.is_file():
+            return p
     p = Path(name)
     if p.suffix == ".toml" and p.is_file():
         return p
-    known = ", ".join(list(SCENE_ALIASES) + sorted(x.stem for x in ASSETS.glob("*.toml")))
+    known = ", ".join([*SCENE_ALIASES, *sorted(x.stem for x in ASSETS.glob("*.toml")), *REFERENCE_SCENE_NAMES])
     raise ValueError(f"--scenes: unknown scene {name!r}; expected one of {known} or a .toml path")
 
 

@@ -9,4 +9,5 @@ COMMAND_MODULES = [
     "app.commands.profile",
     "app.commands.mc",
     "app.commands.view",
+    "app.commands.reference",
 ]

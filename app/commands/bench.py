@@ -63,8 +63,8 @@ def register(sub) -> None:
     rel.set_defaults(func=run_reload_bench)
     acc = bsub.add_parser(
         "accuracy",
-        help="accuracy/time ledger: every SSS technique and setting timed and "
-        "compared with the exact reference image and the Monte Carlo profile",
+        help="accuracy/time ledger: every SSS technique and setting timed and compared with the "
+        "path-traced truth, the exact convolution and the Monte Carlo profile",
     )
     acc.add_argument(
         "--out",
@@ -82,7 +82,16 @@ def register(sub) -> None:
     acc.add_argument(
         "--scenes",
         default=None,
-        help="comma-separated: head, bunny (skim milk), bunny-marble, ... or .toml paths (default head,bunny)",
+        help="comma-separated scene names (assets/scenes/reference/NAME.toml, assets/scenes/NAME.toml; head, "
+        "bunny) or .toml paths (default: every reference scene; --quick head-skin1-matched, bunny-skimmilk, "
+        "slab-edge-skin1)",
+    )
+    acc.add_argument(
+        "--references",
+        action="store_true",
+        help="path-trace the scenes' references that are not cached yet (skinlab reference; minutes per scene "
+        "on 2 cores: full 192x192 at 1024 spp, --quick 96x96 at 256 spp); without it a scene whose reference "
+        "is not cached is measured without the truth",
     )
     acc.add_argument(
         "--frames",
@@ -197,7 +206,12 @@ def run_accuracy_bench(args) -> int:
     sweep = accuracy_sweep_from_args(args)
     for s in sweep.scenes:
         resolve_scene(s)  # bad names fail before any rendering
-    flags = [("--quick", args.quick), ("--tiny", args.tiny), ("--no-peer", args.no_peer)]
+    flags = [
+        ("--quick", args.quick),
+        ("--tiny", args.tiny),
+        ("--no-peer", args.no_peer),
+        ("--references", args.references),
+    ]
     opts = [
         ("--size", args.size),
         ("--scenes", args.scenes),
@@ -220,6 +234,7 @@ def run_accuracy_bench(args) -> int:
         progress=not args.no_progress,
         images=not args.no_images,
         command=command,
+        references=args.references,
     )
     rows = res["rows"]
     n_ok = sum(r["status"] == "ok" for r in rows)

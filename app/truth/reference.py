@@ -1,0 +1,212 @@
+"""Render the path-traced reference of a Skinlab scene with Mitsuba 3, in independent passes, cached.
+
+The image is the mean of ``passes`` (>= 2) independent renders with different seeds; its noise
+floor is :func:`app.truth.compare.image_error` between the means of the first and second half of
+the passes. Each pass is rendered in chunks of at most ``CHUNK_SPP`` samples per pixel (a progress
+bar counts samples).
+
+Results are cached by a hash of everything that affects them: the exported description (world-space
+geometry, media, BSDFs, baked textures, lights, camera, size), samples, passes, seed, variant,
+integrator settings and the Mitsuba version. The cache lives in ``$SKINLAB_CACHE_DIR/reference`` (default
+``~/.cache/skinlab/reference``): ``<key>.npz`` (mean and the two half means, float32) beside
+``<key>.json`` (how it was made), each written to a temporary name and renamed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from app.atomic_write import atomic_path, write_text_atomic
+from scene.graph import Scene
+
+from .compare import image_error, object_mask
+from .export import ReferenceDescription, describe
+
+EXPORT_VERSION = 2  # bump when the exporter changes what a scene renders as
+CHUNK_SPP = 32
+VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
+INSTALL_HINT = "install it with `.venv/bin/pip install 'mitsuba>=3.5'` (make setup does: the 'truth' extra)"
+
+
+class ReferenceUnavailable(RuntimeError):
+    """Mitsuba or the asked-for variant cannot run here (the message says how to fix it)."""
+
+
+@dataclass(frozen=True)
+class ReferenceRequest:
+    width: int
+    height: int
+    spp: int = 1024  # samples per pixel, all passes together
+    passes: int = 4
+    seed: int = 0
+    variant: str = "scalar_rgb"
+    sun_deg: float = 0.0  # > 0: directional lights as distant disks of this angular diameter
+    max_depth: int = -1  # volpath path length limit (-1: none; Russian roulette ends paths)
+    rr_depth: int = 64
+
+    def __post_init__(self) -> None:
+        for name, lo, hi in (("width", 1, 16384), ("height", 1, 16384), ("spp", 2, 1 << 24), ("passes", 2, 1024)):
+            v = getattr(self, name)
+            if not isinstance(v, int) or not lo <= v <= hi:
+                raise ValueError(f"reference {name}: expected an integer in [{lo}, {hi}], got {v!r}")
+        if self.spp < self.passes:
+            raise ValueError(f"reference spp: {self.spp} samples cannot be split into {self.passes} passes")
+        if self.variant not in VARIANTS:
+            raise ValueError(f"reference variant: expected one of {', '.join(VARIANTS)}, got {self.variant!r}")
+        if not isinstance(self.seed, int) or self.seed < 0:
+            raise ValueError(f"reference seed: expected an integer >= 0, got {self.seed!r}")
+
+
+@dataclass
+class Reference:
+    image: np.ndarray  # (H, W, 4) float32 linear radiance, alpha = coverage, row 0 = top
+    half_a: np.ndarray  # mean of the first half of the passes
+    half_b: np.ndarray  # mean of the second half
+    key: str
+    meta: dict = field(default_factory=dict)
+    cached: bool = False
+
+    @property
+    def noise(self) -> dict:
+        """The ledger's error measure between the two halves (the reference's noise floor)."""
+        return self.meta["noise_floor"]
+
+    @property
+    def mask(self) -> np.ndarray:
+        return object_mask(self.image)
+
+
+def cache_dir() -> Path:
+    """$SKINLAB_CACHE_DIR/reference, else $XDG_CACHE_HOME/skinlab/reference, else ~/.cache/skinlab/reference."""
+    base = os.environ.get("SKINLAB_CACHE_DIR")
+    if not base:
+        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "skinlab"
+    return Path(base) / "reference"
+
+
+def _mitsuba():
+    try:
+        import mitsuba as mi
+    except ImportError:
+        raise ReferenceUnavailable(
+            f"the path-traced reference needs Mitsuba 3, which is not installed: {INSTALL_HINT}"
+        ) from None
+    return mi
+
+
+def set_variant(variant: str):
+    mi = _mitsuba()
+    try:
+        mi.set_variant(variant)
+    except Exception as exc:  # Dr.Jit raises ImportError/RuntimeError/AttributeError by backend
+        hint = {
+            "llvm_ad_rgb": "it needs libLLVM >= 11 (Debian: apt-get install libllvm19; then "
+            "export DRJIT_LIBLLVM_PATH=/usr/lib/llvm-19/lib/libLLVM.so.1)",
+            "cuda_ad_rgb": "it needs an NVIDIA GPU with its driver",
+        }.get(variant, "")
+        raise ReferenceUnavailable(f"Mitsuba variant {variant!r} cannot run here: {exc}. {hint}".strip()) from None
+    return mi
+
+
+def reference_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_version: str) -> str:
+    h = hashlib.sha256()
+    h.update(json.dumps({"export": EXPORT_VERSION, "mitsuba": mitsuba_version, "request": asdict(req)}).encode())
+    h.update(json.dumps(desc.content(), sort_keys=True, default=float).encode())
+    for a in desc.arrays():
+        h.update(str(a.shape).encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()[:24]
+
+
+def load_cached(key: str) -> Reference | None:
+    d = cache_dir()
+    npz, js = d / f"{key}.npz", d / f"{key}.json"
+    if not (npz.is_file() and js.is_file()):
+        return None
+    try:
+        with np.load(npz) as z:
+            img, a, b = z["image"], z["half_a"], z["half_b"]
+        meta = json.loads(js.read_text())
+    except (OSError, ValueError, KeyError):
+        return None  # a damaged entry is rendered again
+    return Reference(img, a, b, key, meta, cached=True)
+
+
+def _store(ref: Reference) -> None:
+    d = cache_dir()
+    with atomic_path(d / f"{ref.key}.npz") as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, image=ref.image, half_a=ref.half_a, half_b=ref.half_b)
+    write_text_atomic(d / f"{ref.key}.json", json.dumps(ref.meta, indent=1))
+
+
+def chunk_plan(spp: int, passes: int) -> list[tuple[int, int]]:
+    """(pass index, samples) per render call: each pass gets spp // passes samples (the first
+    spp % passes passes one more), split into chunks of at most CHUNK_SPP."""
+    out = []
+    for p in range(passes):
+        n = spp // passes + (1 if p < spp % passes else 0)
+        k = max(1, math.ceil(n / CHUNK_SPP))
+        out += [(p, n // k + (1 if i < n % k else 0)) for i in range(k)]
+    return out
+
+
+def render_reference(
+    scene: Scene,
+    req: ReferenceRequest,
+    *,
+    progress: bool = True,
+    use_cache: bool = True,
+    desc: ReferenceDescription | None = None,
+) -> Reference:
+    """The path-traced reference of `scene` (from the cache when an identical one was made)."""
+    desc = desc or describe(
+        scene, req.width, req.height, sun_deg=req.sun_deg, max_depth=req.max_depth, rr_depth=req.rr_depth
+    )
+    mi = set_variant(req.variant)
+    key = reference_key(desc, req, mi.__version__)
+    if use_cache and (hit := load_cached(key)) is not None:
+        return hit
+    from tqdm import tqdm
+
+    t0 = time.perf_counter()
+    mscene = mi.load_dict(desc.to_mitsuba(CHUNK_SPP, req.seed))
+    sums = np.zeros((req.passes, req.height, req.width, 4), np.float64)
+    counts = np.zeros(req.passes, np.int64)
+    plan = chunk_plan(req.spp, req.passes)
+    bar = tqdm(total=req.spp, unit="spp", desc=f"path tracing {scene.name}", disable=not progress, leave=False)
+    for i, (p, n) in enumerate(plan):
+        img = np.asarray(mi.render(mscene, spp=n, seed=req.seed * 1_000_003 + i), np.float64)
+        sums[p] += img * n
+        counts[p] += n
+        bar.update(n)
+    bar.close()
+    seconds = time.perf_counter() - t0
+    half = req.passes // 2
+    mean = (sums.sum(0) / counts.sum()).astype(np.float32)
+    a = (sums[:half].sum(0) / counts[:half].sum()).astype(np.float32)
+    b = (sums[half:].sum(0) / counts[half:].sum()).astype(np.float32)
+    if not np.isfinite(mean).all():
+        raise RuntimeError(f"scene {scene.name!r}: the path tracer returned NaN or Inf")
+    noise = image_error(a, b, object_mask(mean))
+    meta = {
+        "scene": scene.name,
+        "source": str(scene.source) if scene.source else None,
+        "request": asdict(req),
+        "mitsuba": mi.__version__,
+        "seconds": round(seconds, 3),
+        "noise_floor": noise,
+        "notes": desc.notes,
+        "made": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+    }
+    ref = Reference(mean, a, b, key, meta, cached=False)
+    if use_cache:
+        _store(ref)
+    return ref
