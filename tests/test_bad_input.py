@@ -153,6 +153,16 @@ CASES = [
     ("demo-size", {}, ["demo", "--out", "{tmp}/o", "--size", "big"], ["--size", "big"]),
     ("demo-out-file", {"o": "x"}, ["demo", "--out", "{tmp}/o"], ["--out", "not a folder"]),
     ("view-frames", {}, ["view", "--frames", "0"], ["--frames"]),
+    ("reference-out-below-file", {"f": "x"}, ["reference", "--out", "{tmp}/f/r.exr"], ["--out", "not a folder"]),
+    ("reference-out-png", {}, ["reference", "--out", "{tmp}/r.png"], ["--out", ".exr"]),
+    ("reference-passes", {}, ["reference", "--out", "{tmp}/r.exr", "--passes", "1"], ["passes"]),
+    ("reference-spp", {}, ["reference", "--out", "{tmp}/r.exr", "--spp", "0"], ["spp"]),
+    (
+        "reference-scene",
+        scene("camera = 5\n" + MESH),
+        ["reference", "{tmp}/s.toml", "--out", "{tmp}/r.exr"],
+        ["[camera]"],
+    ),
     ("command-unknown", {}, ["rendr"], ["rendr"]),
 ]
 

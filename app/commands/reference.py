@@ -4,7 +4,6 @@ the scene path-traced volumetrically by Mitsuba 3 (the image ground truth; docs/
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 from app.render.settings import parse_size
 
@@ -46,11 +45,12 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from app.cli import UserError
-    from app.image_output import image_format, write_image
+    from app.image_output import check_output_path, image_format, write_image
     from app.truth.reference import ReferenceRequest, ReferenceUnavailable, render_reference
     from scene.scenefile import load_scene
 
-    out = Path(args.out)
+    out = check_output_path(args.out, "--out")  # before minutes of path tracing
+    check_output_path(out.with_suffix(".png"), "--out")
     if image_format(out) != "exr":
         raise ValueError(f"--out: the reference is linear radiance: expected a .exr path, got {out}")
     w, h = parse_size(args.size)
