@@ -91,3 +91,21 @@ def read_image(path: str | Path) -> np.ndarray:
     )
     inp.close()
     return np.asarray(data).reshape(spec.height, spec.width, spec.nchannels)
+
+
+def contact_sheet(tiles: list[tuple[np.ndarray, str]], columns: int = 3, label_px: int = 18) -> np.ndarray:
+    """Images (uint8 H x W x C, all the same size) tiled ``columns`` wide on a dark background, each with
+    its label in a strip below it; returns opaque uint8 RGBA (the tiles' alpha is dropped)."""
+    from PIL import Image, ImageDraw
+
+    h, w = tiles[0][0].shape[:2]
+    rows = -(-len(tiles) // columns)
+    sheet = Image.new("RGBA", (columns * w, rows * (h + label_px)), (20, 20, 22, 255))
+    draw = ImageDraw.Draw(sheet)
+    for i, (img, label) in enumerate(tiles):
+        if img.shape[:2] != (h, w):
+            raise ValueError(f"contact sheet: tile {label!r} is {img.shape[1]}x{img.shape[0]}, expected {w}x{h}")
+        x, y = (i % columns) * w, (i // columns) * (h + label_px)
+        sheet.paste(Image.fromarray(np.ascontiguousarray(img[..., :3])).convert("RGBA"), (x, y))  # opaque
+        draw.text((x + 4, y + h + 3), label, fill=(230, 230, 230, 255))
+    return np.asarray(sheet)

@@ -155,7 +155,7 @@ def test_render_a_mesh_file_with_camera_orbit_and_exposure(tmp_path):
 
 
 def test_gallery_contact_sheet_tiles_and_labels():
-    from app.commands.demo import contact_sheet
+    from app.image_output import contact_sheet
 
     tiles = [(np.full((10, 12, 4), 40 * i, np.uint8), f"t{i}") for i in range(5)]
     tiles[0][0][..., 3] = 0  # a tile's alpha does not make the sheet transparent
