@@ -30,7 +30,7 @@ def register(sub) -> None:
     p.add_argument("--seed", type=int, default=0, help="random seed, >= 0 (default 0)")
     p.add_argument(
         "--variant", default="scalar_rgb", choices=("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb"),
-        help="Mitsuba variant (default scalar_rgb: any CPU; llvm_ad_rgb needs libLLVM >= 11; cuda_ad_rgb a GPU)",
+        help="Mitsuba variant (default scalar_rgb: any CPU; llvm_ad_rgb needs libllvm19; cuda_ad_rgb an NVIDIA GPU)",
     )  # fmt: skip
     p.add_argument(
         "--sun-deg", type=float, default=0.0, help="angular diameter of directional lights in degrees, 0-10 "
