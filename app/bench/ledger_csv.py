@@ -17,6 +17,7 @@ CSV_COLUMNS = [
     "tsd_size",
     "taps",
     "ssss_taps",
+    "disk_samples",
     "width",
     "height",
     "blur_levels",

@@ -79,12 +79,12 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
             )
         L.append("")
         L.append(
-            "| setting | technique | model | K | tsd size | taps | ssss taps | blur levels | frames | "
+            "| setting | technique | model | K | tsd size | taps | ssss taps | disk samples | blur levels | frames | "
             "frame ms median | p10 | p90 | tsd ms | image rel-L1 | image max | image p95 | rel-L1 vs exact same size | "
             "profile err vs MC | profile err vs model | truth 4x4 | truth px | truth noise 4x4 | truth energy | "
             "status |"
         )
-        L.append("|---" * 24 + "|")
+        L.append("|---" * 25 + "|")
         for r in srows:
             status = r["status"] + (f": {r['error']}" if r.get("error") else "")
             pct = lambda v: "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100 * v:.2f} %"
@@ -99,6 +99,7 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
                         fmt_cell(r.get("tsd_size")),
                         fmt_cell(r.get("taps")),
                         fmt_cell(r.get("ssss_taps")),
+                        fmt_cell(r.get("disk_samples")),
                         fmt_cell(r.get("blur_levels", "")),
                         fmt_cell(r.get("frames", "")),
                         fmt_cell(r.get("frame_ms_median"), 4),

@@ -31,6 +31,7 @@ class Sweep:
     peer_frames: int
     scenes: tuple[str, ...] = ("head", "bunny")
     extra: tuple = ()  # extra settings (tiny sweep)
+    disk: tuple[int, ...] = ()  # Burley disk SSS sample counts
     every_technique: bool = True  # also a default-settings row for each registered technique not swept above
     # the path-traced truth: reference size and samples (app/bench/truth_ledger.py); None: not measured
     truth: TruthSpec | None = None
@@ -52,6 +53,7 @@ FULL = Sweep(
     photons=200_000,
     peer_frames=30,
     scenes=REFERENCE_SCENE_NAMES,
+    disk=(8, 16, 32, 64),
     truth=TruthSpec((192, 192), 1024),
 )
 QUICK = Sweep(
@@ -70,6 +72,7 @@ QUICK = Sweep(
     photons=20_000,
     peer_frames=5,
     scenes=("head-skin1-matched", "bunny-skimmilk", "slab-edge-skin1"),
+    disk=(8, 32),
     truth=TruthSpec((96, 96), 256),
 )
 # for the tests: five settings on the index-matched head at 64x64, a 32x32 truth
@@ -105,6 +108,7 @@ class Setting:
     tsd_size: int | None = None
     taps: int | None = None  # tsd taps; None = auto (only meaningful for tsd)
     ssss_taps: int | None = None
+    disk_samples: int | None = None
 
     def _style(self):
         from app.render.registry import get_technique
@@ -135,7 +139,7 @@ class Setting:
         return {c: ("auto" if own[c] is None else own[c]) if c in own else "" for c in SETTING_COLUMNS}
 
 
-SETTING_COLUMNS = ("K", "tsd_size", "taps", "ssss_taps")
+SETTING_COLUMNS = ("K", "tsd_size", "taps", "ssss_taps", "disk_samples")
 
 
 def sweep_settings(sweep: Sweep) -> list[Setting]:
@@ -146,6 +150,7 @@ def sweep_settings(sweep: Sweep) -> list[Setting]:
     out += [Setting("tsd", K=kmax, tsd_size=s) for s in sweep.sizes]
     out += [Setting("tsd", K=kmax, tsd_size=sweep.k_size, taps=t) for t in sweep.taps]
     out += [Setting("ssss", ssss_taps=n) for n in sweep.ssss]
+    out += [Setting("disk", disk_samples=n) for n in sweep.disk]
     # the exact convolution at the smaller swept sizes: the irradiance texture's own resolution error
     out += [Setting("exact", tsd_size=s) for s in sweep.sizes if s < sweep.exact_size]
     out += list(sweep.extra)

@@ -22,6 +22,7 @@ BUILTIN_PACKAGES = (
     "app.render.techniques.ssss",
     "app.render.techniques.tint",
     "app.render.techniques.none",
+    "app.render.techniques.disk",
 )
 DEFAULT_TECHNIQUE = "tsd"
 

@@ -1,0 +1,113 @@
+"""The disk pass: importance-sampled Burley disk SSS over the forward pass's subsurface diffuse
+target (shaders/passes/disk_sss.frag), then the composite with the rest of the lit image."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from app.gl.uniforms import set_array, set_uniforms
+from scene.optics.disk import MAX_DISK_PROFILES
+
+DIFFUSE_TARGET = "disk_diffuse"
+
+
+@dataclass
+class DiskParams:
+    samples: int
+    rotate: bool
+    kernels: list  # scene.optics.disk.DiskKernel per profile index
+    labels: list  # the material named for each profile (the plan's explanation)
+
+    def table(self) -> np.ndarray:
+        """(profiles, samples, 4) float32: rgb weight, a radius mm (the shader's u_table)."""
+        t = np.zeros((len(self.kernels), self.samples, 4), np.float32)
+        for j, k in enumerate(self.kernels):
+            t[j, :, :3] = k.weights
+            t[j, :, 3] = k.radii_mm
+        return t
+
+
+class DiskPass:
+    def __init__(self, renderer):
+        self.r = renderer
+        self._targets = None
+        self._table = None
+
+    def targets(self, size):
+        t = self._targets
+        if t is None or t[0].size != tuple(size):
+            self._release_targets()
+            ctx = self.r.ctx
+            texs = [ctx.texture(size, 4, dtype="f4") for _ in range(2)]  # filtered, composite
+            for x in texs:
+                x.repeat_x = x.repeat_y = False
+            self._fbos = [ctx.framebuffer([x]) for x in texs]
+            t = self._targets = tuple(texs)
+        return t
+
+    def table(self, data: np.ndarray):
+        h, w = data.shape[:2]
+        t = self._table
+        if t is None or t.size != (w, h):
+            if t is not None:
+                t.release()
+            t = self._table = self.r.ctx.texture((w, h), 4, dtype="f4")
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        t.write(np.ascontiguousarray(data).tobytes())
+        return t
+
+    def _release_targets(self) -> None:
+        if self._targets is not None:
+            for x in (*self._fbos, *self._targets):
+                x.release()
+            self._targets, self._fbos = None, []
+
+    def release(self) -> None:
+        self._release_targets()
+        if self._table is not None:
+            self._table.release()
+            self._table = None
+
+    def run(self, frame, p) -> None:
+        ctx, prm = self.r.ctx, p.params
+        w, h = p.resolution
+        filtered, out = self.targets((w, h))
+        ffilt, fout = self._fbos
+        cam = frame.scene.camera
+        table = self.table(prm.table())
+        prog = self.r.programs.get("passes/fullscreen.vert", "passes/disk_sss.frag")
+        reach = np.array([k.reach_mm for k in prm.kernels], np.float32)
+        set_array(prog, "u_reach_mm", reach, MAX_DISK_PROFILES)
+        set_uniforms(
+            prog,
+            {
+                "u_src": 0,
+                "u_depth": 1,
+                "u_table": 2,
+                "u_samples": prm.samples,
+                "u_mm_per_unit": frame.scene.mm_per_unit,
+                "u_pixels_per_unit": h / (2.0 * math.tan(cam.yfov / 2.0)),
+                "u_size": (float(w), float(h)),
+                "u_near_far": (cam.znear, cam.zfar),
+                "u_rotate": 1.0 if prm.rotate else 0.0,
+            },
+        )
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+        frame.targets[DIFFUSE_TARGET].use(0)
+        frame.targets["depth"].use(1)
+        table.use(2)
+        ffilt.use()
+        self.r.fullscreen(prog)
+        comp = self.r.programs.get("passes/fullscreen.vert", "passes/ssss_composite.frag")
+        fout.use()
+        frame.targets["hdr_color"].use(0)
+        filtered.use(1)
+        set_uniforms(comp, {"u_color": 0, "u_blurred": 1})
+        self.r.fullscreen(comp)
+        frame.targets["disk_filtered"] = filtered
+        frame.targets["hdr_color_unblurred"] = frame.targets["hdr_color"]
+        frame.targets["hdr_color"] = out
