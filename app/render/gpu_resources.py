@@ -9,10 +9,13 @@ import numpy as np
 
 from app.gl.uniforms import set_uniforms
 from scene.mesh import Mesh
+from scene.optics.preintegrated import vertex_curvature
 from scene.textures import load_texture
 
-VERTEX_FORMAT = "3f 3f 2f 4f"
-VERTEX_ATTRS = ("in_position", "in_normal", "in_uv", "in_tangent")
+VERTEX_FORMAT = "3f 3f 2f 4f 1f"
+# in_curvature: per-vertex mean curvature (1/scene unit; scene/optics/preintegrated.py), for the
+# techniques that look it up (pre-integrated skin)
+VERTEX_ATTRS = ("in_position", "in_normal", "in_uv", "in_tangent", "in_curvature")
 
 
 class GpuMesh:
@@ -25,7 +28,8 @@ class GpuMesh:
             tan = mesh.ensure_tangents()
         else:
             tan = np.tile(np.array([1, 0, 0, 1], np.float32), (n, 1))
-        data = np.concatenate([mesh.positions, mesh.normals, uv, tan], axis=1).astype(np.float32)
+        curv = vertex_curvature(mesh.positions, mesh.normals, mesh.indices)[:, None]
+        data = np.concatenate([mesh.positions, mesh.normals, uv, tan, curv], axis=1).astype(np.float32)
         self.vbo = ctx.buffer(np.ascontiguousarray(data).tobytes())
         self.ibo = ctx.buffer(mesh.indices.astype(np.uint32).tobytes())
         self.count = mesh.indices.size

@@ -23,6 +23,7 @@ BUILTIN_PACKAGES = (
     "app.render.techniques.tint",
     "app.render.techniques.none",
     "app.render.techniques.disk",
+    "app.render.techniques.preintegrated",
 )
 DEFAULT_TECHNIQUE = "tsd"
 

@@ -4,6 +4,7 @@ in vec3 in_position;
 in vec3 in_normal;
 in vec2 in_uv;
 in vec4 in_tangent;
+in float in_curvature;  // per-vertex mean curvature, 1/scene unit (pre-integrated skin)
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 uniform mat4 u_view_proj;
@@ -11,11 +12,13 @@ out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;
 out vec4 v_tangent;
+out float v_curvature;
 void main() {
     vec4 w = u_model * vec4(in_position, 1.0);
     v_world = w.xyz;
     v_normal = u_normal_matrix * in_normal;
     v_tangent = vec4(mat3(u_model) * in_tangent.xyz, in_tangent.w);
     v_uv = in_uv;
+    v_curvature = in_curvature;
     gl_Position = u_view_proj * w;
 }

@@ -1,0 +1,54 @@
+// Subsurface hook of technique "preintegrated" (Penner & Borshukov 2011, pre-integrated skin): the
+// subsurface diffuse term of each light is a lookup in a table of the material's profile integrated
+// around a ring of curvature c, D(N.L, c) per channel (scene/optics/preintegrated.py), instead of
+// max(N.L, 0); the light scatters past the terminator where the surface is curved. Curvature is the
+// mesh's per-vertex mean curvature (v_curvature, precomputed), the normal per channel a blend of the
+// normal-mapped and the geometric normal (the "softened normal": wide channels lose the map's
+// detail). No pass of its own: the cheapest technique. Light enters through the Fresnel
+// transmission at normal incidence (the ring's light enters at every angle; the lookup replaces the
+// cosine). Contract: app/render/technique.py.
+#include "lib/subsurface.glsl"
+#include "lib/preintegrated.glsl"
+
+in float v_curvature;            // 1/scene unit (forward.vert)
+uniform sampler2D u_pis_lut;     // columns N.L -1..1, rows curvature 0..u_pis_curv_max; rgb D
+uniform vec2 u_pis_lut_size;     // (columns, rows)
+uniform float u_pis_curv_scale;  // 1/scene unit -> 1/mm (the node's scale and the scene's mm per unit)
+uniform float u_pis_curv_max;    // 1/mm at the last row (0: the table is max(N.L, 0) everywhere)
+uniform vec3 u_pis_soften;       // per channel: 0 the normal-mapped normal, 1 the geometric normal
+
+float sss_plain_weight() { return 1.0 - u_subsurface; }
+
+void sss_add_light(vec3 e, float vis, float NoL) {}  // the hook runs its own light loop (below)
+
+vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
+    vec3 ng = normalize(v_normal);
+    if (!gl_FrontFacing) ng = -ng;
+    vec3 n = ng;
+#ifdef HAS_NORMAL_MAP
+    n = perturb_normal(ng, vec4(gl_FrontFacing ? v_tangent.xyz : -v_tangent.xyz, v_tangent.w),
+                       texture(u_normal_map, uv).rgb, u_normal_scale);
+#endif
+    float curv = abs(v_curvature) * u_pis_curv_scale;
+    float t = u_pis_curv_max > 0.0 ? curv / u_pis_curv_max : 0.0;
+    vec3 nr = normalize(mix(n, ng, u_pis_soften.r));
+    vec3 nG = normalize(mix(n, ng, u_pis_soften.g));
+    vec3 nb = normalize(mix(n, ng, u_pis_soften.b));
+    vec3 entering = vec3(0.0);
+    for (int i = 0; i < MAX_LIGHTS; ++i) {
+        if (i >= u_num_lights) break;
+        vec3 l, e;
+        light_incidence(i, v_world, ng, l, e);
+        float nlg = dot(ng, l);
+        // shadow maps only where the light faces the surface; past the terminator the ring's light
+        // comes from the lit side
+        float vis = (u_light_shadow[i] >= 0 && nlg > 0.0) ? light_visibility(i, v_world, nlg) : 1.0;
+        vec3 D = vec3(pis_lookup(u_pis_lut, u_pis_lut_size, dot(nr, l), t).r,
+                      pis_lookup(u_pis_lut, u_pis_lut_size, dot(nG, l), t).g,
+                      pis_lookup(u_pis_lut, u_pis_lut_size, dot(nb, l), t).b);
+        entering += e * vis * D;
+    }
+    entering *= fresnel_transmission(SPECULAR_F0_SCALE * u_specular, 1.0);
+    entering += PI * u_ambient * occlusion;
+    return base * entering * ((1.0 - u_metallic) * u_subsurface * INV_PI * sss_exit_weight(abs(NoV)));
+}
