@@ -1,7 +1,8 @@
 """Technique "ssss": screen-space separable subsurface scattering (Jimenez et al., "Separable
 Subsurface Scattering", 2015; docs/references.md). The forward pass writes the subsurface diffuse
-radiance to a second target; one post-process blurs it horizontally then vertically with the
-profile's 1-D kernel (scene/optics/ssss.py) and adds it back."""
+radiance and each pixel's profile index to a second target; one post-process blurs it horizontally
+then vertically with the pixel's own profile's 1-D kernel (scene/optics/ssss.py; a table of up to 16
+profiles per frame) and adds it back."""
 
 from __future__ import annotations
 
@@ -37,10 +38,10 @@ class SsssForward(ForwardHook):
     reason = "; subsurface diffuse to a second target for the screen-space blur"
 
     def shading(self, node, frame):
-        # every mesh writes the second target; the node's own values apply (sss_model overrides
-        # change no uniform)
-        enabled = float(node.uid in self.ssss.scattering)
-        return NodeShading(node.material, HOOK, bind=lambda prog, units: set_uniform(prog, "u_ssss_enabled", enabled))
+        # every mesh writes the second target, its alpha the profile index + 1 (0: not blurred); the
+        # node's own values apply (sss_model overrides change no uniform)
+        index = float(self.ssss.profile.get(node.uid, -1) + 1)
+        return NodeShading(node.material, HOOK, bind=lambda prog, units: set_uniform(prog, "u_ssss_profile", index))
 
 
 class SsssTechnique(Technique):
@@ -55,22 +56,30 @@ class SsssTechnique(Technique):
         ssss = plan_ssss(ctx.meshes, ctx.settings, ctx.plan, o.gaussians, o.taps)
         if ssss is None:
             return TechniquePlan()
+        names = ", ".join(f"'{k.material.name}' ({k.material['sss_model']})" for k in ssss.kernels)
         blur = PlannedPass(
             "ssss_blur",
             "ssss_blur",
             "hdr_color",
             ctx.settings.size,
-            f"screen-space separable SSS (Jimenez et al.): {o.taps}-tap kernel of "
-            f"'{ssss.material.name}' ({ssss.material['sss_model']}), horizontal then vertical, depth-aware",
-            SsssBlurParams(ssss),
+            f"screen-space separable SSS (Jimenez et al.): {o.taps}-tap kernel per pixel's profile "
+            f"({len(ssss.kernels)}: {names}), horizontal then vertical, depth-aware",
+            SsssBlurParams(ssss, o.gaussians),
         )
         return TechniquePlan(SsssForward(ssss), after_forward=[blur])
 
     def edge_response(self, model, medium, plan: FramePlan):
-        """The frame's 1-D kernel across an edge along a screen axis (the separable kernel's best case)."""
+        """The 1-D kernel of the material's profile across an edge along a screen axis (the separable
+        kernel's best case), at the frame's tap count."""
         for p in plan.passes:
             if isinstance(p.params, SsssBlurParams):
-                return separable_edge(p.params.ssss.offsets_mm, p.params.ssss.weights)
+                from scene.optics.ssss import ssss_kernel
+                from scene.optics.tsd import profile_fit
+
+                offsets, weights, _ = ssss_kernel(
+                    profile_fit(model, medium, p.params.gaussians), len(p.params.ssss.offsets_mm)
+                )
+                return separable_edge(offsets, weights)
         return super().edge_response(model, medium, plan)
 
 

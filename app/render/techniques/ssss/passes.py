@@ -11,7 +11,7 @@ import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
 
-from .plan import SsssPlan
+from .plan import MAX_SSSS_PROFILES, SsssPlan
 
 MAX_SSSS_TAPS = 63  # shaders/passes/ssss_blur.frag
 
@@ -19,12 +19,14 @@ MAX_SSSS_TAPS = 63  # shaders/passes/ssss_blur.frag
 @dataclass
 class SsssBlurParams:
     ssss: SsssPlan
+    gaussians: int = 6  # the Gaussian fit the kernels were sampled from
 
 
 class SsssBlurPass:
     def __init__(self, renderer):
         self.r = renderer
         self._targets = None
+        self._table = None
 
     def targets(self, size):
         t = self._targets
@@ -38,7 +40,21 @@ class SsssBlurPass:
             t = self._targets = tuple(texs)
         return t
 
+    def table(self, data: np.ndarray):
+        h, w = data.shape[:2]
+        t = self._table
+        if t is None or t.size != (w, h):
+            if t is not None:
+                t.release()
+            t = self._table = self.r.ctx.texture((w, h), 4, dtype="f4")
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        t.write(np.ascontiguousarray(data).tobytes())
+        return t
+
     def release(self) -> None:
+        if self._table is not None:
+            self._table.release()
+            self._table = None
         if self._targets is not None:
             for x in (*self._fbos, *self._targets):
                 x.release()
@@ -55,21 +71,23 @@ class SsssBlurPass:
         ppu_x = ppu_y  # square pixels (aspect = w / h)
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/ssss_blur.frag")
         n = len(plan.offsets_mm)
-        set_array(prog, "u_offset_mm", plan.offsets_mm.astype(np.float32), MAX_SSSS_TAPS)
-        set_array(prog, "u_weight", plan.weights.astype(np.float32), MAX_SSSS_TAPS)
+        table = self.table(plan.table())
+        ranges = np.array([k.range_mm for k in plan.kernels], np.float32)
+        set_array(prog, "u_range_mm", ranges, MAX_SSSS_PROFILES)
         set_uniforms(
             prog,
             {
                 "u_src": 0,
                 "u_depth": 1,
+                "u_table": 2,
                 "u_taps": n,
-                "u_range_mm": plan.range_mm,
                 "u_mm_per_unit": frame.scene.mm_per_unit,
                 "u_near_far": (cam.znear, cam.zfar),
             },
         )
         ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         frame.targets["depth"].use(1)
+        table.use(2)
         for src, fbo, d, ppu in (
             (frame.targets["ssss_diffuse"], ftmp, (1.0 / w, 0.0), ppu_x),
             (tmp, fblur, (0.0, 1.0 / h), ppu_y),
