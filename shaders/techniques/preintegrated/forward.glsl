@@ -31,9 +31,11 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
 #endif
     float curv = abs(v_curvature) * u_pis_curv_scale;
     float t = u_pis_curv_max > 0.0 ? curv / u_pis_curv_max : 0.0;
+#ifdef HAS_NORMAL_MAP
     vec3 nr = normalize(mix(n, ng, u_pis_soften.r));
     vec3 nG = normalize(mix(n, ng, u_pis_soften.g));
     vec3 nb = normalize(mix(n, ng, u_pis_soften.b));
+#endif
     vec3 entering = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
@@ -43,9 +45,13 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
         // shadow maps only where the light faces the surface; past the terminator the ring's light
         // comes from the lit side
         float vis = (u_light_shadow[i] >= 0 && nlg > 0.0) ? light_visibility(i, v_world, nlg) : 1.0;
+#ifdef HAS_NORMAL_MAP
         vec3 D = vec3(pis_lookup(u_pis_lut, u_pis_lut_size, dot(nr, l), t).r,
                       pis_lookup(u_pis_lut, u_pis_lut_size, dot(nG, l), t).g,
                       pis_lookup(u_pis_lut, u_pis_lut_size, dot(nb, l), t).b);
+#else
+        vec3 D = pis_lookup(u_pis_lut, u_pis_lut_size, nlg, t);  // one normal: one lookup
+#endif
         entering += e * vis * D;
     }
     entering *= fresnel_transmission(SPECULAR_F0_SCALE * u_specular, 1.0);
