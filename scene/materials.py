@@ -130,6 +130,20 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         "x Subsurface Scale in mm",
     ),
     Param(
+        "subsurface_map",
+        "texture",
+        None,
+        doc="subsurface weight map (R channel, linear); multiplies subsurface per texel (every technique)",
+    ),
+    Param(
+        "subsurface_radius_map",
+        "texture",
+        None,
+        doc="subsurface radius scale map (R channel, linear): subsurface_radius x 2 R per texel (mid grey keeps "
+        "it; ears and nostrils scatter further than the forehead); honoured by disk (per-pixel sample radius), "
+        "tsd and exact (through the stretch map); ssss, tint and preintegrated keep one radius per material",
+    ),
+    Param(
         "subsurface_color",
         "color",
         (0.8, 0.4, 0.3),

@@ -114,7 +114,7 @@ def test_flat_lit_slab_is_unchanged(renderer):
     f = renderer.last_frame.targets
     before = np.frombuffer(f["disk_diffuse"].read(), np.float32).reshape(n, n, 4)
     after = np.frombuffer(f["disk_filtered"].read(), np.float32).reshape(n, n, 4)
-    assert before[..., :3].max() > 0 and np.all(before[..., 3] == 1.0)  # profile index 0 + 1
+    assert before[..., :3].max() > 0 and np.all(before[..., 3] == 1.5)  # profile index 0 + 1, radius scale 1 / 2
     np.testing.assert_allclose(after, before, rtol=1e-4)
 
 

@@ -13,6 +13,7 @@
 #define MAX_DISK_PROFILES 16
 in vec2 v_uv;
 uniform sampler2D u_src;        // rgb: subsurface diffuse, a: profile index + 1 (0: not scattering)
+                                // + radius scale / 2 (the material's radius map; 0.5 without one)
 uniform sampler2D u_depth;      // the forward pass's depth buffer
 uniform sampler2D u_table;      // (samples x profiles) rgb weight, a radius mm
 uniform int u_samples;
@@ -34,20 +35,22 @@ float view_depth(ivec2 texel) { return depth_to_view(texelFetch(u_depth, texel, 
 void main() {
     ivec2 centre = ivec2(gl_FragCoord.xy);
     vec4 c = texelFetch(u_src, centre, 0);
-    int prof = int(c.a + 0.5) - 1;
+    float prof_id = floor(c.a);
+    int prof = int(prof_id) - 1;
     if (prof < 0) { f_color = c; return; }
+    float scale = 2.0 * (c.a - prof_id);  // the pixel's radius scale: radii and reach scale with it
     float z = view_depth(centre);
     float px_per_mm = u_pixels_per_unit / (z * u_mm_per_unit);
-    float reach = u_reach_mm[prof];
+    float reach = u_reach_mm[prof] * scale;
     float phi = u_rotate * 2.0 * PI * interleaved_gradient_noise(gl_FragCoord.xy);
     vec3 sum = vec3(0.0), wsum = vec3(0.0);
     for (int i = 0; i < u_samples; ++i) {
         vec4 t = texelFetch(u_table, ivec2(i, prof), 0);
-        vec2 uv = v_uv + disk_offset(float(i), t.a, phi) * px_per_mm / u_size;
+        vec2 uv = v_uv + disk_offset(float(i), t.a * scale, phi) * px_per_mm / u_size;
         if (any(lessThan(uv, vec2(0.0))) || any(greaterThanEqual(uv, vec2(1.0)))) continue;
         ivec2 texel = ivec2(uv * u_size);  // nearest: a filtered fetch would blend profile indices
         vec4 s = texelFetch(u_src, texel, 0);
-        if (abs(s.a - c.a) > 0.5) continue;  // another profile's (or no) scattering material
+        if (floor(s.a) != prof_id) continue;  // another profile's (or no) scattering material
         if (abs(view_depth(texel) - z) * u_mm_per_unit > reach) continue;
         sum += t.rgb * s.rgb;
         wsum += t.rgb;

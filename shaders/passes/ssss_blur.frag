@@ -41,9 +41,9 @@ void main() {
         vec2 uv = v_uv + u_dir * (k.a * px_per_mm);
         vec4 s = texture(u_src, uv);
         float dz_mm = abs(view_depth(uv) - z) * u_mm_per_unit;
-        // another profile (or none): the centre; a filtered fetch between two profiles' pixels is
-        // neither, so it is replaced too
-        float follow = abs(s.a - c.a) < 0.01 ? clamp(dz_mm / max(range_mm, 1e-6), 0.0, 1.0) : 1.0;
+        // another profile (or none): the centre. A filtered fetch on a border blends the indices:
+        // within 1 of the pixel's own it is accepted (as the single-profile blur always did)
+        float follow = abs(s.a - c.a) < 1.0 ? clamp(dz_mm / max(range_mm, 1e-6), 0.0, 1.0) : 1.0;
         sum += k.rgb * mix(s.rgb, c.rgb, follow);
     }
     f_color = vec4(sum, c.a);

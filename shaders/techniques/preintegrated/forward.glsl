@@ -8,6 +8,7 @@
 // transmission at normal incidence (the ring's light enters at every angle; the lookup replaces the
 // cosine). Contract: app/render/technique.py.
 #include "lib/subsurface.glsl"
+#include "lib/sss_maps.glsl"
 #include "lib/preintegrated.glsl"
 
 in float v_curvature;            // 1/scene unit (forward.vert)
@@ -17,7 +18,7 @@ uniform float u_pis_curv_scale;  // 1/scene unit -> 1/mm (the node's scale and t
 uniform float u_pis_curv_max;    // 1/mm at the last row (0: the table is max(N.L, 0) everywhere)
 uniform vec3 u_pis_soften;       // per channel: 0 the normal-mapped normal, 1 the geometric normal
 
-float sss_plain_weight() { return 1.0 - u_subsurface; }
+float sss_plain_weight() { return 1.0 - sss_weight_at(v_uv); }
 
 void sss_add_light(vec3 e, float vis, float NoL) {}  // the hook runs its own light loop (below)
 
@@ -56,5 +57,5 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
     }
     entering *= fresnel_transmission(SPECULAR_F0_SCALE * u_specular, 1.0);
     entering += PI * u_ambient * occlusion;
-    return base * entering * ((1.0 - u_metallic) * u_subsurface * INV_PI * sss_exit_weight(abs(NoV)));
+    return base * entering * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI * sss_exit_weight(abs(NoV)));
 }

@@ -79,8 +79,16 @@ class TsdFrameNode:
 
 def stretch_key(node, scene, size: int) -> tuple:
     """Everything the stretch map depends on: the mesh (identity, version), its world transform,
-    the scene scale and the texture size."""
-    return (node.mesh.uid, node.mesh.version, node.world_matrix.round(9).tobytes(), float(scene.mm_per_unit), size)
+    the scene scale, the texture size and the material's subsurface radius map."""
+    radius_map = str(node.material.values.get("subsurface_radius_map"))
+    return (
+        node.mesh.uid,
+        node.mesh.version,
+        node.world_matrix.round(9).tobytes(),
+        float(scene.mm_per_unit),
+        size,
+        radius_map,
+    )
 
 
 class TsdStore:
@@ -165,8 +173,13 @@ class TsdStretchPass:
         fbo = t.fbo(ctx, t.stretch)
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
-        prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_stretch.frag")
+        radius_map = {k: v for k, v in node.material.textures().items() if k == "u_subsurface_radius_map"}
+        defines = {"HAS_SUBSURFACE_RADIUS_MAP": "1"} if radius_map else {}
+        prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_stretch.frag", defines)
         set_uniforms(prog, {**node_uniforms(node), "u_mm_per_unit": frame.scene.mm_per_unit})
+        units = TextureUnits(ctx)
+        for sampler, (path, cs) in radius_map.items():
+            units.bind(prog, sampler, self.r.resources.texture(path, cs))
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         dilate(self.r, t, t.stretch, prm.dilate)
         t.stretch_key = stretch_key(node, frame.scene, size)
