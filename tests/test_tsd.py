@@ -43,12 +43,16 @@ def test_dilation_pass_matches_its_twin(renderer):
     img[mask, 3] = 1.0
     t = store(renderer).targets(SimpleNamespace(uid=-1), n)
     t.stretch.write(img.tobytes())
-    dilate(renderer, t, t.stretch, 4)
+    dilate(renderer, t, t.stretch, t.stretch, 4)  # in place
     gpu = read_texture(t.stretch)
     ref = tsd.dilate_reference(img, 4)
     np.testing.assert_allclose(gpu, ref, rtol=1e-5, atol=1e-6)
     assert (ref[..., 3] > 0).sum() > mask.sum()  # it did grow
     np.testing.assert_array_equal(gpu[mask], img[mask])  # covered texels are untouched
+    t.raw.write(img.tobytes())  # from one texture into another (the irradiance), an odd count
+    dilate(renderer, t, t.raw, t.irradiance, 3)
+    np.testing.assert_allclose(read_texture(t.irradiance), tsd.dilate_reference(img, 3), rtol=1e-5, atol=1e-6)
+    np.testing.assert_array_equal(read_texture(t.raw), img)  # the source is kept
     store(renderer).nodes.pop(-1).release()
 
 

@@ -1,4 +1,4 @@
-"""`skinlab render [SCENE] --out PATH --size WxH [--technique NAME] [--json] [--explain]`: the
+"""`skinlab render [SCENE] --out PATH --size WxH [--technique NAME] [--json] [--explain] [--reuse]`: the
 technique options come from the registered techniques (app/commands/technique_options.py)."""
 
 from __future__ import annotations
@@ -27,11 +27,19 @@ def register(sub) -> None:
     add_technique_options(p)
     p.add_argument("--json", action="store_true", help="print timings and output paths as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
+    p.add_argument(
+        "--reuse",
+        action="store_true",
+        help="the timed frame reuses the warm-up frame's results whose inputs did not change (shadow maps, "
+        "texture-space irradiance and blurs: what the viewer does while only the camera moves); --explain "
+        "lists them as 'reused: inputs unchanged since frame 1'. Default: every pass runs",
+    )
     p.set_defaults(func=run)
 
 
-def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
-    """Render once and write each output (PNG from the tone-mapped image, EXR linear)."""
+def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, reuse: bool = False):
+    """Render once and write each output (PNG from the tone-mapped image, EXR linear). A warm-up
+    frame comes first; with `reuse` the written frame reuses its view-independent results."""
     from app.gl.context import create_headless_context
     from app.image_output import image_format, write_image
     from app.render.renderer import Renderer
@@ -43,6 +51,8 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     renderer.render(scene, settings, readback=False)  # warm-up: compiles and uploads are not frame time
+    if not reuse:
+        renderer.forget_reuse()  # the timed frame runs every pass
     result = renderer.render(scene, settings)
     written = []
     for o in outputs:
@@ -58,7 +68,7 @@ def settings_from_args(args, w: int, h: int) -> RenderSettings:
 def run(args) -> int:
     w, h = parse_size(args.size)
     settings = settings_from_args(args, w, h)
-    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings)
+    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, args.reuse)
     for warning in result.plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     if args.explain:
@@ -84,4 +94,6 @@ def run(args) -> int:
             print(f"wrote {path}")
         for p in result.timings.passes:
             print(f"  {p.name:<18} {p.cpu_ms:8.2f} ms")
+        for name in result.plan.reused():
+            print(f"  {name:<18}    reused")
     return 0
