@@ -28,6 +28,7 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
     ctx = create_headless_context()
     r = Renderer(ctx)
     r.timer.sync = False  # no glFinish between passes: whole frames are timed here
+    r.reuse = False  # full frames (skinlab bench orbit times frames that reuse)
 
     def timed(settings):
         r.render(scene, settings)
