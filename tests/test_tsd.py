@@ -211,3 +211,12 @@ def test_translucency_through_thin_parts(renderer):
     assert thick.hdr[24, 24, 0] < 0.05 * c[0]
     assert none.hdr[24, 24, :3].max() == 0.0
     assert "translucency" in dict(none.plan.skipped)
+    # past the widest Gaussian's reach the shader skips the term, which is zero in float32 there
+    reach = np.sqrt(tsd.translucency_reach2_mm2(t.kernel))
+    assert np.float32(np.exp(-tsd.TSD_TRANSLUCENCY_MAX_EXPONENT)) < np.finfo(np.float32).tiny
+    assert (tsd.thickness_transmittance([reach * 1.001], t.kernel) == 0).all()
+    assert (tsd.thickness_transmittance([reach * 0.1], t.kernel) > 0).all()
+    beyond = sheet(reach * 1.01 / 20.0)  # light from behind only: nothing comes through
+    renderer.render(beyond, st, readback=False)
+    t2 = frame_nodes(renderer.last_frame)[beyond.find("slab").uid]
+    assert read_texture(t2.targets.irradiance)[32, 32, :3].max() == 0.0

@@ -41,6 +41,7 @@ from .constants import (
     TSD_MAX_STEP_TEXELS,
     TSD_MIN_MM_PER_TEXEL,
     TSD_TAP_RANGE,
+    TSD_TRANSLUCENCY_MAX_EXPONENT,
 )
 from .gaussians import fit_gaussians
 from .media import Medium
@@ -424,11 +425,20 @@ def dilate_reference(img: np.ndarray, rings: int) -> np.ndarray:
     return cur
 
 
+def translucency_reach2_mm2(kernel: DiffusionKernel) -> float:
+    """The squared thickness (mm^2) past which the widest Gaussian cannot carry light through in
+    float32 (every e^{-d^2/2v_k} is below the smallest normal float: TSD_TRANSLUCENCY_MAX_EXPONENT)."""
+    v = max((s.variance_mm2 for s in kernel.steps), default=0.0)
+    return 2.0 * max(v, 1e-12) * TSD_TRANSLUCENCY_MAX_EXPONENT
+
+
 def thickness_transmittance(d_mm, kernel: DiffusionKernel) -> np.ndarray:
     """Twin of the translucency term in shaders/passes/tsd_irradiance.frag: light through d mm,
-    sum_k W_k e^{-d^2 / 2 v_k} over the kernel's blurred levels (per channel)."""
+    sum_k W_k e^{-d^2 / 2 v_k} over the kernel's blurred levels (per channel); 0 where d^2 reaches
+    translucency_reach2_mm2 (where the shader skips the Gaussians)."""
     d = np.atleast_1d(np.asarray(d_mm, np.float64))
     out = np.zeros((len(d), 3))
     for s in kernel.steps:
         out += np.exp(-(d[:, None] ** 2) / (2.0 * max(s.variance_mm2, 1e-12))) * np.asarray(s.weight)[None, :]
+    out[d**2 >= translucency_reach2_mm2(kernel)] = 0.0
     return out

@@ -3,7 +3,8 @@
 // enters the surface - lights through Fresnel transmission, shadows, the normal map, ambient x
 // occlusion (pi L_ambient) - times albedo^mix (pre-scatter texturing). a = 1: the texel is covered.
 // Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts, attenuated through the
-// thickness d (from the shadow pass's distance map) by the profile's Gaussians: sum_k W_k e^{-d^2/2v_k}.
+// thickness d (from the shadow pass's distance map) by the profile's Gaussians: sum_k W_k e^{-d^2/2v_k},
+// skipped where the widest Gaussian cannot cross the thickness (scene/optics/tsd.py translucency_reach2_mm2).
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/subsurface.glsl"
@@ -23,6 +24,7 @@ uniform vec4 u_light_eye[2];              // slot light position (w = 1) or the 
 uniform float u_tsd_var[6];               // the kept Gaussians' variances (mm^2)
 uniform vec3 u_tsd_w[6];
 uniform int u_tsd_levels;
+uniform float u_tsd_reach2;               // squared thickness (mm^2) past which no Gaussian carries light in fp32
 
 // Distance from the light of the first surface it meets on the way to world; false outside the map.
 bool first_hit_distance(int slot, vec3 world, out float first) {
@@ -84,7 +86,8 @@ void main() {
             float first;
             if (first_hit_distance(slot, v_world, first)) {
                 float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit;
-                e_in += e * back * fresnel_transmission(f0, back) * thickness_transmittance(d_mm);
+                if (d_mm * d_mm < u_tsd_reach2)   // thicker: e^{-d^2/2v} is 0 in fp32 for every Gaussian
+                    e_in += e * back * fresnel_transmission(f0, back) * thickness_transmittance(d_mm);
             }
         }
 #endif

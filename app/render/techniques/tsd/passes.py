@@ -21,7 +21,7 @@ from app.gl.uniforms import set_array, set_uniform, set_uniforms
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
 from app.render.texture_units import TextureUnits
-from scene.optics.tsd import MAX_TSD_LEVELS, DiffusionKernel, blur_taps
+from scene.optics.tsd import MAX_TSD_LEVELS, DiffusionKernel, blur_taps, translucency_reach2_mm2
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
 
@@ -221,6 +221,7 @@ class TsdIrradiancePass(TsdPass):
             set_array(prog, "u_tsd_var", np.array([s.variance_mm2 for s in kernel.steps]), MAX_TSD_LEVELS)
             set_array(prog, "u_tsd_w", kernel.weights(), MAX_TSD_LEVELS)
             set_uniform(prog, "u_tsd_levels", kernel.levels)
+            set_uniform(prog, "u_tsd_reach2", translucency_reach2_mm2(kernel))
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         self.publish(frame, p)
 
