@@ -66,7 +66,9 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
             "forward",
             "+".join(["hdr_color", "depth", *hook.outputs]),
             settings.size,
-            f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)" + hook.reason,
+            ("depth pre-pass, then " if settings.depth_prepass else "")
+            + f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)"
+            + hook.reason,
             ForwardParams(lights, shadow_lights[:2], hook),
         )
     )
