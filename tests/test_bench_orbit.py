@@ -45,3 +45,14 @@ def test_orbit_cli_json_and_bad_input():
     assert bad.returncode == 2 and "--scenes" in bad.stderr and "Traceback" not in bad.stderr
     bad = skinlab("bench", "orbit", "--frames", "0")
     assert bad.returncode == 2 and "--frames" in bad.stderr
+
+
+def test_peer_bench_reports_the_plain_frame_per_pass_and_the_prepass_in_one_run():
+    from app.bench.peer import peer_bench
+
+    res = peer_bench((32, 32), frames=1)
+    assert res["skinlab_ms"] > 0 and res["pyrender_ms"] > 0 and res["skinlab_no_prepass_ms"] > 0
+    assert res["ratio_skinlab_over_pyrender"] == pytest.approx(res["skinlab_ms"] / res["pyrender_ms"])
+    assert res["ratio_no_prepass_over_pyrender"] == pytest.approx(res["skinlab_no_prepass_ms"] / res["pyrender_ms"])
+    assert set(res["skinlab_passes_ms"]) == {"forward", "tonemap"}  # the peer scene casts no shadow
+    assert len(res["loadavg"]) == 3

@@ -2,17 +2,26 @@
 
 from __future__ import annotations
 
+import os
 import statistics
 import time
 
 from app.render.settings import RenderSettings
 
 
+def _loadavg():
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except OSError:
+        return None
+
+
 def peer_bench(size=(512, 512), frames: int = 30) -> dict:
     """Median frame times, both including the colour+depth read-back (pyrender always reads back).
     ``skinlab_ms`` is the plain-PBR frame (sss_model none, like pyrender's: no subsurface scattering);
     ``skinlab_default_ms`` the frame with the default RenderSettings (the head's skin scatters, so
-    texture-space diffusion runs)."""
+    texture-space diffusion runs); ``skinlab_no_prepass_ms`` the plain frame without the depth
+    pre-pass; ``skinlab_passes_ms`` where the plain frame's time goes (glFinish after each pass)."""
     from app.bench.pyrender_peer import run_peer
     from app.gl.context import create_headless_context, describe
     from app.render.renderer import Renderer
@@ -41,8 +50,19 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
         return out
 
     try:
-        ours = timed(RenderSettings(w, h, sss_model="none"))
+        plain = RenderSettings(w, h, sss_model="none")
+        ours = timed(plain)
+        ours_no_prepass = timed(RenderSettings(w, h, sss_model="none", depth_prepass=False))
         ours_default = timed(RenderSettings(w, h))
+        # where the plain frame's time goes: glFinish after each pass (median of a few frames)
+        r.timer.sync = True
+        per: dict[str, list[float]] = {}
+        for _ in range(max(3, min(frames, 7))):
+            for p in r.render(scene, plain, readback=False).timings.passes:
+                per.setdefault(p.name, []).append(p.cpu_ms)
+        t0 = time.perf_counter()
+        r.render(scene, plain, readback=("ldr", "depth"))
+        readback_ms = (time.perf_counter() - t0) * 1e3 - sum(statistics.median(v) for v in per.values())
     finally:
         r.release()
     cam = scene.camera
@@ -51,6 +71,7 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
     theirs = list(map(float, peer["times"]))
     mo, mt = statistics.median(ours), statistics.median(theirs)
     md = statistics.median(ours_default)
+    mn = statistics.median(ours_no_prepass)
     return {
         "size": [w, h],
         "frames": frames,
@@ -58,6 +79,11 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
         "skinlab_ms": mo,
         "pyrender_ms": mt,
         "ratio_skinlab_over_pyrender": mo / mt,
+        "skinlab_no_prepass_ms": mn,
+        "ratio_no_prepass_over_pyrender": mn / mt,
+        "skinlab_passes_ms": {k: statistics.median(v) for k, v in per.items()},
+        "skinlab_readback_ms_estimate": max(readback_ms, 0.0),
+        "loadavg": _loadavg(),
         "skinlab_default_ms": md,
         "ratio_default_over_pyrender": md / mt,
     }

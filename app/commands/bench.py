@@ -129,6 +129,16 @@ def run_peer_bench(args) -> int:
         print(f"  pyrender  {res['pyrender_ms']:8.2f} ms/frame")
         print(f"  ratio skinlab/pyrender = {res['ratio_skinlab_over_pyrender']:.2f}")
         print(
+            f"  skinlab without the depth pre-pass {res['skinlab_no_prepass_ms']:8.2f} ms/frame, "
+            f"ratio {res['ratio_no_prepass_over_pyrender']:.2f}"
+        )
+        parts = ", ".join(f"{k} {v:.1f}" for k, v in res["skinlab_passes_ms"].items())
+        print(
+            f"  skinlab plain frame per pass (ms, glFinish after each): {parts}, "
+            f"read-back ~{res['skinlab_readback_ms_estimate']:.1f}"
+        )
+        print(f"  load average {res['loadavg']}")
+        print(
             f"  skinlab with the default settings (texture-space diffusion on the skin) "
             f"{res['skinlab_default_ms']:8.2f} ms/frame, ratio {res['ratio_default_over_pyrender']:.2f}"
         )
