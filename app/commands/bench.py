@@ -133,10 +133,7 @@ def run_peer_bench(args) -> int:
             f"ratio {res['ratio_no_prepass_over_pyrender']:.2f}"
         )
         parts = ", ".join(f"{k} {v:.1f}" for k, v in res["skinlab_passes_ms"].items())
-        print(
-            f"  skinlab plain frame per pass (ms, glFinish after each): {parts}, "
-            f"read-back ~{res['skinlab_readback_ms_estimate']:.1f}"
-        )
+        print(f"  skinlab plain frame per pass (ms, glFinish after each): {parts}")
         print(f"  load average {res['loadavg']}")
         print(
             f"  skinlab with the default settings (texture-space diffusion on the skin) "
