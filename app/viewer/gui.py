@@ -52,6 +52,9 @@ class Gui:
             for p in t.passes:
                 gpu = f"  gpu {p.gpu_ms:6.2f}" if p.gpu_ms is not None else ""
                 imgui.text(f"  {p.name:<16} {p.cpu_ms:7.2f} ms{gpu}")
+            for p in res.plan.passes:  # kept from an earlier frame (app/render/reuse.py)
+                if p.reused_since is not None:
+                    imgui.text_colored(GREY, f"  {p.name:<16} reused: inputs unchanged since frame {p.reused_since}")
         name, _ = core.current_target()
         s = core.settings
         imgui.text_colored(
