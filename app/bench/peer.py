@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import os
 import statistics
+import sys
 import time
+
+from tqdm import tqdm
 
 from app.render.settings import RenderSettings
 
@@ -16,7 +19,7 @@ def _loadavg():
         return None
 
 
-def peer_bench(size=(512, 512), frames: int = 30) -> dict:
+def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False) -> dict:
     """Median frame times, both including the colour+depth read-back (pyrender always reads back).
     ``skinlab_ms`` is the plain-PBR frame (sss_model none, like pyrender's: no subsurface scattering);
     ``skinlab_default_ms`` the frame with the default RenderSettings (the head's skin scatters, so
@@ -40,21 +43,27 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
     r.timer.sync = False  # no glFinish between passes: whole frames are timed here
     r.reuse = False  # full frames (skinlab bench orbit times frames that reuse)
 
-    def timed(settings):
+    # frames (with 2 warm-ups) of three Skinlab settings, then pyrender's in one subprocess (one step)
+    bar = tqdm(total=3 * (frames + 2) + 1, desc="bench peer", unit="frame", file=sys.stderr, disable=not progress)
+
+    def timed(settings, what):
+        bar.set_postfix_str(what)
         r.render(scene, settings)
         r.render(scene, settings)
+        bar.update(2)
         out = []
         for _ in range(frames):
             t0 = time.perf_counter()
             r.render(scene, settings, readback=("ldr", "depth"))  # what pyrender reads back
             out.append((time.perf_counter() - t0) * 1e3)
+            bar.update()
         return out
 
     try:
         plain = RenderSettings(w, h, sss_model="none")
-        ours = timed(plain)
-        ours_no_prepass = timed(RenderSettings(w, h, sss_model="none", depth_prepass=False))
-        ours_default = timed(RenderSettings(w, h))
+        ours = timed(plain, "skinlab plain PBR")
+        ours_no_prepass = timed(RenderSettings(w, h, sss_model="none", depth_prepass=False), "skinlab no pre-pass")
+        ours_default = timed(RenderSettings(w, h), "skinlab default")
         # where the plain frame's time goes: glFinish after each pass, then the read-back alone
         r.timer.sync = True
         per: dict[str, list[float]] = {"readback": []}
@@ -66,9 +75,12 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
             per["readback"].append((time.perf_counter() - t0) * 1e3)
     finally:
         r.release()
+    bar.set_postfix_str("pyrender (subprocess)")
     cam = scene.camera
     meshes = [(str(n.mesh.source), n.world_matrix) for n in scene.mesh_nodes()]
     peer = run_peer(meshes, cam.world_matrix, cam.yfov, cam.znear, cam.zfar, size, frames=frames)
+    bar.update()
+    bar.close()
     theirs = list(map(float, peer["times"]))
     mo, mt = statistics.median(ours), statistics.median(theirs)
     md = statistics.median(ours_default)

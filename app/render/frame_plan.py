@@ -63,14 +63,15 @@ class FramePlan:
     def reused(self) -> list[str]:
         return [p.name for p in self.passes if p.reused_since is not None]
 
-    def explain(self) -> str:
+    def explain(self, warnings: bool = True) -> str:
+        """The plan as text; ``warnings=False`` leaves out the warnings (for a caller that prints them)."""
         lines = ["frame plan:"]
         for i, p in enumerate(self.passes, 1):
             why = p.reason if p.reused_since is None else f"reused: inputs unchanged since frame {p.reused_since}"
             lines.append(f"  {i}. {p.name:<18} -> {p.target} {p.resolution[0]}x{p.resolution[1]}: {why}")
         for what, why in self.skipped:
             lines.append(f"  -  {what:<18} skipped: {why}")
-        for w in self.warnings:
+        for w in self.warnings if warnings else ():
             lines.append(f"  !  warning: {w}")
         return "\n".join(lines)
 
