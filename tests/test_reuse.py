@@ -68,6 +68,14 @@ def change_scale(scene):
     scene.mm_per_unit *= 1.5
 
 
+def brighten_ambient(scene):
+    scene.environment.ambient = np.array([0.05, 0.05, 0.06])
+
+
+def hide_occluder(scene):
+    scene.find("occluder").visible = False
+
+
 def move_camera(scene):
     cam = scene.camera
     eye = cam.world_position
@@ -83,6 +91,8 @@ CHANGES = [
     ("transform", move_slab, {}, {SHADOW} | LIGHTING),  # a move changes no length: stretch kept
     ("mesh", change_mesh, {}, VIEW_INDEPENDENT),
     ("scene scale", change_scale, {}, {STRETCH} | LIGHTING),
+    ("ambient light", brighten_ambient, {}, LIGHTING),
+    ("a mesh hidden", hide_occluder, {}, {SHADOW} | LIGHTING),  # the shadow map loses the occluder
     ("setting albedo_mix", None, {"albedo_mix": 0.3}, LIGHTING),
     ("setting shadow_size", None, {"shadow_size": 256}, {SHADOW} | LIGHTING),
 ]
