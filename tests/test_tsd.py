@@ -10,6 +10,8 @@ from app.render.techniques.tsd import TsdSettings
 from app.render.techniques.tsd.passes import frame_nodes, read_texture, store
 from scene.mesh import Mesh
 from scene.optics import tsd
+from scene.optics.boundary import boundary_tables, table_lookup
+from scene.optics.single_scattering import single_scatter_brdf
 
 
 def tsd_node(renderer, scene, name="slab"):
@@ -91,9 +93,10 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
 
 
 @pytest.mark.parametrize("model", ["burley", "dipole", "pbd"])
-def test_shadow_edge_follows_the_profile_edge_response(renderer, model):
-    """A slab lit across a sharp shadow edge: radiance / lit radiance follows the integral of the
-    exact profile over the lit half-plane within 2 % (absolute, of the lit level) at every pixel."""
+def test_shadow_edge_follows_the_profile_edge_response(renderer, model, multiple_only):
+    """A slab lit across a sharp shadow edge: the multiply scattered radiance / its lit level follows
+    the integral of the exact profile over the lit half-plane within 2 % (absolute, of the lit level)
+    at every pixel."""
     n = 192
     scene = slab_scene(occluder=True, material=skin(model))
     res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, technique=TsdSettings(size=n)))
@@ -124,10 +127,16 @@ def test_constant_irradiance_keeps_its_mean(renderer):
     np.testing.assert_allclose(np.asarray(t.kernel.identity) + t.kernel.weights().sum(axis=0), 1.0, rtol=1e-12)
     img = res.hdr[..., :3]
     np.testing.assert_allclose(img, np.broadcast_to(img[32, 32], img.shape), rtol=1e-4)
-    # the diffuse level is albedo x irradiance / pi x exit weight (normal view, NoV = 1)
-    expected = (
-        np.array([0.7, 0.5, 0.4]) * irr[64, 64] / np.power([0.7, 0.5, 0.4], 0.5) / np.pi * tsd.sss_exit_weight(1.0)
-    )
+    # the level: albedo x entering irradiance / pi x the exit distribution (normal view, NoV = 1),
+    # the irradiance being light x entry factor x albedo^mix; plus single scattering, albedo x
+    # light x Jensen's term (scene/optics/boundary.py)
+    base = np.array([0.7, 0.5, 0.4])
+    medium = tsd.material_medium(t.material.values)
+    tab = boundary_tables(medium.alpha_arr, t.material["subsurface_color"], medium.eta)
+    light = irr[64, 64] / (table_lookup(tab.entry, 1.0) * np.sqrt(base))
+    z = np.array([0.0, 0.0, 1.0])
+    single = light * base * single_scatter_brdf(z, z, z, tab.single, medium.eta, 0.0)
+    expected = base * irr[64, 64] / np.sqrt(base) / np.pi * table_lookup(tab.exit, 1.0) + single
     np.testing.assert_allclose(img[32, 32], expected, rtol=1e-3)
 
 
@@ -146,8 +155,9 @@ def test_scale_invariance(renderer):
     ).hdr
     np.testing.assert_allclose(a, d, atol=2e-4 * a.max())
     # and the physics does depend on the ratio: the same radius at twice the size is a sharper edge
+    # (single scattering, the same at every scale, is a part of both)
     c = renderer.render(slab_scene(occluder=True, mm_per_unit=40.0, material=skin(radius=(8.0, 4.0, 2.0))), st).hdr
-    assert np.abs(c - a).max() > 0.02 * a.max()
+    assert np.abs(c - a).max() > 0.01 * a.max()
 
 
 def test_uv_seam_does_not_darken(renderer):

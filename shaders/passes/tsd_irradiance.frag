@@ -1,12 +1,14 @@
 #version 330 core
 // Texture-space irradiance (d'Eon & Luebke 2007): per texel of the mesh's UV layout, the light that
-// enters the surface - lights through Fresnel transmission, shadows, the normal map, ambient x
-// occlusion (pi L_ambient) - times albedo^mix (pre-scatter texturing). a = 1: the texel is covered.
+// enters the surface's multiple scattering - each light times the entry factor at its incidence
+// (lib/sss_boundary.glsl: A_ms(mu0) / A_colour), shadows, the normal map, ambient x occlusion
+// (pi L_ambient x A_ms_d / A_colour) - times albedo^mix (pre-scatter texturing). a = 1: covered.
 // Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts, attenuated through the
 // thickness d (from the shadow pass's distance map) by the profile's Gaussians: sum_k W_k e^{-d^2/2v_k}.
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/subsurface.glsl"
+#include "lib/sss_boundary.glsl"
 #include "skinlab/material.glsl"
 
 in vec3 v_world;
@@ -75,7 +77,7 @@ void main() {
         float NoL = dot(n, l);
         if (NoL > 0.0) {
             float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
-            e_in += e * (vis * NoL * fresnel_transmission(f0, NoL));
+            e_in += e * (vis * NoL) * sss_entry(NoL);
         }
 #ifdef TSD_TRANSLUCENCY
         int slot = u_light_shadow[i];
@@ -89,6 +91,6 @@ void main() {
         }
 #endif
     }
-    e_in += PI * u_ambient * occlusion;
+    e_in += PI * u_ambient * occlusion * u_sss_entry_diffuse;
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 }

@@ -1,16 +1,19 @@
 """Forward shading of every visible mesh into an HDR target with depth. The subsurface part of the
 diffuse term is the technique's hook (ForwardParams.hook; app/render/technique.py): per mesh it
-names the material, the hook's GLSL file and variant, and binds the hook's uniforms and textures."""
+names the material, the hook's GLSL file and variant, and binds the hook's uniforms and textures.
+The entry/exit factors and single scattering every technique shares (app/render/boundary.py) are
+bound here for a mesh the hook shades as scattering, zeros for the others."""
 
 from __future__ import annotations
 
 import moderngl
 
 from app.gl.uniforms import set_uniforms
+from app.render.boundary import bind_boundary
 from app.render.frame_plan import ForwardParams
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
-from app.render.technique import HOOK_INCLUDE, NodeShading
+from app.render.technique import HOOK_INCLUDE, PLAIN_HOOK, NodeShading
 from app.render.texture_units import TextureUnits
 
 
@@ -72,6 +75,8 @@ class ForwardPass:
             set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
             set_uniforms(prog, node_uniforms(node))
             self.r.resources.bind_material(prog, sh.material, units)
+            scatters = sh.hook != PLAIN_HOOK and sh.subsurface
+            bind_boundary(prog, sh.material if scatters else None)
             if sh.bind is not None:
                 sh.bind(prog, units)
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)

@@ -18,6 +18,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
+from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
 from app.render.texture_units import TextureUnits
@@ -194,6 +195,7 @@ class TsdIrradiancePass:
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units)
+        bind_boundary(prog, mat)
         if prm.translucency:
             for slot in (0, 1):
                 d = frame.targets.get(f"shadow_distance{slot}")
