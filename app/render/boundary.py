@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
-from scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables
+from scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables, slab_parameters
 from scene.optics.tsd import material_medium
 
 _ZERO_TABLE = np.zeros((ANGULAR_NODES, 3))
@@ -28,8 +28,13 @@ def bind_boundary(prog, material) -> None:
     if t is None:
         set_array(prog, "u_sss_entry", _ZERO_TABLE, ANGULAR_NODES)
         set_array(prog, "u_sss_exit", _ZERO_TABLE, ANGULAR_NODES)
-        set_uniforms(prog, {"u_sss_entry_diffuse": (0.0, 0.0, 0.0), "u_sss_single": (0.0, 0.0, 0.0), "u_sss_eta": 1.0})
+        zero = (0.0, 0.0, 0.0)
+        set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0})
+        set_uniforms(prog, {"u_sss_sigma_tr": zero, "u_sss_z0": zero, "u_sss_zb": zero, "u_sss_mfp": zero})
         return
     set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
     set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
     set_uniforms(prog, {"u_sss_entry_diffuse": t.entry_diffuse, "u_sss_single": t.single, "u_sss_eta": t.eta})
+    medium = material_medium(material.values)
+    s, z0, zb = slab_parameters(medium.alpha_arr, medium.mfp_arr, medium.eta)
+    set_uniforms(prog, {"u_sss_sigma_tr": s, "u_sss_z0": z0, "u_sss_zb": zb, "u_sss_mfp": medium.mfp_arr})

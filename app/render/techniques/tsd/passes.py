@@ -22,7 +22,7 @@ from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
 from app.render.texture_units import TextureUnits
-from scene.optics.tsd import MAX_TSD_LEVELS, DiffusionKernel, blur_taps
+from scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
 
@@ -202,9 +202,6 @@ class TsdIrradiancePass:
                 units.bind(prog, f"u_distance{slot}", d if d is not None else self.r.dummy_texture())
             eyes = np.stack([frame.shadow_eyes.get(s, np.zeros(4)) for s in (0, 1)])
             set_array(prog, "u_light_eye", eyes, 2)
-            set_array(prog, "u_tsd_var", np.array([s.variance_mm2 for s in kernel.steps]), MAX_TSD_LEVELS)
-            set_array(prog, "u_tsd_w", kernel.weights(), MAX_TSD_LEVELS)
-            set_uniform(prog, "u_tsd_levels", kernel.levels)
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         gather = prm.gather if prm.gather is not None else kernel
         frame_nodes(frame)[node.uid] = TsdFrameNode(t, gather, mat, prm.mix)
