@@ -227,6 +227,25 @@ class Scene:
     def lights(self) -> list[LightNode]:
         return [n for n in self.nodes() if isinstance(n, LightNode) and n.is_visible()]
 
+    def orbit_camera(self, degrees: float) -> None:
+        """Swing the camera ``degrees`` about the world +Y axis through the centre of the visible
+        meshes' bounds (positive: counter-clockwise seen from above, i.e. the camera moves to its
+        right), keeping its distance, height and what it looks at relative to that centre."""
+        if self.camera is None:
+            raise ValueError(f"scene {self.name!r}: no camera to orbit")
+        if not np.isfinite(degrees):
+            raise ValueError(f"camera orbit: expected a finite angle in degrees, got {degrees}")
+        lo, hi = self.world_bounds()
+        c = (lo + hi) / 2
+        a = np.radians(degrees)
+        rot = np.eye(4)
+        rot[0, 0], rot[0, 2], rot[2, 0], rot[2, 2] = np.cos(a), np.sin(a), -np.sin(a), np.cos(a)
+        to, back = np.eye(4), np.eye(4)
+        to[:3, 3], back[:3, 3] = -c, c
+        world = back @ rot @ to @ self.camera.world_matrix
+        parent = self.camera.parent.world_matrix if self.camera.parent is not None else np.eye(4)
+        self.camera.set_matrix(np.linalg.inv(parent) @ world)
+
     def world_bounds(self) -> tuple[np.ndarray, np.ndarray]:
         lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
         for n in self.mesh_nodes():

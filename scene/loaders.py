@@ -38,6 +38,13 @@ def load_mesh_file(path: str | Path) -> list[LoadedNode]:
 
 
 def _mesh_from_trimesh(name: str, tm, source: str) -> Mesh:
+    faces = np.asarray(tm.faces)
+    n = len(tm.vertices)
+    if faces.size and (faces.min() < 0 or faces.max() >= n):
+        bad = int(faces.max()) if faces.max() >= n else int(faces.min())
+        raise ValueError(
+            f"{source}: mesh {name!r}: a face uses vertex {bad}, but there are only {n} vertices (0..{n - 1})"
+        )
     uv = None
     vis = getattr(tm, "visual", None)
     if vis is not None and getattr(vis, "uv", None) is not None and len(vis.uv) == len(tm.vertices):

@@ -70,9 +70,11 @@ class Param:
         if self.kind == "texture":
             if value is None or value == "":
                 return None
+            if not isinstance(value, str | Path):
+                raise ValueError(f"{label}: expected a file path (string), got {value!r}")
             return Path(value)
         if self.kind == "choice":
-            if value not in self.choices:
+            if not isinstance(value, str) or value not in self.choices:
                 raise ValueError(f"{label}: expected one of {', '.join(self.choices)}; got {value!r}")
             return value
         arr = self._numbers(value, label)
@@ -92,27 +94,57 @@ class Param:
         return self._canonical(np.clip(arr, *self.range))
 
 
+# One meaning per parameter, stated here once: the panel's tooltips, the docs (docs/scenes.md, generated
+# from this table by `python -m scene.scene_docs`) and errors all read it.
 PRINCIPLED_PARAMS: tuple[Param, ...] = (
-    Param("base_color", "color", (0.8, 0.8, 0.8), (0.0, 1.0), doc="diffuse albedo / metal F0 (linear RGB)"),
-    Param("base_color_map", "texture", None, colorspace="srgb", doc="colour map, sRGB; multiplies base_color"),
+    Param(
+        "base_color",
+        "color",
+        (0.8, 0.8, 0.8),
+        (0.0, 1.0),
+        unit="linear RGB",
+        doc="diffuse albedo of the surface without subsurface scattering, or the F0 of a metal",
+    ),
+    Param("base_color_map", "texture", None, colorspace="srgb", doc="colour map (sRGB file); multiplies base_color"),
     Param("roughness", "float", 0.5, (0.0, 1.0), doc="perceptual roughness; GGX alpha = roughness^2"),
-    Param("roughness_map", "texture", None, doc="roughness (R channel), linear; multiplies roughness"),
-    Param("metallic", "float", 0.0, (0.0, 1.0)),
-    Param("specular", "float", 0.5, (0.0, 1.0), doc="dielectric F0 = 0.08 * specular (0.5 -> 4 %)"),
-    Param("normal_map", "texture", None, doc="tangent-space normal map, linear"),
-    Param("normal_scale", "float", 1.0, (0.0, 4.0), doc="strength of the normal map"),
-    Param("occlusion_map", "texture", None, doc="ambient occlusion (R channel), linear"),
-    Param("subsurface", "float", 0.0, (0.0, 1.0), doc="weight of subsurface scattering against plain diffuse"),
+    Param("roughness_map", "texture", None, doc="roughness map (R channel, linear); multiplies roughness"),
+    Param("metallic", "float", 0.0, (0.0, 1.0), doc="0 dielectric, 1 metal (base_color becomes the specular F0)"),
+    Param("specular", "float", 0.5, (0.0, 1.0), doc="dielectric F0 = 0.08 * specular (0.5 -> 4 %, index 1.5)"),
+    Param("normal_map", "texture", None, doc="tangent-space normal map (linear, OpenGL +Y)"),
+    Param("normal_scale", "float", 1.0, (0.0, 4.0), doc="strength of the normal map (0: off)"),
+    Param("occlusion_map", "texture", None, doc="ambient occlusion (R channel, linear); multiplies the ambient light"),
+    Param(
+        "subsurface",
+        "float",
+        0.0,
+        (0.0, 1.0),
+        doc="weight of subsurface scattering against plain diffuse (Blender: Subsurface Weight)",
+    ),
     Param(
         "subsurface_radius",
         "vec3",
         (1.0, 0.2, 0.1),
         (0.0, 1000.0),
         unit="mm",
-        doc="scattering distance per channel (artist mean free path), millimetres",
+        doc="artist radius R = 4 pi l per channel (l: mean free path), millimetres; Blender's Subsurface Radius "
+        "x Subsurface Scale in mm",
     ),
-    Param("subsurface_color", "color", (0.8, 0.4, 0.3), (0.0, 1.0), doc="multiple-scattering albedo"),
-    Param("sss_model", "choice", "burley", choices=SSS_MODELS, doc="diffusion profile for subsurface scattering"),
+    Param(
+        "subsurface_color",
+        "color",
+        (0.8, 0.4, 0.3),
+        (0.0, 1.0),
+        unit="linear RGB",
+        doc="surface albedo of the scattering medium: its total diffuse reflectance, the colour seen from afar "
+        "(inverted to the single-scattering albedo by photon beam diffusion)",
+    ),
+    Param(
+        "sss_model",
+        "choice",
+        "burley",
+        choices=SSS_MODELS,
+        doc="diffusion profile for subsurface scattering (none: plain diffuse)",
+    ),
 )
 
 

@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import hashlib
 import itertools
+import os
+import sys
+import tempfile
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -72,6 +77,21 @@ class Mesh:
         generate_atlas(self)
 
 
+_ATLASED: dict[int, Mesh] = {}
+
+
+def with_atlas(mesh: Mesh) -> Mesh:
+    """``mesh`` if it has UVs, else a copy of it with an xatlas atlas (one per source mesh and
+    process). The source is left alone: meshes from scene.loaders are shared through its cache."""
+    if mesh.uvs is not None:
+        return mesh
+    if mesh.uid not in _ATLASED:
+        copy = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, None, None, mesh.source)
+        generate_atlas(copy)
+        _ATLASED[mesh.uid] = copy
+    return _ATLASED[mesh.uid]
+
+
 def vertex_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
     """Area-weighted vertex normals; degenerate vertices get +Z rather than NaN."""
     p = positions.astype(np.float64)
@@ -115,11 +135,76 @@ def compute_tangents(positions, normals, uvs, indices) -> np.ndarray:
     return np.concatenate([t, w[:, None]], axis=1).astype(np.float32)
 
 
-def generate_atlas(mesh: Mesh) -> None:
-    """Give ``mesh`` a UV atlas with xatlas (vertices are split along chart seams)."""
+ATLAS_CACHE_VERSION = 1  # bump when the way atlases are made changes
+
+
+def cache_dir() -> Path:
+    """Where derived data (UV atlases) is cached: $SKINLAB_CACHE_DIR, else $XDG_CACHE_HOME/skinlab,
+    else ~/.cache/skinlab. Deleting it is always safe."""
+    env = os.environ.get("SKINLAB_CACHE_DIR")
+    if env:
+        return Path(env)
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "skinlab"
+
+
+def atlas_key(positions: np.ndarray, indices: np.ndarray) -> str:
+    """Content hash of a mesh's geometry (the atlas depends on nothing else), with the xatlas version."""
     import xatlas
 
-    vmapping, idx, uvs = xatlas.parametrize(mesh.positions, mesh.indices)
+    h = hashlib.sha256()
+    h.update(f"atlas-v{ATLAS_CACHE_VERSION}-xatlas-{getattr(xatlas, '__version__', '?')}".encode())
+    for a in (np.ascontiguousarray(positions, np.float32), np.ascontiguousarray(indices, np.uint32)):
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()[:32]
+
+
+def _read_atlas(path: Path, n_vertices: int):
+    try:
+        with np.load(path) as z:
+            vmapping, idx, uvs = z["vmapping"], z["indices"], z["uvs"]
+    except Exception:  # missing, truncated or from elsewhere: make it again
+        return None
+    if vmapping.ndim != 1 or len(vmapping) != len(uvs) or (len(vmapping) and vmapping.max() >= n_vertices):
+        return None
+    if idx.ndim != 2 or idx.shape[1] != 3 or (idx.size and idx.max() >= len(vmapping)):
+        return None
+    return vmapping, idx, uvs
+
+
+def generate_atlas(mesh: Mesh, cache: bool = True) -> None:
+    """Give ``mesh`` a UV atlas with xatlas (vertices are split along chart seams). Atlases are
+    cached by mesh content under :func:`cache_dir` (xatlas takes seconds on a 70k-triangle scan);
+    ``cache=False`` or SKINLAB_CACHE_DIR=off always recomputes."""
+    use_cache = cache and os.environ.get("SKINLAB_CACHE_DIR", "").lower() != "off"
+    key = atlas_key(mesh.positions, mesh.indices)
+    path = cache_dir() / "atlas" / f"{key}.npz"
+    found = _read_atlas(path, len(mesh.positions)) if use_cache else None
+    if found is None:
+        import xatlas
+
+        where = f"mesh {mesh.name!r}" + (f" ({Path(mesh.source).name})" if mesh.source else "")
+        print(
+            f"skinlab: generating a UV atlas for {where}, {len(mesh.indices)} triangles, with xatlas"
+            + (f"; cached in {path.parent} for next time" if use_cache else ""),
+            file=sys.stderr,
+            flush=True,
+        )
+        vmapping, idx, uvs = xatlas.parametrize(mesh.positions, mesh.indices)
+        if use_cache:
+            tmp = None
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".npz", dir=path.parent)
+                with os.fdopen(fd, "wb") as f:
+                    np.savez(f, vmapping=vmapping, indices=idx, uvs=uvs)
+                os.replace(tmp, path)
+            except OSError as exc:
+                if tmp is not None:
+                    Path(tmp).unlink(missing_ok=True)  # a read-only home is no reason to fail a render
+                print(f"skinlab: could not cache the atlas in {path.parent}: {exc}", file=sys.stderr)
+    else:
+        vmapping, idx, uvs = found
     mesh.positions = np.ascontiguousarray(mesh.positions[vmapping])
     mesh.normals = np.ascontiguousarray(mesh.normals[vmapping])
     mesh.indices = np.ascontiguousarray(idx, np.uint32)

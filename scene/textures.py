@@ -32,6 +32,9 @@ def load_texture(path: str | Path, colorspace: str = "linear") -> np.ndarray:
     try:
         spec = inp.spec()
         data = inp.read_image(0, 0, 0, spec.nchannels, "float")
+        # a truncated or corrupt file may still decode partly (grey rows below the damage): refuse it
+        if inp.has_error:
+            raise ValueError(f"{path}: cannot decode texture: {inp.geterror()}")
     finally:
         inp.close()
     if data is None:

@@ -1,8 +1,15 @@
+import atexit
 import os
+import shutil
+import tempfile
 
 import pytest
 
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+# derived-data caches (UV atlases) go to a folder of this test session, never the user's ~/.cache
+_CACHE = tempfile.mkdtemp(prefix="skinlab-test-cache-")
+os.environ["SKINLAB_CACHE_DIR"] = _CACHE
+atexit.register(shutil.rmtree, _CACHE, ignore_errors=True)
 
 from hypothesis import settings as _hyp_settings  # noqa: E402
 

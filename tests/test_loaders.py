@@ -88,3 +88,64 @@ def test_bunny_without_uvs_gets_an_atlas_or_a_clear_error():
         return 0.5 * np.linalg.norm(np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]), axis=1).sum()
 
     assert area(copy.positions, copy.indices) == pytest.approx(area(m.positions, m.indices), rel=1e-6)
+
+
+def _grid_mesh(n=6):
+    from scene.mesh import Mesh
+
+    xs, ys = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n))
+    pos = np.stack([xs.ravel(), ys.ravel(), np.sin(3 * xs.ravel()) * 0.2], axis=1)
+    q = np.arange(n * n).reshape(n, n)[:-1, :-1].ravel()
+    faces = np.concatenate([np.stack([q, q + 1, q + n], 1), np.stack([q + 1, q + n + 1, q + n], 1)])
+    return Mesh("grid", pos, faces, source="grid.obj")
+
+
+def test_atlas_is_cached_by_mesh_content(tmp_path, monkeypatch, capsys):
+    """The second atlas of the same geometry comes from the cache (xatlas is not called), says
+    nothing, and equals the first; other geometry misses; a damaged cache file is remade."""
+    import xatlas
+
+    from scene.mesh import generate_atlas
+
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path))
+    first = _grid_mesh()
+    generate_atlas(first)
+    err = capsys.readouterr().err
+    assert "generating a UV atlas for mesh 'grid' (grid.obj), 50 triangles" in err and str(tmp_path) in err
+    (cached,) = (tmp_path / "atlas").glob("*.npz")
+    assert not [p for p in (tmp_path / "atlas").iterdir() if p.name.startswith(".")]  # no temporary left
+
+    def refuse(*a, **k):
+        raise AssertionError("xatlas called although the atlas is cached")
+
+    monkeypatch.setattr(xatlas, "parametrize", refuse)
+    second = _grid_mesh()
+    generate_atlas(second)
+    assert capsys.readouterr().err == ""
+    assert np.array_equal(second.uvs, first.uvs) and np.array_equal(second.indices, first.indices)
+    assert np.array_equal(second.positions, first.positions)
+    other = _grid_mesh(5)
+    with pytest.raises(AssertionError, match="xatlas called"):
+        generate_atlas(other)  # different content: a miss
+    monkeypatch.undo()
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path))
+    cached.write_bytes(b"broken")
+    third = _grid_mesh()
+    generate_atlas(third)
+    assert "generating a UV atlas" in capsys.readouterr().err
+    assert np.array_equal(third.uvs, first.uvs)
+
+
+def test_generated_atlases_leave_the_loader_cache_alone(tmp_path):
+    """generate_uvs (and texture-space diffusion on a mesh without UVs) give the scene an atlased
+    copy: loading the file again still gives the mesh as the file has it."""
+    from scene.scenefile import load_scene
+
+    scene_file = tmp_path / "s.toml"
+    scene_file.write_text(f'[[meshes]]\nfile = "{ASSETS / "stanford-bunny" / "bunny.ply"}"\ngenerate_uvs = true\n')
+    (node,) = load_scene(scene_file).mesh_nodes()
+    assert node.mesh.uvs is not None
+    (again,) = load_mesh_file(ASSETS / "stanford-bunny" / "bunny.ply")
+    assert again.mesh.uvs is None and again.mesh is not node.mesh
+    (node2,) = load_scene(scene_file).mesh_nodes()
+    assert node2.mesh is node.mesh  # one atlas per source mesh and process

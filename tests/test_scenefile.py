@@ -58,10 +58,16 @@ def test_overrides_and_default_camera(tmp_path):
     "text, match",
     [
         ("[scene\n", r"s.toml: not valid TOML"),
-        ("[scene]\nmm_per_unit = 1\n[[meshes]]\nfile='nope.glb'\n", r"s.toml: mesh file not found: .*nope.glb"),
+        (
+            "[scene]\nmm_per_unit = 1\n[[meshes]]\nfile='nope.glb'\n",
+            r"s.toml: \[\[meshes\]\] #1.file: mesh file not found: .*nope.glb",
+        ),
         ("[[meshes]]\nfil='x'\n", r"s.toml: \[\[meshes\]\] #1: unknown key\(s\) fil"),
-        ("[materials.m]\nroughness = 2\n", r"s.toml: material 'm': roughness: value 2 outside the valid range"),
-        ("[materials.m]\nbase_color_map = 'missing.png'\n", r"\[materials.m\]: texture file not found: .*missing.png"),
+        ("[materials.m]\nroughness = 2\n", r"s.toml: \[materials.m\].roughness: value 2 outside the valid range"),
+        (
+            "[materials.m]\nbase_color_map = 'missing.png'\n",
+            r"\[materials.m\].base_color_map: texture file not found: .*missing.png",
+        ),
         ("[[lights]]\ntype='point'\n", r"\[\[lights\]\] #1: a point light needs 'position'"),
         ("[scene]\nmm_per_unit = 1\n", r"the scene has no meshes"),
     ],

@@ -83,6 +83,11 @@ def test_negligible_and_subtexel_gaussians_are_skipped():
     skipped = dict(k.skipped)
     assert any("weight" in why for why in skipped.values())  # the 8 mm2 one
     assert any("texel" in why for why in skipped.values())  # the 1e-4 mm2 one
+    # like with like: the width in texels is compared with the threshold in texels
+    (why,) = [w for w in skipped.values() if "texel" in w]
+    assert why.startswith(
+        f"sigma 0.01 mm = 0.1 texel (at the median 0.1 mm per texel), under the {tsd.TSD_SUBTEXEL_SIGMA}"
+    )
     np.testing.assert_allclose(k.identity + k.weights().sum(axis=0), 1.0)
     np.testing.assert_allclose(k.identity, 0.3 / 0.9999, rtol=1e-6)  # sub-texel mass is kept, unblurred
     # chained variances: each step blurs by the difference

@@ -103,6 +103,15 @@ def test_zero_uv_area_and_out_of_range_triangles():
     (w,) = r.warnings()
     assert "'flat'" in w and "zero UV area" in w and "no irradiance" in w
 
+    # the same sliver on a surface 1e5 times larger is a note (no warning on every render)
+    big = pos.copy()
+    big[:4] *= 1000.0
+    r3 = analyse_uvs(Mesh("big", big, idx, uvs=uv), mm_per_unit=1.0)
+    assert r3.zero_area_uv == 1 and r3.zero_area_uv_surface < 1e-4 and r3.warnings() == []
+    (note,) = r3.notes()
+    assert "1 of 3 triangles" in note and "no irradiance" in note
+    assert r.notes() == [] and r.zero_area_uv_surface == pytest.approx(0.5 / 1.5)
+
     uv2 = uv.copy()
     uv2[4:] = [[1.5, 0.5], [2.0, 0.5], [1.5, 1.0]]  # a proper triangle entirely outside the square
     r2 = analyse_uvs(Mesh("outside", pos, idx, uvs=uv2), mm_per_unit=1.0)

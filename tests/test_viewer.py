@@ -468,10 +468,12 @@ def test_core_settings_follow_size_and_sss_cycle(core):
     assert next_sss_model("pbd") is None and next_sss_model(None, -1) == "pbd"
     # T cycles the technique; the frame plan follows (screen-space SSS has its blur pass)
     assert c.settings.technique_name == "tsd"
-    assert c.cycle_technique() == "exact" and c.cycle_technique() == "ssss" and c.dirty
+    assert c.cycle_technique() == "ssss" and c.dirty  # T skips the slow exact reference
     c.render()
     assert {"ssss_diffuse", "ssss_blurred"} <= set(c.targets())
-    assert c.cycle_technique(-1) == "exact"
+    assert c.cycle_technique(-1) == "tsd"
+    assert c.set_technique("exact") == "exact"  # from the panel; the overlay says it is slow
+    assert "a frame may take seconds" in c.log[-1][2] and c.log[-1][1] == "warning"
     # the panel edits the current technique's own settings; each technique keeps its own
     assert c.set_technique("tsd") == "tsd" and c.settings.technique.size == 64
     assert c.set_technique_option("gaussians", 3) == 3 and c.settings.technique.gaussians == 3
@@ -574,3 +576,81 @@ def test_technique_settings_widgets_come_from_the_declaration():
     for name, w in ws.items():  # and every such value is accepted by the settings class
         v = technique_value(st, name, w.range[1] if w.range else w.value)
         assert getattr(st.replace(**{name: v}), name) == v
+
+
+def test_panel_labels_texture_fields_and_m_override_note(tmp_path):
+    from app.viewer.panel import resolve_texture_input, sss_override_note, texture_text, widget_label
+    from scene.materials import Material
+
+    labels = {p.name: widget_label(widget_for(p)) for p in PRINCIPLED_PARAMS}
+    assert labels["subsurface_radius"] == "subsurface_radius (mm)"
+    assert labels["base_color"] == "base_color (linear RGB)" and labels["roughness"] == "roughness"
+    assert texture_text(Path("/very/long/absolute/folder/Map-COL.jpg")) == "Map-COL.jpg"
+    assert texture_text(None) == ""
+    cur = tmp_path / "maps" / "a.png"
+    assert resolve_texture_input("b.png", cur, tmp_path) == str(tmp_path / "maps" / "b.png")
+    assert resolve_texture_input("t/b.png", None, tmp_path) == str(tmp_path / "t" / "b.png")
+    assert resolve_texture_input(str(tmp_path / "x.png"), cur, None) == str(tmp_path / "x.png")
+    assert resolve_texture_input("  ", cur, tmp_path) == ""
+    m = Material("skin", {"sss_model": "burley"})
+    assert sss_override_note(m, None) is None
+    assert "'dipole'" in sss_override_note(m, "dipole") and "'burley' is not used" in sss_override_note(m, "dipole")
+
+
+def test_panel_texture_edit_by_file_name_resolves_next_to_the_current_map(tmp_path):
+    import shutil
+
+    from scene.scenefile import load_scene
+
+    scene = load_scene()
+    panel = PanelModel(scene)
+    current = panel.material["normal_map"]
+    assert current is not None
+    # a bare name that exists next to the current map is taken from there, not from the working folder
+    assert panel.edit("normal_map", current.name) == current
+    other = tmp_path / "other.png"
+    shutil.copy(current, other)
+    assert panel.edit("normal_map", str(other)) == other.resolve()
+    with pytest.raises(ValueError, match="normal_map: texture file not found: .*missing.png"):
+        panel.edit("normal_map", "missing.png")
+
+
+def test_technique_cycle_skips_slow_techniques_and_title_names_the_scene():
+    from app.render.registry import get_technique, technique_names
+    from app.viewer.core import cycle_techniques, next_technique, window_title
+    from scene.scenefile import load_scene
+
+    cycle = cycle_techniques()
+    assert get_technique("exact").slow and "exact" not in cycle
+    assert set(cycle) == {n for n in technique_names() if not get_technique(n).slow} and "tsd" in cycle
+    seen, t = [], "tsd"
+    for _ in range(len(cycle)):
+        t = next_technique(t)
+        seen.append(t)
+    assert "exact" not in seen and seen[-1] == "tsd" and sorted(seen) == sorted(cycle)
+    assert next_technique("exact") == cycle[0]
+    assert next_technique("tsd", -1) == cycle[cycle.index("tsd") - 1]
+    assert window_title(load_scene()) == "Skinlab - head (head.toml)"
+
+
+def test_wheel_over_the_panel_is_decided_by_where_the_panel_was_drawn():
+    from app.viewer.gui import Gui
+
+    gui = Gui(core=None)
+    assert not gui.over_panel(10, 10)  # not drawn yet
+    gui.panel_rect = (600.0, 6.0, 340.0, 500.0)
+    assert gui.over_panel(700, 100) and gui.over_panel(600, 6) and gui.over_panel(940, 506)
+    assert not gui.over_panel(599, 100) and not gui.over_panel(700, 507)
+    gui.show_panel = False
+    assert not gui.over_panel(700, 100)
+
+
+def test_viewer_opens_a_mesh_file_directly(ctx, tmp_path):
+    obj = tmp_path / "quad.obj"
+    obj.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n")
+    c = ViewerCore(ctx, obj, RenderSettings(32, 32, **SMALL), watch=False)
+    try:
+        assert c.render() and c.errors() == [] and c.title == "Skinlab - quad (quad.obj)"
+        assert c.panel.material is not None and c.panel.key_light().name == "key"
+    finally:
+        c.close()

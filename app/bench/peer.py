@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import statistics
+import sys
 import time
+
+from tqdm import tqdm
 
 from app.render.settings import RenderSettings
 
 
-def peer_bench(size=(512, 512), frames: int = 30) -> dict:
+def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False) -> dict:
     """Median frame times, both including the colour+depth read-back (pyrender always reads back).
     ``skinlab_ms`` is the plain-PBR frame (sss_model none, like pyrender's: no subsurface scattering);
     ``skinlab_default_ms`` the frame with the default RenderSettings (the head's skin scatters, so
@@ -29,24 +32,33 @@ def peer_bench(size=(512, 512), frames: int = 30) -> dict:
     r = Renderer(ctx)
     r.timer.sync = False  # no glFinish between passes: whole frames are timed here
 
-    def timed(settings):
+    # frames (with 2 warm-ups) of two Skinlab settings, then pyrender's in one subprocess (one step)
+    bar = tqdm(total=2 * (frames + 2) + 1, desc="bench peer", unit="frame", file=sys.stderr, disable=not progress)
+
+    def timed(settings, what):
+        bar.set_postfix_str(what)
         r.render(scene, settings)
         r.render(scene, settings)
+        bar.update(2)
         out = []
         for _ in range(frames):
             t0 = time.perf_counter()
             r.render(scene, settings, readback=("ldr", "depth"))  # what pyrender reads back
             out.append((time.perf_counter() - t0) * 1e3)
+            bar.update()
         return out
 
     try:
-        ours = timed(RenderSettings(w, h, sss_model="none"))
-        ours_default = timed(RenderSettings(w, h))
+        ours = timed(RenderSettings(w, h, sss_model="none"), "skinlab plain PBR")
+        ours_default = timed(RenderSettings(w, h), "skinlab default")
     finally:
         r.release()
+    bar.set_postfix_str("pyrender (subprocess)")
     cam = scene.camera
     meshes = [(str(n.mesh.source), n.world_matrix) for n in scene.mesh_nodes()]
     peer = run_peer(meshes, cam.world_matrix, cam.yfov, cam.znear, cam.zfar, size, frames=frames)
+    bar.update()
+    bar.close()
     theirs = list(map(float, peer["times"]))
     mo, mt = statistics.median(ours), statistics.median(theirs)
     md = statistics.median(ours_default)

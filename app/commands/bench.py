@@ -17,13 +17,18 @@ from app.render.settings import parse_size
 
 
 def register(sub) -> None:
+    from app.bench.accuracy import SWEEPS  # the sweeps' numbers are the help's defaults
+
     p = sub.add_parser("bench", help="benchmarks (timings are printed, never asserted)")
     bsub = p.add_subparsers(dest="bench", metavar="BENCH")
     bsub.required = True
     peer = bsub.add_parser("peer", help="Skinlab vs pyrender on the same head, size and EGL context kind")
-    peer.add_argument("--size", default="512x512")
-    peer.add_argument("--frames", type=int, default=30, help="timed frames per renderer (after warm-up)")
-    peer.add_argument("--json", action="store_true")
+    peer.add_argument("--size", default="512x512", help="frame size WIDTHxHEIGHT in pixels (default 512x512)")
+    peer.add_argument(
+        "--frames", type=int, default=30, help="timed frames per renderer, after 2 warm-up frames (default 30)"
+    )
+    peer.add_argument("--json", action="store_true", help="print the result as JSON")
+    peer.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     peer.set_defaults(func=run_peer_bench)
     rel = bsub.add_parser(
         "reload",
@@ -42,8 +47,8 @@ def register(sub) -> None:
         default=0.05,
         help="ShaderWatcher settle time in seconds (default 0.05, as skinlab view)",
     )
-    rel.add_argument("--shadow-size", type=int, default=512)
-    rel.add_argument("--tsd-size", type=int, default=256)
+    rel.add_argument("--shadow-size", type=int, default=512, help="shadow map texels per side (default 512)")
+    rel.add_argument("--tsd-size", type=int, default=256, help="texture-space diffusion texels per side (default 256)")
     rel.add_argument(
         "--mode",
         choices=("on-demand", "continuous"),
@@ -51,8 +56,10 @@ def register(sub) -> None:
         help="on-demand: the viewer's default loop (idle polls at 60 Hz, a frame only after a "
         "change); continuous: a frame every iteration (as with skinlab view --continuous)",
     )
-    rel.add_argument("--timeout", type=float, default=20.0, help="give up on one edit after this many seconds")
-    rel.add_argument("--json", action="store_true")
+    rel.add_argument(
+        "--timeout", type=float, default=20.0, help="give up on one edit after this many seconds (default 20)"
+    )
+    rel.add_argument("--json", action="store_true", help="print the result as JSON (every sample)")
     rel.set_defaults(func=run_reload_bench)
     acc = bsub.add_parser(
         "accuracy",
@@ -66,7 +73,12 @@ def register(sub) -> None:
     )
     acc.add_argument("--quick", action="store_true", help="a subset at 160x160 (a few minutes at most on 2 cores)")
     acc.add_argument("--tiny", action="store_true", help=argparse.SUPPRESS)  # tests: 4 settings, head, 64x64
-    acc.add_argument("--size", default=None, help="WIDTHxHEIGHT (default 640x640; --quick 160x160)")
+    full, quick = SWEEPS["full"], SWEEPS["quick"]
+    acc.add_argument(
+        "--size",
+        default=None,
+        help=f"WIDTHxHEIGHT (default {full.size[0]}x{full.size[1]}; --quick {quick.size[0]}x{quick.size[1]})",
+    )
     acc.add_argument(
         "--scenes",
         default=None,
@@ -81,15 +93,24 @@ def register(sub) -> None:
         "on 2 cores: full 192x192 at 1024 spp, --quick 96x96 at 256 spp); without it a scene whose reference "
         "is not cached is measured without the truth",
     )
-    acc.add_argument("--frames", type=int, default=None, help="timed frames per setting (default 10; --quick 5)")
     acc.add_argument(
-        "--photons", type=int, default=None, help="Monte Carlo photons per channel (default 200000; --quick 20000)"
+        "--frames",
+        type=int,
+        default=None,
+        help=f"timed frames per setting (default {full.frames}; --quick {quick.frames})",
+    )
+    acc.add_argument(
+        "--photons",
+        type=int,
+        default=None,
+        help=f"Monte Carlo photons per channel (default {full.photons}; --quick {quick.photons})",
     )
     acc.add_argument(
         "--exact-size",
         type=int,
         default=None,
-        help="irradiance texels per side of the exact reference (default 1024; --quick 256)",
+        help=f"irradiance texels per side of the exact reference (default {full.exact_size}; "
+        f"--quick {quick.exact_size})",
     )
     acc.add_argument("--no-peer", action="store_true", help="skip the pyrender comparison")
     acc.add_argument("--no-images", action="store_true", help="do not write images/SCENE-SETTING.png")
@@ -98,7 +119,7 @@ def register(sub) -> None:
 
 
 def run_peer_bench(args) -> int:
-    res = peer_bench(parse_size(args.size), args.frames)
+    res = peer_bench(parse_size(args.size), args.frames, progress=not args.no_progress)
     if args.json:
         print(json.dumps(res, indent=2))
     else:

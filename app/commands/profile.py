@@ -11,6 +11,7 @@ import numpy as np
 
 from app.atomic_write import atomic_path
 
+MAX_LENGTH_MM = 1e6  # a kilometre of mean free path: beyond it the profiles underflow to nothing
 DEFAULT_R = "0,0.01,0.02,0.05,0.1,0.2,0.5,1,2,5,10"
 
 
@@ -23,6 +24,8 @@ def _triple(text: str, name: str):
         vals *= 3
     if len(vals) != 3:
         raise ValueError(f"{name}: expected 1 or 3 comma-separated values, got {len(vals)}")
+    if name in ("mfp", "radius") and any(abs(v) > MAX_LENGTH_MM for v in vals if np.isfinite(v)):
+        raise ValueError(f"{name}: expected lengths of at most {MAX_LENGTH_MM:g} mm, got {text!r}")
     return vals
 
 
@@ -43,9 +46,17 @@ def register(sub) -> None:
     p.add_argument("model", choices=profile_names() + ["all"], help="profile model ('all': every model)")
     src = p.add_mutually_exclusive_group()
     src.add_argument("--preset", help="Jensen 2001 Table 1 material (e.g. skin1, marble)")
-    src.add_argument("--albedo", help="surface albedo (diffuse reflectance) R,G,B in [0, 1]; needs --mfp or --radius")
-    p.add_argument("--mfp", help="mean free path 1/sigma_t' in mm, R,G,B (with --albedo)")
-    p.add_argument("--radius", help="Blender artist radius in mm, R,G,B (with --albedo; l = R/(4 pi))")
+    src.add_argument(
+        "--albedo",
+        help="surface albedo (total diffuse reflectance, the colour seen from afar) R,G,B in [0, 1]; "
+        "needs --mfp or --radius",
+    )
+    p.add_argument("--mfp", help="mean free path l = 1/sigma_t' in mm, R,G,B (with --albedo)")
+    p.add_argument(
+        "--radius",
+        help="artist radius R = 4 pi l in mm, R,G,B (with --albedo): the scene files' subsurface_radius "
+        "and Blender's Subsurface Radius x Scale",
+    )
     p.add_argument(
         "--eta", type=float, default=None, help="relative index of refraction (default 1.3, or the preset's)"
     )
@@ -58,8 +69,13 @@ def register(sub) -> None:
     p.add_argument("--r", default=DEFAULT_R, help=f"radii in mm (default {DEFAULT_R})")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--plot", help="PNG path: every model vs the Monte Carlo reference (log axes)")
-    p.add_argument("--mc-photons", type=float, default=2e5, help="photons per channel for --plot")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--mc-photons",
+        type=float,
+        default=2e5,
+        help="Monte Carlo photons per channel for --plot, an integer >= 2 (default 2e5)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="Monte Carlo random seed for --plot (default 0)")
     p.set_defaults(func=run)
 
 
@@ -85,8 +101,10 @@ def medium_from_args(args):
 
 
 def run(args) -> int:
-    from scene.optics.profiles import evaluate_profile, profile_names, total_reflectance
+    from scene.optics.profiles import PROFILE_MODELS, evaluate_profile, profile_names, total_reflectance
 
+    if args.seed < 0:
+        raise ValueError(f"--seed: expected an integer >= 0, got {args.seed}")
     m = medium_from_args(args)
     r = _radii(args.r)
     names = profile_names() if args.model == "all" else [args.model]
@@ -103,7 +121,15 @@ def run(args) -> int:
         "surface_albedo": m.surface_albedo().tolist(),
     }
     if args.plot:
+        if not np.isfinite(args.mc_photons) or args.mc_photons != int(args.mc_photons) or args.mc_photons < 2:
+            raise ValueError(f"--mc-photons: expected an integer >= 2, got {args.mc_photons!r}")
+        from app.image_output import check_output_path
+
+        if not args.plot.lower().endswith(".png"):
+            raise ValueError(f"--plot: expected a .png path, got {args.plot!r}")
+        check_output_path(args.plot, "--plot")
         plot_models(m, args.plot, int(args.mc_photons), args.seed)
+    notes = {n: PROFILE_MODELS[n].note for n in names if PROFILE_MODELS[n].note}
     if args.json:
         out = {"medium": medium, "r_mm": r.tolist(), "units": "R in 1/mm^2 per unit entering flux"}
         if len(names) == 1:
@@ -112,7 +138,16 @@ def run(args) -> int:
             out["models"] = models
         if args.plot:
             out["plot"] = args.plot
-        print(json.dumps(out))
+        nulls: list[str] = []
+        out = strict_json(out, "", nulls)
+        if nulls:  # JSON has no Infinity or NaN: such numbers are null, and this says where and why
+            notes["null"] = (
+                f"{', '.join(nulls)}: not finite (a mean free path of 0 mm gives infinite coefficients), "
+                "written as null"
+            )
+        if notes:
+            out["notes"] = notes
+        print(json.dumps(out, allow_nan=False))
     else:
         print(
             f"medium {m.name or '(custom)'}: alpha' = {np.round(m.alpha, 5).tolist()}, "
@@ -120,12 +155,31 @@ def run(args) -> int:
         )
         for n in names:
             print(f"\n{n}: total reflectance R,G,B = {np.round(models[n]['total'], 5).tolist()}")
+            if n in notes:
+                print(f"  note: {notes[n]}")
             print(f"{'r (mm)':>10} {'R':>12} {'G':>12} {'B':>12}   (1/mm^2)")
             for ri, row in zip(r, models[n]["R"]):
                 print(f"{ri:10.4g} " + " ".join(f"{v:12.5g}" for v in row))
         if args.plot:
             print(f"\nwrote {args.plot}")
     return 0
+
+
+def strict_json(value, where: str, nulls: list[str]):
+    """``value`` with every non-finite float replaced by None; the dotted paths replaced go to ``nulls``
+    (a list with any bad element is named once)."""
+    if isinstance(value, dict):
+        return {k: strict_json(v, f"{where}.{k}" if where else k, nulls) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        inner: list[str] = []
+        out = [strict_json(v, where, inner) for v in value]
+        if inner:
+            nulls.append(where)
+        return out
+    if isinstance(value, float) and not np.isfinite(value):
+        nulls.append(where)
+        return None
+    return value
 
 
 def plot_models(m, path, photons, seed=0):

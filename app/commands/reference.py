@@ -4,7 +4,6 @@ the scene path-traced volumetrically by Mitsuba 3 (the image ground truth; docs/
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 from app.render.settings import parse_size
 
@@ -31,7 +30,7 @@ def register(sub) -> None:
     p.add_argument("--seed", type=int, default=0, help="random seed, >= 0 (default 0)")
     p.add_argument(
         "--variant", default="scalar_rgb", choices=("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb"),
-        help="Mitsuba variant (default scalar_rgb: any CPU; llvm_ad_rgb needs libLLVM >= 11; cuda_ad_rgb a GPU)",
+        help="Mitsuba variant (default scalar_rgb: any CPU; llvm_ad_rgb needs libllvm19; cuda_ad_rgb an NVIDIA GPU)",
     )  # fmt: skip
     p.add_argument(
         "--sun-deg", type=float, default=0.0, help="angular diameter of directional lights in degrees, 0-10 "
@@ -46,11 +45,12 @@ def register(sub) -> None:
 
 def run(args) -> int:
     from app.cli import UserError
-    from app.image_output import image_format, write_image
+    from app.image_output import check_output_path, image_format, write_image
     from app.truth.reference import ReferenceRequest, ReferenceUnavailable, render_reference
     from scene.scenefile import load_scene
 
-    out = Path(args.out)
+    out = check_output_path(args.out, "--out")  # before minutes of path tracing
+    check_output_path(out.with_suffix(".png"), "--out")
     if image_format(out) != "exr":
         raise ValueError(f"--out: the reference is linear radiance: expected a .exr path, got {out}")
     w, h = parse_size(args.size)

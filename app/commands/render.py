@@ -1,4 +1,4 @@
-"""`skinlab render [SCENE] --out PATH --size WxH [--technique NAME] [--json] [--explain]`: the
+"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--technique NAME] [--json] [--explain]`: the
 technique options come from the registered techniques (app/commands/technique_options.py)."""
 
 from __future__ import annotations
@@ -14,32 +14,60 @@ from scene.materials import SSS_MODELS
 
 def register(sub) -> None:
     p = sub.add_parser("render", help="render a scene headless to PNG or EXR")
-    p.add_argument("scene", nargs="?", help="scene file (TOML); default: the Lee Perry-Smith head")
-    p.add_argument("--out", default="out/render.png", help="output image: .png (tone mapped) or .exr (linear)")
-    p.add_argument("--size", default="640x640", help="WIDTHxHEIGHT (default 640x640)")
-    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
+    p.add_argument(
+        "scene",
+        nargs="?",
+        help="scene file (TOML) or a mesh file (.glb .gltf .obj .ply .stl .off: default camera, two lights "
+        "and a plain grey material); default: the Lee Perry-Smith head",
+    )
+    p.add_argument(
+        "--out",
+        default="out/render.png",
+        help="output image: .png (tone mapped, 8-bit sRGB) or .exr (linear radiance, 32-bit float, with alpha) "
+        "(default out/render.png)",
+    )
+    p.add_argument("--size", default="640x640", help="image size WIDTHxHEIGHT in pixels (default 640x640)")
+    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)")
+    p.add_argument(
+        "--exposure",
+        type=float,
+        default=None,
+        help="linear multiplier on radiance before tone mapping, > 0 (default: the scene's [environment] exposure, "
+        "1.0 if unset); EXR output is radiance, unaffected",
+    )
+    p.add_argument(
+        "--camera-orbit",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="swing the scene's camera DEG degrees about the vertical axis through the meshes' centre "
+        "(positive: the camera moves to its right; default 0)",
+    )
     p.add_argument(
         "--sss",
         choices=SSS_MODELS,
         default=None,
         help="subsurface model for every material (default: each material's own sss_model)",
     )
-    add_technique_options(p)
-    p.add_argument("--json", action="store_true", help="print timings and output paths as JSON")
+    add_technique_options(p)  # an option of another technique than --technique is an error naming it
+    p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
     p.set_defaults(func=run)
 
 
-def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings):
-    """Render once and write each output (PNG from the tone-mapped image, EXR linear)."""
+def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, prepare=None):
+    """Render once and write each output (PNG from the tone-mapped image, EXR linear).
+    ``prepare(scene)`` may adjust the loaded scene (camera, exposure) before rendering."""
     from app.gl.context import create_headless_context
-    from app.image_output import image_format, write_image
+    from app.image_output import check_output_path, image_format, write_image
     from app.render.renderer import Renderer
     from scene.scenefile import load_scene
 
     for o in outputs:
-        image_format(o)  # fail before rendering
+        check_output_path(o, "--out")  # fail before rendering
     scene = load_scene(scene_path)
+    if prepare is not None:
+        prepare(scene)
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     renderer.render(scene, settings, readback=False)  # warm-up: compiles and uploads are not frame time
@@ -58,11 +86,22 @@ def settings_from_args(args, w: int, h: int) -> RenderSettings:
 def run(args) -> int:
     w, h = parse_size(args.size)
     settings = settings_from_args(args, w, h)
-    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings)
+    if args.exposure is not None and not (args.exposure > 0 and args.exposure < float("inf")):
+        raise ValueError(f"--exposure: expected a finite multiplier > 0, got {args.exposure}")
+    if args.camera_orbit != args.camera_orbit or abs(args.camera_orbit) == float("inf"):
+        raise ValueError(f"--camera-orbit: expected a finite angle in degrees, got {args.camera_orbit}")
+
+    def prepare(scene):
+        if args.exposure is not None:
+            scene.environment.exposure = args.exposure
+        if args.camera_orbit:
+            scene.orbit_camera(args.camera_orbit)
+
+    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare)
     for warning in result.plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
-    if args.explain:
-        print(result.plan.explain(), file=sys.stderr if args.json else sys.stdout)
+    if args.explain:  # the warnings were printed above, once
+        print(result.plan.explain(warnings=False), file=sys.stderr if args.json else sys.stdout)
     if args.json:
         from app.gl.context import describe
 
@@ -75,6 +114,7 @@ def run(args) -> int:
                     "gl": describe(ctx),
                     "timings": result.timings.as_dict(),
                     "plan": result.plan.as_dict(),
+                    "warnings": result.plan.warnings,
                 },
                 indent=2,
             )
@@ -82,6 +122,5 @@ def run(args) -> int:
     else:
         for path in written:
             print(f"wrote {path}")
-        for p in result.timings.passes:
-            print(f"  {p.name:<18} {p.cpu_ms:8.2f} ms")
+        print(result.timings.table())
     return 0

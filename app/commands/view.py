@@ -14,9 +14,14 @@ def register(sub) -> None:
     p = sub.add_parser(
         "view", help="open the desktop viewer (orbit camera, parameter panel, pass inspector, hot reload)"
     )
-    p.add_argument("scene", nargs="?", help="scene file (TOML); default: the Lee Perry-Smith head")
+    p.add_argument(
+        "scene",
+        nargs="?",
+        help="scene file (TOML) or a mesh file (.glb .gltf .obj .ply .stl .off: default camera, two lights and "
+        "a plain grey material); default: the Lee Perry-Smith head",
+    )
     p.add_argument("--size", default="960x720", help="window size WIDTHxHEIGHT (default 960x720)")
-    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map resolution")
+    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)")
     add_technique_options(p)  # the technique the viewer starts with (T cycles) and its settings
     w = p.add_mutually_exclusive_group()
     w.add_argument(

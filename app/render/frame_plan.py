@@ -45,13 +45,14 @@ class FramePlan:
     def names(self) -> list[str]:
         return [p.name for p in self.passes]
 
-    def explain(self) -> str:
+    def explain(self, warnings: bool = True) -> str:
+        """The plan as text; ``warnings=False`` leaves out the warnings (for a caller that prints them)."""
         lines = ["frame plan:"]
         for i, p in enumerate(self.passes, 1):
             lines.append(f"  {i}. {p.name:<18} -> {p.target} {p.resolution[0]}x{p.resolution[1]}: {p.reason}")
         for what, why in self.skipped:
             lines.append(f"  -  {what:<18} skipped: {why}")
-        for w in self.warnings:
+        for w in self.warnings if warnings else ():
             lines.append(f"  !  warning: {w}")
         return "\n".join(lines)
 

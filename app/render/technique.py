@@ -2,7 +2,8 @@
 
 A technique (app/render/techniques/<name>/, registered in app/render/registry.py) declares
 
-- ``name`` and a one-line ``description`` (shown by `skinlab render --help` and the viewer);
+- ``name`` and a one-line ``description`` (shown by `skinlab render --help` and the viewer); ``slow``
+  when a frame may take seconds (the viewer's T key skips it);
 - ``settings_type``: its settings dataclass (app/render/options.py), the value of
   ``RenderSettings.technique``;
 - :meth:`Technique.plan`: its passes for the visible meshes (PlannedPass lists with reasons, skips in
@@ -127,6 +128,9 @@ class Technique:
     state: tuple[str, Callable[[Any], Any]] | None = None  # (key shared by techniques, factory(ctx))
     ledger: LedgerStyle = LedgerStyle("o", "grey")
     scatters: bool = True  # False: the technique renders no material as scattering (its model is "none")
+    # not empty: why a frame may take long (an image reference); the viewer's T key skips the technique
+    # and its panel marks it with this, so a slow GPU is not stalled by one key press
+    slow: str = ""
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         return TechniquePlan()

@@ -34,6 +34,23 @@ class FrameTimings:
             return sum(p.gpu_ms for p in self.passes)
         return sum(p.cpu_ms for p in self.passes)
 
+    def table(self) -> str:
+        """Per-pass times as an aligned table with the frame total (skinlab render and demo)."""
+        clock = "CPU, synchronised; software GL" if self.software_gl else "GPU timer queries"
+        width = max([len(p.name) for p in self.passes] + [len("frame (total)")])
+        lines = [f"per-pass time in ms (frame time from: {clock})", f"  {'pass':<{width}}  {'cpu':>9}  {'gpu':>9}"]
+        for p in self.passes:
+            gpu = f"{p.gpu_ms:9.2f}" if p.gpu_ms is not None else f"{'n/a':>9}"
+            lines.append(f"  {p.name:<{width}}  {p.cpu_ms:9.2f}  {gpu}")
+        lines.append(f"  {'-' * width}  {'-' * 9}  {'-' * 9}")
+        gpu_total = (
+            f"{sum(p.gpu_ms for p in self.passes):9.2f}"
+            if self.passes and all(p.gpu_ms is not None for p in self.passes)
+            else f"{'n/a':>9}"
+        )
+        lines.append(f"  {'frame (total)':<{width}}  {sum(p.cpu_ms for p in self.passes):9.2f}  {gpu_total}")
+        return "\n".join(lines)
+
     def as_dict(self) -> dict:
         return {
             "frame_ms": self.frame_ms,

@@ -108,8 +108,8 @@ def set_variant(variant: str):
         mi.set_variant(variant)
     except Exception as exc:  # Dr.Jit raises ImportError/RuntimeError/AttributeError by backend
         hint = {
-            "llvm_ad_rgb": "it needs libLLVM >= 11 (Debian: apt-get install libllvm19; then "
-            "export DRJIT_LIBLLVM_PATH=/usr/lib/llvm-19/lib/libLLVM.so.1)",
+            "llvm_ad_rgb": "it needs a newer libLLVM than Mesa's (Debian: apt-get install libllvm19; if Dr.Jit "
+            "still does not find it, export DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1)",
             "cuda_ad_rgb": "it needs an NVIDIA GPU with its driver",
         }.get(variant, "")
         raise ReferenceUnavailable(f"Mitsuba variant {variant!r} cannot run here: {exc}. {hint}".strip()) from None

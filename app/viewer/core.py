@@ -18,7 +18,7 @@ import numpy as np
 
 from app.gl.hot_reload import ShaderWatcher
 from app.gl.shader_source import ShaderLibrary
-from app.render.registry import get_technique, technique_names
+from app.render.registry import get_technique, techniques
 from app.render.renderer import FrameResult, Renderer
 from app.render.settings import RenderSettings
 from scene.materials import SSS_MODELS
@@ -37,6 +37,25 @@ def next_sss_model(current: str | None, step: int = 1) -> str | None:
     """None (each material's own model) -> every model of scene.materials.SSS_MODELS -> None."""
     i = SSS_CYCLE.index(current) if current in SSS_CYCLE else 0
     return SSS_CYCLE[(i + step) % len(SSS_CYCLE)]
+
+
+def cycle_techniques() -> list[str]:
+    """The registered techniques T goes through: all but the slow ones (Technique.slow: image
+    references taking seconds per frame), which the panel's technique list offers, marked."""
+    return [t.name for t in techniques() if not t.slow]
+
+
+def next_technique(current: str, step: int = 1) -> str:
+    """The technique T (shift+T) switches to; the cycle skips slow techniques."""
+    names = cycle_techniques()
+    if current not in names:
+        return names[0 if step > 0 else -1]
+    return names[(names.index(current) + step) % len(names)]
+
+
+def window_title(scene) -> str:
+    source = getattr(scene, "source", None)
+    return f"Skinlab - {scene.name}" + (f" ({Path(source).name})" if source else "")
 
 
 class ViewerCore:
@@ -80,6 +99,11 @@ class ViewerCore:
     @property
     def scene(self):
         return self.scene_src.value
+
+    @property
+    def title(self) -> str:
+        """The window title: Skinlab, the scene's name and its file (follows scene reloads)."""
+        return window_title(self.scene)
 
     def note(self, level: str, text: str) -> None:
         self.log.append((time.monotonic(), level, text))
@@ -125,18 +149,18 @@ class ViewerCore:
         return model
 
     def cycle_technique(self, step: int = 1) -> str:
-        names = technique_names()
-        i = names.index(self.settings.technique_name)
-        return self.set_technique(names[(i + step) % len(names)])
+        """T: the next registered technique, skipping slow ones (chosen in the panel instead)."""
+        return self.set_technique(next_technique(self.settings.technique_name, step))
 
     def set_technique(self, technique: str) -> str:
         """How subsurface scattering is rendered (a registered technique, app/render/registry.py);
-        each technique keeps the settings it had when the viewer last left it."""
-        get_technique(technique)  # a clear error for an unknown name
+        each technique keeps the settings it had when the viewer last left it. A slow one is noted
+        as a warning (the overlay shows it in yellow)."""
+        slow = get_technique(technique).slow  # a clear error for an unknown name
         self._technique_settings[self.settings.technique_name] = self.settings.technique
         chosen = self._technique_settings.get(technique, technique)
         self.settings = dataclasses.replace(self.settings, technique=chosen)  # validated again
-        self.note("info", f"SSS technique: {technique}")
+        self.note("warning" if slow else "info", f"SSS technique: {technique}" + (f" ({slow})" if slow else ""))
         self.invalidate()
         return technique
 

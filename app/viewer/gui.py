@@ -17,7 +17,15 @@ from scene.materials import SSS_MODELS
 
 from .core import ViewerCore
 from .inspector import display_mode
-from .panel import angles_from_direction, direction_from_angles, technique_value, technique_widgets
+from .panel import (
+    angles_from_direction,
+    direction_from_angles,
+    sss_override_note,
+    technique_value,
+    technique_widgets,
+    texture_text,
+    widget_label,
+)
 
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 GREY = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
@@ -29,6 +37,16 @@ class Gui:
         self.core = core
         self.show_panel = True
         self._text: dict[str, str] = {}  # texture path fields being typed
+        self.panel_rect: tuple[float, float, float, float] | None = None  # x, y (from the top), w, h
+
+    def over_panel(self, x: float, y_from_top: float) -> bool:
+        """Whether a point (window coordinates, y down) lies on the panel as last drawn. The window
+        asks this for wheel events, which can arrive before Dear ImGui's next frame knows where the
+        mouse is (so want_capture_mouse alone lets a slow frame's scroll zoom the camera too)."""
+        if not self.show_panel or self.panel_rect is None:
+            return False
+        px, py, pw, ph = self.panel_rect
+        return px <= x <= px + pw and py <= y_from_top <= py + ph
 
     # -- overlay: timings, errors, messages ---------------------------------------------------
     def overlay(self, ui_fps: float) -> None:
@@ -47,11 +65,9 @@ class Gui:
         res = core.result
         if res is not None:
             t = res.timings
-            clock = t.as_dict()["clock"]
-            imgui.text(f"frame {t.frame_ms:7.2f} ms ({clock}), render call {res.cpu_ms:.1f} ms")
-            for p in t.passes:
-                gpu = f"  gpu {p.gpu_ms:6.2f}" if p.gpu_ms is not None else ""
-                imgui.text(f"  {p.name:<16} {p.cpu_ms:7.2f} ms{gpu}")
+            imgui.text(f"frame {t.frame_ms:7.2f} ms, render call {res.cpu_ms:.1f} ms")
+            for line in t.table().splitlines():  # the same table as skinlab render and demo print
+                imgui.text(line)
         name, _ = core.current_target()
         s = core.settings
         imgui.text_colored(
@@ -62,7 +78,7 @@ class Gui:
         errors = core.errors()
         if errors:
             width = imgui.get_io().display_size.x
-            imgui.push_text_wrap_pos(max(width - 360.0 if self.show_panel else width - 20.0, 200.0))
+            imgui.push_text_wrap_pos(max(width - 460.0 if self.show_panel else width - 20.0, 200.0))
             for e in errors:
                 imgui.text_colored(RED, e)
             imgui.pop_text_wrap_pos()
@@ -77,10 +93,12 @@ class Gui:
         if not self.show_panel:
             return
         io = imgui.get_io()
-        w = min(340.0, io.display_size.x * 0.5)
+        w = min(440.0, io.display_size.x * 0.5)  # room for a label and three number fields
         imgui.set_next_window_pos(imgui.ImVec2(io.display_size.x - w - 6, 6), imgui.Cond_.first_use_ever)
         imgui.set_next_window_size(imgui.ImVec2(w, io.display_size.y * 0.9), imgui.Cond_.first_use_ever)
         expanded, _ = imgui.begin("Skinlab (H hides)", None)
+        pos, size = imgui.get_window_pos(), imgui.get_window_size()
+        self.panel_rect = (pos.x, pos.y, size.x, size.y)
         if expanded:
             self._render_section()
             self._inspector_section()
@@ -103,8 +121,9 @@ class Gui:
             imgui.end_combo()
         cur = core.settings.technique_name
         if imgui.begin_combo("technique (T)", cur):
-            for t in techniques():
-                clicked, _ = imgui.selectable(t.name, t.name == cur)
+            for t in techniques():  # T skips the slow ones; here they are, marked
+                text = f"{t.name}  ({t.slow})" if t.slow else t.name
+                clicked, _ = imgui.selectable(f"{text}##{t.name}", t.name == cur)
                 if imgui.is_item_hovered():
                     imgui.set_tooltip(t.description)
                 if clicked:
@@ -119,7 +138,7 @@ class Gui:
         core = self.core
         st = core.settings.technique
         for w in technique_widgets(st):
-            label = f"{w.param}##{st.technique}"
+            label = f"{widget_label(w)}##{st.technique}"
             new = w.value
             if w.widget.endswith("_or_auto"):
                 changed, auto = imgui.checkbox(f"{w.param} automatic##{st.technique}", w.value is None)
@@ -196,12 +215,23 @@ class Gui:
                 if clicked:
                     self._try(panel.apply_preset, n)
             imgui.end_combo()
-        for w in panel.widgets():
-            label = f"{w.param}{' (' + w.unit + ')' if w.unit else ''}"
+        note = sss_override_note(m, self.core.settings.sss_model)
+        if note:
+            imgui.push_text_wrap_pos(0.0)
+            imgui.text_colored(YELLOW, note)
+            imgui.pop_text_wrap_pos()
+        widgets = panel.widgets()
+        # widgets leave room for the longest label, so no label is cut off at the panel's edge
+        label_w = max((imgui.calc_text_size(widget_label(w)).x for w in widgets), default=0.0)
+        imgui.push_item_width(-(label_w + imgui.get_style().item_inner_spacing.x + 4.0))
+        for w in widgets:
+            label = widget_label(w)
+            if w.param == "sss_model" and note:
+                label = f"{w.param} (M overrides)"
             if w.widget == "slider_float":
                 ch, v = imgui.slider_float(label, float(w.value), w.range[0], w.range[1])
-            elif w.widget == "color_edit3":
-                ch, v = imgui.color_edit3(label, [float(x) for x in w.value])
+            elif w.widget == "color_edit3":  # linear values 0-1, as in the scene file
+                ch, v = imgui.color_edit3(label, [float(x) for x in w.value], imgui.ColorEditFlags_.float)
             elif w.widget == "drag_float3":
                 speed = max((w.range[1] - w.range[0]) * 1e-4, 1e-3)
                 flags = imgui.SliderFlags_.logarithmic if w.logarithmic else 0
@@ -218,7 +248,7 @@ class Gui:
                     imgui.end_combo()
             elif w.widget == "file_path":
                 key = f"{id(m)}:{w.param}"
-                text = self._text.get(key, "" if w.value is None else str(w.value))
+                text = self._text.get(key, texture_text(w.value))
                 ch_text, text = imgui.input_text(label, text, imgui.InputTextFlags_.enter_returns_true)
                 self._text[key] = text
                 ch, v = ch_text, text
@@ -226,10 +256,14 @@ class Gui:
                     self._text.pop(key, None)
             else:  # widget_for() only returns the kinds above
                 raise ValueError(f"parameter {w.param}: no drawing code for widget {w.widget!r}")
-            if imgui.is_item_hovered() and w.doc:
-                imgui.set_tooltip(w.doc)
+            if imgui.is_item_hovered() and (w.doc or w.widget == "file_path"):
+                tip = w.doc
+                if w.widget == "file_path":
+                    tip += f"\n{w.value or 'no map'}\n(a name alone: next to the current map)"
+                imgui.set_tooltip(tip)
             if ch:
                 self._try(panel.edit, w.param, v)
+        imgui.pop_item_width()
         if panel.error:
             imgui.push_text_wrap_pos(0.0)
             imgui.text_colored(RED, panel.error)

@@ -63,6 +63,39 @@ def widget_for(param: Param, value: Any = None) -> Widget:
     return Widget(param.name, kind, value, rng, tuple(param.choices), param.unit, param.doc, log)
 
 
+def widget_label(w: Widget) -> str:
+    """What the panel prints beside a widget: the parameter and its unit (colours: linear RGB)."""
+    return f"{w.param} ({w.unit})" if w.unit else w.param
+
+
+def texture_text(value: Any) -> str:
+    """A texture field shows the file's name (the full path is the tooltip); empty: no map."""
+    return "" if value is None else Path(str(value)).name
+
+
+def resolve_texture_input(text: str, current: Any, scene_dir: Path | None) -> str:
+    """A texture typed into the panel: an absolute path as is; a relative one (a bare file name
+    included) next to the current map, else relative to the scene file's folder."""
+    text = text.strip()
+    if not text:
+        return ""
+    p = Path(text).expanduser()
+    if p.is_absolute():
+        return str(p)
+    base = Path(str(current)).parent if current is not None else scene_dir
+    return str((base / p) if base is not None else p)
+
+
+def sss_override_note(material: Material, override: str | None) -> str | None:
+    """The line that says the M key (RenderSettings.sss_model) overrides the material's own model."""
+    if override is None:
+        return None
+    own = material.values.get("sss_model")
+    if own == override:
+        return f"sss_model: M forces '{override}' on every material (this one's own is the same)"
+    return f"sss_model: M forces '{override}' on every material; this one's own '{own}' is not used"
+
+
 def clamp_value(param: Param, value: Any) -> Any:
     """The value a widget hands back, made valid for ``param``: numbers are clamped into the
     range (NaN -> the default), colours/vec3 element-wise; choices must be one of the options;
@@ -191,6 +224,9 @@ class PanelModel:
         if param is None:
             raise ValueError(f"material {m.name!r}: unknown parameter {name!r}; known: {', '.join(m.param_map)}")
         try:
+            if param.kind == "texture" and isinstance(value, str):
+                source = getattr(self.scene, "source", None)
+                value = resolve_texture_input(value, m.values.get(name), Path(source).parent if source else None)
             v = clamp_value(param, value)
             m.update({name: v})
         except ValueError as exc:

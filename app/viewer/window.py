@@ -98,6 +98,7 @@ class ViewerWindow:
             self.window.close()
             raise
         log.info("GL: %s", describe(self.ctx))
+        self.window.set_caption(self.core.title)
         self.screenshot_dir = Path(screenshot_dir)
         self.continuous = continuous
         self.closed = False
@@ -151,7 +152,8 @@ class ViewerWindow:
         self.core.invalidate()
 
     def on_mouse_scroll(self, x, y, scroll_x, scroll_y):
-        if self._wants("want_capture_mouse"):
+        # pyglet's y grows upwards, Dear ImGui's downwards
+        if self._wants("want_capture_mouse") or self.gui.over_panel(x, self.window.height - y):
             return
         self.core.orbit.zoom(scroll_y)
         self.core.invalidate()
@@ -211,7 +213,8 @@ class ViewerWindow:
         if self.closed:
             return False
         core = self.core
-        core.poll_reloads()
+        if core.poll_reloads() and self.window.caption != core.title:
+            self.window.set_caption(core.title)  # a reloaded scene may have a new name
         rendered = False
         fw, fh = self.window.get_framebuffer_size()
         if fw > 0 and fh > 0:

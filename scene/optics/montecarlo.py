@@ -37,6 +37,7 @@ import numpy as np
 from .fresnel import fresnel_dielectric
 
 BATCH = 1 << 16
+MAX_PHOTONS = 10**10  # about a day on one core; more is a typo (1e30) rather than a plan
 DEFAULT_EDGES = np.concatenate([[0.0], np.geomspace(1e-2, 1e2, 81)])
 
 
@@ -75,8 +76,8 @@ def _check(albedo, eta, g, incidence, photons):
         raise ValueError(f"g: Henyey-Greenstein asymmetry must lie in (-1, 1), got {g!r}")
     if incidence not in ("normal", "diffuse"):
         raise ValueError(f"incidence: expected 'normal' or 'diffuse', got {incidence!r}")
-    if int(photons) != photons or photons < 2:
-        raise ValueError(f"photons: need an integer >= 2, got {photons!r}")
+    if not np.isfinite(float(photons)) or int(photons) != photons or not 2 <= photons <= MAX_PHOTONS:
+        raise ValueError(f"photons: need an integer in [2, {MAX_PHOTONS:.0e}], got {photons!r}")
 
 
 def _sample_hg(rng, n, g):
@@ -201,6 +202,10 @@ def simulate(
     albedo, eta, g = float(albedo), float(eta), float(g)
     _check(albedo, eta, g, incidence, photons)
     photons = int(photons)
+    if int(max_steps) != max_steps or max_steps < 1:
+        raise ValueError(f"max_steps: need an integer >= 1 (collisions per walk), got {max_steps!r}")
+    if int(workers) != workers or workers < 1:
+        raise ValueError(f"workers: need an integer >= 1, got {workers!r}")
     edges = DEFAULT_EDGES if r_edges is None else np.asarray(r_edges, dtype=np.float64)
     if edges.ndim != 1 or len(edges) < 2 or np.any(np.diff(edges) <= 0) or edges[0] < 0:
         raise ValueError("r_edges: need an increasing sequence of at least 2 radii >= 0")

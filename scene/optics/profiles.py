@@ -43,6 +43,7 @@ class ProfileModel:
     description: str
     evaluate: Callable[[np.ndarray, Medium], np.ndarray]  # (r_mm (N,), medium) -> (N, 3) 1/mm^2
     total: Callable[[Medium], np.ndarray]  # medium -> (3,)
+    note: str = ""  # what a reader of a table of R(r) must know (a delta, a singularity at r = 0)
 
 
 def _r(r):
@@ -90,8 +91,20 @@ def _A(m: Medium):
     return m.surface_albedo("pbd")
 
 
+_R0_NOTE = (
+    "R(r) diverges like 1/r at r = 0; the value shown at r = 0 is R at r = 2^-10 d (BURLEY_R0_EPS, d = l/s), "
+    "the rim of a tiny disc, finite so that renderers can use it"
+)
+
 _MODELS = [
-    ProfileModel("none", "no subsurface transport (delta at r = 0)", lambda r, m: np.zeros((len(r), 3)), _A),
+    ProfileModel(
+        "none",
+        "no subsurface transport (delta at r = 0)",
+        lambda r, m: np.zeros((len(r), 3)),
+        _A,
+        "no subsurface transport: all light leaves where it entered (a delta at r = 0, not a function), so "
+        "R(r) = 0 for every r and the total is the surface albedo, rendered as plain diffuse",
+    ),
     ProfileModel(
         "dipole",
         "Jensen et al. 2001 dipole",
@@ -114,12 +127,14 @@ _MODELS = [
         "Christensen-Burley 2015, searchlight s(A)",
         lambda r, m: burley_profile(r, _A(m), m.mfp_arr, "searchlight"),
         _A,
+        _R0_NOTE,
     ),
     ProfileModel(
         "blender-burley",
         "Blender Burley (R = 4 pi l, diffuse s(A), truncated at 16 d)",
         lambda r, m: blender_burley_profile(r, _A(m), mfp_to_radius(m.mfp_mm)),
         _A,
+        _R0_NOTE,
     ),
     ProfileModel("gaussians", "6 shared-variance Gaussians fitted to PBD", _gauss_eval, _gauss_total),
     ProfileModel(

@@ -197,8 +197,9 @@ def design_kernel(
             skipped.append(
                 (
                     f"gaussian {k} (v={v:.3g} mm2)",
-                    f"sigma {math.sqrt(max(v, 0)):.3g} mm < {TSD_SUBTEXEL_SIGMA} texel ({p50:.3g} mm per "
-                    "texel, median): joins the unblurred term",
+                    f"sigma {math.sqrt(max(v, 0)):.3g} mm = {math.sqrt(max(v, 0)) / p50:.3g} texel "
+                    f"(at the median {p50:.3g} mm per texel), under the {TSD_SUBTEXEL_SIGMA} texel a blur "
+                    "needs: joins the unblurred term",
                 )
             )
             ident += w

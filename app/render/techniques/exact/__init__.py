@@ -26,7 +26,7 @@ FIT_GAUSSIANS = 6
 @dataclass(frozen=True)
 class ExactSettings(TechniqueSettings):
     technique = "exact"
-    size: int = option(512, "irradiance texels per side", "int", range=(16, 8192))
+    size: int = option(512, "irradiance texels per side", "int", range=(16, 8192), unit="texels")
     albedo_mix: float = option(
         0.5, "pre-/post-scatter texturing: albedo^mix before the convolution", "float", range=(0, 1)
     )
@@ -36,6 +36,7 @@ class ExactSettings(TechniqueSettings):
 class ExactTechnique(Technique):
     name = "exact"
     description = "brute-force texture-space convolution with the exact profile (the slow image reference)"
+    slow = "the brute-force reference: a frame may take seconds"
     settings_type = ExactSettings
     passes = {**TSD_PASSES, "tsd_exact": TsdExactPass}
     state = (STATE_KEY, TsdStore)  # texture-space diffusion's per-mesh textures, shared

@@ -29,7 +29,7 @@ class TsdSettings(TechniqueSettings):
     # defaults from the accuracy/time ledger (docs/ledger.md): the cheapest setting within 1 % image
     # error of the exact reference on the head and the bunny
     technique = "tsd"
-    size: int = option(512, "irradiance texels per side", "int", range=(16, 8192), flags=("--tsd-size",))
+    size: int = option(512, "irradiance texels per side", "int", range=(16, 8192), unit="texels", flags=("--tsd-size",))
     gaussians: int = option(
         6, "K: Gaussians fitted to the diffusion profile", "int", range=(1, 6), flags=("--gaussians",)
     )

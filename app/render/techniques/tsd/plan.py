@@ -14,6 +14,7 @@ import numpy as np
 
 from app.render.frame_plan import PlannedPass
 from app.render.scattering import scattering_material
+from scene.mesh import with_atlas
 from scene.optics.tsd import BlurStep, DiffusionKernel, design_kernel, material_medium, profile_fit
 from scene.uv_checks import analyse_uvs
 
@@ -99,11 +100,13 @@ def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None) -> Tsd
             "diffusion generated an atlas with xatlas (set generate_uvs = true in the scene "
             "file to do it at load time)"
         )
-        mesh.ensure_uvs("texture-space diffusion needs UVs", generate=True)
+        node.mesh = mesh = with_atlas(mesh)  # a copy: the loader's cached mesh stays as the file has it
     rep = uv_report(node, scene.mm_per_unit, size)
     for w in rep.warnings():
         if w not in plan.warnings:
             plan.warnings.append(w)
+    for n in rep.notes():
+        plan.skipped.append((f"uv[{mesh.name}] slivers", n))
     pct = rep.mm_per_texel_percentiles
     p10 = float(np.nanmin(pct["p10"])) if pct else math.nan
     p50 = float(np.nanmean(pct["p50"])) if pct else math.nan
