@@ -233,14 +233,14 @@ def simulate(
             results = list(ex.map(_run_batch, jobs))
     else:
         results = (_run_batch(job) for job in jobs)
-    for (a, b, c, d, e, f, g), n in zip(results, sizes):
-        s1 += a
-        s2 += b
-        t1 += c
-        t2 += d
-        capped += e
-        u1 += f
-        u2 += g
+    for (b1, b2, b_t1, b_t2, b_cap, b_u1, b_u2), n in zip(results, sizes):
+        s1 += b1
+        s2 += b2
+        t1 += b_t1
+        t2 += b_t2
+        capped += b_cap
+        u1 += b_u1
+        u2 += b_u2
         bar.update(n)
     bar.close()
     N = photons
