@@ -6,7 +6,7 @@ under a temporary folder); none of them is what the renderer runs.
 
     .venv/bin/python tools/irradiance_cost.py [--size 640] [--rounds 7] [--scene PATH]
 
-Variants: base (as shipped), no_cut (translucency without the reach cut), pcf_1tap (one shadow
+Variants: base (as shipped), pcf_1tap (one shadow
 compare instead of the 3x3 PCF), no_translucency, no_maps (no normal, colour or occlusion map
 fetches), raster_only (the interpolated inputs written out: the cost of rasterising the UV layout).
 """
@@ -27,7 +27,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 IRR = "passes/tsd_irradiance.frag"
 VARIANTS = {
     "base": [],
-    "no_cut": [(IRR, "if (d_mm * d_mm < u_tsd_reach2)", "")],
     "pcf_1tap": [
         (
             "lib/shadow.glsl",

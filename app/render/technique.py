@@ -67,6 +67,9 @@ class NodeShading:
     hook: str = PLAIN_HOOK
     defines: dict[str, object] = field(default_factory=dict)
     bind: Callable[[moderngl.Program, TextureUnits], None] | None = None
+    # the mesh scatters below its surface: the forward pass binds its medium's entry/exit factors
+    # and single scattering (app/render/boundary.py); False for a hook that shades it without
+    subsurface: bool = True
 
 
 class ForwardHook:

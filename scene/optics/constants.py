@@ -172,10 +172,6 @@ TSD_TAP_RANGE = 3.0  # blur taps span +-3 sigma
 TSD_MIN_MM_PER_TEXEL = 1e-6  # zero-area triangles (infinite stretch) clamp to this
 TSD_MAX_STEP_TEXELS = 4096.0  # one sigma never spans more texels than this (finite for any stretch)
 COVERAGE_EPS = 1e-6  # premultiplied coverage below this is "no surface"
-# Translucency through d mm is sum_k W_k e^{-d^2/2v_k}: past d^2 = 2 v_max x this exponent every term
-# is below e^-88 = 6e-39, under the smallest normal float32 (1.2e-38), so zero in fp32 arithmetic:
-# the irradiance pass skips the Gaussians there (and the twin returns 0) without changing a value.
-TSD_TRANSLUCENCY_MAX_EXPONENT = 88.0
 GLSL_CONSTANTS.update(
     {
         "TSD_MIN_MM_PER_TEXEL": TSD_MIN_MM_PER_TEXEL,

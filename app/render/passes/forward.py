@@ -2,6 +2,9 @@
 diffuse term is the technique's hook (ForwardParams.hook; app/render/technique.py): per mesh it
 names the material, the hook's GLSL file and variant, and binds the hook's uniforms and textures.
 
+The entry/exit factors and single scattering every technique shares (app/render/boundary.py) are
+bound here for a mesh the hook shades as scattering, zeros for the others.
+
 With ``RenderSettings.depth_prepass`` the meshes are first drawn depth-only (forward.vert with an
 empty fragment shader), then shaded with the depth test ``<=`` and no depth writes: each pixel is
 shaded once, however many surfaces lie behind it (the same image; where two surfaces have exactly
@@ -12,10 +15,11 @@ from __future__ import annotations
 import moderngl
 
 from app.gl.uniforms import set_uniforms
+from app.render.boundary import bind_boundary
 from app.render.frame_plan import ForwardParams
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
-from app.render.technique import HOOK_INCLUDE, NodeShading
+from app.render.technique import HOOK_INCLUDE, PLAIN_HOOK, NodeShading
 from app.render.texture_units import TextureUnits
 
 
@@ -105,6 +109,8 @@ class ForwardPass:
             set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
             set_uniforms(prog, node_uniforms(node))
             self.r.resources.bind_material(prog, sh.material, units)
+            scatters = sh.hook != PLAIN_HOOK and sh.subsurface
+            bind_boundary(prog, sh.material if scatters else None)
             if sh.bind is not None:
                 sh.bind(prog, units)
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)

@@ -2,7 +2,8 @@
 // Luebke 2007): the subsurface diffuse term is the weighted sum of the blurred irradiance levels x
 // albedo^(1-mix) (post-scatter texturing), mixed with plain Burley diffuse by u_subsurface. Variant:
 // TSD_LEVELS = n (0..6) blurred levels. Contract: app/render/technique.py.
-#include "lib/subsurface.glsl"
+#include "lib/sss_boundary.glsl"
+#include "skinlab/constants.glsl"
 
 uniform float u_tsd_mix;
 uniform vec3 u_tsd_identity;         // weight of the unblurred irradiance per channel
@@ -58,7 +59,8 @@ float sss_plain_weight() { return 1.0 - u_subsurface; }
 void sss_add_light(vec3 e, float vis, float NoL) {}  // the irradiance pass gathered the light
 
 vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
-    // the diffused light leaving toward the viewer (1/pi: Lambertian exit)
+    // the diffused light leaving toward the viewer: the angular distribution of what leaves the
+    // medium (lib/sss_boundary.glsl; the irradiance pass applied the entry factor)
     vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
-    return (1.0 - u_metallic) * u_subsurface * post * tsd_diffused(uv) * (INV_PI * sss_exit_weight(abs(NoV)));
+    return (1.0 - u_metallic) * u_subsurface * INV_PI * post * tsd_diffused(uv) * sss_exit(abs(NoV));
 }

@@ -40,7 +40,12 @@ class SsssForward(ForwardHook):
         # every mesh writes the second target; the node's own values apply (sss_model overrides
         # change no uniform)
         enabled = float(node.uid in self.ssss.scattering)
-        return NodeShading(node.material, HOOK, bind=lambda prog, units: set_uniform(prog, "u_ssss_enabled", enabled))
+        return NodeShading(
+            node.material,
+            HOOK,
+            bind=lambda prog, units: set_uniform(prog, "u_ssss_enabled", enabled),
+            subsurface=bool(enabled),
+        )
 
 
 class SsssTechnique(Technique):

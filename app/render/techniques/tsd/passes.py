@@ -18,10 +18,11 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
+from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
 from app.render.texture_units import TextureUnits
-from scene.optics.tsd import MAX_TSD_LEVELS, DiffusionKernel, blur_taps, translucency_reach2_mm2
+from scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
 
@@ -197,7 +198,7 @@ class TsdIrradiancePass(TsdPass):
 
     def run(self, frame, p) -> None:
         prm: TsdIrradianceParams = p.params
-        ctx, node, size, mat, kernel = self.r.ctx, prm.node, prm.size, prm.material, prm.kernel
+        ctx, node, size, mat = self.r.ctx, prm.node, prm.size, prm.material
         t = self.node_targets(p)
         fbo = t.fbo(ctx, t.raw)
         _uv_raster_setup(ctx, fbo, size)
@@ -212,16 +213,13 @@ class TsdIrradiancePass(TsdPass):
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units)
+        bind_boundary(prog, mat)
         if prm.translucency:
             for slot in (0, 1):
                 d = frame.targets.get(f"shadow_distance{slot}")
                 units.bind(prog, f"u_distance{slot}", d if d is not None else self.r.dummy_texture())
             eyes = np.stack([frame.shadow_eyes.get(s, np.zeros(4)) for s in (0, 1)])
             set_array(prog, "u_light_eye", eyes, 2)
-            set_array(prog, "u_tsd_var", np.array([s.variance_mm2 for s in kernel.steps]), MAX_TSD_LEVELS)
-            set_array(prog, "u_tsd_w", kernel.weights(), MAX_TSD_LEVELS)
-            set_uniform(prog, "u_tsd_levels", kernel.levels)
-            set_uniform(prog, "u_tsd_reach2", translucency_reach2_mm2(kernel))
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         self.publish(frame, p)
 
