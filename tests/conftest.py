@@ -44,3 +44,22 @@ def renderer(ctx):
     r = Renderer(ctx)
     yield r
     r.release()
+
+
+@pytest.fixture
+def multiple_only(monkeypatch):
+    """Frames without Jensen's single-scattering term (it is local, unblurred): what is left is the
+    multiple scattering the profile spreads."""
+    import dataclasses
+
+    import numpy as np
+
+    import app.render.boundary as render_boundary
+
+    whole = render_boundary.material_boundary
+
+    def without_single(material):
+        t = whole(material)
+        return None if t is None else dataclasses.replace(t, single=np.zeros(3))
+
+    monkeypatch.setattr(render_boundary, "material_boundary", without_single)

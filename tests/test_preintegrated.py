@@ -10,12 +10,14 @@ import pytest
 from tsd_scenes import light_from, skin, slab_scene
 
 from app.gl.glsl_eval import assert_close_fp32
+from app.render.boundary import material_boundary
 from app.render.settings import RenderSettings
 from app.render.techniques.tsd import TsdSettings
 from scene.graph import CameraNode, MeshNode, Scene
 from scene.mesh import Mesh
 from scene.optics import preintegrated as pis
 from scene.optics import tsd
+from scene.optics.boundary import table_lookup
 
 
 def medium(radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5)):
@@ -114,10 +116,11 @@ def test_flat_slab_shades_like_the_unblurred_subsurface_term(renderer):
     np.testing.assert_allclose(res.hdr[24, 24, :3], tsd_img, rtol=2e-3)
 
 
-def test_sphere_follows_the_table(renderer):
+def test_sphere_follows_the_table(renderer, multiple_only):
     """A sphere of radius 10 mm lit from the side, seen along z (nearly orthographic): along the
-    middle row each pixel is base x E x T(1) x D(N.L, 1/R) x subsurface / pi x exit(N.V) (the hook
-    in NumPy), past the terminator too."""
+    middle row each pixel is base x E x [max(N.L, 0) entry(N.L) + (D(N.L, 1/R) - max(N.L, 0)) entry_d]
+    x exit(N.V) x subsurface / pi (the hook in NumPy; the shared single-scattering term left out),
+    past the terminator too."""
     R, mm = 1.0, 10.0
     p, n, idx = uv_sphere(R)
     mat = skin("burley", radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5), specular=0.0)
@@ -137,7 +140,11 @@ def test_sphere_follows_the_table(renderer):
     nol, nov = x / R, np.sqrt(np.maximum(1 - (x / R) ** 2, 0))
     lut = pis.preintegrated_lut("burley", tsd.material_medium(mat.values))
     D = pis.lut_lookup(lut, nol, np.full_like(x, 1.0 / (R * mm)))
-    ref = np.asarray(mat["base_color"]) * D * tsd.sss_exit_weight(nov)[:, None] / math.pi  # E = 1, T(1) = 1
+    b = material_boundary(mat)
+    flat = np.maximum(nol, 0.0)[:, None]
+    entering = flat * table_lookup(b.entry, flat[:, 0]) + (D - flat) * b.entry_diffuse[None, :]
+    base = np.asarray(mat["base_color"])
+    ref = base * entering * table_lookup(b.exit, nov) / math.pi  # E = 1
     np.testing.assert_allclose(row[inside], ref[inside], rtol=0.05, atol=2e-3)
     past = inside & (nol < -0.05)
     # light past the terminator (without the table: none), red scattering furthest

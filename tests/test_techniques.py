@@ -19,7 +19,7 @@ def edge_row(res, n):
 
 
 @pytest.mark.parametrize("model", ["burley", "pbd"])
-def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer, model):
+def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer, model, multiple_only):
     n = 192
     scene = slab_scene(occluder=True, material=skin(model))
     res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, technique=ExactSettings(size=n)))
@@ -43,7 +43,7 @@ def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer
     assert np.all(rel < 0.02), rel
 
 
-def test_screen_space_sss_follows_its_separable_kernel(renderer):
+def test_screen_space_sss_follows_its_separable_kernel(renderer, multiple_only):
     """Across a straight shadow edge facing the camera, the horizontal pass does all the work: the
     rendered edge is the 1-D kernel's cumulative sum (at the pixel scale), within 2 %; and it is a
     fair approximation of the exact profile's edge (within 6 %)."""
@@ -89,7 +89,7 @@ def test_screen_space_sss_does_not_bleed_across_depth_discontinuities(renderer):
     np.testing.assert_allclose(a[20:76, cols], b[20:76, cols], rtol=0.02, atol=1e-4)
 
 
-def test_tint_baseline_is_the_profile_colour_without_blur(renderer):
+def test_tint_baseline_is_the_profile_colour_without_blur(renderer, multiple_only):
     scene = slab_scene(material=skin("burley"))
     st = RenderSettings(48, 48, technique=TsdSettings(size=64))
     tsd_img = renderer.render(scene, st).hdr[24, 24, :3]

@@ -4,28 +4,17 @@ import numpy as np
 import pytest
 from tsd_scenes import exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
-from app.gl.glsl_eval import assert_close_fp32
 from app.render.settings import RenderSettings
 from app.render.techniques.tsd import TsdSettings
 from app.render.techniques.tsd.passes import frame_nodes, read_texture, store
 from scene.mesh import Mesh
 from scene.optics import tsd
+from scene.optics.boundary import boundary_tables, slab_single_transmittance, slab_transmittance, table_lookup
+from scene.optics.single_scattering import single_scatter_brdf
 
 
 def tsd_node(renderer, scene, name="slab"):
     return frame_nodes(renderer.last_frame)[scene.find(name).uid]
-
-
-def test_subsurface_glsl_twins(glsl):
-    c = np.array([-0.5, 0.0, 1e-6, 1e-3, 0.1, 0.5, 0.9, 1.0, 1.5], np.float64)
-    for f0 in (0.0, 0.028, 0.08):
-        gpu = glsl.evaluate("lib/subsurface.glsl", f"fresnel_transmission({f0}, c)", {"c": c})[:, 0]
-        assert_close_fp32(gpu, tsd.fresnel_transmission(f0, c), what="fresnel_transmission")
-    gpu = glsl.evaluate("lib/subsurface.glsl", "sss_exit_weight(c)", {"c": c})[:, 0]
-    assert_close_fp32(gpu, tsd.sss_exit_weight(c), what="sss_exit_weight")
-    # the exit weight averages to 1 over the cosine-weighted hemisphere
-    mu = np.linspace(0, 1, 20001)
-    assert abs(np.trapezoid(2 * mu * tsd.sss_exit_weight(mu), mu) - 1.0) < 1e-6
 
 
 def test_dilation_pass_matches_its_twin(renderer):
@@ -43,12 +32,16 @@ def test_dilation_pass_matches_its_twin(renderer):
     img[mask, 3] = 1.0
     t = store(renderer).targets(SimpleNamespace(uid=-1), n)
     t.stretch.write(img.tobytes())
-    dilate(renderer, t, t.stretch, 4)
+    dilate(renderer, t, t.stretch, t.stretch, 4)  # in place
     gpu = read_texture(t.stretch)
     ref = tsd.dilate_reference(img, 4)
     np.testing.assert_allclose(gpu, ref, rtol=1e-5, atol=1e-6)
     assert (ref[..., 3] > 0).sum() > mask.sum()  # it did grow
     np.testing.assert_array_equal(gpu[mask], img[mask])  # covered texels are untouched
+    t.raw.write(img.tobytes())  # from one texture into another (the irradiance), an odd count
+    dilate(renderer, t, t.raw, t.irradiance, 3)
+    np.testing.assert_allclose(read_texture(t.irradiance), tsd.dilate_reference(img, 3), rtol=1e-5, atol=1e-6)
+    np.testing.assert_array_equal(read_texture(t.raw), img)  # the source is kept
     store(renderer).nodes.pop(-1).release()
 
 
@@ -91,9 +84,10 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
 
 
 @pytest.mark.parametrize("model", ["burley", "dipole", "pbd"])
-def test_shadow_edge_follows_the_profile_edge_response(renderer, model):
-    """A slab lit across a sharp shadow edge: radiance / lit radiance follows the integral of the
-    exact profile over the lit half-plane within 2 % (absolute, of the lit level) at every pixel."""
+def test_shadow_edge_follows_the_profile_edge_response(renderer, model, multiple_only):
+    """A slab lit across a sharp shadow edge: the multiply scattered radiance / its lit level follows
+    the integral of the exact profile over the lit half-plane within 2 % (absolute, of the lit level)
+    at every pixel."""
     n = 192
     scene = slab_scene(occluder=True, material=skin(model))
     res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, technique=TsdSettings(size=n)))
@@ -124,10 +118,16 @@ def test_constant_irradiance_keeps_its_mean(renderer):
     np.testing.assert_allclose(np.asarray(t.kernel.identity) + t.kernel.weights().sum(axis=0), 1.0, rtol=1e-12)
     img = res.hdr[..., :3]
     np.testing.assert_allclose(img, np.broadcast_to(img[32, 32], img.shape), rtol=1e-4)
-    # the diffuse level is albedo x irradiance / pi x exit weight (normal view, NoV = 1)
-    expected = (
-        np.array([0.7, 0.5, 0.4]) * irr[64, 64] / np.power([0.7, 0.5, 0.4], 0.5) / np.pi * tsd.sss_exit_weight(1.0)
-    )
+    # the level: albedo x entering irradiance / pi x the exit distribution (normal view, NoV = 1),
+    # the irradiance being light x entry factor x albedo^mix; plus single scattering, albedo x
+    # light x Jensen's term (scene/optics/boundary.py)
+    base = np.array([0.7, 0.5, 0.4])
+    medium = tsd.material_medium(t.material.values)
+    tab = boundary_tables(medium.alpha_arr, t.material["subsurface_color"], medium.eta)
+    light = irr[64, 64] / (table_lookup(tab.entry, 1.0) * np.sqrt(base))
+    z = np.array([0.0, 0.0, 1.0])
+    single = light * base * single_scatter_brdf(z, z, z, tab.single, medium.eta, 0.0)
+    expected = base * irr[64, 64] / np.sqrt(base) / np.pi * table_lookup(tab.exit, 1.0) + single
     np.testing.assert_allclose(img[32, 32], expected, rtol=1e-3)
 
 
@@ -146,8 +146,9 @@ def test_scale_invariance(renderer):
     ).hdr
     np.testing.assert_allclose(a, d, atol=2e-4 * a.max())
     # and the physics does depend on the ratio: the same radius at twice the size is a sharper edge
+    # (single scattering, the same at every scale, is a part of both)
     c = renderer.render(slab_scene(occluder=True, mm_per_unit=40.0, material=skin(radius=(8.0, 4.0, 2.0))), st).hdr
-    assert np.abs(c - a).max() > 0.02 * a.max()
+    assert np.abs(c - a).max() > 0.01 * a.max()
 
 
 def test_uv_seam_does_not_darken(renderer):
@@ -178,9 +179,9 @@ def test_uv_seam_does_not_darken(renderer):
 
 
 def test_translucency_through_thin_parts(renderer):
-    """Light from behind a thin sheet comes through (attenuated by the profile's Gaussians at the
-    sheet's thickness); a thick block lets almost nothing through; no shadow-casting light, no
-    translucency."""
+    """Light from behind a thin sheet comes through (diffusion through the slab's thickness plus the
+    light scattered once inside it, scene/optics/boundary.py); a thick block lets almost nothing
+    through; no shadow-casting light, no translucency."""
 
     def sheet(thickness_units, shadow=True):
         s = slab_scene(material=skin(radius=(8.0, 4.0, 2.0)), light_dir=(0, 0, 1))
@@ -198,12 +199,19 @@ def test_translucency_through_thin_parts(renderer):
     none = renderer.render(sheet(0.5 / 20.0, shadow=False), st)
     c = thin.hdr[24, 24, :3]
     assert c[0] > 0.05 and c[0] > c[2]  # red goes furthest
-    # the irradiance texel is the light through 0.5 mm: e x cos x (1 - F) x sum_k W_k e^{-d^2/2v_k}
+    # the irradiance texel is the light through 0.5 mm at normal incidence (e = 1, base colour 1):
+    # entry(1) x slab transmittance + single scattering through the slab
     st_thin = sheet(0.5 / 20.0)
     renderer.render(st_thin, st, readback=False)
     t = frame_nodes(renderer.last_frame)[st_thin.find("slab").uid]
     irr = tsd.unpremultiply(read_texture(t.targets.irradiance))[32, 32]
-    np.testing.assert_allclose(irr, tsd.thickness_transmittance(0.5, t.kernel)[0], rtol=1e-3)
+    medium = tsd.material_medium(t.material.values)
+    tab = boundary_tables(medium.alpha_arr, t.material["subsurface_color"], medium.eta)
+    through = table_lookup(tab.entry, 1.0) * slab_transmittance(0.5, medium.alpha_arr, medium.mfp_arr, medium.eta)[0]
+    single = slab_single_transmittance(1.0, 0.5, medium.alpha_arr, medium.mfp_arr) / np.asarray(
+        t.material["subsurface_color"]
+    )
+    np.testing.assert_allclose(irr, through + single, rtol=2e-3)
     assert thick.hdr[24, 24, 0] < 0.05 * c[0]
     assert none.hdr[24, 24, :3].max() == 0.0
     assert "translucency" in dict(none.plan.skipped)

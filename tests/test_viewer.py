@@ -454,6 +454,28 @@ def test_core_renders_every_target_and_screenshots(core, ctx, tmp_path):
         c.screenshot(tmp_path / "s.bmp")
 
 
+def test_core_orbit_runs_only_the_view_dependent_passes(core):
+    c, _ = core
+    c.set_technique_option("size", 256)  # wide enough for the skin's blurs
+    assert c.render()
+    first = set(c.result.plan.ran())
+    assert {"shadow[key]", "tsd_irradiance[LeePerrySmith]", "forward", "tonemap"} <= first
+    for _ in range(3):  # while a person orbits, the view-independent passes keep their results
+        c.orbit.orbit(25, 4)
+        assert c.render()
+        assert c.result.plan.ran() == ["forward", "tonemap"], c.result.plan.explain()
+        assert "tsd_irradiance[LeePerrySmith]" in c.result.plan.reused()
+    c.scene.find("key").color = np.array([1.0, 0.8, 0.6])  # a light's colour: the irradiance again
+    assert c.render()
+    ran = c.result.plan.ran()
+    assert "tsd_irradiance[LeePerrySmith]" in ran and "shadow[key]" not in ran
+    c.set_technique("ssss")  # screen-space SSS: its blur is view-dependent and runs every frame
+    c.render()
+    c.orbit.orbit(25, 0)
+    c.render()
+    assert c.result.plan.ran() == ["forward", "ssss_blur", "tonemap"]
+
+
 def test_core_settings_follow_size_and_sss_cycle(core):
     c, _ = core
     c.render()

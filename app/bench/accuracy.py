@@ -143,6 +143,7 @@ def run_sweep(
     ctx = create_headless_context()
     gl = describe(ctx)
     renderer = Renderer(ctx)
+    renderer.reuse = False  # each setting's cost is that of a full frame (no pass kept from the last)
     rows: list[dict] = []
     truth_notes: dict[str, str] = {}
     sheet: dict[str, dict[str, np.ndarray]] = {}

@@ -1,5 +1,7 @@
 """`skinlab bench peer`: our plain-PBR frame time against pyrender's, same scene, size and EGL
 (app/bench/peer.py).
+`skinlab bench orbit`: frame time while the camera orbits, with and without reuse across frames, and
+the plain frame (app/bench/orbit.py).
 `skinlab bench reload`: latency from saving a shader file to the first frame rendered with it
 (app/bench/reload.py).
 `skinlab bench accuracy`: the accuracy/time ledger of the SSS techniques (app/bench/accuracy.py).
@@ -11,6 +13,8 @@ import argparse
 import json
 from pathlib import Path
 
+from app.bench.orbit import SCENES as ORBIT_SCENES
+from app.bench.orbit import orbit_bench
 from app.bench.peer import peer_bench
 from app.bench.reload import reload_bench
 from app.render.settings import parse_size
@@ -30,6 +34,26 @@ def register(sub) -> None:
     peer.add_argument("--json", action="store_true", help="print the result as JSON")
     peer.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     peer.set_defaults(func=run_peer_bench)
+    orb = bsub.add_parser(
+        "orbit",
+        help="frame time while the camera orbits the head and the bunny: with reuse across frames (as the viewer), "
+        "without, and the plain frame (--sss none), in one run",
+    )
+    orb.add_argument("--size", default="640x640", help="frame size WIDTHxHEIGHT in pixels (default 640x640)")
+    orb.add_argument(
+        "--frames",
+        type=int,
+        default=24,
+        help="timed camera steps per scene over one full turn, after 2 warm-up frames (default 24)",
+    )
+    orb.add_argument(
+        "--scenes",
+        default=",".join(ORBIT_SCENES),
+        help=f"comma-separated scene names, from {', '.join(ORBIT_SCENES)} (default {','.join(ORBIT_SCENES)})",
+    )
+    orb.add_argument("--json", action="store_true", help="print the result as JSON")
+    orb.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    orb.set_defaults(func=run_orbit_bench)
     rel = bsub.add_parser(
         "reload",
         help="shader hot reload: time from saving a file to the first frame rendered with the new program (headless)",
@@ -131,9 +155,42 @@ def run_peer_bench(args) -> int:
         print(f"  pyrender  {res['pyrender_ms']:8.2f} ms/frame")
         print(f"  ratio skinlab/pyrender = {res['ratio_skinlab_over_pyrender']:.2f}")
         print(
+            f"  skinlab without the depth pre-pass {res['skinlab_no_prepass_ms']:8.2f} ms/frame, "
+            f"ratio {res['ratio_no_prepass_over_pyrender']:.2f}"
+        )
+        parts = ", ".join(f"{k} {v:.1f}" for k, v in res["skinlab_passes_ms"].items())
+        print(f"  skinlab plain frame per pass (ms, glFinish after each): {parts}")
+        print(f"  load average {res['loadavg']}")
+        print(
             f"  skinlab with the default settings (texture-space diffusion on the skin) "
             f"{res['skinlab_default_ms']:8.2f} ms/frame, ratio {res['ratio_default_over_pyrender']:.2f}"
         )
+    return 0
+
+
+def run_orbit_bench(args) -> int:
+    scenes = tuple(s.strip() for s in args.scenes.split(",") if s.strip())
+    res = orbit_bench(parse_size(args.size), args.frames, scenes, progress=not args.no_progress)
+    if args.json:
+        print(json.dumps(res, indent=2))
+        return 0
+    w, h = res["size"]
+    print(
+        f"{res['gl']}, {w}x{h}, median of {res['frames']} orbit steps after {res['warmup']} warm-up frames "
+        f"(wall time + glFinish, no read-back); load average {res['loadavg_start']} -> {res['loadavg_end']} "
+        f"on {res['cpu_count']} cores"
+    )
+    for r in res["scenes"]:
+        print(f"  {r['scene']}:")
+        print(f"    orbit (texture-space diffusion, reuse) {r['orbit_ms']:8.2f} ms")
+        print(f"    full  (texture-space diffusion)        {r['full_ms']:8.2f} ms")
+        print(f"    plain (--sss none)                     {r['plain_ms']:8.2f} ms")
+        print(f"    plain with reuse (shadow map kept)     {r['plain_orbit_ms']:8.2f} ms")
+        print(
+            f"    orbit_over_plain {r['orbit_over_plain']:.2f}   full_over_plain {r['full_over_plain']:.2f}   "
+            f"orbit_over_plain_orbit {r['orbit_over_plain_orbit']:.2f}"
+        )
+        print(f"    passes run while orbiting: {', '.join(r['passes_run_while_orbiting'])}")
     return 0
 
 

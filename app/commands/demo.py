@@ -61,6 +61,7 @@ def gallery(folder: Path, w: int, h: int, progress: bool = True) -> list[Path]:
     from scene.scenefile import load_scene
 
     renderer = Renderer(create_headless_context())
+    renderer.reuse = False  # the gallery's frame times are full frames
     jobs = [(f"head-{m}", None, m) for m in SSS_MODELS] + [
         (f"bunny-{b}", ASSETS / f"bunny-{b}.toml", None) for b in BUNNIES
     ]
@@ -70,7 +71,7 @@ def gallery(folder: Path, w: int, h: int, progress: bool = True) -> list[Path]:
         bar.set_postfix_str(name)
         scene = load_scene(path)
         st = RenderSettings(w, h, sss_model=model)
-        renderer.render(scene, st, readback=False)  # warm-up: compiles, uploads, stretch maps
+        renderer.render(scene, st, readback=False)  # warm-up: compiles and uploads
         res = renderer.render(scene, st, readback=("ldr",))
         p = write_image(folder / f"{name}.png", res.ldr)
         written.append(p)

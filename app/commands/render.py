@@ -1,4 +1,4 @@
-"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--technique NAME] [--json] [--explain]`: the
+"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--technique NAME] [--json] [--explain] [--reuse]`: the
 technique options come from the registered techniques (app/commands/technique_options.py)."""
 
 from __future__ import annotations
@@ -52,12 +52,20 @@ def register(sub) -> None:
     add_technique_options(p)  # an option of another technique than --technique is an error naming it
     p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
+    p.add_argument(
+        "--reuse",
+        action="store_true",
+        help="the timed frame reuses the warm-up frame's results whose inputs did not change (shadow maps, "
+        "texture-space irradiance and blurs: what the viewer does while only the camera moves); --explain "
+        "lists them as 'reused: inputs unchanged since frame 1'. Default: every pass runs",
+    )
     p.set_defaults(func=run)
 
 
-def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, prepare=None):
+def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, prepare=None, reuse: bool = False):
     """Render once and write each output (PNG from the tone-mapped image, EXR linear).
-    ``prepare(scene)`` may adjust the loaded scene (camera, exposure) before rendering."""
+    ``prepare(scene)`` may adjust the loaded scene (camera, exposure) before rendering. A warm-up
+    frame comes first; with `reuse` the written frame reuses its view-independent results."""
     from app.gl.context import create_headless_context
     from app.image_output import check_output_path, image_format, write_image
     from app.render.renderer import Renderer
@@ -71,6 +79,8 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, p
     ctx = create_headless_context()
     renderer = Renderer(ctx)
     renderer.render(scene, settings, readback=False)  # warm-up: compiles and uploads are not frame time
+    if not reuse:
+        renderer.forget_reuse()  # the timed frame runs every pass
     result = renderer.render(scene, settings)
     written = []
     for o in outputs:
@@ -97,7 +107,7 @@ def run(args) -> int:
         if args.camera_orbit:
             scene.orbit_camera(args.camera_orbit)
 
-    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare)
+    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare, args.reuse)
     for warning in result.plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     if args.explain:  # the warnings were printed above, once
@@ -123,4 +133,6 @@ def run(args) -> int:
         for path in written:
             print(f"wrote {path}")
         print(result.timings.table())
+        for name in result.plan.reused():
+            print(f"  {name}: reused, inputs unchanged since the warm-up frame")
     return 0

@@ -92,6 +92,7 @@ class ProgramCache:
         self.library = library or ShaderLibrary()
         self.entries: dict[tuple, ProgramEntry] = {}
         self.compiles = 0
+        self.generation = 0  # bumps whenever a program is recompiled (frame reuse keys on it)
 
     def get(
         self,
@@ -130,6 +131,7 @@ class ProgramCache:
                 entry.program.release()
             entry.program, entry.deps, entry.error = prog, deps, None
             entry.generation += 1
+            self.generation += 1
         return errors
 
     def release(self) -> None:

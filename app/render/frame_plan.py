@@ -20,6 +20,17 @@ class PlannedPass:
     resolution: tuple[int, int]
     reason: str
     params: Any = None  # the kind's typed parameters (ShadowParams, ForwardParams, a technique's own)
+    # What the pass's output depends on besides the passes named in `after` (app/render/reuse.py): a
+    # hashable value built from the scene's geometry versions and transforms, lights, materials,
+    # settings and scale. None: the pass runs every frame (it depends on the camera).
+    inputs: Any = None
+    after: tuple[str, ...] = ()  # names of this plan's passes whose results it reads
+    reused_since: int | None = None  # set by the renderer: not run, its result is frame N's
+
+
+def shadow_pass_name(light: LightNode) -> str:
+    """The name of the pass that renders `light`'s shadow map (a pass reading it names it in ``after``)."""
+    return f"shadow[{light.name}]"
 
 
 @dataclass
@@ -45,11 +56,19 @@ class FramePlan:
     def names(self) -> list[str]:
         return [p.name for p in self.passes]
 
+    def ran(self) -> list[str]:
+        """The passes the renderer ran (not reused from an earlier frame)."""
+        return [p.name for p in self.passes if p.reused_since is None]
+
+    def reused(self) -> list[str]:
+        return [p.name for p in self.passes if p.reused_since is not None]
+
     def explain(self, warnings: bool = True) -> str:
         """The plan as text; ``warnings=False`` leaves out the warnings (for a caller that prints them)."""
         lines = ["frame plan:"]
         for i, p in enumerate(self.passes, 1):
-            lines.append(f"  {i}. {p.name:<18} -> {p.target} {p.resolution[0]}x{p.resolution[1]}: {p.reason}")
+            why = p.reason if p.reused_since is None else f"reused: inputs unchanged since frame {p.reused_since}"
+            lines.append(f"  {i}. {p.name:<18} -> {p.target} {p.resolution[0]}x{p.resolution[1]}: {why}")
         for what, why in self.skipped:
             lines.append(f"  -  {what:<18} skipped: {why}")
         for w in self.warnings if warnings else ():
@@ -65,6 +84,7 @@ class FramePlan:
                     "target": p.target,
                     "resolution": list(p.resolution),
                     "reason": p.reason,
+                    "reused_since": p.reused_since,
                 }
                 for p in self.passes
             ],

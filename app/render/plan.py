@@ -4,8 +4,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams
+from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams, shadow_pass_name
 from .registry import get_technique
+from .reuse import light_placement, scene_geometry
 from .technique import PlanContext
 
 if TYPE_CHECKING:
@@ -41,16 +42,18 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
     technique = get_technique(settings.technique_name)
     tp = technique.plan(PlanContext(scene, settings, meshes, lights, shadow_lights[:2], plan, state))
     distance = tp.shadow_distance and bool(shadow_lights)
+    geometry = scene_geometry(scene) if shadow_lights else ()
     for slot, l in enumerate(shadow_lights[:2]):
         plan.passes.append(
             PlannedPass(
-                f"shadow[{l.name}]",
+                shadow_pass_name(l),
                 "shadow",
                 f"shadow_map{slot}" + (f"+shadow_distance{slot}" if distance else ""),
                 (settings.shadow_size, settings.shadow_size),
                 f"{l.kind} light '{l.name}' casts shadows on {len(meshes)} visible mesh(es)"
                 + ("; distance map for translucency" if distance else ""),
                 ShadowParams(l, slot, distance),
+                inputs=(slot, distance, light_placement(l), geometry),
             )
         )
     for l in shadow_lights[2:]:
@@ -63,7 +66,9 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
             "forward",
             "+".join(["hdr_color", "depth", *hook.outputs]),
             settings.size,
-            f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)" + hook.reason,
+            ("depth pre-pass, then " if settings.depth_prepass else "")
+            + f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)"
+            + hook.reason,
             ForwardParams(lights, shadow_lights[:2], hook),
         )
     )

@@ -20,6 +20,7 @@ from .passes.shadow import ShadowPass
 from .passes.tonemap import TonemapPass
 from .plan import plan_frame
 from .registry import get_technique, pass_class
+from .reuse import ReuseRecord, pass_key
 from .settings import RenderSettings
 from .technique import RenderPass
 from .timing import FrameTimings, PassTimer
@@ -53,6 +54,11 @@ class Renderer:
         self._dummy_shadow = None
         self._dummy_texture = None
         self.last_frame: Frame | None = None  # the latest frame's targets (viewer's pass inspector)
+        # reuse across frames (app/render/reuse.py): a pass whose inputs are unchanged since it last
+        # ran is not run again; False runs every pass every frame (benchmarks of the full frame)
+        self.reuse = True
+        self.reuse_record = ReuseRecord()
+        self.frame_number = 0  # frames rendered by this renderer (the plan's "since frame N")
 
     # -- helpers for passes -----------------------------------------------------------
     def fullscreen(self, prog: moderngl.Program) -> None:
@@ -117,14 +123,38 @@ class Renderer:
             cam.projection_matrix(settings.width / settings.height),
             cam.world_position,
         )
+        self.frame_number += 1
         self.timer.start_frame()
-        for p in plan.passes:
-            with self.timer.measure(p.name):
-                self.pass_for(p.kind).run(frame, p)
+        self.run_passes(frame, plan)
         self.last_frame = frame
         wanted = ("hdr", "ldr", "depth") if readback is True else (readback or ())
         hdr, ldr, depth = self.read_targets(frame, wanted)
         return FrameResult(hdr, ldr, depth, self.timer.frame, plan, (time.perf_counter() - t0) * 1e3)
+
+    def run_passes(self, frame: Frame, plan: FramePlan) -> None:
+        """Run the plan's passes in order; with ``self.reuse`` a pass whose outputs still hold the
+        result for its current inputs is published from them instead (PlannedPass.reused_since)."""
+        keys: dict[str, object] = {}
+        record = self.reuse_record
+        for p in plan.passes:
+            impl = self.pass_for(p.kind)
+            key = keys[p.name] = pass_key(p, keys, self.programs.generation)
+            outputs = impl.outputs(frame, p) if key is not None and hasattr(impl, "outputs") else ()
+            if self.reuse and outputs:
+                since = record.since(outputs, key)
+                if since is not None:
+                    impl.publish(frame, p)
+                    p.reused_since = since
+                    continue
+            record.forget(outputs)  # a run that fails half-way leaves them holding nothing known
+            with self.timer.measure(p.name):
+                impl.run(frame, p)
+            if outputs:
+                record.record(outputs, key, self.frame_number)
+
+    def forget_reuse(self) -> None:
+        """Run every pass on the next frame (after a change the input keys cannot see)."""
+        self.reuse_record.clear()
 
     def read_targets(self, frame: Frame, wanted=("hdr", "ldr", "depth")):
         w, h = frame.settings.size
@@ -159,6 +189,7 @@ class Renderer:
         self._dummy_shadow = self._dummy_texture = None
         self.programs.release()
         self.resources.release()
+        self.reuse_record.clear()
         for st in self.states.values():
             st.release()
         self.states.clear()

@@ -25,6 +25,8 @@ class RenderSettings:
     sss_model: str | None = None
     # how subsurface scattering is rendered: a registered technique (app/render/registry.py)
     technique: TechniqueSettings | str = DEFAULT_TECHNIQUE
+    # draw depth first, then shade each visible pixel once (app/render/passes/forward.py)
+    depth_prepass: bool = True
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):

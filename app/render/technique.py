@@ -48,7 +48,10 @@ HOOK_INCLUDE = "skinlab/sss_hook.glsl"  # the include name forward.frag uses for
 
 class RenderPass(Protocol):
     """A pass kind's implementation: made once per renderer, run for each planned pass of its kind.
-    A pass holding GPU objects of its own also has ``release()``, called by Renderer.release."""
+    A pass holding GPU objects of its own also has ``release()``, called by Renderer.release. A pass
+    that can be reused across frames (its PlannedPass has ``inputs``; app/render/reuse.py) also has
+    ``outputs(frame, planned)`` (the textures holding its result) and ``publish(frame, planned)``
+    (hands them to the frame as ``run`` does)."""
 
     def __init__(self, renderer) -> None: ...
 
@@ -64,6 +67,9 @@ class NodeShading:
     hook: str = PLAIN_HOOK
     defines: dict[str, object] = field(default_factory=dict)
     bind: Callable[[moderngl.Program, TextureUnits], None] | None = None
+    # the mesh scatters below its surface: the forward pass binds its medium's entry/exit factors
+    # and single scattering (app/render/boundary.py); False for a hook that shades it without
+    subsurface: bool = True
 
 
 class ForwardHook:

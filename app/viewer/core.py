@@ -217,6 +217,7 @@ class ViewerCore:
         cache = self.renderer.resources.textures
         for key in [k for k in cache if Path(k[0]).resolve() in changed]:
             cache.pop(key).release()
+        self.renderer.forget_reuse()  # a changed file the input keys cannot see (a texture's pixels)
         self.panel.set_scene(scene)
         cam = scene.camera.world_matrix.copy()
         if not np.allclose(cam, self._file_camera):  # the file's camera moved: follow it

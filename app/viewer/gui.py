@@ -68,6 +68,9 @@ class Gui:
             imgui.text(f"frame {t.frame_ms:7.2f} ms, render call {res.cpu_ms:.1f} ms")
             for line in t.table().splitlines():  # the same table as skinlab render and demo print
                 imgui.text(line)
+            for p in res.plan.passes:  # kept from an earlier frame (app/render/reuse.py)
+                if p.reused_since is not None:
+                    imgui.text_colored(GREY, f"  {p.name:<16} reused: inputs unchanged since frame {p.reused_since}")
         name, _ = core.current_target()
         s = core.settings
         imgui.text_colored(

@@ -17,6 +17,9 @@ light arrives from z < 0 at the origin. Per photon:
   weight / roulette_p (unbiased). Walks still alive after ``max_steps`` collisions are dropped and
   their weight reported as ``capped`` (a bias bound: the exact total lies in [total, total + capped]).
 
+Exits after exactly one collision are also tallied apart (``single``): the single-scattering part
+(Jensen 2001's term), counted from first-bounce photons.
+
 Each photon exits at most once, so its contribution x_i to a bin (or to the total) is its weight or
 0; the standard errors are sqrt((mean(x^2) - mean(x)^2)/(N - 1)) from the per-photon sums.
 Deterministic for a seed: photons are generated in fixed-size batches, batch k from
@@ -50,6 +53,8 @@ class MCResult:
     photons: int
     capped: float  # weight per photon dropped at max_steps (upper bias bound of total)
     params: dict = field(default_factory=dict)
+    single: float = 0.0  # reflectance of photons that left after exactly one collision
+    single_se: float = 0.0
 
     @property
     def r_mid(self) -> np.ndarray:
@@ -126,6 +131,7 @@ def _run_batch(args):
     z = np.zeros(n)
     steps = np.zeros(n, dtype=np.int64)
     t1 = t2 = 0.0
+    u1 = u2 = 0.0
     capped = 0.0
     while len(w):
         s = rng.standard_exponential(len(w))
@@ -146,6 +152,9 @@ def _run_batch(args):
             s2 += np.bincount(b[inb], wl[inb] ** 2, nb)
             t1 += wl.sum()
             t2 += (wl**2).sum()
+            w1 = wl[steps[il] == 1]
+            u1 += w1.sum()
+            u2 += (w1**2).sum()
             ir = io[~leave]
             x[ir], y[ir], z[ir] = xe[~leave], ye[~leave], 0.0
             uz[ir] = -uz[ir]
@@ -171,7 +180,7 @@ def _run_batch(args):
             keep[io[leave]] = False
         if not keep.all():
             x, y, z, ux, uy, uz, w, steps = (a[keep] for a in (x, y, z, ux, uy, uz, w, steps))
-    return s1, s2, t1, t2, capped
+    return s1, s2, t1, t2, capped, u1, u2
 
 
 def simulate(
@@ -218,26 +227,21 @@ def simulate(
     )
     s1 = np.zeros(len(edges) - 1)
     s2 = np.zeros_like(s1)
-    t1 = t2 = capped = 0.0
+    t1 = t2 = capped = u1 = u2 = 0.0
     if workers > 1 and len(jobs) > 1:
         with ProcessPoolExecutor(workers) as ex:
-            results = ex.map(_run_batch, jobs)
-            for (a, b, c, d, e), n in zip(results, sizes):
-                s1 += a
-                s2 += b
-                t1 += c
-                t2 += d
-                capped += e
-                bar.update(n)
+            results = list(ex.map(_run_batch, jobs))
     else:
-        for job, n in zip(jobs, sizes):
-            a, b, c, d, e = _run_batch(job)
-            s1 += a
-            s2 += b
-            t1 += c
-            t2 += d
-            capped += e
-            bar.update(n)
+        results = (_run_batch(job) for job in jobs)
+    for (b1, b2, b_t1, b_t2, b_cap, b_u1, b_u2), n in zip(results, sizes):
+        s1 += b1
+        s2 += b2
+        t1 += b_t1
+        t2 += b_t2
+        capped += b_cap
+        u1 += b_u1
+        u2 += b_u2
+        bar.update(n)
     bar.close()
     N = photons
     area = np.pi * (edges[1:] ** 2 - edges[:-1] ** 2)
@@ -245,6 +249,8 @@ def simulate(
     var = np.maximum(s2 / N - mean**2, 0.0) / (N - 1)
     tmean = t1 / N
     tvar = max(t2 / N - tmean**2, 0.0) / (N - 1)
+    umean = u1 / N
+    uvar = max(u2 / N - umean**2, 0.0) / (N - 1)
     return MCResult(
         edges,
         mean / area,
@@ -262,6 +268,8 @@ def simulate(
             max_steps=int(max_steps),
             entry_fresnel=bool(entry_fresnel),
         ),
+        umean,
+        float(np.sqrt(uvar)),
     )
 
 

@@ -346,22 +346,6 @@ def edge_response(x_mm: np.ndarray, fit_or_profile, kind: str = "gaussians") -> 
     return res
 
 
-# -- Fresnel factors of the specular layer (twins of shaders/lib/subsurface.glsl) ------------------------
-
-
-def fresnel_transmission(f0, c):
-    """1 - Schlick F: the fraction of light entering at incidence cosine c."""
-    c = np.clip(np.asarray(c, np.float64), 0.0, 1.0)
-    f0 = np.asarray(f0, np.float64)
-    return 1.0 - (f0 + (1.0 - f0) * (1.0 - c) ** 5)
-
-
-def sss_exit_weight(NoV):
-    """Burley 2015 diffuse transmission 1 - (1 - NoV)^5 / 2 over its cosine-weighted mean 1 - 1/42."""
-    c = np.clip(np.asarray(NoV, np.float64), 0.0, 1.0)
-    return (1.0 - 0.5 * (1.0 - c) ** 5) / (1.0 - 1.0 / 42.0)
-
-
 def profile_tint(model: str, medium: Medium) -> np.ndarray:
     """The per-pixel tint baseline (no convolution): the exact profile evaluated at one radius, the
     mean free path averaged over the scattering channels, scaled so the brightest channel is 1.
@@ -423,13 +407,3 @@ def dilate_reference(img: np.ndarray, rings: int) -> np.ndarray:
         fill = np.where(n[..., None] > 0, s / np.maximum(n, 1)[..., None], 0.0)
         cur = np.where(cov[..., None], cur, fill).astype(np.float32)
     return cur
-
-
-def thickness_transmittance(d_mm, kernel: DiffusionKernel) -> np.ndarray:
-    """Twin of the translucency term in shaders/passes/tsd_irradiance.frag: light through d mm,
-    sum_k W_k e^{-d^2 / 2 v_k} over the kernel's blurred levels (per channel)."""
-    d = np.atleast_1d(np.asarray(d_mm, np.float64))
-    out = np.zeros((len(d), 3))
-    for s in kernel.steps:
-        out += np.exp(-(d[:, None] ** 2) / (2.0 * max(s.variance_mm2, 1e-12))) * np.asarray(s.weight)[None, :]
-    return out

@@ -19,7 +19,7 @@ vec3 single_scatter_brdf(vec3 n, vec3 wi, vec3 wo, vec3 alpha, float eta, float 
     vec3 to = -wo / eta + (co / eta - cto) * n;
     float cos_s = clamp(-dot(ti, to), -1.0, 1.0);
     float ft = (1.0 - fresnel_from_cosines(ci, cti, 1.0, eta)) * (1.0 - fresnel_from_cosines(co, cto, 1.0, eta));
-    return alpha * (ft * hg_phase(cos_s, g) / max(cti + cto, 1e-4));
+    return alpha * (ft * hg_phase(cos_s, g) / (max(cti + cto, 1e-4) * eta * eta));  // 1/eta^2: solid angle
 }
 
 vec3 single_scatter_profile(float r, vec3 alpha, vec3 mfp, float eta, float g) {

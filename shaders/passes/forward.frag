@@ -5,8 +5,11 @@
 // of the diffuse term is the technique's hook (skinlab/sss_hook.glsl, resolved per program to
 // shaders/techniques/<name>/forward.glsl; the contract is in app/render/technique.py): plain
 // Burley diffuse weighted by sss_plain_weight(), the hook told about each light, and its radiance
-// added after the lights. Specular and ambient specular as usual.
+// added after the lights. Specular and ambient specular as usual. Single scattering (Jensen 2001,
+// lib/sss_boundary.glsl) is added per light for a mesh whose technique scatters (u_sss_single > 0):
+// it leaves within about a mean free path of where it entered, so no technique blurs it.
 #include "lib/brdf.glsl"
+#include "lib/sss_boundary.glsl"
 #include "lib/lights.glsl"
 #include "skinlab/material.glsl"
 
@@ -21,6 +24,7 @@ uniform vec3 u_ambient;
 layout(location = 0) out vec4 f_color;
 
 #include "skinlab/sss_hook.glsl"
+#include "lib/sss_maps.glsl"
 
 void main() {
     vec3 ng = normalize(v_normal);
@@ -48,6 +52,8 @@ void main() {
     float a = ggx_alpha(rough);
     float NoV = dot(n, v);
     vec3 color = vec3(0.0);
+    bool single = any(greaterThan(u_sss_single, vec3(0.0)));
+    vec3 single_w = base * ((1.0 - u_metallic) * sss_weight_at(v_uv));  // x the weight map
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, e;
@@ -60,6 +66,7 @@ void main() {
         vec3 diffuse = base * ((1.0 - u_metallic) * plain * burley_diffuse(NoL, NoV, LoH, rough));
         vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
         color += e * vis * (diffuse + spec) * NoL;
+        if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
         sss_add_light(e, vis, NoL);
     }
     color += u_ambient * occlusion * (base * ((1.0 - u_metallic) * plain) + f0);

@@ -1,12 +1,16 @@
 #version 330 core
 // Texture-space irradiance (d'Eon & Luebke 2007): per texel of the mesh's UV layout, the light that
-// enters the surface - lights through Fresnel transmission, shadows, the normal map, ambient x
-// occlusion (pi L_ambient) - times albedo^mix (pre-scatter texturing). a = 1: the texel is covered.
-// Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts, attenuated through the
-// thickness d (from the shadow pass's distance map) by the profile's Gaussians: sum_k W_k e^{-d^2/2v_k}.
+// enters the surface's multiple scattering - each light times the entry factor at its incidence
+// (lib/sss_boundary.glsl: A_ms(mu0) / A_colour), shadows, the normal map, ambient x occlusion
+// (pi L_ambient x A_ms_d / A_colour) - times albedo^mix (pre-scatter texturing). a = 1: covered.
+// Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts: the entry factor at the
+// light's incidence on the far side times the diffusion slab transmittance through the thickness
+// (lib/sss_boundary.glsl sss_slab_transmittance; the thickness along the light from the shadow
+// pass's distance map, times the cosine to the normal: a flat slab's own thickness), plus the light
+// scattered once inside the slab (sss_slab_single).
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
-#include "lib/subsurface.glsl"
+#include "lib/sss_boundary.glsl"
 #include "skinlab/material.glsl"
 
 in vec3 v_world;
@@ -20,9 +24,6 @@ uniform float u_tsd_mix;
 uniform sampler2D u_distance0;            // light-space distance of the first surface (scene units)
 uniform sampler2D u_distance1;
 uniform vec4 u_light_eye[2];              // slot light position (w = 1) or the direction light travels (w = 0)
-uniform float u_tsd_var[6];               // the kept Gaussians' variances (mm^2)
-uniform vec3 u_tsd_w[6];
-uniform int u_tsd_levels;
 
 // Distance from the light of the first surface it meets on the way to world; false outside the map.
 bool first_hit_distance(int slot, vec3 world, out float first) {
@@ -37,16 +38,6 @@ bool first_hit_distance(int slot, vec3 world, out float first) {
 float distance_from_light(int slot, vec3 world) {
     vec4 e = u_light_eye[slot];
     return e.w == 0.0 ? dot(world, e.xyz) : length(world - e.xyz);
-}
-
-// Transmittance through d mm: the profile's Gaussians at depth d (G(v, sqrt(r^2+d^2)) = e^{-d^2/2v} G(v, r)).
-vec3 thickness_transmittance(float d_mm) {
-    vec3 t = vec3(0.0);
-    for (int k = 0; k < 6; ++k) {
-        if (k >= u_tsd_levels) break;
-        t += u_tsd_w[k] * exp(-d_mm * d_mm / (2.0 * max(u_tsd_var[k], 1e-12)));
-    }
-    return t;
 }
 #endif
 
@@ -66,7 +57,6 @@ void main() {
 #ifdef HAS_OCCLUSION_MAP
     occlusion = texture(u_occlusion_map, v_uv).r;
 #endif
-    float f0 = SPECULAR_F0_SCALE * u_specular;
     vec3 e_in = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
@@ -75,7 +65,7 @@ void main() {
         float NoL = dot(n, l);
         if (NoL > 0.0) {
             float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
-            e_in += e * (vis * NoL * fresnel_transmission(f0, NoL));
+            e_in += e * (vis * NoL) * sss_entry(NoL);
         }
 #ifdef TSD_TRANSLUCENCY
         int slot = u_light_shadow[i];
@@ -83,12 +73,16 @@ void main() {
         if (slot >= 0 && back > 0.0) {
             float first;
             if (first_hit_distance(slot, v_world, first)) {
-                float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit;
-                e_in += e * back * fresnel_transmission(f0, back) * thickness_transmittance(d_mm);
+                float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit * back;
+                // multiple scattering (diffusion through the slab) + single scattering through it
+                float t_in = 1.0 - fresnel_dielectric(back, max(u_sss_eta, 1.0));
+                vec3 through = sss_entry(back) * sss_slab_transmittance(d_mm)
+                             + t_in * sss_slab_single(refract_cos(back, max(u_sss_eta, 1.0)), d_mm);
+                e_in += e * back * through;
             }
         }
 #endif
     }
-    e_in += PI * u_ambient * occlusion;
+    e_in += PI * u_ambient * occlusion * u_sss_entry_diffuse;
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 }

@@ -34,6 +34,11 @@ def light_view_proj(light: LightNode, lo: np.ndarray, hi: np.ndarray) -> np.ndar
     return tf.perspective(fov, 1.0, max(dist - radius, 1e-4), dist + radius) @ view
 
 
+def light_eye(light: LightNode) -> np.ndarray:
+    """The light's position (w = 1) or the direction its light travels (w = 0)."""
+    return np.append(light.direction, 0.0) if light.kind == "directional" else np.append(light.world_position, 1.0)
+
+
 class ShadowPass:
     def __init__(self, renderer):
         self.r = renderer
@@ -68,6 +73,22 @@ class ShadowPass:
                     x.release()
         self.maps.clear()
 
+    def outputs(self, frame, p) -> tuple:
+        """The textures holding the pass's result (reuse across frames, app/render/reuse.py)."""
+        tex, _, dist = self.target(p.params.slot, p.resolution[0], p.params.distance)
+        return (tex,) if dist is None else (tex, dist)
+
+    def publish(self, frame, p) -> None:
+        """Hand the slot's maps and matrices to the frame (after run, or when reused)."""
+        prm: ShadowParams = p.params
+        light, slot = prm.light, prm.slot
+        tex, _, dist = self.target(slot, p.resolution[0], prm.distance)
+        frame.targets[f"shadow_map{slot}"] = tex
+        frame.shadow_eyes[slot] = light_eye(light)
+        if dist is not None:
+            frame.targets[f"shadow_distance{slot}"] = dist
+        frame.shadow_matrices[slot] = _BIAS @ light_view_proj(light, *frame.scene.world_bounds())
+
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
         prm: ShadowParams = p.params
@@ -78,8 +99,7 @@ class ShadowPass:
         prog = self.r.programs.get(
             "passes/shadow.vert", "passes/shadow.frag", {"SHADOW_DISTANCE": 1} if distance else None
         )
-        eye = np.append(light.direction, 0.0) if light.kind == "directional" else np.append(light.world_position, 1.0)
-        set_uniforms(prog, {"u_light_eye": eye})
+        set_uniforms(prog, {"u_light_eye": light_eye(light)})
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         if dist is not None:  # "no surface": as far as it gets
@@ -91,8 +111,4 @@ class ShadowPass:
             set_uniforms(prog, {"u_model": node.world_matrix, "u_light_view_proj": vp})
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         ctx.polygon_offset = (0.0, 0.0)
-        frame.targets[f"shadow_map{slot}"] = tex
-        frame.shadow_eyes[slot] = eye
-        if dist is not None:
-            frame.targets[f"shadow_distance{slot}"] = dist
-        frame.shadow_matrices[slot] = _BIAS @ vp
+        self.publish(frame, p)

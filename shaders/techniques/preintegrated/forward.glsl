@@ -4,10 +4,11 @@
 // max(N.L, 0); the light scatters past the terminator where the surface is curved. Curvature is the
 // mesh's per-vertex mean curvature (v_curvature, precomputed), the normal per channel a blend of the
 // normal-mapped and the geometric normal (the "softened normal": wide channels lose the map's
-// detail). No pass of its own: the cheapest technique. Light enters through the Fresnel
-// transmission at normal incidence (the ring's light enters at every angle; the lookup replaces the
-// cosine). Contract: app/render/technique.py.
-#include "lib/subsurface.glsl"
+// detail). No pass of its own: the cheapest technique. How light enters and leaves is the shared
+// boundary (lib/sss_boundary.glsl): the light a flat surface would take in, max(N.L, 0), enters by
+// sss_entry(N.L) as in every technique; what the ring moves, D - max(N.L, 0), enters at every angle
+// around it, so by the diffuse entry factor. Contract: app/render/technique.py.
+#include "lib/sss_boundary.glsl"
 #include "lib/sss_maps.glsl"
 #include "lib/preintegrated.glsl"
 
@@ -53,9 +54,9 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
 #else
         vec3 D = pis_lookup(u_pis_lut, u_pis_lut_size, nlg, t);  // one normal: one lookup
 #endif
-        entering += e * vis * D;
+        float flat_nl = max(nlg, 0.0);
+        entering += e * vis * (flat_nl * sss_entry(flat_nl) + (D - flat_nl) * u_sss_entry_diffuse);
     }
-    entering *= fresnel_transmission(SPECULAR_F0_SCALE * u_specular, 1.0);
-    entering += PI * u_ambient * occlusion;
-    return base * entering * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI * sss_exit_weight(abs(NoV)));
+    entering += PI * u_ambient * occlusion * u_sss_entry_diffuse;
+    return base * entering * sss_exit(abs(NoV)) * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI);
 }

@@ -1,7 +1,7 @@
 // Subsurface hook of technique "ssss" (screen-space separable SSS, Jimenez et al.): the subsurface
 // diffuse radiance goes to a second target (f_diffuse, a = the material's profile index + 1, 0 where
-// nothing scatters) for the screen-space blur, the rest to f_color. Every mesh uses this hook while the technique runs, so the
-// second target is written everywhere. Contract: app/render/technique.py.
+// nothing scatters) for the screen-space blur, the rest to f_color. Every mesh uses this hook while
+// the technique runs, so the second target is written everywhere. Contract: app/render/technique.py.
 #include "lib/sss_local.glsl"
 #include "lib/sss_maps.glsl"
 

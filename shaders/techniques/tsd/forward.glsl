@@ -1,8 +1,10 @@
 // Subsurface hook of technique "tsd" (and "exact"): the texture-space diffusion gather (d'Eon &
 // Luebke 2007): the subsurface diffuse term is the weighted sum of the blurred irradiance levels x
 // albedo^(1-mix) (post-scatter texturing), mixed with plain Burley diffuse by the subsurface weight
-// (x its map, lib/sss_maps.glsl). Variant: TSD_LEVELS = n (0..6) blurred levels. Contract: app/render/technique.py.
-#include "lib/subsurface.glsl"
+// (x its map, lib/sss_maps.glsl). Variant: TSD_LEVELS = n (0..6) blurred levels. Contract:
+// app/render/technique.py.
+#include "lib/sss_boundary.glsl"
+#include "skinlab/constants.glsl"
 #include "lib/sss_maps.glsl"
 
 uniform float u_tsd_mix;
@@ -59,7 +61,8 @@ float sss_plain_weight() { return 1.0 - sss_weight_at(v_uv); }
 void sss_add_light(vec3 e, float vis, float NoL) {}  // the irradiance pass gathered the light
 
 vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
-    // the diffused light leaving toward the viewer (1/pi: Lambertian exit)
+    // the diffused light leaving toward the viewer: the angular distribution of what leaves the
+    // medium (lib/sss_boundary.glsl; the irradiance pass applied the entry factor)
     vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
-    return (1.0 - u_metallic) * sss_weight_at(v_uv) * post * tsd_diffused(uv) * (INV_PI * sss_exit_weight(abs(NoV)));
+    return (1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI * post * tsd_diffused(uv) * sss_exit(abs(NoV));
 }

@@ -43,7 +43,9 @@ class DiskForward(ForwardHook):
         hit = self.profiles.get(node.uid)
         mat, index = hit if hit is not None else (node.material, -1)
         value = float(index + 1)
-        return NodeShading(mat, HOOK, bind=lambda prog, units: set_uniform(prog, "u_disk_profile", value))
+        return NodeShading(
+            mat, HOOK, bind=lambda prog, units: set_uniform(prog, "u_disk_profile", value), subsurface=index >= 0
+        )
 
 
 def plan_profiles(ctx: PlanContext):

@@ -8,7 +8,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_uniforms
-from app.render.techniques.tsd.passes import store
+from app.render.techniques.tsd.passes import TsdPass, store
 from app.render.techniques.tsd.plan import TsdExactParams
 from scene.optics.tsd import exact_profile_lut, material_medium
 
@@ -16,12 +16,18 @@ EXACT_INNER_HALF = 24  # brute force: texels summed one by one within 24 texels 
 EXACT_RING_RATIO = 1.15  # ...then annuli r -> 1.15 r out to r_max, cells read from the mip pyramid
 
 
-class TsdExactPass:
+class TsdExactPass(TsdPass):
     """Brute-force convolution with the exact profile into level 0."""
 
     def __init__(self, renderer):
-        self.r = renderer
+        super().__init__(renderer)
         self._luts: dict = {}
+
+    def output(self, t, p):
+        return t.level(self.r.ctx, 0)
+
+    def publish(self, frame, p) -> None:
+        frame.targets[f"tsd_exact[{p.params.node.name}]"] = self.output(self.node_targets(p), p)
 
     def lut(self, model, medium):
         key = (model, medium)
@@ -73,4 +79,4 @@ class TsdExactPass:
         ctx.viewport = (0, 0, size, size)
         self.r.fullscreen(prog)
         t.irradiance.filter = (moderngl.LINEAR, moderngl.LINEAR)
-        frame.targets[f"tsd_exact[{node.name}]"] = dst
+        self.publish(frame, p)

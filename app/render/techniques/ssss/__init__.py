@@ -41,7 +41,12 @@ class SsssForward(ForwardHook):
         # every mesh writes the second target, its alpha the profile index + 1 (0: not blurred); the
         # node's own values apply (sss_model overrides change no uniform)
         index = float(self.ssss.profile.get(node.uid, -1) + 1)
-        return NodeShading(node.material, HOOK, bind=lambda prog, units: set_uniform(prog, "u_ssss_profile", index))
+        return NodeShading(
+            node.material,
+            HOOK,
+            bind=lambda prog, units: set_uniform(prog, "u_ssss_profile", index),
+            subsurface=index > 0,
+        )
 
 
 class SsssTechnique(Technique):

@@ -18,10 +18,11 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
+from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
 from app.render.texture_units import TextureUnits
-from scene.optics.tsd import MAX_TSD_LEVELS, DiffusionKernel, blur_taps
+from scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
 
@@ -39,15 +40,18 @@ def _texture(ctx, size: int) -> moderngl.Texture:
 
 @dataclass
 class TsdNodeTargets:
-    """The GPU textures of one subsurface mesh node (float32 RGBA, premultiplied by coverage)."""
+    """The GPU textures of one subsurface mesh node (float32 RGBA, premultiplied by coverage): the
+    irradiance as rasterised (raw) and dilated, a scratch texture for ping-ponging, the stretch map
+    and the blurred levels. Each pass's result stays in its own texture, so a pass whose inputs
+    did not change can be reused on later frames (app/render/reuse.py)."""
 
     size: int
     irradiance: moderngl.Texture
     scratch: moderngl.Texture
     stretch: moderngl.Texture
+    raw: moderngl.Texture
     levels: list = field(default_factory=list)
     fbos: dict = field(default_factory=dict)
-    stretch_key: tuple | None = None
 
     def fbo(self, ctx, tex: moderngl.Texture) -> moderngl.Framebuffer:
         f = self.fbos.get(id(tex))
@@ -63,7 +67,7 @@ class TsdNodeTargets:
     def release(self) -> None:
         for f in self.fbos.values():
             f.release()
-        for t in [self.irradiance, self.scratch, self.stretch, *self.levels]:
+        for t in [self.irradiance, self.scratch, self.stretch, self.raw, *self.levels]:
             t.release()
 
 
@@ -77,23 +81,10 @@ class TsdFrameNode:
     mix: float
 
 
-def stretch_key(node, scene, size: int) -> tuple:
-    """Everything the stretch map depends on: the mesh (identity, version), its world transform,
-    the scene scale, the texture size and the material's subsurface radius map."""
-    radius_map = str(node.material.values.get("subsurface_radius_map"))
-    return (
-        node.mesh.uid,
-        node.mesh.version,
-        node.world_matrix.round(9).tobytes(),
-        float(scene.mm_per_unit),
-        size,
-        radius_map,
-    )
-
-
 class TsdStore:
-    """Per-node TSD textures, kept across frames (stretch maps are reused while geometry is unchanged).
-    The renderer keeps one per renderer (Renderer.state) and calls begin_frame with each frame plan."""
+    """Per-node TSD textures, kept across frames (the renderer reuses the results of passes whose
+    inputs did not change). The renderer keeps one per renderer (Renderer.state) and calls
+    begin_frame with each frame plan."""
 
     def __init__(self, ctx):
         self.ctx = ctx
@@ -106,7 +97,7 @@ class TsdStore:
             if t is not None:
                 t.release()
             c = self.ctx
-            t = self.nodes[node.uid] = TsdNodeTargets(size, _texture(c, size), _texture(c, size), _texture(c, size))
+            t = self.nodes[node.uid] = TsdNodeTargets(size, *(_texture(c, size) for _ in range(4)))
         return t
 
     def retain(self, uids) -> int:
@@ -120,10 +111,6 @@ class TsdStore:
     def begin_frame(self, plan) -> None:
         """Keep the textures of the nodes this frame's passes use; release the rest."""
         self.retain({p.params.node.uid for p in plan.passes if isinstance(p.params, TsdNodeParams)})
-
-    def stretch_valid(self, node, scene, size: int) -> bool:
-        t = self.nodes.get(node.uid)
-        return t is not None and t.size == size and t.stretch_key == stretch_key(node, scene, size)
 
     def release(self) -> None:
         for t in self.nodes.values():
@@ -147,29 +134,47 @@ def _uv_raster_setup(ctx, fbo, size: int) -> None:
     ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
 
 
-def dilate(renderer, t: TsdNodeTargets, tex: moderngl.Texture, rings: int) -> None:
-    """`rings` one-texel dilation steps of `tex`, ping-ponging with the scratch texture (even count
-    ends in `tex`)."""
+def dilate(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, rings: int) -> None:
+    """`rings` one-texel dilation steps from `src` into `dst`, ping-ponging with the scratch
+    texture (in place, src is dst, the count is rounded up to an even one)."""
     ctx = renderer.ctx
     prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_dilate.frag")
-    src, dst = tex, t.scratch
-    for _ in range(rings + (rings % 2)):
-        t.fbo(ctx, dst).use()
+    steps = rings + (rings % 2) if src is dst else max(rings, 1)
+    for i in range(steps):
+        out = dst if (steps - 1 - i) % 2 == 0 else t.scratch
+        t.fbo(ctx, out).use()
         ctx.viewport = (0, 0, t.size, t.size)
         src.use(0)
         set_uniform(prog, "u_src", 0)
         renderer.fullscreen(prog)
-        src, dst = dst, src
+        src = out
 
 
-class TsdStretchPass:
+class TsdPass:
+    """A texture-space pass of one mesh node; ``output`` names the node texture holding its result."""
+
     def __init__(self, renderer):
         self.r = renderer
+
+    def node_targets(self, p) -> TsdNodeTargets:
+        return store(self.r).targets(p.params.node, p.params.size)
+
+    def outputs(self, frame, p) -> tuple:
+        """The texture holding the pass's result (reuse across frames, app/render/reuse.py)."""
+        return (self.output(self.node_targets(p), p),)
+
+    def publish(self, frame, p) -> None:
+        """Hand the result to the frame (after run, or when reused)."""
+
+
+class TsdStretchPass(TsdPass):
+    def output(self, t, p):
+        return t.stretch
 
     def run(self, frame, p) -> None:
         prm: TsdNodeParams = p.params
         ctx, node, size = self.r.ctx, prm.node, prm.size
-        t = store(self.r).targets(node, size)
+        t = self.node_targets(p)
         fbo = t.fbo(ctx, t.stretch)
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
@@ -181,20 +186,26 @@ class TsdStretchPass:
         for sampler, (path, cs) in radius_map.items():
             units.bind(prog, sampler, self.r.resources.texture(path, cs))
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
-        dilate(self.r, t, t.stretch, prm.dilate)
-        t.stretch_key = stretch_key(node, frame.scene, size)
+        dilate(self.r, t, t.stretch, t.stretch, prm.dilate)
         store(self.r).stretch_updates += 1
 
 
-class TsdIrradiancePass:
-    def __init__(self, renderer):
-        self.r = renderer
+class TsdIrradiancePass(TsdPass):
+    def output(self, t, p):
+        return t.raw
+
+    def publish(self, frame, p) -> None:
+        prm: TsdIrradianceParams = p.params
+        t = self.node_targets(p)
+        gather = prm.gather if prm.gather is not None else prm.kernel
+        frame_nodes(frame)[prm.node.uid] = TsdFrameNode(t, gather, prm.material, prm.mix)
+        frame.targets[f"tsd_irradiance_raw[{prm.node.name}]"] = t.raw
 
     def run(self, frame, p) -> None:
         prm: TsdIrradianceParams = p.params
-        ctx, node, size, mat, kernel = self.r.ctx, prm.node, prm.size, prm.material, prm.kernel
-        t = store(self.r).targets(node, size)
-        fbo = t.fbo(ctx, t.irradiance)
+        ctx, node, size, mat = self.r.ctx, prm.node, prm.size, prm.material
+        t = self.node_targets(p)
+        fbo = t.fbo(ctx, t.raw)
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights
@@ -207,43 +218,46 @@ class TsdIrradiancePass:
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units)
+        bind_boundary(prog, mat)
         if prm.translucency:
             for slot in (0, 1):
                 d = frame.targets.get(f"shadow_distance{slot}")
                 units.bind(prog, f"u_distance{slot}", d if d is not None else self.r.dummy_texture())
             eyes = np.stack([frame.shadow_eyes.get(s, np.zeros(4)) for s in (0, 1)])
             set_array(prog, "u_light_eye", eyes, 2)
-            set_array(prog, "u_tsd_var", np.array([s.variance_mm2 for s in kernel.steps]), MAX_TSD_LEVELS)
-            set_array(prog, "u_tsd_w", kernel.weights(), MAX_TSD_LEVELS)
-            set_uniform(prog, "u_tsd_levels", kernel.levels)
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
-        gather = prm.gather if prm.gather is not None else kernel
-        frame_nodes(frame)[node.uid] = TsdFrameNode(t, gather, mat, prm.mix)
-        frame.targets[f"tsd_irradiance_raw[{node.name}]"] = t.irradiance
+        self.publish(frame, p)
 
 
-class TsdDilatePass:
-    def __init__(self, renderer):
-        self.r = renderer
+class TsdDilatePass(TsdPass):
+    def output(self, t, p):
+        return t.irradiance
+
+    def publish(self, frame, p) -> None:
+        name = p.params.node.name
+        t = self.node_targets(p)
+        frame.targets.pop(f"tsd_irradiance_raw[{name}]", None)
+        frame.targets[f"tsd_irradiance[{name}]"] = t.irradiance
+        frame.targets[f"tsd_stretch[{name}]"] = t.stretch
 
     def run(self, frame, p) -> None:
-        prm: TsdNodeParams = p.params
-        node = prm.node
-        t = store(self.r).targets(node, prm.size)
-        dilate(self.r, t, t.irradiance, prm.dilate)
-        frame.targets.pop(f"tsd_irradiance_raw[{node.name}]", None)
-        frame.targets[f"tsd_irradiance[{node.name}]"] = t.irradiance
-        frame.targets[f"tsd_stretch[{node.name}]"] = t.stretch
+        t = self.node_targets(p)
+        dilate(self.r, t, t.raw, t.irradiance, p.params.dilate)
+        self.publish(frame, p)
 
 
-class TsdBlurPass:
-    def __init__(self, renderer):
-        self.r = renderer
+class TsdBlurPass(TsdPass):
+    def output(self, t, p):
+        return t.level(self.r.ctx, p.params.step.level)
+
+    def publish(self, frame, p) -> None:
+        prm: TsdBlurParams = p.params
+        frame.targets[f"tsd_level{prm.step.level}[{prm.node.name}]"] = self.output(self.node_targets(p), p)
 
     def run(self, frame, p) -> None:
         prm: TsdBlurParams = p.params
-        ctx, node, size, step = self.r.ctx, prm.node, prm.size, prm.step
-        t = store(self.r).targets(node, size)
+        ctx, size, step = self.r.ctx, prm.size, prm.step
+        t = self.node_targets(p)
         src = t.irradiance if step.level == 0 else t.level(ctx, step.level - 1)
         dst = t.level(ctx, step.level)
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
@@ -259,7 +273,7 @@ class TsdBlurPass:
             a.use(0)
             set_uniform(prog, "u_axis", axis)
             self.r.fullscreen(prog)
-        frame.targets[f"tsd_level{step.level}[{node.name}]"] = dst
+        self.publish(frame, p)
 
 
 def read_texture(tex: moderngl.Texture) -> np.ndarray:

@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from app.render.frame_plan import PlannedPass
+from app.render.frame_plan import PlannedPass, shadow_pass_name
+from app.render.reuse import light_state, material_state, node_geometry
 from app.render.scattering import scattering_material
 from scene.mesh import with_atlas
 from scene.optics.tsd import BlurStep, DiffusionKernel, design_kernel, material_medium, profile_fit
@@ -141,36 +142,63 @@ def plan_tsd(ctx, size: int, gaussians: int, taps: int | None, mix: float, trans
         )
     if not nodes:
         plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
-    stretch_valid = ctx.state.stretch_valid if ctx.state is not None else None
     passes = []
     for t in nodes:
-        passes += _node_passes(t, ctx, mix, use_translucency, stretch_valid, exact)
+        passes += _node_passes(t, ctx, mix, use_translucency, exact)
     return passes, nodes, use_translucency
 
 
-def _node_passes(t, ctx, mix, translucency, stretch_valid, exact) -> list[PlannedPass]:
+def stretch_inputs(node, scene) -> tuple:
+    """What a stretch map depends on: the mesh (identity, version), the scene scale, the metric
+    of the node's world transform (M^T M of its linear part: a translation or rotation changes
+    no length on the surface) and the material's subsurface radius map (it divides the stretch)."""
+    m = np.asarray(node.world_matrix, np.float64)[:3, :3]
+    radius_map = str(node.material.values.get("subsurface_radius_map"))
+    return (node.mesh.uid, node.mesh.version, (m.T @ m).round(12).tobytes(), float(scene.mm_per_unit), radius_map)
+
+
+def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tuple:
+    """What the texture-space irradiance depends on besides the shadow maps it reads: the node's
+    geometry and transform, its material, the lights, the ambient light, the scene scale (the
+    translucency's thickness in mm), the albedo mix and the translucency's Gaussians. Not the camera."""
+    k = t.kernel
+    trans = (
+        (tuple(s.variance_mm2 for s in k.steps), np.asarray(k.weights(), np.float64).tobytes())
+        if translucency
+        else None
+    )
+    return (
+        node_geometry(t.node),
+        material_state(t.material),
+        tuple(light_state(l) for l in ctx.lights),
+        tuple(l.uid for l in ctx.shadow_lights),
+        np.asarray(ctx.scene.environment.ambient, np.float64).tobytes(),
+        float(ctx.scene.mm_per_unit),
+        float(mix),
+        trans,
+        ctx.settings.max_lights,
+    )
+
+
+def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
     node, n, k = t.node, t.size, t.kernel
     base = dict(node=node, size=n, material=t.material, kernel=k, dilate=DILATE_RINGS)
     res = (n, n)
-    out = []
-    if stretch_valid is not None and stretch_valid(node, ctx.scene, n):
-        ctx.plan.skipped.append(
-            (f"tsd_stretch[{node.name}]", f"geometry unchanged (mesh version {node.mesh.version}); stretch map reused")
+    stretch, irradiance, dilated = (f"tsd_{x}[{node.name}]" for x in ("stretch", "irradiance", "dilate"))
+    out = [
+        PlannedPass(
+            stretch,
+            "tsd_stretch",
+            "tsd_stretch",
+            res,
+            f"mm per texel of '{node.mesh.name}' (depends on the geometry and the scene scale)",
+            TsdNodeParams(**base),
+            inputs=(stretch_inputs(node, ctx.scene), DILATE_RINGS),
         )
-    else:
-        out.append(
-            PlannedPass(
-                f"tsd_stretch[{node.name}]",
-                "tsd_stretch",
-                "tsd_stretch",
-                res,
-                f"mm per texel of '{node.mesh.name}' (new or changed geometry / scale)",
-                TsdNodeParams(**base),
-            )
-        )
+    ]
     out.append(
         PlannedPass(
-            f"tsd_irradiance[{node.name}]",
+            irradiance,
             "tsd_irradiance",
             "tsd_irradiance",
             res,
@@ -184,16 +212,20 @@ def _node_passes(t, ctx, mix, translucency, stretch_valid, exact) -> list[Planne
                 mix=mix,
                 gather=UNIT_KERNEL if exact else k,
             ),
+            inputs=irradiance_inputs(t, ctx, mix, translucency),
+            after=tuple(shadow_pass_name(l) for l in ctx.shadow_lights),
         )
     )
     out.append(
         PlannedPass(
-            f"tsd_dilate[{node.name}]",
+            dilated,
             "tsd_dilate",
             "tsd_irradiance",
             res,
             f"push irradiance {DILATE_RINGS} texels past UV chart borders (seams)",
             TsdNodeParams(**base),
+            inputs=(DILATE_RINGS,),
+            after=(irradiance,),
         )
     )
     if exact:
@@ -206,20 +238,27 @@ def _node_passes(t, ctx, mix, translucency, stretch_valid, exact) -> list[Planne
                 f"brute-force convolution with the exact {t.material['sss_model']} profile (image reference; slow "
                 "on purpose)",
                 TsdExactParams(**base, model=t.material["sss_model"]),
+                inputs=(t.material["sss_model"], material_state(t.material)),
+                after=(dilated, stretch),
             )
         )
         return out
+    previous = dilated
     for s in k.steps:
         w = ", ".join(f"{x:.3f}" for x in s.weight)
+        name = f"tsd_blur[{node.name}]{s.level}"
         out.append(
             PlannedPass(
-                f"tsd_blur[{node.name}]{s.level}",
+                name,
                 "tsd_blur",
                 f"tsd_level{s.level}",
                 res,
                 f"Gaussian v={s.variance_mm2:.4g} mm2 (step sigma {s.sigma_mm:.3g} mm, {s.taps} taps), "
                 f"weight RGB ({w})",
                 TsdBlurParams(**base, step=s),
+                inputs=(s.level, s.sigma_mm, s.taps),
+                after=(previous, stretch),
             )
         )
+        previous = name
     return out

@@ -1,0 +1,40 @@
+"""The uniforms of shaders/lib/sss_boundary.glsl for one mesh: how light enters and leaves its
+material's medium (scene/optics/boundary.py). The forward pass and the passes that gather light
+into a profile (texture-space irradiance) bind them; every technique shares them, so only the
+convolution differs between techniques."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from app.gl.uniforms import set_array, set_uniforms
+from scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables, slab_parameters
+from scene.optics.tsd import material_medium
+
+_ZERO_TABLE = np.zeros((ANGULAR_NODES, 3))
+
+
+def material_boundary(material) -> BoundaryTables | None:
+    """The tables of a material that scatters below its surface; None for one that does not."""
+    if material is None or not material.has_subsurface:
+        return None
+    medium = material_medium(material.values)
+    return boundary_tables(medium.alpha_arr, material["subsurface_color"], medium.eta)
+
+
+def bind_boundary(prog, material) -> None:
+    """Write the u_sss_* boundary uniforms for `material` (zeros: no subsurface term)."""
+    t = material_boundary(material)
+    if t is None:
+        set_array(prog, "u_sss_entry", _ZERO_TABLE, ANGULAR_NODES)
+        set_array(prog, "u_sss_exit", _ZERO_TABLE, ANGULAR_NODES)
+        zero = (0.0, 0.0, 0.0)
+        set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0})
+        set_uniforms(prog, {"u_sss_sigma_tr": zero, "u_sss_z0": zero, "u_sss_zb": zero, "u_sss_mfp": zero})
+        return
+    set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
+    set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
+    set_uniforms(prog, {"u_sss_entry_diffuse": t.entry_diffuse, "u_sss_single": t.single, "u_sss_eta": t.eta})
+    medium = material_medium(material.values)
+    s, z0, zb = slab_parameters(medium.alpha_arr, medium.mfp_arr, medium.eta)
+    set_uniforms(prog, {"u_sss_sigma_tr": s, "u_sss_z0": z0, "u_sss_zb": zb, "u_sss_mfp": medium.mfp_arr})

@@ -1,0 +1,120 @@
+"""Where the texture-space irradiance pass's time goes: the pass on the head at the default settings,
+run again with one part of shaders/passes/tsd_irradiance.frag (or of lib/shadow.glsl) taken out,
+the variants interleaved round by round so that a change of machine load hits all alike; the
+forward pass of the same frame beside it. The variants are measurements only (copies of shaders/
+under a temporary folder); none of them is what the renderer runs.
+
+    .venv/bin/python tools/irradiance_cost.py [--size 640] [--rounds 7] [--scene PATH]
+
+Variants: base (as shipped), pcf_1tap (one shadow
+compare instead of the 3x3 PCF), no_translucency, no_maps (no normal, colour or occlusion map
+fetches), raster_only (the interpolated inputs written out: the cost of rasterising the UV layout).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+IRR = "passes/tsd_irradiance.frag"
+VARIANTS = {
+    "base": [],
+    "pcf_1tap": [
+        (
+            "lib/shadow.glsl",
+            "for (int y = -1; y <= 1; ++y)\n        for (int x = -1; x <= 1; ++x)\n"
+            "            sum += texture(map, vec3(c.xy + vec2(x, y) * texel, c.z - bias));\n    return sum / 9.0;",
+            "return texture(map, vec3(c.xy, c.z - bias));",
+        )
+    ],
+    "no_translucency": [(IRR, "#ifdef TSD_TRANSLUCENCY\n        int slot", "#if 0\n        int slot")],
+    "no_maps": [
+        (IRR, "#ifdef HAS_NORMAL_MAP\n    n = perturb", "#if 0\n    n = perturb"),
+        (IRR, "#ifdef HAS_BASE_COLOR_MAP\n    base *=", "#if 0\n    base *="),
+        (IRR, "#ifdef HAS_OCCLUSION_MAP\n    occlusion =", "#if 0\n    occlusion ="),
+    ],
+    "raster_only": [
+        (
+            IRR,
+            "void main() {",
+            "void main() { f_irradiance = vec4(v_world + v_normal + v_tangent.xyz + vec3(v_uv, 0.0), 1.0); return;",
+        )
+    ],
+}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--size", type=int, default=640, help="frame width and height (default 640)")
+    ap.add_argument("--rounds", type=int, default=7, help="timed rounds (default 7)")
+    ap.add_argument("--scene", default=None, help="scene file (default: the head)")
+    args = ap.parse_args(argv)
+    from app.gl.context import create_headless_context, describe
+    from app.gl.shader_source import SHADER_ROOT, ShaderLibrary
+    from app.render.renderer import Renderer
+    from app.render.settings import RenderSettings
+    from scene.scenefile import load_scene
+
+    ctx = create_headless_context()
+    scene = load_scene(args.scene)
+    st = RenderSettings(args.size, args.size)
+    tmp = Path(tempfile.mkdtemp(prefix="skinlab-irradiance-cost-"))
+    runs = {}
+    try:
+        for name, edits in VARIANTS.items():
+            root = tmp / name
+            shutil.copytree(SHADER_ROOT, root)
+            for rel, old, new in edits:
+                f = root / rel
+                text = f.read_text()
+                if old not in text:
+                    raise SystemExit(f"{rel}: the variant {name!r} no longer matches the shader; update this tool")
+                f.write_text(text.replace(old, new))
+            r = Renderer(ctx, ShaderLibrary(root=root))
+            r.reuse = False
+            res = r.render(scene, st, readback=False)
+            irr = next(p for p in res.plan.passes if p.kind == "tsd_irradiance")
+            fwd = next(p for p in res.plan.passes if p.kind == "forward")
+            runs[name] = (r, r.last_frame, irr, fwd)
+        load0 = os.getloadavg()
+        times = {k: [] for k in runs}
+        fwd_times = []
+        for _ in range(args.rounds):
+            for name, (r, frame, irr, _fwd) in runs.items():
+                ctx.finish()
+                t0 = time.perf_counter()
+                r.pass_for("tsd_irradiance").run(frame, irr)
+                ctx.finish()
+                times[name].append((time.perf_counter() - t0) * 1e3)
+            r, frame, irr, fwd = runs["base"]
+            ctx.finish()
+            t0 = time.perf_counter()
+            r.pass_for("forward").run(frame, fwd)
+            ctx.finish()
+            fwd_times.append((time.perf_counter() - t0) * 1e3)
+        texels = irr.resolution[0] * irr.resolution[1]
+        print(f"{describe(ctx)}; {irr.name} {irr.resolution[0]}x{irr.resolution[1]} texels, frame {args.size}^2")
+        print(f"load average {tuple(round(x, 2) for x in load0)} -> {tuple(round(x, 2) for x in os.getloadavg())}")
+        base = statistics.median(times["base"])
+        for name, v in times.items():
+            m = statistics.median(v)
+            print(f"  {name:<16} {m:8.1f} ms  ({m / base:5.0%} of base; {m * 1e6 / texels:6.0f} ns per texel)")
+        f = statistics.median(fwd_times)
+        print(f"  forward pass     {f:8.1f} ms  ({f * 1e6 / args.size**2:6.0f} ns per pixel)")
+    finally:
+        for r, *_ in runs.values():
+            r.release()
+        shutil.rmtree(tmp, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

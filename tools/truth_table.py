@@ -1,0 +1,53 @@
+"""Every reference scene x technique (default settings) against its cached path-traced truth at
+96x96, 256 spp (the quick ledger's references; nothing is rendered by Mitsuba here): relative L1 on
+4x4 blocks and per pixel, per-channel energy, the worst 8x8 block (luminance), the truth's noise.
+
+    python tools/truth_table.py [SCENES] [TECHNIQUES]      # comma-separated; default all
+
+SKINLAB_SSS_MODEL=<model> overrides every material's sss_model (burley, dipole, pbd, ...).
+Used for the before/after tables in docs/ground-truth.md."""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import numpy as np
+
+from app.bench.sweep import QUICK
+from app.bench.truth_ledger import REFERENCE_SCENES, TruthSpec, load_truth, reference_scene_names
+from app.gl.context import create_headless_context
+from app.render.renderer import Renderer
+from app.render.settings import RenderSettings
+from app.truth.compare import image_error, relative_difference
+from scene.scenefile import load_scene
+
+
+def main(argv: list[str]) -> int:
+    scenes = argv[0].split(",") if argv and argv[0] else reference_scene_names()
+    techs = argv[1].split(",") if len(argv) > 1 else ["none", "tint", "tsd", "exact", "ssss"]
+    model = os.environ.get("SKINLAB_SSS_MODEL") or None
+    r = Renderer(create_headless_context())
+    for s in scenes:
+        scene = load_scene(REFERENCE_SCENES / f"{s}.toml")
+        truth = load_truth(scene, TruthSpec((96, 96), 256), progress=False)
+        if truth is None:
+            print(f"{s}: no cached 96x96 reference (skinlab bench accuracy --quick --references)")
+            continue
+        for t in techs:
+            rs = RenderSettings.for_technique(t, 96, 96, shadow_size=QUICK.shadow_size, sss_model=model)
+            img = r.render(scene, rs, readback=("hdr",)).hdr
+            e = image_error(img, truth.image)
+            d = relative_difference(img, truth.image, block=8)
+            worst = float(np.nanmax(np.abs(d))) if np.isfinite(d).any() else float("nan")
+            energy = " ".join(f"{100 * x:+6.1f}" for x in e["energy"])
+            print(
+                f"{s:24s} {t:6s} 4x4 {100 * e['rel_l1_block']:6.1f}%  px {100 * e['rel_l1']:6.1f}%  energy {energy}"
+                f"  worst8 {100 * worst:4.0f}%  noise {100 * truth.noise['rel_l1_block']:.1f}%",
+                flush=True,
+            )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
