@@ -120,3 +120,38 @@ def disk_edge_response(x_mm, kernel: DiskKernel) -> np.ndarray:
     step = np.where(x < 0, 1.0, np.where(x == 0, 0.5, 0.0))
     none = kernel.weights.sum(axis=0) <= 0
     return np.where(none[None, :], step[:, None], out)
+
+
+def disk_filter_reference(img, alpha, view_z, kernels, reach_mm, mm_per_unit, pixels_per_unit, phi) -> np.ndarray:
+    """NumPy model of the disk pass (shaders/passes/disk_sss.frag) on the forward pass's targets, in
+    GL row order (row 0 at the bottom): img (H, W, 3) subsurface diffuse, alpha (H, W) profile index
+    + 1 + radius scale / 2 (0: not scattering), view_z (H, W) view depth in scene units, kernels
+    (profiles, n, 4) rgb weight and radius mm, reach_mm (profiles,), phi (H, W) rotations (radians).
+    Nearest-texel fetches; a sample off the image, on another profile's pixel or beyond the reach
+    in depth is rejected; each channel divided by its accepted weight (none: the centre)."""
+    img = np.asarray(img, np.float64)
+    h, w, _ = img.shape
+    out = img.copy()
+    kernels = np.asarray(kernels, np.float64)
+    n = kernels.shape[1]
+    idx = np.arange(n)
+    for y, x in zip(*np.nonzero(np.asarray(alpha) >= 1.0)):
+        a = float(alpha[y, x])
+        prof_id = math.floor(a)
+        prof, scale = prof_id - 1, 2.0 * (a - prof_id)
+        z = float(view_z[y, x])
+        px_per_mm = pixels_per_unit / (z * mm_per_unit)
+        k = kernels[prof]
+        off = disk_offset(idx, k[:, 3] * scale, phi[y, x]) * px_per_mm  # pixels
+        u = (x + 0.5 + off[:, 0]) / w
+        v = (y + 0.5 + off[:, 1]) / h
+        ok = (u >= 0) & (v >= 0) & (u < 1) & (v < 1)
+        tx = np.clip(np.floor(u * w).astype(int), 0, w - 1)
+        ty = np.clip(np.floor(v * h).astype(int), 0, h - 1)
+        ok &= np.floor(np.asarray(alpha)[ty, tx]) == prof_id
+        ok &= np.abs(np.asarray(view_z)[ty, tx] - z) * mm_per_unit <= reach_mm[prof] * scale
+        wts = k[:, :3] * ok[:, None]
+        ws = wts.sum(axis=0)
+        acc = (wts * img[ty, tx]).sum(axis=0)
+        out[y, x] = np.where(ws > 0, acc / np.where(ws > 0, ws, 1.0), img[y, x])
+    return out
