@@ -31,7 +31,7 @@ from scene import transform as tf
 from scene.materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
 from scene.scenefile import ASSETS, DEFAULT_SCENE
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 SMALL = dict(shadow_size=256, technique=TsdSettings(size=64))
 
 

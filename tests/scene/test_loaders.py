@@ -7,7 +7,7 @@ import trimesh
 from scene.loaders import load_mesh_file
 from scene.scenefile import load_scene
 
-ASSETS = Path(__file__).resolve().parents[1] / "assets"
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
 
 
 def two_level_glb(path):

@@ -3,7 +3,6 @@ separable SSS and the per-pixel tint baseline, each against its own NumPy model.
 
 import numpy as np
 import pytest
-from tsd_scenes import exact_profile, pixel_x, skin, slab_scene
 
 from app.render.settings import RenderSettings
 from app.render.techniques.exact import ExactSettings
@@ -11,6 +10,7 @@ from app.render.techniques.ssss import SsssSettings
 from app.render.techniques.tsd import TsdSettings
 from app.render.techniques.tsd.passes import frame_nodes, read_texture
 from scene.optics import ssss, tsd
+from tests.tsd_scenes import exact_profile, pixel_x, skin, slab_scene
 
 
 def edge_row(res, n):
@@ -71,9 +71,8 @@ def test_screen_space_sss_follows_its_separable_kernel(renderer, multiple_only):
 def test_screen_space_sss_does_not_bleed_across_depth_discontinuities(renderer):
     """A second, nearer slab over half the view: its scattering must not pull in the far slab's
     light across the silhouette (follow-the-surface), so the near slab's unlit side stays dark."""
-    from tsd_scenes import quad_mesh
-
     from scene.graph import MeshNode
+    from tests.tsd_scenes import quad_mesh
 
     scene = slab_scene(material=skin("burley"))
     near = quad_mesh("near", -1.5, 0.0, -1.5, 1.5, z=10.0)  # 10 units = 200 mm nearer the camera

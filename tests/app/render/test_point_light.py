@@ -7,7 +7,7 @@ from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
 from scene.scenefile import load_scene
 
-BUNNY = Path(__file__).resolve().parents[1] / "assets" / "stanford-bunny" / "bunny.ply"
+BUNNY = Path(__file__).resolve().parents[3] / "assets" / "stanford-bunny" / "bunny.ply"
 
 
 def scene(tmp_path, position, shadow=True):

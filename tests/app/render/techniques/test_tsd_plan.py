@@ -4,7 +4,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tsd_scenes import quad_mesh, skin, slab_scene
 
 from app.render.settings import RenderSettings
 from app.render.techniques.tsd import TsdSettings
@@ -13,6 +12,7 @@ from scene.materials import Material
 from scene.mesh import Mesh
 from scene.optics import tsd
 from scene.scenefile import load_scene
+from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
 ST = RenderSettings(48, 48, shadow_size=256, technique=TsdSettings(size=64))
 
@@ -187,7 +187,7 @@ def test_unknown_model_and_bad_settings_are_clear_errors():
 
 
 def test_bunny_preset_scene_generates_uvs_and_scatters(renderer, tmp_path):
-    scene = load_scene(Path(__file__).resolve().parents[1] / "assets" / "scenes" / "bunny-skimmilk.toml")
+    scene = load_scene(Path(__file__).resolve().parents[4] / "assets" / "scenes" / "bunny-skimmilk.toml")
     (node,) = scene.mesh_nodes()
     assert node.mesh.uvs is not None  # generate_uvs = true
     assert node.material["subsurface_radius"][0] > 10  # skim milk scatters far (Jensen 2001)

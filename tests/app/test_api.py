@@ -5,7 +5,7 @@ import pytest
 
 from app.api import Skinlab, load
 
-ASSETS = __import__("pathlib").Path(__file__).resolve().parents[1] / "assets"
+ASSETS = __import__("pathlib").Path(__file__).resolve().parents[2] / "assets"
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,6 @@ import sys
 
 import numpy as np
 import pytest
-from tsd_scenes import light_from, skin, slab_scene
 
 from app.truth import export as ex
 from app.truth.reference import ReferenceRequest, chunk_plan
@@ -16,6 +15,7 @@ from scene.materials import Material
 from scene.optics.media import preset
 from scene.optics.tsd import eta_from_specular, material_medium
 from scene.primitives import box_mesh
+from tests.tsd_scenes import light_from, skin, slab_scene
 
 
 def _box_scene(mat=None, mm_per_unit=1.0, node_kw=None) -> Scene:

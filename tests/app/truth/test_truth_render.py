@@ -5,7 +5,6 @@ import math
 
 import numpy as np
 import pytest
-from tsd_scenes import skin
 
 from app.bench.truth_ledger import REFERENCE_SCENES
 from app.truth.compare import image_error, object_mask
@@ -15,6 +14,7 @@ from scene.materials import Material
 from scene.optics.montecarlo import exact_albedo_isotropic
 from scene.optics.tsd import material_medium
 from scene.primitives import box_mesh
+from tests.tsd_scenes import skin
 
 pytest.importorskip("mitsuba")
 

@@ -12,15 +12,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tsd_scenes import quad_mesh, skin, slab_scene
 
 from app.render import registry
 from app.render.boundary import material_boundary
 from app.render.settings import RenderSettings
 from scene.graph import MeshNode
 from scene.materials import PRINCIPLED_PARAMS, Material
+from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "architecture.md"
 
 
@@ -274,7 +274,7 @@ def test_library_modules_never_import_the_cli_layer():
 
 def test_tests_use_public_names_only():
     """No test imports a private name of the project or reaches one through an imported module."""
-    for path in sorted((ROOT / "tests").glob("*.py")):
+    for path in sorted((ROOT / "tests").rglob("*.py")):
         tree = ast.parse(path.read_text(encoding="utf-8"))
         modules = set()  # names bound to project modules
         for node in ast.walk(tree):

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-from tsd_scenes import exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 from app.render.settings import RenderSettings
 from app.render.techniques.tsd import TsdSettings
@@ -11,6 +10,7 @@ from scene.mesh import Mesh
 from scene.optics import tsd
 from scene.optics.boundary import boundary_tables, slab_single_transmittance, slab_transmittance, table_lookup
 from scene.optics.single_scattering import single_scatter_brdf
+from tests.tsd_scenes import exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 
 def tsd_node(renderer, scene, name="slab"):

@@ -17,7 +17,7 @@ import pytest
 from app.bench import accuracy as acc
 from scene.optics import edges
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 HEAD = "head-skin1-matched"
@@ -217,10 +217,9 @@ def test_edge_error_scores_a_step_one_and_the_reference_zero():
 
 def test_each_technique_gives_its_edge_response_from_the_frame_plan(renderer):
     """The ledger asks the technique (registry) for its edge response as the frame rendered it."""
-    from tsd_scenes import skin, slab_scene
-
     from app.render.settings import RenderSettings
     from scene.optics.tsd import material_medium
+    from tests.tsd_scenes import skin, slab_scene
 
     scene = slab_scene(material=skin("burley"))
     medium = material_medium(scene.find("slab").material.values)

@@ -11,7 +11,7 @@ import pytest
 
 from app.bench.reload import bench_edit, reload_bench
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[3]
 FAST = dict(size=(32, 32), shadow_size=64, tsd_size=16)
 
 

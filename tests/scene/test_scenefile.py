@@ -5,7 +5,7 @@ import pytest
 
 from scene.scenefile import DEFAULT_SCENE, SceneFileError, load_scene
 
-ASSETS = Path(__file__).resolve().parents[1] / "assets"
+ASSETS = Path(__file__).resolve().parents[2] / "assets"
 
 
 def write(tmp_path, text):

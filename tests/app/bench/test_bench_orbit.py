@@ -7,7 +7,7 @@ import pytest
 
 from app.bench.orbit import orbit_bench, orbit_path
 from scene.graph import CameraNode
-from tests.test_cli import skinlab
+from tests.app.commands.test_cli import skinlab
 
 
 def test_orbit_path_circles_the_centre_at_the_camera_distance():

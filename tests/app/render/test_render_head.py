@@ -2,13 +2,13 @@
 
 import numpy as np
 import pytest
-from head_probe import landmarks, project, redness
 
 from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
 from app.render.techniques.tsd import TsdSettings
 from scene import scenefile
 from scene.scenefile import load_scene
+from tests.head_probe import landmarks, project, redness
 
 SIZE = (160, 160)
 

@@ -4,7 +4,7 @@ tests/data/technique_images.npz holds small HDR frames rendered by the code befo
 moved into packages (app/render/techniques/); each technique must reproduce them to fp32 rounding.
 After a deliberate change of a technique's images, regenerate them with
 
-    python tests/test_technique_images.py
+    python -m tests.app.render.test_technique_images
 
 and say why in the commit message.
 """
@@ -16,14 +16,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tsd_scenes import quad_mesh, skin, slab_scene
 
 from app.render.registry import get_technique
 from app.render.settings import RenderSettings
 from scene.graph import MeshNode
 from scene.materials import Material
+from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
-DATA = Path(__file__).parent / "data" / "technique_images.npz"
+DATA = Path(__file__).resolve().parents[2] / "data" / "technique_images.npz"
 TECHNIQUES = ("none", "tint", "tsd", "exact", "ssss")
 SIZE = 48
 
