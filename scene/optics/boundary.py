@@ -38,7 +38,7 @@ as diffuse light (all-order albedo A_d1 at eta 1), and so on:
 
 (light once reflected inside counts as multiply scattered; the first single-scattering exit is
 Jensen's term). Against the flat-medium Monte Carlo at eta 1.3, normal incidence: -3 % at a = 0.894,
-+0.2 % at a = 0.5 (tests/test_boundary.py checks 6 %).
++0.2 % at a = 0.5 (tests/scene/optics/test_boundary.py checks 6 %).
 
 The tables handed to the shader are the factors relative to the material's surface colour (the
 frame multiplies by the possibly textured base colour): entry(mu0) = A_ms(mu0)/A_colour and

@@ -127,7 +127,7 @@ def _chebyshev_fit(fn, lo: float, hi: float, n: int = 14) -> tuple[float, ...]:
 
 # The pbrt moment polynomials cancel badly in fp32 (FM2 for eta >= 1 sums terms of +-500 to
 # get ~0.1). GLSL evaluates the same functions re-expanded as Chebyshev series on the two eta
-# intervals (Clenshaw: well conditioned); truncation error < 1e-10 (tests/test_profile_models.py).
+# intervals (Clenshaw: well conditioned); truncation error < 1e-10 (tests/scene/optics/test_profile_models.py).
 FM_CHEB_N = 22
 FM1_CHEB_LT1 = _chebyshev_fit(lambda e: _fm_reference(e, 1), DIFFUSION_ETA_MIN, 1.0, FM_CHEB_N)
 FM1_CHEB_GE1 = _chebyshev_fit(lambda e: _fm_reference(e, 1), 1.0, DIFFUSION_ETA_MAX, FM_CHEB_N)

@@ -9,7 +9,7 @@ Two forms:
   T_o the refracted directions. It is what a renderer adds to the dipole at a shading point. The
   1/eta^2 is the change of solid angle across the interface (Hanrahan & Krueger 1993's radiance
   compression), which the paper's printed form leaves out: without it the term's albedo at eta 1.3
-  was 1.68 times that of the flat-medium Monte Carlo's first-bounce photons (tests/test_boundary.py).
+  was 1.68 times that of the flat-medium Monte Carlo's first-bounce photons (tests/scene/optics/test_boundary.py).
 * :func:`single_scatter_profile` - the same physics as a *radial profile* for a normally incident
   beam: the light scattered once at depth t on the refracted beam and leaving through the surface
   at distance r (pbrt-v4 src/pbrt/bssrdf.cpp ``BeamDiffusionSS``, Habel et al. 2013). This is the

@@ -1,0 +1,155 @@
+"""Tiny path-traced references (Mitsuba 3, scalar_rgb): the physics of the exported medium against
+Chandrasekhar's exact albedo, the framing against Skinlab's own frame, and the cache."""
+
+import math
+
+import numpy as np
+import pytest
+
+from app.bench.truth_ledger import REFERENCE_SCENES
+from app.truth.compare import image_error, object_mask
+from app.truth.reference import ReferenceRequest, render_reference
+from scene.graph import CameraNode, LightNode, MeshNode, Scene
+from scene.materials import Material
+from scene.optics.montecarlo import exact_albedo_isotropic
+from scene.optics.tsd import material_medium
+from scene.primitives import box_mesh
+from tests.tsd_scenes import skin
+
+pytest.importorskip("mitsuba")
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path / "cache"))
+
+
+def sky_slab(color, mfp=(1.0, 1.0, 1.0)) -> Scene:
+    """A slab many mean free paths wide and deep (index-matched) under a uniform sky of radiance 1,
+    seen straight from above through a narrow camera."""
+    s = Scene("sky-slab", 1.0)
+    s.environment.ambient = np.ones(3)
+    mat = skin(radius=tuple(4 * math.pi * l for l in mfp), color=color, specular=0.0)
+    s.add(MeshNode("slab", box_mesh((800.0, 800.0, 400.0)), mat, translation=(0.0, 0.0, -200.0)))
+    cam = CameraNode("cam", yfov=math.radians(2.0), znear=100.0, zfar=3000.0)
+    cam.look_at((0.0, 0.0, 1000.0), (0.0, 0.0, 0.0))
+    s.add(cam)
+    return s
+
+
+@pytest.mark.parametrize("mfp", [(1.0, 1.0, 1.0), (4.0, 1.0, 0.5)])
+def test_index_matched_slab_reflects_chandrasekhars_albedo(mfp):
+    """Under a uniform sky the radiance leaving toward the normal equals, by reciprocity, the
+    albedo for normal incidence: 1 - H(1) sqrt(1 - alpha) for an isotropic semi-infinite medium,
+    whatever the mean free path. Channels of different extinction are what skin and milk have (and
+    what plain volpath gets 30 % wrong: the exporter uses volpathmis)."""
+    s = sky_slab((0.2, 0.5, 0.8), mfp)
+    alpha = material_medium(s.find("slab").material.values).alpha_arr
+    ref = render_reference(s, ReferenceRequest(8, 8, spp=256, passes=2), progress=False)
+    got = ref.image[..., :3].reshape(-1, 3).mean(0)
+    want = np.array([exact_albedo_isotropic(a, 1.0) for a in alpha])
+    # standard error of the 64-pixel mean from the spread between the halves of the passes
+    se = np.abs(ref.half_a - ref.half_b)[..., :3].reshape(-1, 3).mean(0) / 2
+    assert np.all(np.abs(got - want) < 0.01 + 4 * se), (got, want, se)
+    assert np.all(ref.image[..., 3] > 0.99)
+
+
+def test_framing_matches_skinlabs_frame(renderer):
+    """An asymmetric object at a non-square size covers the same pixels in both renderers."""
+    s = Scene("ell", 1.0)
+    grey = Material("grey", {"base_color": (0.5, 0.5, 0.5)})
+    s.add(MeshNode("bar", box_mesh((4.0, 1.0, 1.0)), grey, translation=(1.5, 0.0, 0.0)))
+    s.add(MeshNode("post", box_mesh((1.0, 3.0, 1.0)), grey, translation=(0.0, 2.0, 0.0)))
+    key = LightNode("key", "directional")
+    s.add(key)
+    cam = CameraNode("cam", yfov=math.radians(50), znear=0.5, zfar=100)
+    cam.look_at((2.0, 2.0, 8.0), (1.0, 1.0, 0.0))
+    s.add(cam)
+    from app.render.settings import RenderSettings
+
+    w, h = 80, 56
+    ref = render_reference(s, ReferenceRequest(w, h, spp=8, passes=2), progress=False)
+    mine = renderer.render(s, RenderSettings(w, h, sss_model="none")).hdr
+    a, b = object_mask(ref.image), mine[..., 3] > 0.5
+    assert (a & b).sum() / (a | b).sum() > 0.93
+    # the disagreement is at the silhouette only: no pixel deep inside either mask differs
+    inner = a & np.roll(a, 1, 0) & np.roll(a, -1, 0) & np.roll(a, 1, 1) & np.roll(a, -1, 1)
+    assert b[inner].all()
+
+
+def test_reference_is_cached_by_content():
+    s = sky_slab((0.3, 0.3, 0.3))
+    req = ReferenceRequest(4, 4, spp=8, passes=2)
+    first = render_reference(s, req, progress=False)
+    again = render_reference(s, req, progress=False)
+    assert not first.cached and again.cached and again.key == first.key
+    assert np.array_equal(first.image, again.image)
+    assert set(first.meta["noise_floor"]) >= {"rel_l1", "rel_l1_block", "energy"}
+    other = render_reference(s, ReferenceRequest(4, 4, spp=8, passes=2, seed=1), progress=False)
+    assert not other.cached and other.key != first.key
+
+
+def test_error_measures_on_known_images():
+    ref = np.zeros((8, 8, 4), np.float32)
+    ref[2:6, 2:6] = (1.0, 1.0, 1.0, 1.0)
+    img = ref.copy()
+    img[2:4, 2:6, :3] = 1.5  # half the object 50 % too bright
+    e = image_error(img, ref)
+    assert e["rel_l1"] == pytest.approx(0.25) and e["pixels"] == 16
+    assert e["energy"] == pytest.approx([0.25, 0.25, 0.25])
+    noisy = ref.copy()
+    noisy[2:6, 2:6, :3] += np.array([[0.2, -0.2] * 2, [-0.2, 0.2] * 2] * 2)[..., None]
+    n = image_error(noisy, ref)
+    assert n["rel_l1"] == pytest.approx(0.2) and n["rel_l1_block"] == pytest.approx(0.0, abs=1e-6)
+    with pytest.raises(ValueError, match="differ"):
+        image_error(img[:4], ref)
+
+
+def test_reference_command_writes_exr_png_and_reports_its_noise(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    from app.image_output import read_image
+
+    out = tmp_path / "ref" / "slab.exr"
+    scene = REFERENCE_SCENES / "slab-edge-skin1.toml"
+    r = subprocess.run(
+        [sys.executable, "-m", "app.cli", "reference", str(scene), "--out", str(out), "--size", "12x8",
+         "--spp", "4", "--passes", "2", "--json"],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert r.returncode == 0, r.stderr
+    res = json.loads(r.stdout)
+    assert res["noise_floor"]["pixels"] > 0 and res["spp"] == 4 and not res["cached"]
+    img = read_image(out)
+    assert img.shape == (8, 12, 4) and np.isfinite(img).all() and img[..., 3].min() > 0.99
+    assert out.with_suffix(".png").is_file()
+    assert not [p for p in out.parent.iterdir() if p.name.startswith(".")]  # no temporary left
+
+
+def test_missing_mitsuba_says_how_to_install(monkeypatch):
+    import sys
+
+    from app.truth.reference import ReferenceUnavailable, set_variant
+
+    monkeypatch.setitem(sys.modules, "mitsuba", None)
+    with pytest.raises(ReferenceUnavailable, match="pip install"):
+        set_variant("scalar_rgb")
+
+
+def test_error_map_signs_and_dark_blocks():
+    from app.truth.compare import error_map_rgb, relative_difference
+
+    ref = np.zeros((8, 8, 4), np.float32)
+    ref[..., 3] = 1.0
+    ref[:4, :, :3] = 1.0  # a lit top half, a black bottom half
+    img = ref.copy()
+    img[:4, :4, :3] = 1.2  # 20 % brighter at the top left
+    img[:4, 4:, :3] = 0.9  # 10 % darker at the top right
+    img[4:, :, :3] = 0.05  # light where the truth has none: not a relative difference
+    d = relative_difference(img, ref)
+    assert np.allclose(d[:4, :4], 0.2) and np.allclose(d[:4, 4:], -0.1) and np.isnan(d[4:]).all()
+    rgb = error_map_rgb(d)
+    assert rgb[0, 0, 0] > rgb[0, 0, 2] and rgb[0, 7, 2] > rgb[0, 7, 0]  # red brighter, blue darker
+    assert (rgb[7, 7] == (40, 40, 40)).all()
