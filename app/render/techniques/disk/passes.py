@@ -10,6 +10,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
+from app.render.passes.screen_targets import ScreenTargets
 from scene.optics.disk import MAX_DISK_PROFILES
 
 DIFFUSE_TARGET = "disk_diffuse"
@@ -34,51 +35,18 @@ class DiskParams:
 class DiskPass:
     def __init__(self, renderer):
         self.r = renderer
-        self._targets = None
-        self._table = None
-
-    def targets(self, size):
-        t = self._targets
-        if t is None or t[0].size != tuple(size):
-            self._release_targets()
-            ctx = self.r.ctx
-            texs = [ctx.texture(size, 4, dtype="f4") for _ in range(2)]  # filtered, composite
-            for x in texs:
-                x.repeat_x = x.repeat_y = False
-            self._fbos = [ctx.framebuffer([x]) for x in texs]
-            t = self._targets = tuple(texs)
-        return t
-
-    def table(self, data: np.ndarray):
-        h, w = data.shape[:2]
-        t = self._table
-        if t is None or t.size != (w, h):
-            if t is not None:
-                t.release()
-            t = self._table = self.r.ctx.texture((w, h), 4, dtype="f4")
-            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        t.write(np.ascontiguousarray(data).tobytes())
-        return t
-
-    def _release_targets(self) -> None:
-        if self._targets is not None:
-            for x in (*self._fbos, *self._targets):
-                x.release()
-            self._targets, self._fbos = None, []
+        self._gpu = ScreenTargets(renderer.ctx, 2)  # filtered, composite
 
     def release(self) -> None:
-        self._release_targets()
-        if self._table is not None:
-            self._table.release()
-            self._table = None
+        self._gpu.release()
 
     def run(self, frame, p) -> None:
         ctx, prm = self.r.ctx, p.params
         w, h = p.resolution
-        filtered, out = self.targets((w, h))
-        ffilt, fout = self._fbos
+        filtered, out = self._gpu.at((w, h))
+        ffilt, fout = self._gpu.fbos
         cam = frame.scene.camera
-        table = self.table(prm.table())
+        table = self._gpu.table(prm.table())
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/disk_sss.frag")
         reach = np.array([k.reach_mm for k in prm.kernels], np.float32)
         set_array(prog, "u_reach_mm", reach, MAX_DISK_PROFILES)

@@ -10,6 +10,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
+from app.render.passes.screen_targets import ScreenTargets
 
 from .plan import MAX_SSSS_PROFILES, SsssPlan
 
@@ -25,53 +26,23 @@ class SsssBlurParams:
 class SsssBlurPass:
     def __init__(self, renderer):
         self.r = renderer
-        self._targets = None
-        self._table = None
-
-    def targets(self, size):
-        t = self._targets
-        if t is None or t[0].size != tuple(size):
-            self.release()
-            ctx = self.r.ctx
-            texs = [ctx.texture(size, 4, dtype="f4") for _ in range(3)]  # tmp, blurred, composite
-            for x in texs:
-                x.repeat_x = x.repeat_y = False
-            self._fbos = [ctx.framebuffer([x]) for x in texs]
-            t = self._targets = tuple(texs)
-        return t
-
-    def table(self, data: np.ndarray):
-        h, w = data.shape[:2]
-        t = self._table
-        if t is None or t.size != (w, h):
-            if t is not None:
-                t.release()
-            t = self._table = self.r.ctx.texture((w, h), 4, dtype="f4")
-            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        t.write(np.ascontiguousarray(data).tobytes())
-        return t
+        self._gpu = ScreenTargets(renderer.ctx, 3)  # tmp, blurred, composite
 
     def release(self) -> None:
-        if self._table is not None:
-            self._table.release()
-            self._table = None
-        if self._targets is not None:
-            for x in (*self._fbos, *self._targets):
-                x.release()
-            self._targets, self._fbos = None, []
+        self._gpu.release()
 
     def run(self, frame, p) -> None:
         ctx, plan = self.r.ctx, p.params.ssss
         w, h = p.resolution
-        tmp, blurred, out = self.targets((w, h))
-        ftmp, fblur, fout = self._fbos
+        tmp, blurred, out = self._gpu.at((w, h))
+        ftmp, fblur, fout = self._gpu.fbos
         cam = frame.scene.camera
         # pixels per scene unit at view depth 1: rows span 2 tan(yfov/2), columns the same times aspect
         ppu_y = h / (2.0 * math.tan(cam.yfov / 2.0))
         ppu_x = ppu_y  # square pixels (aspect = w / h)
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/ssss_blur.frag")
         n = len(plan.offsets_mm)
-        table = self.table(plan.table())
+        table = self._gpu.table(plan.table())
         ranges = np.array([k.range_mm for k in plan.kernels], np.float32)
         set_array(prog, "u_range_mm", ranges, MAX_SSSS_PROFILES)
         set_uniforms(
