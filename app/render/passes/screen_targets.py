@@ -7,6 +7,8 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
+from app.gl.uniforms import set_uniforms
+
 
 class ScreenTargets:
     def __init__(self, ctx: moderngl.Context, count: int):
@@ -47,3 +49,18 @@ class ScreenTargets:
         if self._table is not None:
             self._table.release()
             self._table = None
+
+
+def composite(renderer, frame, out_fbo, out_tex, filtered, name: str) -> None:
+    """Add a screen-space pass's filtered subsurface light back onto the lit image
+    (passes/ssss_composite.frag) into `out_tex`; the frame's targets then show `filtered` as
+    `name`, the image before as hdr_color_unblurred and the composite as hdr_color."""
+    comp = renderer.programs.get("passes/fullscreen.vert", "passes/ssss_composite.frag")
+    out_fbo.use()
+    frame.targets["hdr_color"].use(0)
+    filtered.use(1)
+    set_uniforms(comp, {"u_color": 0, "u_blurred": 1})
+    renderer.fullscreen(comp)
+    frame.targets[name] = filtered
+    frame.targets["hdr_color_unblurred"] = frame.targets["hdr_color"]
+    frame.targets["hdr_color"] = out_tex

@@ -10,7 +10,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
-from app.render.passes.screen_targets import ScreenTargets
+from app.render.passes.screen_targets import ScreenTargets, composite
 from scene.optics.disk import MAX_DISK_PROFILES
 
 DIFFUSE_TARGET = "disk_diffuse"
@@ -70,12 +70,4 @@ class DiskPass:
         table.use(2)
         ffilt.use()
         self.r.fullscreen(prog)
-        comp = self.r.programs.get("passes/fullscreen.vert", "passes/ssss_composite.frag")
-        fout.use()
-        frame.targets["hdr_color"].use(0)
-        filtered.use(1)
-        set_uniforms(comp, {"u_color": 0, "u_blurred": 1})
-        self.r.fullscreen(comp)
-        frame.targets["disk_filtered"] = filtered
-        frame.targets["hdr_color_unblurred"] = frame.targets["hdr_color"]
-        frame.targets["hdr_color"] = out
+        composite(self.r, frame, fout, out, filtered, "disk_filtered")

@@ -10,7 +10,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
-from app.render.passes.screen_targets import ScreenTargets
+from app.render.passes.screen_targets import ScreenTargets, composite
 
 from .plan import MAX_SSSS_PROFILES, SsssPlan
 
@@ -67,12 +67,4 @@ class SsssBlurPass:
             src.use(0)
             set_uniforms(prog, {"u_dir": d, "u_pixels_per_unit": ppu})
             self.r.fullscreen(prog)
-        comp = self.r.programs.get("passes/fullscreen.vert", "passes/ssss_composite.frag")
-        fout.use()
-        frame.targets["hdr_color"].use(0)
-        blurred.use(1)
-        set_uniforms(comp, {"u_color": 0, "u_blurred": 1})
-        self.r.fullscreen(comp)
-        frame.targets["ssss_blurred"] = blurred
-        frame.targets["hdr_color_unblurred"] = frame.targets["hdr_color"]
-        frame.targets["hdr_color"] = out
+        composite(self.r, frame, fout, out, blurred, "ssss_blurred")
