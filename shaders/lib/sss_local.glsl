@@ -2,8 +2,13 @@
 // scatter locally or in screen space (tint, ssss): the same entry/exit model as texture-space
 // diffusion (lib/sss_boundary.glsl: the multiple-scattering albedo at the light's incidence in, its
 // angular distribution out) so that only the convolution differs between the techniques. Needs the
-// material uniforms and u_ambient.
+// material uniforms and u_ambient. Variant SSS_TRANSLUCENCY: plus the light through thin parts
+// (lib/sss_translucency.glsl, the same term texture-space diffusion gathers in its irradiance
+// pass), entering with the rest, so a screen-space blur spreads it as texture-space diffusion's does.
 #include "lib/sss_boundary.glsl"
+#ifdef SSS_TRANSLUCENCY
+#include "lib/sss_translucency.glsl"
+#endif
 
 vec3 sss_in = vec3(0.0);  // irradiance entering the medium (this fragment)
 
@@ -14,5 +19,8 @@ void sss_add_light(vec3 e, float vis, float NoL) {
 // The radiance leaving the medium toward the viewer for subsurface weight sss_w (ambient included).
 vec3 sss_local_radiance(vec3 base, float NoV, float occlusion, float sss_w) {
     vec3 entering = sss_in + PI * u_ambient * occlusion * u_sss_entry_diffuse;
+#ifdef SSS_TRANSLUCENCY
+    entering += sss_translucent_irradiance(v_world, gl_FrontFacing ? normalize(v_normal) : -normalize(v_normal));
+#endif
     return base * entering * sss_exit(abs(NoV)) * ((1.0 - u_metallic) * sss_w * INV_PI);
 }

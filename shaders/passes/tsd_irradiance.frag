@@ -7,7 +7,8 @@
 // light's incidence on the far side times the diffusion slab transmittance through the thickness
 // (lib/sss_boundary.glsl sss_slab_transmittance; the thickness along the light from the shadow
 // pass's distance map, times the cosine to the normal: a flat slab's own thickness), plus the light
-// scattered once inside the slab (sss_slab_single).
+// scattered once inside the slab (sss_slab_single); lib/sss_translucency.glsl, shared with the
+// forward hooks of the screen-space techniques.
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
@@ -21,24 +22,7 @@ in vec4 v_tangent;
 uniform vec3 u_ambient;
 uniform float u_tsd_mix;
 #ifdef TSD_TRANSLUCENCY
-uniform sampler2D u_distance0;            // light-space distance of the first surface (scene units)
-uniform sampler2D u_distance1;
-uniform vec4 u_light_eye[2];              // slot light position (w = 1) or the direction light travels (w = 0)
-
-// Distance from the light of the first surface it meets on the way to world; false outside the map.
-bool first_hit_distance(int slot, vec3 world, out float first) {
-    vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
-    vec2 uv = p.xy / p.w;
-    first = 0.0;
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
-    first = slot == 0 ? texture(u_distance0, uv).r : texture(u_distance1, uv).r;
-    return first < 1e29;   // cleared texels: no surface
-}
-
-float distance_from_light(int slot, vec3 world) {
-    vec4 e = u_light_eye[slot];
-    return e.w == 0.0 ? dot(world, e.xyz) : length(world - e.xyz);
-}
+#include "lib/sss_translucency.glsl"
 #endif
 
 out vec4 f_irradiance;
@@ -68,19 +52,7 @@ void main() {
             e_in += e * (vis * NoL) * sss_entry(NoL);
         }
 #ifdef TSD_TRANSLUCENCY
-        int slot = u_light_shadow[i];
-        float back = -dot(ng, l);
-        if (slot >= 0 && back > 0.0) {
-            float first;
-            if (first_hit_distance(slot, v_world, first)) {
-                float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit * back;
-                // multiple scattering (diffusion through the slab) + single scattering through it
-                float t_in = 1.0 - fresnel_dielectric(back, max(u_sss_eta, 1.0));
-                vec3 through = sss_entry(back) * sss_slab_transmittance(d_mm)
-                             + t_in * sss_slab_single(refract_cos(back, max(u_sss_eta, 1.0)), d_mm);
-                e_in += e * back * through;
-            }
-        }
+        e_in += sss_translucent_light(i, v_world, ng, l, e);
 #endif
     }
     e_in += PI * u_ambient * occlusion * u_sss_entry_diffuse;

@@ -7,8 +7,13 @@
 // detail). No pass of its own: the cheapest technique. How light enters and leaves is the shared
 // boundary (lib/sss_boundary.glsl): the light a flat surface would take in, max(N.L, 0), enters by
 // sss_entry(N.L) as in every technique; what the ring moves, D - max(N.L, 0), enters at every angle
-// around it, so by the diffuse entry factor. Contract: app/render/technique.py.
+// around it, so by the diffuse entry factor. Variant SSS_TRANSLUCENCY: plus the light through thin
+// parts per light (lib/sss_translucency.glsl, as texture-space diffusion gathers it). Contract:
+// app/render/technique.py.
 #include "lib/sss_boundary.glsl"
+#ifdef SSS_TRANSLUCENCY
+#include "lib/sss_translucency.glsl"
+#endif
 #include "lib/sss_maps.glsl"
 #include "lib/preintegrated.glsl"
 
@@ -56,6 +61,9 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
 #endif
         float flat_nl = max(nlg, 0.0);
         entering += e * vis * (flat_nl * sss_entry(flat_nl) + (D - flat_nl) * u_sss_entry_diffuse);
+#ifdef SSS_TRANSLUCENCY
+        entering += sss_translucent_light(i, v_world, ng, l, e);
+#endif
     }
     entering += PI * u_ambient * occlusion * u_sss_entry_diffuse;
     return base * entering * sss_exit(abs(NoV)) * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI);

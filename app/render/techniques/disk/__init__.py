@@ -4,7 +4,9 @@ Unity HDRP and Blender EEVEE Next ship it). The forward pass writes the subsurfa
 and each pixel's profile index to a second target; one post-process gathers, per pixel, samples on
 a disc whose radii follow the Burley CDF (millimetres on the surface, from the pixel's depth),
 weighted by the pixel's own profile (a table of up to 16 profiles per frame: many media in one
-frame), with depth-aware rejection and a per-pixel rotation. NumPy model: scene/optics/disk.py."""
+frame), with depth-aware rejection and a per-pixel rotation. NumPy model: scene/optics/disk.py. With
+`translucency` the forward pass adds the light through thin parts (app/render/translucency.py, as
+texture-space diffusion's irradiance pass does) to the light the disk pass gathers."""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from app.render.frame_plan import FramePlan, PlannedPass
 from app.render.options import TechniqueSettings, option
 from app.render.scattering import scattering_material
 from app.render.technique import ForwardHook, LedgerStyle, NodeShading, PlanContext, Technique, TechniquePlan
+from app.render.translucency import DEFINE, OPTION_DOC, REASON, bind_translucency, plan_translucency
 from scene.optics.disk import MAX_DISK_PROFILES, MAX_DISK_SAMPLES, disk_edge_response, disk_kernel
 from scene.optics.tsd import material_medium
 
@@ -30,22 +33,36 @@ class DiskSettings(TechniqueSettings):
         32, "disk samples per pixel, radii from the Burley CDF (Golubev 2018)", "int", range=(8, MAX_DISK_SAMPLES)
     )
     rotate: bool = option(True, "rotate each pixel's sample spiral (noise instead of banding)", "bool")
+    translucency: bool = option(True, OPTION_DOC, "bool")
 
 
 @dataclass
 class DiskForward(ForwardHook):
     profiles: dict = field(default_factory=dict)  # node uid -> (effective material, profile index)
+    translucency: bool = False  # add the light through thin parts (shadow distance maps) before the disk pass
 
     outputs = (DIFFUSE_TARGET,)
-    reason = "; subsurface diffuse and profile index to a second target for the disk pass"
+
+    @property
+    def reason(self) -> str:
+        return (
+            "; subsurface diffuse"
+            + (f" and {REASON}" if self.translucency else "")
+            + (" and profile index to a second target for the disk pass")
+        )
 
     def shading(self, node, frame):
         hit = self.profiles.get(node.uid)
         mat, index = hit if hit is not None else (node.material, -1)
         value = float(index + 1)
-        return NodeShading(
-            mat, HOOK, bind=lambda prog, units: set_uniform(prog, "u_disk_profile", value), subsurface=index >= 0
-        )
+        through = self.translucency and index >= 0
+
+        def bind(prog, units):
+            set_uniform(prog, "u_disk_profile", value)
+            if through:
+                bind_translucency(prog, frame, units)
+
+        return NodeShading(mat, HOOK, {DEFINE: 1} if through else {}, bind, subsurface=index >= 0)
 
 
 def plan_profiles(ctx: PlanContext):
@@ -94,7 +111,8 @@ class DiskTechnique(Technique):
             f"{', rotated per pixel' if o.rotate else ''}, depth-aware; {len(keys)} profile(s): {names}",
             DiskParams(o.samples, o.rotate, kernels, labels),
         )
-        return TechniquePlan(DiskForward(nodes), after_forward=[p])
+        through = plan_translucency(ctx, True, o.translucency)
+        return TechniquePlan(DiskForward(nodes, through), after_forward=[p], shadow_distance=through)
 
     def edge_response(self, model, medium, plan: FramePlan):
         """The disk kernel's edge response averaged over the per-pixel rotation."""

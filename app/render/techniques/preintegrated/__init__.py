@@ -2,7 +2,9 @@
 scattering material's profile is integrated around rings of curvature 1/r into a lookup table over
 N.L x curvature (scene/optics/preintegrated.py, built in NumPy, cached per medium, uploaded as a
 texture); the forward hook looks it up per light with the mesh's per-vertex curvature and a
-softened normal. No pass of its own: the cheapest technique that moves light past the terminator."""
+softened normal. No pass of its own: the cheapest technique that moves light past the terminator.
+With `translucency` the hook adds the light through thin parts per light (app/render/translucency.py,
+as texture-space diffusion's irradiance pass does)."""
 
 from __future__ import annotations
 
@@ -15,6 +17,7 @@ from app.gl.uniforms import set_uniforms
 from app.render.options import TechniqueSettings, option
 from app.render.scattering import scattering_material
 from app.render.technique import ForwardHook, LedgerStyle, NodeShading, PlanContext, Technique, TechniquePlan
+from app.render.translucency import DEFINE, OPTION_DOC, REASON, bind_translucency, plan_translucency
 from scene.optics.preintegrated import LUT_CURV, LUT_NOL, preintegrated_lut
 from scene.optics.tsd import material_medium, profile_fit
 
@@ -31,6 +34,7 @@ class PreintegratedSettings(TechniqueSettings):
         "float",
         range=(0, 1),
     )
+    translucency: bool = option(True, OPTION_DOC, "bool")
 
 
 class LutTextures:
@@ -71,10 +75,17 @@ def channel_softening(model, medium, softening: float) -> np.ndarray:
 class PreintegratedForward(ForwardHook):
     nodes: dict = field(default_factory=dict)  # node uid -> (material, key, lut, soften)
     state: LutTextures | None = None
+    translucency: bool = False  # add the light through thin parts (shadow distance maps) per light
 
     @property
     def reason(self) -> str:
-        return f"; pre-integrated skin lookup (N.L x curvature) for {len(self.nodes)}" if self.nodes else ""
+        if not self.nodes:
+            return ""
+        return (
+            "; pre-integrated skin lookup (N.L x curvature)"
+            + (f" and {REASON}" if self.translucency else "")
+            + (f" for {len(self.nodes)}")
+        )
 
     def shading(self, node, frame):
         hit = self.nodes.get(node.uid)
@@ -83,9 +94,11 @@ class PreintegratedForward(ForwardHook):
         mat, key, lut, soften = hit
         scale = abs(float(np.linalg.det(node.world_matrix[:3, :3]))) ** (1.0 / 3.0)
         curv_scale = 1.0 / (frame.scene.mm_per_unit * max(scale, 1e-12))
-        state = self.state
+        state, through = self.state, self.translucency
 
         def bind(prog, units):
+            if through:
+                bind_translucency(prog, frame, units)
             tex = state.get(key, lut) if state is not None else None
             if tex is not None:
                 units.bind(prog, "u_pis_lut", tex)
@@ -99,7 +112,7 @@ class PreintegratedForward(ForwardHook):
                 },
             )
 
-        return NodeShading(mat, HOOK, bind=bind)
+        return NodeShading(mat, HOOK, {DEFINE: 1} if through else {}, bind)
 
 
 class PreintegratedTechnique(Technique):
@@ -118,7 +131,8 @@ class PreintegratedTechnique(Technique):
             key = (mat["sss_model"], material_medium(mat.values))
             lut = preintegrated_lut(*key)
             nodes[n.uid] = (mat, key, lut, channel_softening(*key, ctx.options.softening))
-        return TechniquePlan(PreintegratedForward(nodes, ctx.state))
+        through = plan_translucency(ctx, bool(nodes), ctx.options.translucency)
+        return TechniquePlan(PreintegratedForward(nodes, ctx.state, through), shadow_distance=through)
 
 
 TECHNIQUE = PreintegratedTechnique()

@@ -2,7 +2,9 @@
 Subsurface Scattering", 2015; docs/references.md). The forward pass writes the subsurface diffuse
 radiance and each pixel's profile index to a second target; one post-process blurs it horizontally
 then vertically with the pixel's own profile's 1-D kernel (scene/optics/ssss.py; a table of up to 16
-profiles per frame) and adds it back."""
+profiles per frame) and adds it back. With `translucency` the forward pass adds the light through
+thin parts (app/render/translucency.py, as texture-space diffusion's irradiance pass does) to the
+light that gets blurred."""
 
 from __future__ import annotations
 
@@ -12,6 +14,7 @@ from app.gl.uniforms import set_uniform
 from app.render.frame_plan import FramePlan, PlannedPass
 from app.render.options import TechniqueSettings, option
 from app.render.technique import ForwardHook, LedgerStyle, NodeShading, PlanContext, Technique, TechniquePlan
+from app.render.translucency import DEFINE, OPTION_DOC, REASON, bind_translucency, plan_translucency
 from scene.optics.edges import separable_edge
 
 from .passes import MAX_SSSS_TAPS, SsssBlurParams, SsssBlurPass
@@ -28,25 +31,36 @@ class SsssSettings(TechniqueSettings):
         17, "screen-space kernel samples (Jimenez presets: 11, 17, 25)", "int", range=(3, MAX_SSSS_TAPS), odd=True
     )
     gaussians: int = option(6, "Gaussians fitted to the profile the kernel is sampled from", "int", range=(1, 6))
+    translucency: bool = option(True, OPTION_DOC, "bool")
 
 
 @dataclass
 class SsssForward(ForwardHook):
     ssss: SsssPlan
+    translucency: bool = False  # add the light through thin parts (shadow distance maps) before the blur
 
     outputs = (DIFFUSE_TARGET,)
-    reason = "; subsurface diffuse to a second target for the screen-space blur"
+
+    @property
+    def reason(self) -> str:
+        return (
+            "; subsurface diffuse"
+            + (f" and {REASON}" if self.translucency else "")
+            + (" to a second target for the screen-space blur")
+        )
 
     def shading(self, node, frame):
         # every mesh writes the second target, its alpha the profile index + 1 (0: not blurred); the
         # node's own values apply (sss_model overrides change no uniform)
         index = float(self.ssss.profile.get(node.uid, -1) + 1)
-        return NodeShading(
-            node.material,
-            HOOK,
-            bind=lambda prog, units: set_uniform(prog, "u_ssss_profile", index),
-            subsurface=index > 0,
-        )
+        through = self.translucency and index > 0
+
+        def bind(prog, units):
+            set_uniform(prog, "u_ssss_profile", index)
+            if through:
+                bind_translucency(prog, frame, units)
+
+        return NodeShading(node.material, HOOK, {DEFINE: 1} if through else {}, bind, subsurface=index > 0)
 
 
 class SsssTechnique(Technique):
@@ -71,7 +85,8 @@ class SsssTechnique(Technique):
             f"({len(ssss.kernels)}: {names}), horizontal then vertical, depth-aware",
             SsssBlurParams(ssss, o.gaussians),
         )
-        return TechniquePlan(SsssForward(ssss), after_forward=[blur])
+        through = plan_translucency(ctx, True, o.translucency)
+        return TechniquePlan(SsssForward(ssss, through), after_forward=[blur], shadow_distance=through)
 
     def edge_response(self, model, medium, plan: FramePlan):
         """The 1-D kernel of the material's profile across an edge along a screen axis (the separable

@@ -22,6 +22,7 @@ from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import bind_shadow_maps, set_light_uniforms
 from app.render.texture_units import TextureUnits
+from app.render.translucency import bind_translucency
 from scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
@@ -220,11 +221,7 @@ class TsdIrradiancePass(TsdPass):
         self.r.resources.bind_material(prog, mat, units)
         bind_boundary(prog, mat)
         if prm.translucency:
-            for slot in (0, 1):
-                d = frame.targets.get(f"shadow_distance{slot}")
-                units.bind(prog, f"u_distance{slot}", d if d is not None else self.r.dummy_texture())
-            eyes = np.stack([frame.shadow_eyes.get(s, np.zeros(4)) for s in (0, 1)])
-            set_array(prog, "u_light_eye", eyes, 2)
+            bind_translucency(prog, frame, units, self.r.dummy_texture())
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         self.publish(frame, p)
 

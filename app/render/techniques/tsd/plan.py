@@ -15,6 +15,7 @@ import numpy as np
 from app.render.frame_plan import PlannedPass, shadow_pass_name
 from app.render.reuse import light_state, material_state, node_geometry
 from app.render.scattering import scattering_material
+from app.render.translucency import plan_translucency
 from scene.mesh import with_atlas
 from scene.optics.tsd import BlurStep, DiffusionKernel, design_kernel, material_medium, profile_fit
 from scene.uv_checks import analyse_uvs
@@ -135,11 +136,7 @@ def plan_tsd(ctx, size: int, gaussians: int, taps: int | None, mix: float, trans
     (passes, node plans, translucency)."""
     plan = ctx.plan
     nodes = [t for t in (plan_tsd_node(n, ctx, size, gaussians, taps) for n in ctx.meshes) if t is not None]
-    use_translucency = bool(nodes) and translucency and bool(ctx.shadow_lights)
-    if nodes and not use_translucency:
-        plan.skipped.append(
-            ("translucency", "disabled in the settings" if not translucency else "no shadow-casting light")
-        )
+    use_translucency = plan_translucency(ctx, bool(nodes), translucency)
     if not nodes:
         plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
     passes = []

@@ -1,0 +1,96 @@
+"""Light through thin parts: NumPy twin of shaders/lib/sss_translucency.glsl.
+
+The thickness of matter between a light and a surface point comes from the shadow pass's distance
+map (per texel, the distance from the light of the first surface it meets: scene units, 1e30 where
+none), as in Jimenez, Whelan, Sundstedt & Gutierrez 2010, "Real-Time Realistic Skin Translucency"
+(docs/references.md#jimenez-2010): the point's distance from the light minus the first surface's,
+looked up at the point moved `shrink` inward along its normal (so that a point which is itself the
+first surface reads 0, not the map's quantisation noise), times the cosine between the normal and
+the light (a flat slab's own thickness), plus the shrink (which a flat part's lookup lost). What
+crosses that thickness is the slab transmission of scene/optics/boundary.py: the entry factor at the
+far side's incidence times the diffusion slab transmittance, plus single scattering through the
+slab. Texture-space diffusion gathers it in its irradiance pass, the screen-space techniques in the
+forward pass; both call the same GLSL functions.
+
+Distance maps are (H, W) with row 0 at texture v = 0 (GL order), sampled NEAREST with clamp-to-edge
+(the renderer's distance maps, app/render/passes/shadow.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .boundary import BoundaryTables, slab_single_transmittance, slab_transmittance, table_lookup
+from .fresnel import fresnel_dielectric
+from .single_scattering import refract_cos
+
+NO_SURFACE = 1e29  # a distance-map texel at or above this holds no surface (cleared to 1e30)
+
+
+def _points(world) -> np.ndarray:
+    return np.atleast_2d(np.asarray(world, np.float64))
+
+
+def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
+    """(first, hit) per point of world (N, 3): the map's distance at the point's light-space texel;
+    hit False outside the map or where it holds no surface (first 0 outside). GLSL first_hit_distance."""
+    world = _points(world)
+    dist = np.asarray(distance_map, np.float64)
+    h, w = dist.shape
+    p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        uv = p[:, :2] / p[:, 3:4]
+    inside = np.all((uv >= 0.0) & (uv <= 1.0), axis=1)
+    uv = np.where(inside[:, None], uv, 0.0)
+    i = np.clip(np.floor(uv[:, 0] * w).astype(np.int64), 0, w - 1)
+    j = np.clip(np.floor(uv[:, 1] * h).astype(np.int64), 0, h - 1)
+    first = np.where(inside, dist[j, i], 0.0)
+    return first, inside & (first < NO_SURFACE)
+
+
+def distance_from_light(eye, world) -> np.ndarray:
+    """Distance from the light along its travel (directional: eye = (direction it travels, 0)) or to
+    its position (point: eye = (position, 1)); scene units. GLSL distance_from_light."""
+    eye = np.asarray(eye, np.float64).reshape(4)
+    world = _points(world)
+    return world @ eye[:3] if eye[3] == 0.0 else np.linalg.norm(world - eye[:3], axis=1)
+
+
+def thickness_mm(distance_map, shadow_matrix, eye, world, normal, back, shrink, mm_per_unit):
+    """(d_mm, hit): the thickness (mm, along the normal) of matter between the light and each point;
+    normal (N, 3) the outward geometric normal, back (N,) its cosine with the direction the light
+    travels, shrink in scene units. GLSL sss_thickness_mm."""
+    p = _points(world) - float(shrink) * _points(normal)
+    first, hit = first_hit_distance(distance_map, shadow_matrix, p)
+    inside = np.maximum(distance_from_light(eye, p) - first, 0.0)
+    d = (inside * np.asarray(back, np.float64) + float(shrink)) * float(mm_per_unit)
+    return np.where(hit, d, 0.0), hit
+
+
+def through(back, d_mm, tables: BoundaryTables, medium) -> np.ndarray:
+    """(N, 3): of the irradiance on a surface facing the light, per unit base colour, what crosses a
+    slab d_mm thick lit at cosine `back` on its far side and leaves through this side: entry(back) x
+    slab_transmittance(d) + (1 - F(back)) x single scattering through the slab at the refracted
+    cosine (scene/optics/boundary.py; per unit base colour: x tables.single / alpha). `tables`: the
+    material's boundary tables, `medium` its medium (alpha_arr, mfp_arr, eta: what
+    app/render/boundary.py binds). GLSL sss_through."""
+    back = np.atleast_1d(np.asarray(back, np.float64))
+    d = np.broadcast_to(np.atleast_1d(np.asarray(d_mm, np.float64)), back.shape)
+    al = np.clip(np.asarray(medium.alpha_arr, np.float64).reshape(3), 0.0, 1.0)
+    mfp_mm = medium.mfp_arr
+    eta = max(float(tables.eta), 1.0)
+    per_colour = np.divide(np.asarray(tables.single, np.float64), al, out=np.zeros(3), where=al > 0)
+    multiple = table_lookup(tables.entry, back) * slab_transmittance(d, al, mfp_mm, medium.eta)
+    t_in = 1.0 - fresnel_dielectric(back, eta)
+    mu_t = refract_cos(back, eta)
+    single = np.stack([slab_single_transmittance(m, x, al, mfp_mm) for m, x in zip(mu_t, d)]) * per_colour
+    return multiple + t_in[:, None] * single
+
+
+def translucent_irradiance(e, back, d_mm, hit, tables: BoundaryTables, medium) -> np.ndarray:
+    """(N, 3) irradiance entering through thin parts from one light of irradiance e (3,) on a surface
+    facing it: e back through(back, d) where the light is behind the surface (back > 0) and the map
+    has a surface in front (hit); 0 elsewhere. GLSL sss_translucent_light."""
+    back = np.atleast_1d(np.asarray(back, np.float64))
+    ok = (back > 0) & np.asarray(hit, bool)
+    t = through(np.where(ok, back, 1.0), np.where(ok, d_mm, 0.0), tables, medium)
+    return np.where(ok[:, None], np.asarray(e, np.float64).reshape(1, 3) * back[:, None] * t, 0.0)

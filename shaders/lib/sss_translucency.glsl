@@ -1,0 +1,80 @@
+// Light through thin parts, shared by every technique that has it: texture-space diffusion's
+// irradiance pass (passes/tsd_irradiance.frag, d'Eon & Luebke 2007) and the forward hooks of the
+// techniques without a texture-space pass (screen-space SSS, disk, pre-integrated skin), in the
+// manner of Jimenez, Whelan, Sundstedt & Gutierrez 2010 ("Real-Time Realistic Skin Translucency"):
+// the distance the light travelled inside the object is its distance from the light minus the
+// distance of the first surface it met there (the shadow pass's distance map, passes/shadow.frag),
+// looked up at the position shrunk a little along the normal; what comes through is the slab
+// transmission of lib/sss_boundary.glsl (diffusion plus single scattering through that thickness).
+// NumPy twin: scene/optics/translucency.py. Bound by app/render/translucency.py.
+#include "lib/lights.glsl"
+#include "lib/sss_boundary.glsl"
+
+uniform sampler2D u_distance0;   // light-space distance of the first surface (scene units), slot 0
+uniform sampler2D u_distance1;   // slot 1
+uniform vec4 u_light_eye[2];     // slot light position (w = 1) or the direction light travels (w = 0)
+uniform float u_thickness_shrink;  // scene units: about half a distance-map texel
+
+// Distance from the light of the first surface it meets on the way to world; false outside the map
+// or where the map holds no surface.
+bool first_hit_distance(int slot, vec3 world, out float first) {
+    vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
+    vec2 uv = p.xy / p.w;
+    first = 0.0;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
+    first = slot == 0 ? texture(u_distance0, uv).r : texture(u_distance1, uv).r;
+    return first < 1e29;  // cleared texels: no surface
+}
+
+float distance_from_light(int slot, vec3 world) {
+    vec4 e = u_light_eye[slot];
+    return e.w == 0.0 ? dot(world, e.xyz) : length(world - e.xyz);
+}
+
+// Thickness (mm, along the normal ng) of the matter between the light of `slot` and world, for a
+// surface whose normal makes cosine `back` with the direction the light travels: the distance
+// inside along the light times that cosine (a flat slab's own thickness). The lookup point is
+// world - shrink ng (Jimenez et al. 2010: off the surface, so a fragment that is itself the first
+// surface, within the map's texel, reads 0 instead of noise); shrink x 1 is added back, so a flat
+// part keeps its exact thickness. False where the map has no surface in front.
+bool sss_thickness_mm(int slot, vec3 world, vec3 ng, float back, out float d_mm) {
+    vec3 p = world - u_thickness_shrink * ng;
+    float first;
+    d_mm = 0.0;
+    if (!first_hit_distance(slot, p, first)) return false;
+    d_mm = (max(distance_from_light(slot, p) - first, 0.0) * back + u_thickness_shrink) * u_mm_per_unit;
+    return true;
+}
+
+// What crosses a slab d_mm thick from its far side, lit there at cosine `back`, and leaves through
+// this side, per unit irradiance on a surface facing the light and per unit base colour: the entry
+// factor at that incidence times the diffusion slab transmittance, plus the light scattered once in
+// the slab (Fresnel transmission in, refracted cosine).
+vec3 sss_through(float back, float d_mm) {
+    float eta = max(u_sss_eta, 1.0);
+    float t_in = 1.0 - fresnel_dielectric(back, eta);
+    return sss_entry(back) * sss_slab_transmittance(d_mm) + t_in * sss_slab_single(refract_cos(back, eta), d_mm);
+}
+
+// Irradiance entering the medium at world through thin parts from light i (direction to it l, its
+// irradiance e on a surface facing it); ng: the surface's outward geometric normal. Zero for a light
+// without a distance map (no shadow slot) or in front of the surface.
+vec3 sss_translucent_light(int i, vec3 world, vec3 ng, vec3 l, vec3 e) {
+    int slot = u_light_shadow[i];
+    float back = -dot(ng, l);
+    float d_mm;
+    if (slot < 0 || back <= 0.0 || !sss_thickness_mm(slot, world, ng, back, d_mm)) return vec3(0.0);
+    return e * back * sss_through(back, d_mm);
+}
+
+// The sum over the lights (for a hook that does not run its own light loop).
+vec3 sss_translucent_irradiance(vec3 world, vec3 ng) {
+    vec3 acc = vec3(0.0);
+    for (int i = 0; i < MAX_LIGHTS; ++i) {
+        if (i >= u_num_lights) break;
+        vec3 l, e;
+        light_incidence(i, world, ng, l, e);
+        acc += sss_translucent_light(i, world, ng, l, e);
+    }
+    return acc;
+}

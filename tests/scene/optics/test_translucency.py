@@ -1,0 +1,211 @@
+"""Light through thin parts (scene/optics/translucency.py) and its GLSL twin (lib/sss_translucency.glsl):
+the thickness lookup in the shadow pass's distance map and the slab transmission through it."""
+
+import moderngl
+import numpy as np
+
+from app.gl.glsl_eval import assert_close_fp32
+from app.render.boundary import bind_boundary, material_boundary
+from scene.optics import boundary as b
+from scene.optics import translucency as tr
+from scene.optics.tsd import material_medium
+from tests.tsd_scenes import skin
+
+
+def _distance_texture(ctx, dist: np.ndarray):
+    h, w = dist.shape
+    tex = ctx.texture((w, h), 1, np.ascontiguousarray(dist, np.float32).tobytes(), dtype="f4")
+    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    tex.repeat_x = tex.repeat_y = False
+    return tex
+
+
+def _lookup_setup(maps, matrices, eyes, shrink, mm_per_unit, material=None):
+    """A GLSLEvaluator setup binding lib/sss_translucency.glsl's uniforms and distance maps."""
+    from app.gl.uniforms import set_array, set_uniforms
+
+    def setup(prog):
+        for slot, tex in enumerate(maps):
+            tex.use(10 + slot)
+            if f"u_distance{slot}" in prog:
+                prog[f"u_distance{slot}"].value = 10 + slot
+        if "u_shadow_matrix" in prog:
+            mats = np.stack([m.T for m in matrices]).astype(np.float32)
+            prog["u_shadow_matrix"].write(mats[: max(prog["u_shadow_matrix"].array_length, 1)].tobytes())
+        set_array(prog, "u_light_eye", np.asarray(eyes, np.float64), 2)
+        set_uniforms(prog, {"u_thickness_shrink": shrink, "u_mm_per_unit": mm_per_unit})
+        if "u_light_shadow" in prog:
+            ids = np.array([0, 1, -1, -1], np.int32)
+            prog["u_light_shadow"].write(ids[: max(prog["u_light_shadow"].array_length, 1)].tobytes())
+        if material is not None:
+            bind_boundary(prog, material)
+
+    return setup
+
+
+# (hit, thickness) of sss_thickness_mm as one value
+LOOK = """vec2 look(int slot, vec3 p, vec3 n, float c) {
+    float d;
+    bool hit = sss_thickness_mm(slot, p, n, c, d);
+    return vec2(hit ? 1.0 : 0.0, d);
+}"""
+
+
+def test_thickness_lookup_matches_numpy_twin(ctx, glsl):
+    """sss_thickness_mm against thickness_mm for a directional (slot 0) and a point light (slot 1) on
+    random distance maps, including texels with no surface, points outside the map, points in front
+    of the first surface (thickness clamps to the shrink) and grazing cosines; within fp32 (1e-4)."""
+    rng = np.random.default_rng(12)
+    h, w = 16, 24
+    maps, texes = [], []
+    for _ in range(2):
+        d = rng.uniform(5.0, 10.0, (h, w))
+        d[rng.uniform(size=(h, w)) < 0.1] = 1e30  # cleared: no surface
+        maps.append(d)
+        texes.append(_distance_texture(ctx, d))
+    m = np.eye(4)
+    m[:3, :3] *= 0.5
+    m[:3, 3] = 0.5  # world [-1, 1]^3 -> texture [0, 1]^3
+    eyes = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, -5.0, 1.0]])  # travels +z; a point at z = -5
+    n = 3000
+    # texel centres jittered away from texel borders (NEAREST picks the same texel on both sides),
+    # normals nearly along z so the shrink (0.004 units, 0.05 texel) keeps the point in its texel
+    uv = (rng.integers(0, [w, h], (n, 2)) + rng.uniform(0.25, 0.75, (n, 2))) / [w, h]
+    world = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, rng.uniform(3.0, 12.0, n)], 1)
+    world[:60, 0] = 1.5  # outside the map
+    normal = np.column_stack([rng.normal(0, 0.2, (n, 2)), np.ones(n)])
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    back = rng.uniform(0.0, 1.0, n)
+    back[:100] = rng.uniform(0.0, 1e-4, 100)  # grazing
+    shrink, mm = 0.004, 20.0
+    world, normal, back = (x.astype(np.float32).astype(np.float64) for x in (world, normal, back))
+    setup = _lookup_setup(texes, [m, m], eyes, shrink, mm)
+    for slot in (0, 1):
+        gpu = glsl.evaluate(
+            "lib/sss_translucency.glsl",
+            f"look({slot}, pos, nrm, c)",
+            {"pos": world, "nrm": normal, "c": back},
+            2,
+            prelude=LOOK,
+            setup=setup,
+        )
+        ref, hit = tr.thickness_mm(maps[slot], m, eyes[slot], world, normal, back, shrink, mm)
+        assert np.array_equal(gpu[:, 0] == 1.0, hit), f"slot {slot}: hit flags differ"
+        assert 0.5 < hit.mean() < 0.95 and not hit[:60].any()
+        assert_close_fp32(gpu[:, 1], ref, rtol=1e-4, atol=1e-4, what=f"sss_thickness_mm slot {slot}")
+        clamped = hit & (ref == shrink * mm)  # points in front of the first surface: the shrink only
+        assert clamped.sum() > 50
+    for t in texes:
+        t.release()
+
+
+def _slab_map(direction, size, radius, z_lit):
+    """(distance map, shadow matrix, eye) of a directional light travelling along `direction` onto
+    the plane z = z_lit (the slab's lit face), orthographic over a disc of `radius` around the origin
+    as app/render/passes/shadow.py fits it: each texel holds the distance of the plane along the ray
+    through the texel's centre."""
+    d = np.asarray(direction, np.float64) / np.linalg.norm(direction)
+    e1 = np.cross(d, [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(d, e1)
+    m = np.eye(4)
+    m[0, :3], m[1, :3] = e1 / (2 * radius), e2 / (2 * radius)
+    m[0, 3] = m[1, 3] = 0.5
+    m[2, :3], m[2, 3] = 0.0, 0.0
+    c = (np.arange(size) + 0.5) / size * 2 * radius - radius
+    a, bb = np.meshgrid(c, c)  # columns: e1, rows: e2
+    q = a[..., None] * e1 + bb[..., None] * e2
+    t = (z_lit - q[..., 2]) / d[2]  # along the ray to the plane; q is perpendicular to d
+    return t, m, np.append(d, 0.0)
+
+
+def test_flat_slab_keeps_its_thickness():
+    """A 3 mm slab lit at 30 degrees from behind: the thickness read on its far face is 3 mm within
+    the map's quantisation (half a texel times the lit face's slope, sin 30), and its mean is 3 mm
+    without the shrink's bias (the shrink is added back); the shrink where the point is itself the
+    first surface."""
+    d = (np.sin(np.radians(30)), 0.0, np.cos(np.radians(30)))
+    size, radius = 512, 40.0
+    dist, m, eye = _slab_map(d, size, radius, -1.5)
+    texel = 2 * radius / size
+    shrink = radius / size  # half a texel (app/render/translucency.py thickness_shrink)
+    rng = np.random.default_rng(3)
+    p = np.column_stack([rng.uniform(-25, 25, (4000, 2)), np.full(4000, 1.5)])
+    nrm = np.tile([0.0, 0.0, 1.0], (4000, 1))
+    back = np.full(4000, float(np.dot(nrm[0], d)))
+    got, hit = tr.thickness_mm(dist, m, eye, p, nrm, back, shrink, 1.0)
+    assert hit.all()
+    assert np.abs(got - 3.0).max() <= 0.5 * texel * np.sin(np.radians(30)) + 1e-9
+    assert abs(got.mean() - 3.0) < 0.1 * shrink  # unbiased
+    # a point that is itself the first surface although its (interpolated) normal faces away from
+    # the light, as near a smooth mesh's terminator: without the shrink it reads the map's
+    # quantisation noise (0 to half a texel's slope), with it exactly the shrink
+    lit = np.column_stack([p[:, :2], np.full(4000, -1.5)])
+    got_lit, _ = tr.thickness_mm(dist, m, eye, lit, nrm, back, shrink, 1.0)
+    assert np.all(got_lit == shrink)
+    noisy, _ = tr.thickness_mm(dist, m, eye, lit, nrm, back, 0.0, 1.0)
+    assert noisy.max() > 0.2 * texel * np.sin(np.radians(30)) and noisy.std() > 0
+
+
+def test_through_matches_slab_transmission_and_glsl(glsl):
+    """sss_through(back, d) against its twin (the entry factor times boundary.slab_transmittance plus
+    Fresnel-weighted single scattering through the slab) within 1e-4, for skin at eta 1 and 1.4, at
+    the hard cases: zero thickness (nothing collides: 0), grazing light (finite), very thick (0)."""
+    backs = np.array([1.0, 0.866, 0.5, 1e-3, 0.0, 1.0, 0.3, 1.0])
+    dd = np.array([0.5, 3.0, 1.0, 2.0, 2.0, 0.0, 1e-5, 1e4])
+    for eta in (1.0, 1.4):
+        # specular 0.347: F0 = 0.08 x 0.347 = ((1.4 - 1) / (1.4 + 1))^2, the medium's index 1.4
+        mat = skin(specular=0.347) if eta != 1.0 else skin()
+        med = material_medium(mat.values)
+        tabs = material_boundary(mat)
+        ref = tr.through(backs, dd, tabs, med)
+        assert np.all(np.isfinite(ref)) and np.all(ref >= 0)
+        assert np.all(ref[5] == 0) and np.all(ref[-1] < 1e-12)
+        # the diffusion part is the boundary's slab transmittance times the entry factor
+        diff = b.table_lookup(tabs.entry, backs[:3]) * b.slab_transmittance(dd[:3], med.alpha_arr, med.mfp_arr, med.eta)
+        assert np.all(ref[:3] >= diff) and np.all(ref[:3] < diff + 0.3)
+        gpu = glsl.evaluate(
+            "lib/sss_translucency.glsl",
+            "sss_through(c, d)",
+            {"c": backs, "d": dd},
+            3,
+            setup=lambda prog, mat=mat: bind_boundary(prog, mat),
+        )
+        assert_close_fp32(gpu, ref, atol=1e-4, what=f"sss_through eta {eta}")
+
+
+def test_translucent_light_matches_numpy(ctx, glsl):
+    """sss_translucent_light for one shadow-casting directional light on a flat map: e back through
+    where the light is behind the surface and 0 where it is in front, at grazing incidence or where
+    the map has no surface; GPU within 1e-4 of NumPy."""
+    mat = skin()
+    med, tabs = material_medium(mat.values), material_boundary(mat)
+    dist = np.full((8, 8), 10.0)
+    dist[:, :2] = 1e30
+    tex = _distance_texture(ctx, dist)
+    m = np.eye(4)
+    m[:3, :3] *= 0.5
+    m[:3, 3] = 0.5
+    eye = np.array([0.0, 0.0, 1.0, 0.0])  # travels +z: l = (0, 0, -1)
+    world = np.array([[0.1, 0.1, 10.05], [0.1, 0.1, 10.2], [0.1, 0.1, 10.2], [-0.9, 0.1, 10.2], [0.3, 0.3, 11.0]])
+    ng = np.array([[0, 0, 1.0], [0, 0, 1.0], [0, 0, -1.0], [0, 0, 1.0], [0.9999995, 0, 0.001]])
+    ng /= np.linalg.norm(ng, axis=1, keepdims=True)
+    l = np.array([0.0, 0.0, -1.0])
+    e = np.array([2.0, 1.0, 0.5])
+    shrink, mm = 0.01, 10.0
+    setup = _lookup_setup([tex, tex], [m, m], [eye, eye], shrink, mm, mat)
+    gpu = glsl.evaluate(
+        "lib/sss_translucency.glsl",
+        "sss_translucent_light(0, pos, nrm, vec3(0.0, 0.0, -1.0), vec3(2.0, 1.0, 0.5))",
+        {"pos": world, "nrm": ng},
+        3,
+        setup=setup,
+    )
+    back = -(ng @ l)
+    d_mm, hit = tr.thickness_mm(dist, m, eye, world, ng, back, shrink, mm)
+    ref = tr.translucent_irradiance(e, back, d_mm, hit, tabs, med)
+    assert_close_fp32(gpu, ref, atol=1e-4, what="sss_translucent_light")
+    assert ref[0].min() > 0 and ref[1].min() > 0 and ref[0, 0] > ref[1, 0]  # thinner passes more (red)
+    assert np.all(ref[2] == 0) and np.all(ref[3] == 0)  # light in front; no surface in the map
+    assert np.all(np.isfinite(ref[4])) and ref[4].max() < 1e-2 * ref[1].max()  # grazing: back ~ 0.001
+    tex.release()
