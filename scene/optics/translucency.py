@@ -4,9 +4,10 @@ The thickness of matter between a light and a surface point comes from the shado
 map (per texel, the distance from the light of the first surface it meets: scene units, 1e30 where
 none), as in Jimenez, Whelan, Sundstedt & Gutierrez 2010, "Real-Time Realistic Skin Translucency"
 (docs/references.md#jimenez-2010): the point's distance from the light minus the first surface's,
-looked up at the point moved `shrink` inward along its normal (so that a point which is itself the
-first surface reads 0, not the map's quantisation noise), times the cosine between the normal and
-the light (a flat slab's own thickness), plus the shrink (which a flat part's lookup lost). What
+looked up at the point moved `shrink` inward along its normal, times the cosine between the normal
+and the light (a flat slab's own thickness), plus the shrink (which a flat part's lookup lost); 0
+where the moved point is still in front of the first surface (a point that is itself the first
+surface reads 0, not the map's quantisation noise; so does a part thinner than the shrink). What
 crosses that thickness is the slab transmission of scene/optics/boundary.py: the entry factor at the
 far side's incidence times the diffusion slab transmittance, plus single scattering through the
 slab. Texture-space diffusion gathers it in its irradiance pass, the screen-space techniques in the
@@ -61,8 +62,8 @@ def thickness_mm(distance_map, shadow_matrix, eye, world, normal, back, shrink, 
     travels, shrink in scene units. GLSL sss_thickness_mm."""
     p = _points(world) - float(shrink) * _points(normal)
     first, hit = first_hit_distance(distance_map, shadow_matrix, p)
-    inside = np.maximum(distance_from_light(eye, p) - first, 0.0)
-    d = (inside * np.asarray(back, np.float64) + float(shrink)) * float(mm_per_unit)
+    inside = distance_from_light(eye, p) - first
+    d = np.where(inside > 0.0, (inside * np.asarray(back, np.float64) + float(shrink)) * float(mm_per_unit), 0.0)
     return np.where(hit, d, 0.0), hit
 
 

@@ -34,15 +34,17 @@ float distance_from_light(int slot, vec3 world) {
 // Thickness (mm, along the normal ng) of the matter between the light of `slot` and world, for a
 // surface whose normal makes cosine `back` with the direction the light travels: the distance
 // inside along the light times that cosine (a flat slab's own thickness). The lookup point is
-// world - shrink ng (Jimenez et al. 2010: off the surface, so a fragment that is itself the first
-// surface, within the map's texel, reads 0 instead of noise); shrink x 1 is added back, so a flat
-// part keeps its exact thickness. False where the map has no surface in front.
+// world - shrink ng (Jimenez et al. 2010): a fragment that is itself the first surface (within the
+// map's texel) or lies less than the shrink behind it reads 0, not the map's quantisation noise;
+// behind that, the shrink is added back, so a flat part keeps its exact thickness. False where the
+// map has no surface in front.
 bool sss_thickness_mm(int slot, vec3 world, vec3 ng, float back, out float d_mm) {
     vec3 p = world - u_thickness_shrink * ng;
     float first;
     d_mm = 0.0;
     if (!first_hit_distance(slot, p, first)) return false;
-    d_mm = (max(distance_from_light(slot, p) - first, 0.0) * back + u_thickness_shrink) * u_mm_per_unit;
+    float inside = distance_from_light(slot, p) - first;
+    d_mm = inside > 0.0 ? (inside * back + u_thickness_shrink) * u_mm_per_unit : 0.0;
     return true;
 }
 
