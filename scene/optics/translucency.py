@@ -13,8 +13,8 @@ far side's incidence times the diffusion slab transmittance, plus single scatter
 slab. Texture-space diffusion gathers it in its irradiance pass, the screen-space techniques in the
 forward pass; both call the same GLSL functions.
 
-Distance maps are (H, W) with row 0 at texture v = 0 (GL order), sampled NEAREST with clamp-to-edge
-(the renderer's distance maps, app/render/passes/shadow.py)."""
+Distance maps are (H, W) with row 0 at texture v = 0 (GL order), read texel by texel (texelFetch:
+the bilinear weights are computed, not the sampler's, so the twin is exact to fp32)."""
 
 from __future__ import annotations
 
@@ -32,8 +32,10 @@ def _points(world) -> np.ndarray:
 
 
 def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
-    """(first, hit) per point of world (N, 3): the map's distance at the point's light-space texel;
-    hit False outside the map or where it holds no surface (first 0 outside). GLSL first_hit_distance."""
+    """(first, hit) per point of world (N, 3): the map's distance at the point's light-space
+    position, bilinear between the four nearest texel centres (clamped to the map) where all four
+    hold a surface, else the texel containing the point; hit False outside the map or where that
+    texel holds no surface (first 0 outside). GLSL first_hit_distance."""
     world = _points(world)
     dist = np.asarray(distance_map, np.float64)
     h, w = dist.shape
@@ -42,10 +44,19 @@ def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, 
         uv = p[:, :2] / p[:, 3:4]
     inside = np.all((uv >= 0.0) & (uv <= 1.0), axis=1)
     uv = np.where(inside[:, None], uv, 0.0)
+    x, y = uv[:, 0] * w - 0.5, uv[:, 1] * h - 0.5
+    i0, j0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+    fx, fy = x - i0, y - j0
+    ia, ib = np.clip(i0, 0, w - 1), np.clip(i0 + 1, 0, w - 1)
+    ja, jb = np.clip(j0, 0, h - 1), np.clip(j0 + 1, 0, h - 1)
+    d00, d10, d01, d11 = dist[ja, ia], dist[ja, ib], dist[jb, ia], dist[jb, ib]
+    bilinear = (d00 * (1 - fx) + d10 * fx) * (1 - fy) + (d01 * (1 - fx) + d11 * fx) * fy
+    all4 = np.maximum(np.maximum(d00, d10), np.maximum(d01, d11)) < NO_SURFACE
     i = np.clip(np.floor(uv[:, 0] * w).astype(np.int64), 0, w - 1)
     j = np.clip(np.floor(uv[:, 1] * h).astype(np.int64), 0, h - 1)
-    first = np.where(inside, dist[j, i], 0.0)
-    return first, inside & (first < NO_SURFACE)
+    nearest = dist[j, i]
+    first = np.where(inside, np.where(all4, bilinear, nearest), 0.0)
+    return first, inside & (all4 | (nearest < NO_SURFACE))
 
 
 def distance_from_light(eye, world) -> np.ndarray:
