@@ -31,7 +31,11 @@ bool first_hit_distance(int slot, vec3 world, out float first) {
     vec2 uv = p.xy / p.w;
     first = 0.0;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
+#if SHADOW_SLOTS > 1
     first = slot == 0 ? texture(u_distance0, uv).r : texture(u_distance1, uv).r;
+#else
+    first = texture(u_distance0, uv).r;  // the one slot (lib/lights.glsl SHADOW_SLOTS)
+#endif
     return first < 1e29;   // cleared texels: no surface
 }
 

@@ -20,7 +20,7 @@ import numpy as np
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
 from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
-from app.render.lights import bind_shadow_maps, set_light_uniforms
+from app.render.lights import bind_shadow_maps, light_defines, set_light_uniforms
 from app.render.texture_units import TextureUnits
 from scene.optics.tsd import DiffusionKernel, blur_taps
 
@@ -209,7 +209,7 @@ class TsdIrradiancePass(TsdPass):
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights
-        defines = {**mat.defines(), "MAX_LIGHTS": nmax}
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax)}
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
