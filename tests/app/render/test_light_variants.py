@@ -22,7 +22,7 @@ def test_light_defines_count_the_filled_slots():
 def _frame_programs(renderer, frag: str) -> dict:
     """Compiled programs of `frag`, by their SHADOW_SLOTS define."""
     out = {}
-    for (vs, fs, defines, _inc), entry in renderer.programs.entries.items():
+    for (_vs, fs, defines, _inc), entry in renderer.programs.entries.items():
         if fs == frag:
             out[dict(defines).get("SHADOW_SLOTS")] = entry.program
     return out
