@@ -20,22 +20,20 @@ in vec4 v_tangent;
 
 uniform vec3 u_ambient;
 uniform float u_tsd_mix;
+uniform int u_slot_light[2];              // the light each shadow slot holds (lib/lights.glsl slots)
 #ifdef TSD_TRANSLUCENCY
 uniform sampler2D u_distance0;            // light-space distance of the first surface (scene units)
 uniform sampler2D u_distance1;
 uniform vec4 u_light_eye[2];              // slot light position (w = 1) or the direction light travels (w = 0)
 
 // Distance from the light of the first surface it meets on the way to world; false outside the map.
+// `slot` is a compile-time constant at every call (the map is chosen without a branch).
 bool first_hit_distance(int slot, vec3 world, out float first) {
     vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
     vec2 uv = p.xy / p.w;
     first = 0.0;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
-#if SHADOW_SLOTS > 1
     first = slot == 0 ? texture(u_distance0, uv).r : texture(u_distance1, uv).r;
-#else
-    first = texture(u_distance0, uv).r;  // the one slot (lib/lights.glsl SHADOW_SLOTS)
-#endif
     return first < 1e29;   // cleared texels: no surface
 }
 
@@ -46,6 +44,32 @@ float distance_from_light(int slot, vec3 world) {
 #endif
 
 out vec4 f_irradiance;
+
+// What the light in shadow slot `slot` (a compile-time constant) brings: direct light through the
+// shadow map, and with TSD_TRANSLUCENCY the light through thin parts. Only shadow-casting lights
+// can shine through (the thickness comes from their distance map), so the translucency runs once
+// per filled slot, never for the other lights (a software rasteriser runs a branch's masked side).
+vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
+    int i = u_slot_light[slot];
+    vec3 l, e;
+    light_incidence(i, v_world, n, l, e);
+    vec3 sum = vec3(0.0);
+    float NoL = dot(n, l);
+    if (NoL > 0.0) sum += e * (light_visibility(i, v_world, dot(ng, l)) * NoL) * sss_entry(NoL);
+#ifdef TSD_TRANSLUCENCY
+    float back = -dot(ng, l);
+    float first;
+    if (back > 0.0 && first_hit_distance(slot, v_world, first)) {
+        float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit * back;
+        // multiple scattering (diffusion through the slab) + single scattering through it
+        float t_in = 1.0 - fresnel_dielectric(back, max(u_sss_eta, 1.0));
+        vec3 through = sss_entry(back) * sss_slab_transmittance(d_mm)
+                     + t_in * sss_slab_single(refract_cos(back, max(u_sss_eta, 1.0)), d_mm);
+        sum += e * back * through;
+    }
+#endif
+    return sum;
+}
 
 void main() {
     vec3 ng = normalize(v_normal);
@@ -62,31 +86,20 @@ void main() {
     occlusion = texture(u_occlusion_map, v_uv).r;
 #endif
     vec3 e_in = vec3(0.0);
-    for (int i = 0; i < MAX_LIGHTS; ++i) {
+    for (int i = 0; i < MAX_LIGHTS; ++i) {   // the lights without a shadow map
         if (i >= u_num_lights) break;
+        if (u_light_shadow[i] >= 0 && u_light_shadow[i] < SHADOW_SLOTS) continue;  // below, per slot
         vec3 l, e;
         light_incidence(i, v_world, n, l, e);
         float NoL = dot(n, l);
-        if (NoL > 0.0) {
-            float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
-            e_in += e * (vis * NoL) * sss_entry(NoL);
-        }
-#ifdef TSD_TRANSLUCENCY
-        int slot = u_light_shadow[i];
-        float back = -dot(ng, l);
-        if (slot >= 0 && back > 0.0) {
-            float first;
-            if (first_hit_distance(slot, v_world, first)) {
-                float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit * back;
-                // multiple scattering (diffusion through the slab) + single scattering through it
-                float t_in = 1.0 - fresnel_dielectric(back, max(u_sss_eta, 1.0));
-                vec3 through = sss_entry(back) * sss_slab_transmittance(d_mm)
-                             + t_in * sss_slab_single(refract_cos(back, max(u_sss_eta, 1.0)), d_mm);
-                e_in += e * back * through;
-            }
-        }
-#endif
+        if (NoL > 0.0) e_in += e * NoL * sss_entry(NoL);
     }
+#if SHADOW_SLOTS > 0
+    e_in += shadowed_light(0, n, ng);
+#endif
+#if SHADOW_SLOTS > 1
+    e_in += shadowed_light(1, n, ng);
+#endif
     e_in += PI * u_ambient * occlusion * u_sss_entry_diffuse;
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 }

@@ -219,6 +219,11 @@ class TsdIrradiancePass(TsdPass):
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units)
         bind_boundary(prog, mat)
+        if "u_slot_light" in prog:  # the light each filled shadow slot holds (its lights are shaded per slot)
+            slot_light = np.full(2, -1, np.int32)
+            for s, light in enumerate(prm.shadow_lights[:2]):
+                slot_light[s] = next(i for i, x in enumerate(prm.lights) if x is light)
+            prog["u_slot_light"].write(slot_light[: max(prog["u_slot_light"].array_length, 1)].tobytes())
         if prm.translucency:
             for slot in (0, 1):
                 d = frame.targets.get(f"shadow_distance{slot}")
