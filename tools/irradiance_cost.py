@@ -6,6 +6,10 @@ under a temporary folder); none of them is what the renderer runs.
 
     .venv/bin/python tools/irradiance_cost.py [--size 640] [--rounds 7] [--scene PATH]
     .venv/bin/python tools/irradiance_cost.py --coverage [--rounds 9]
+    .venv/bin/python tools/irradiance_cost.py --against 9f5625f [--rounds 7]
+
+--against REV[,REV...]: the pass as shipped against the shaders/ of git revisions (the same Python
+code drives them), interleaved: what a change of the shaders saved.
 
 --coverage: the pass on a square whose UVs cover 100 %, 25 %, 6.25 % and 1 % of a 512x512 layout
 (tests/tsd_scenes.py slab_scene), interleaved: the time follows the covered texels (the pass
@@ -22,6 +26,7 @@ import argparse
 import os
 import shutil
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -97,6 +102,7 @@ def main(argv=None) -> int:
     ap.add_argument("--rounds", type=int, default=7, help="timed rounds (default 7)")
     ap.add_argument("--scene", default=None, help="scene file (default: the head)")
     ap.add_argument("--coverage", action="store_true", help="the pass's time against the UV area covered")
+    ap.add_argument("--against", default=None, help="comma-separated git revisions whose shaders/ to time instead")
     args = ap.parse_args(argv)
     if args.coverage:
         return coverage(args.rounds)
@@ -112,9 +118,23 @@ def main(argv=None) -> int:
     tmp = Path(tempfile.mkdtemp(prefix="skinlab-irradiance-cost-"))
     runs = {}
     try:
-        for name, edits in VARIANTS.items():
+        variants = VARIANTS
+        if args.against:
+            variants = {"base": []} | {rev: None for rev in args.against.split(",")}
+        for name, edits in variants.items():
             root = tmp / name
-            shutil.copytree(SHADER_ROOT, root)
+            if edits is None:  # a revision's shaders
+                root.mkdir()
+                repo = SHADER_ROOT.parent
+                archive = subprocess.run(
+                    ["git", "-C", str(repo), "archive", name, "shaders"], capture_output=True, check=False
+                )
+                if archive.returncode != 0:
+                    raise SystemExit(f"--against: git archive {name} failed: {archive.stderr.decode().strip()}")
+                subprocess.run(["tar", "-x", "-C", str(root)], input=archive.stdout, check=True)
+                root, edits = root / "shaders", []
+            else:
+                shutil.copytree(SHADER_ROOT, root)
             for rel, old, new in edits:
                 f = root / rel
                 text = f.read_text()
