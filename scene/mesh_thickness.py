@@ -42,15 +42,16 @@ class _Rays:
         corners = (self.v0, self.v0 + self.e1, self.v0 + self.e2)
         self.radius = np.sqrt(np.max([((x - self.centre) ** 2).sum(1) for x in corners], axis=0))
 
-    def any_hit(self, pr: np.ndarray, pt: np.ndarray, limit: float) -> bool:
-        """Whether some ray pr[k] leaves through triangle pt[k] at a distance in (t_min, limit]."""
+    def nearest_hit(self, pr: np.ndarray, pt: np.ndarray, limit: float) -> float:
+        """The shortest distance in (t_min, limit] at which some ray pr[k] leaves through triangle
+        pt[k]; inf when none does."""
         d, nf = self.dirs[pr], self.n_face[pt]
         dn = np.einsum("ij,ij->i", nf, d)
         with np.errstate(divide="ignore", invalid="ignore"):
             t = np.einsum("ij,ij->i", self.v0[pt] - self.orig[pr], nf) / dn
         keep = np.flatnonzero((dn > 0) & (t > self.t_min) & (t <= limit))  # exit side, within reach
         if len(keep) == 0:
-            return False
+            return np.inf
         pr, pt, d, t = pr[keep], pt[keep], d[keep], t[keep]
         x = self.orig[pr] + t[:, None] * d - self.v0[pt]  # the hit on the triangle's plane
         e1, e2 = self.e1[pt], self.e2[pt]
@@ -60,7 +61,8 @@ class _Rays:
         with np.errstate(divide="ignore", invalid="ignore"):
             u, v = (c * p - b * q) / det, (a * q - b * p) / det
         eps = 1e-9
-        return bool(np.any((det > 0) & (u >= -eps) & (v >= -eps) & (u + v <= 1 + eps)))
+        inside = (det > 0) & (u >= -eps) & (v >= -eps) & (u + v <= 1 + eps)
+        return float(t[inside].min()) if inside.any() else np.inf
 
 
 def is_closed(mesh) -> bool:
@@ -80,33 +82,51 @@ def is_closed(mesh) -> bool:
 
 def thinner_than(mesh, limit: float) -> bool:
     """Whether some part of the mesh is thinner than `limit` (mesh units; see the module docstring);
-    always for an open mesh. Cached per mesh identity, version and limit."""
-    key = (mesh.uid, mesh.version, float(limit))
-    hit = _CACHE.get(key)
-    if hit is not None:
-        return hit
-    if len(_CACHE) > 256:
-        _CACHE.clear()
-    hit = _CACHE[key] = (not is_closed(mesh)) or (_thinner_than(_Rays(mesh), float(limit)) if limit > 0 else False)
-    return hit
+    always for an open mesh. What a search finds is kept per mesh identity and version: the thinnest
+    part seen so far and the largest limit known to have no part thinner, so that a new limit
+    between them (a material being edited) is answered without a new search in most cases."""
+    if not is_closed(mesh):
+        return True
+    if not limit > 0:
+        return False
+    key = ("thickness", mesh.uid, mesh.version)
+    known = _CACHE.get(key)
+    if known is None:
+        if len(_CACHE) > 256:
+            _CACHE.clear()
+        known = _CACHE[key] = {"thin": np.inf, "thick": 0.0}
+    if limit >= known["thin"]:
+        return True
+    if limit <= known["thick"]:
+        return False
+    found = _nearest_within(_Rays(mesh), float(limit))
+    if found <= limit:
+        known["thin"] = min(known["thin"], found)
+        return True
+    known["thick"] = max(known["thick"], float(limit))
+    return False
 
 
-def _thinner_than(r: _Rays, limit: float) -> bool:
+def _nearest_within(r: _Rays, limit: float) -> float:
+    """A hit distance <= limit (the nearest of the first batch that has one), or inf."""
     n_rays, n_tri = len(r.orig), len(r.v0)
     seed = np.random.default_rng(0).choice(n_rays, size=min(_SEED_RAYS, n_rays), replace=False)
     for chunk in np.array_split(seed, max(1, len(seed) * n_tri // _PAIRS)):
-        if r.any_hit(np.repeat(chunk, n_tri), np.tile(np.arange(n_tri), len(chunk)), limit):
-            return True
+        t = r.nearest_hit(np.repeat(chunk, n_tri), np.tile(np.arange(n_tri), len(chunk)), limit)
+        if t <= limit:
+            return t
     # every ray against the triangles near enough to be hit within the limit (the hit lies within
     # `limit` of the vertex, so the triangle's centre within limit + its radius); the few large
     # triangles (a cap, a floor) against every ray, so that they do not widen the search of the rest
     big = r.radius > np.quantile(r.radius, 0.99)
     large, small = np.flatnonzero(big), np.flatnonzero(~big)
     for chunk in np.array_split(np.arange(n_rays), max(1, n_rays * len(large) // _PAIRS)):
-        if len(large) and r.any_hit(np.repeat(chunk, len(large)), np.tile(large, len(chunk)), limit):
-            return True
+        if len(large):
+            t = r.nearest_hit(np.repeat(chunk, len(large)), np.tile(large, len(chunk)), limit)
+            if t <= limit:
+                return t
     if len(small) == 0:
-        return False
+        return np.inf
     tree = cKDTree(r.centre[small])
     reach = limit + float(r.radius[small].max())
     for chunk in np.array_split(np.arange(n_rays), max(1, n_rays // 1024)):
@@ -115,6 +135,7 @@ def _thinner_than(r: _Rays, limit: float) -> bool:
         if counts.sum() == 0:
             continue
         pt = small[np.concatenate([np.asarray(x, np.int64) for x in near])]
-        if r.any_hit(np.repeat(chunk, counts), pt, limit):
-            return True
-    return False
+        t = r.nearest_hit(np.repeat(chunk, counts), pt, limit)
+        if t <= limit:
+            return t
+    return np.inf

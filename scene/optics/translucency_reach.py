@@ -6,10 +6,13 @@ through the slab) stays below a fraction of what the same light brings to a surf
 Per unit irradiance e along the light, the translucency adds e back [E(back) T(d) + t_in S(mu_t, d)]
 with T = slab_transmittance, S = slab_single_transmittance x (u_sss_single / alpha) (the shader's
 sss_slab_single per unit base colour), t_in <= 1 the Fresnel transmission in; a surface facing the
-light receives e E(1). Bounded over every cosine (back <= 1, E(back) <= max E, the worst mu_t),
-the ratio is
+light receives e E(1). Single scattering through a slab tau = d / l mean free paths thick is the
+light that reaches depth t at cosine mu_i and leaves through the far face, alpha/2 int_0^tau
+e^{-t/mu_i}/mu_i E_2(tau - t) dt <= alpha/2 e^{-tau} min(tau/mu_i, 1/(1 - mu_i)) <= alpha/2 (1 + tau)
+e^{-tau} for every mu_i (E_2(x) <= e^{-x}; a test checks it against slab_single_transmittance).
+Bounded over every cosine (back <= 1, E(back) <= max E, the worst mu_i), the ratio is
 
-    r(d) <= [max_mu E(mu) T(d) + max_mu_t S(mu_t, d)] / E(1)        per channel.
+    r(d) <= [max_mu E(mu) T(d) + (u_sss_single / 2) (1 + tau) e^{-tau}] / E(1)     per channel.
 
 T and S rise from 0 at d = 0 and fall (exponentially in an absorbing medium) beyond a mean free
 path or so; the reach is the smallest d past which r(d) < eps for good (inf when the fall is too
@@ -23,11 +26,10 @@ from functools import lru_cache
 
 import numpy as np
 
-from scene.optics.boundary import boundary_tables, slab_single_transmittance, slab_transmittance
+from scene.optics.boundary import boundary_tables, slab_transmittance
 
 REACH_EPS = 1e-4  # of the light a surface facing it receives: below this, translucency is left out
-_GRID = np.geomspace(1e-3, 1e5, 161)  # thicknesses in mean free paths (ratio 1.12 between points)
-_MU = (0.2, 0.6, 1.0)  # refracted cosines for the single-scattering term
+_GRID = np.geomspace(1e-3, 1e5, 481)  # thicknesses in mean free paths (ratio 1.04 between points)
 
 
 def transmission_bound(d_mm, alpha, mfp_mm, eta, colour) -> np.ndarray:
@@ -38,7 +40,8 @@ def transmission_bound(d_mm, alpha, mfp_mm, eta, colour) -> np.ndarray:
     al = np.clip(np.asarray(alpha, np.float64).reshape(3), 0.0, 1.0)
     per_alpha = np.where(al > 0, t.single / np.where(al > 0, al, 1.0), 0.0)
     diffusion = t.entry.max(0) * slab_transmittance(d, alpha, mfp_mm, eta)
-    single = np.array([np.max([slab_single_transmittance(m, x, alpha, mfp_mm) for m in _MU], axis=0) for x in d])
+    tau = d[:, None] / np.maximum(np.asarray(mfp_mm, np.float64).reshape(3), 1e-30)
+    single = np.where(al > 0, 0.5 * al, 0.0) * (1.0 + tau) * np.exp(-tau)  # >= slab_single_transmittance
     with np.errstate(divide="ignore", invalid="ignore"):
         r = (diffusion + single * per_alpha) / front
     return np.where(front > 0, r, 0.0)

@@ -18,6 +18,7 @@ from scene import transform as tf
 from scene.graph import LightNode
 from scene.mesh import Mesh
 from scene.mesh_thickness import is_closed, thinner_than
+from scene.optics.boundary import slab_single_transmittance
 from scene.optics.translucency_reach import REACH_EPS, translucency_reach_mm, transmission_bound
 from scene.optics.tsd import material_medium
 from scene.scenefile import load_scene
@@ -102,8 +103,18 @@ def test_reach_bounds_the_transmission():
     past = reach * np.geomspace(1.0, 100.0, 60)
     r = transmission_bound(past, med.alpha_arr, med.mfp_arr, med.eta, colour)
     assert (r < REACH_EPS).all()
-    before = transmission_bound([reach / 1.2], med.alpha_arr, med.mfp_arr, med.eta, colour)
+    before = transmission_bound([reach / 1.05], med.alpha_arr, med.mfp_arr, med.eta, colour)
     assert before.max() >= REACH_EPS  # the grid's previous point is still above: reach is not loose by more
+
+
+def test_single_scattering_bound_holds():
+    """(alpha / 2) (1 + tau) e^{-tau} bounds single scattering through a slab at every incidence."""
+    alpha, mfp = np.array([0.9, 0.5, 0.99]), np.array([1.0, 0.5, 2.0])
+    for mu in np.linspace(0.001, 1.0, 25):
+        for d in np.geomspace(1e-4, 60.0, 40):
+            s = slab_single_transmittance(mu, d, alpha, mfp)
+            tau = d / mfp
+            assert (s <= 0.5 * alpha * (1 + tau) * np.exp(-tau) * (1 + 1e-9)).all(), (mu, d)
 
 
 @pytest.mark.parametrize(
@@ -151,6 +162,17 @@ def test_thinnest_part_of_boxes_and_open_sheets():
     thick = _box(160.0, 160.0, 40.0)
     assert thinner_than(thick, 40.5) and not thinner_than(thick, 39.5)
     sheet = Mesh("sheet", np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0.0]]), np.array([[0, 1, 2], [0, 2, 3]]))
+    # answers stay right in any order of limits (what one search finds is kept for the next)
+    fresh = _box(60.0, 60.0, 3.0)
+    assert [thinner_than(fresh, x) for x in (100.0, 2.0, 2.9, 3.1, 1.0, 2.999, 3.001)] == [
+        True,
+        False,
+        False,
+        True,
+        False,
+        False,
+        True,
+    ]
     # an open sheet bounds nothing (the light may have entered another mesh in front of it)
     assert not is_closed(sheet) and thinner_than(sheet, 1e-6)
     assert is_closed(box) and is_closed(thick)
