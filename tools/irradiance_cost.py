@@ -5,6 +5,15 @@ forward pass of the same frame beside it. The variants are measurements only (co
 under a temporary folder); none of them is what the renderer runs.
 
     .venv/bin/python tools/irradiance_cost.py [--size 640] [--rounds 7] [--scene PATH]
+    .venv/bin/python tools/irradiance_cost.py --coverage [--rounds 9]
+    .venv/bin/python tools/irradiance_cost.py --against 9f5625f [--rounds 7]
+
+--against REV[,REV...]: the pass as shipped against the shaders/ of git revisions (the same Python
+code drives them), interleaved: what a change of the shaders saved.
+
+--coverage: the pass on a square whose UVs cover 100 %, 25 %, 6.25 % and 1 % of a 512x512 layout
+(tests/tsd_scenes.py slab_scene), interleaved: the time follows the covered texels (the pass
+rasterises the mesh's triangles in UV space; texels no triangle covers are only cleared).
 
 Variants: base (as shipped), pcf_1tap (one shadow
 compare instead of the 3x3 PCF), no_translucency, no_maps (no normal, colour or occlusion map
@@ -17,10 +26,13 @@ import argparse
 import os
 import shutil
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
+
+import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -35,7 +47,7 @@ VARIANTS = {
             "return texture(map, vec3(c.xy, c.z - bias));",
         )
     ],
-    "no_translucency": [(IRR, "#ifdef TSD_TRANSLUCENCY\n        int slot", "#if 0\n        int slot")],
+    "no_translucency": [(IRR, "#ifdef TSD_TRANSLUCENCY\n    float back", "#if 0\n    float back")],
     "no_maps": [
         (IRR, "#ifdef HAS_NORMAL_MAP\n    n = perturb", "#if 0\n    n = perturb"),
         (IRR, "#ifdef HAS_BASE_COLOR_MAP\n    base *=", "#if 0\n    base *="),
@@ -51,12 +63,49 @@ VARIANTS = {
 }
 
 
+def coverage(rounds: int) -> int:
+    from app.gl.context import create_headless_context, describe
+    from app.render.renderer import Renderer
+    from app.render.settings import RenderSettings
+    from tests.tsd_scenes import quad_mesh, skin, slab_scene
+
+    ctx = create_headless_context()
+    runs = {}
+    for side in (1.0, 0.5, 0.25, 0.1):
+        mesh = quad_mesh("slab", -1, 1, -1, 1, uv=((0, 0), (side, side)))
+        scene = slab_scene(mesh=mesh, material=skin(), occluder=True)
+        r = Renderer(ctx)
+        r.reuse = False
+        res = r.render(scene, RenderSettings.for_technique("tsd", 64, 64, size=512, shadow_size=1024), readback=False)
+        runs[side] = (r, r.last_frame, next(p for p in res.plan.passes if p.kind == "tsd_irradiance"))
+    load0 = os.getloadavg()
+    times = {k: [] for k in runs}
+    for _ in range(rounds):
+        for side, (r, frame, irr) in runs.items():
+            ctx.finish()
+            t0 = time.perf_counter()
+            r.pass_for("tsd_irradiance").run(frame, irr)
+            ctx.finish()
+            times[side].append((time.perf_counter() - t0) * 1e3)
+    print(f"{describe(ctx)}; tsd_irradiance 512x512 texels on a square, median of {rounds}")
+    print(f"load average {tuple(round(x, 2) for x in load0)} -> {tuple(round(x, 2) for x in os.getloadavg())}")
+    for side, v in times.items():
+        print(f"  UV area {side * side:7.2%} of the layout: {statistics.median(v):7.2f} ms")
+    for r, *_ in runs.values():
+        r.release()
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", type=int, default=640, help="frame width and height (default 640)")
     ap.add_argument("--rounds", type=int, default=7, help="timed rounds (default 7)")
     ap.add_argument("--scene", default=None, help="scene file (default: the head)")
+    ap.add_argument("--coverage", action="store_true", help="the pass's time against the UV area covered")
+    ap.add_argument("--against", default=None, help="comma-separated git revisions whose shaders/ to time instead")
     args = ap.parse_args(argv)
+    if args.coverage:
+        return coverage(args.rounds)
     from app.gl.context import create_headless_context, describe
     from app.gl.shader_source import SHADER_ROOT, ShaderLibrary
     from app.render.renderer import Renderer
@@ -69,9 +118,23 @@ def main(argv=None) -> int:
     tmp = Path(tempfile.mkdtemp(prefix="skinlab-irradiance-cost-"))
     runs = {}
     try:
-        for name, edits in VARIANTS.items():
+        variants = VARIANTS
+        if args.against:
+            variants = {"base": []} | {rev: None for rev in args.against.split(",")}
+        for name, edits in variants.items():
             root = tmp / name
-            shutil.copytree(SHADER_ROOT, root)
+            if edits is None:  # a revision's shaders
+                root.mkdir()
+                repo = SHADER_ROOT.parent
+                archive = subprocess.run(
+                    ["git", "-C", str(repo), "archive", name, "shaders"], capture_output=True, check=False
+                )
+                if archive.returncode != 0:
+                    raise SystemExit(f"--against: git archive {name} failed: {archive.stderr.decode().strip()}")
+                subprocess.run(["tar", "-x", "-C", str(root)], input=archive.stdout, check=True)
+                root, edits = root / "shaders", []
+            else:
+                shutil.copytree(SHADER_ROOT, root)
             for rel, old, new in edits:
                 f = root / rel
                 text = f.read_text()
@@ -101,7 +164,11 @@ def main(argv=None) -> int:
             ctx.finish()
             fwd_times.append((time.perf_counter() - t0) * 1e3)
         texels = irr.resolution[0] * irr.resolution[1]
+        r, frame, irr, _ = runs["base"]
+        raw = np.frombuffer(frame.targets[f"tsd_irradiance_raw[{irr.params.node.name}]"].read(), np.float32)
+        covered = float((raw.reshape(-1, 4)[:, 3] > 0).mean())
         print(f"{describe(ctx)}; {irr.name} {irr.resolution[0]}x{irr.resolution[1]} texels, frame {args.size}^2")
+        print(f"texels covered by a triangle: {covered:.1%} (the pass rasterises triangles: only those are shaded)")
         print(f"load average {tuple(round(x, 2) for x in load0)} -> {tuple(round(x, 2) for x in os.getloadavg())}")
         base = statistics.median(times["base"])
         for name, v in times.items():

@@ -16,6 +16,12 @@ def bind_shadow_maps(renderer, frame, prog, units) -> None:
         units.bind(prog, f"u_shadow{slot}", tex if tex is not None else renderer.dummy_shadow_map())
 
 
+def light_defines(shadow_lights, nmax: int) -> dict:
+    """The variant defines of a program that lights surfaces (shaders/lib/lights.glsl): MAX_LIGHTS,
+    and SHADOW_SLOTS, the shadow-map slots this frame fills (the others' lookups are compiled out)."""
+    return {"MAX_LIGHTS": nmax, "SHADOW_SLOTS": min(len(shadow_lights), SHADOW_SLOTS)}
+
+
 def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
     """Upload lights (direction or position, radiance, shadow slot) and shadow matrices to `prog`."""
     slots = {id(l): i for i, l in enumerate(shadow_lights)}

@@ -21,11 +21,31 @@ in vec4 v_tangent;
 
 uniform vec3 u_ambient;
 uniform float u_tsd_mix;
+uniform int u_slot_light[2];              // the light each shadow slot holds (lib/lights.glsl slots)
 #ifdef TSD_TRANSLUCENCY
 #include "lib/sss_translucency.glsl"
 #endif
 
 out vec4 f_irradiance;
+
+// What the light in shadow slot `slot` (a compile-time constant) brings: direct light through the
+// shadow map, and with TSD_TRANSLUCENCY the light through thin parts. Only shadow-casting lights
+// can shine through (the thickness comes from their distance map), so the translucency runs once
+// per filled slot, never for the other lights (a software rasteriser runs a branch's masked side).
+vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
+    int i = u_slot_light[slot];
+    vec3 l, e;
+    light_incidence(i, v_world, n, l, e);
+    vec3 sum = vec3(0.0);
+    float NoL = dot(n, l);
+    if (NoL > 0.0) sum += e * (light_visibility(i, v_world, dot(ng, l)) * NoL) * sss_entry(NoL);
+#ifdef TSD_TRANSLUCENCY
+    float back = -dot(ng, l);
+    float d_mm;
+    if (back > 0.0 && sss_thickness_mm(slot, v_world, ng, back, d_mm)) sum += e * back * sss_through(back, d_mm);
+#endif
+    return sum;
+}
 
 void main() {
     vec3 ng = normalize(v_normal);
@@ -42,19 +62,20 @@ void main() {
     occlusion = texture(u_occlusion_map, v_uv).r;
 #endif
     vec3 e_in = vec3(0.0);
-    for (int i = 0; i < MAX_LIGHTS; ++i) {
+    for (int i = 0; i < MAX_LIGHTS; ++i) {   // the lights without a shadow map
         if (i >= u_num_lights) break;
+        if (u_light_shadow[i] >= 0 && u_light_shadow[i] < SHADOW_SLOTS) continue;  // below, per slot
         vec3 l, e;
         light_incidence(i, v_world, n, l, e);
         float NoL = dot(n, l);
-        if (NoL > 0.0) {
-            float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
-            e_in += e * (vis * NoL) * sss_entry(NoL);
-        }
-#ifdef TSD_TRANSLUCENCY
-        e_in += sss_translucent_light(i, v_world, ng, l, e);
-#endif
+        if (NoL > 0.0) e_in += e * NoL * sss_entry(NoL);
     }
+#if SHADOW_SLOTS > 0
+    e_in += shadowed_light(0, n, ng);
+#endif
+#if SHADOW_SLOTS > 1
+    e_in += shadowed_light(1, n, ng);
+#endif
     e_in += PI * u_ambient * occlusion * u_sss_entry_diffuse;
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 }

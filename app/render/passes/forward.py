@@ -18,7 +18,7 @@ from app.gl.uniforms import set_uniforms
 from app.render.boundary import bind_boundary
 from app.render.frame_plan import ForwardParams
 from app.render.gpu_resources import node_uniforms
-from app.render.lights import bind_shadow_maps, set_light_uniforms
+from app.render.lights import bind_shadow_maps, light_defines, set_light_uniforms
 from app.render.technique import HOOK_INCLUDE, PLAIN_HOOK, NodeShading
 from app.render.texture_units import TextureUnits
 
@@ -99,7 +99,7 @@ class ForwardPass:
         ctx, hook, nmax = self.r.ctx, prm.hook, frame.settings.max_lights
         for node in frame.scene.mesh_nodes():
             sh = hook.shading(node, frame) or NodeShading(node.material)
-            defines = {**sh.material.defines(), "MAX_LIGHTS": nmax, **sh.defines}
+            defines = {**sh.material.defines(), **light_defines(prm.shadow_lights, nmax), **sh.defines}
             prog = self.r.programs.get(
                 "passes/forward.vert", "passes/forward.frag", defines, includes={HOOK_INCLUDE: sh.hook}
             )

@@ -164,6 +164,8 @@ CASES = [
         ["[camera]"],
     ),
     ("command-unknown", {}, ["rendr"], ["rendr"]),
+    ("peer-frames", {}, ["bench", "peer", "--frames", "0", "--no-progress"], ["--frames"]),
+    ("peer-rounds", {}, ["bench", "peer", "--rounds", "0", "--no-progress"], ["--rounds"]),
 ]
 
 

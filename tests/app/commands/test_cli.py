@@ -201,15 +201,25 @@ def test_bench_peer_shows_progress(monkeypatch, capsys):
 
     calls = []
 
-    def fake_peer(meshes, pose, yfov, znear, zfar, size, frames=0, timeout=600):
-        calls.append(frames)
-        return {"times": [1.0] * frames}
+    class FakePeer:
+        def __init__(self, meshes, pose, yfov, znear, zfar, size, timeout=600):
+            pass
 
-    monkeypatch.setattr(pyrender_peer, "run_peer", fake_peer)
-    res = peer_bench((16, 16), frames=1, progress=True)
+        def time_frames(self, n):
+            calls.append(n)
+            return [1.0] * n
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            pass
+
+    monkeypatch.setattr(pyrender_peer, "PeerSession", FakePeer)
+    res = peer_bench((16, 16), frames=2, progress=True, rounds=2)
     err = capsys.readouterr().err
-    assert calls == [1] and res["pyrender_ms"] == 1.0
-    assert "bench peer" in err and "10/10" in err  # 3 x (2 warm-up + 1 timed) + pyrender
+    assert calls == [1, 1] and res["pyrender_ms"] == 1.0 and len(res["ratio_per_round"]) == 2
+    assert "bench peer" in err and "14/14" in err  # 3 x 2 warm-up + 2 rounds x (3 Skinlab + 1 pyrender)
     peer_bench((16, 16), frames=1, progress=False)
     assert "bench peer" not in capsys.readouterr().err
 

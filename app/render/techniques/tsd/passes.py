@@ -20,7 +20,7 @@ import numpy as np
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
 from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
-from app.render.lights import bind_shadow_maps, set_light_uniforms
+from app.render.lights import bind_shadow_maps, light_defines, set_light_uniforms
 from app.render.texture_units import TextureUnits
 from app.render.translucency import bind_translucency
 from scene.optics.tsd import DiffusionKernel, blur_taps
@@ -210,7 +210,7 @@ class TsdIrradiancePass(TsdPass):
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights
-        defines = {**mat.defines(), "MAX_LIGHTS": nmax}
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax)}
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
@@ -220,6 +220,11 @@ class TsdIrradiancePass(TsdPass):
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units)
         bind_boundary(prog, mat)
+        if "u_slot_light" in prog:  # the light each filled shadow slot holds (its lights are shaded per slot)
+            slot_light = np.full(2, -1, np.int32)
+            for s, light in enumerate(prm.shadow_lights[:2]):
+                slot_light[s] = next(i for i, x in enumerate(prm.lights) if x is light)
+            prog["u_slot_light"].write(slot_light[: max(prog["u_slot_light"].array_length, 1)].tobytes())
         if prm.translucency:
             bind_translucency(prog, frame, units, self.r.dummy_texture())
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)

@@ -17,6 +17,8 @@ from app.render.reuse import light_state, material_state, node_geometry
 from app.render.scattering import scattering_material
 from app.render.translucency import plan_translucency
 from scene.mesh import with_atlas
+from scene.mesh_thickness import thinner_than
+from scene.optics.translucency_reach import REACH_EPS, translucency_reach_mm
 from scene.optics.tsd import BlurStep, DiffusionKernel, design_kernel, material_medium, profile_fit
 from scene.uv_checks import analyse_uvs
 
@@ -139,10 +141,39 @@ def plan_tsd(ctx, size: int, gaussians: int, taps: int | None, mix: float, trans
     use_translucency = plan_translucency(ctx, bool(nodes), translucency)
     if not nodes:
         plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
-    passes = []
+    passes, any_translucent = [], False
     for t in nodes:
-        passes += _node_passes(t, ctx, mix, use_translucency, exact)
-    return passes, nodes, use_translucency
+        node_translucency = use_translucency and can_shine_through(t, ctx.scene, plan)
+        any_translucent |= node_translucency
+        passes += _node_passes(t, ctx, mix, node_translucency, exact)
+    return passes, nodes, any_translucent
+
+
+def can_shine_through(t: TsdNodePlan, scene, plan) -> bool:
+    """Whether light can cross some part of the node's mesh: a part thinner than the thickness past
+    which its material lets through less than REACH_EPS of the light a surface facing it receives
+    (scene/optics/translucency_reach.py; thickness along the inward normals, scene/mesh_thickness.py).
+    When none is, the node's irradiance pass runs without the translucency variant (no distance-map
+    lookups, no slab evaluation) and the plan says so."""
+    mat, node = t.material, t.node
+    medium = material_medium(mat.values)
+    reach_mm = translucency_reach_mm(medium.alpha_arr, medium.mfp_arr, medium.eta, mat["subsurface_color"])
+    if not math.isfinite(reach_mm):
+        return True
+    # the node's world transform shrinks no length by more than its smallest singular value
+    shrink = float(np.linalg.svd(np.asarray(node.world_matrix, np.float64)[:3, :3], compute_uv=False).min())
+    if shrink <= 0:
+        return True
+    if reach_mm > 0 and thinner_than(node.mesh, reach_mm / (scene.mm_per_unit * shrink)):
+        return True
+    plan.skipped.append(
+        (
+            f"translucency[{node.name}]",
+            f"no part of mesh '{node.mesh.name}' is thinner than {reach_mm:.3g} mm, past which material "
+            f"'{mat.name}' lets through less than {REACH_EPS:g} of the light a surface facing it receives",
+        )
+    )
+    return False
 
 
 def stretch_inputs(node, scene) -> tuple:
