@@ -17,7 +17,10 @@ other side. ``seam_extension`` builds, once per mesh and band width, the geometr
   frame and their original UVs in B's chart (``src_uv``: where their irradiance is), and ``depth``,
   the distance past A's edge line (UV units), so that where bands of several edges (or of two
   charts packed close) overlap, the nearest edge's extension wins. Triangles are clipped to the far
-  side of the edge line (depth >= 0, so it stays affine over each and the depth test is exact).
+  side of the edge line (depth >= 0, so it stays affine over each and the depth test is exact);
+- every chart border edge's own strip of gutter (``border_bands``), which claims the gutter nearest
+  that border wherever no extension is nearer (there the gutter keeps dilation, not another chart's
+  continuation).
 
 The GPU side (app/render/techniques/tsd/seams.py) rasterises the extension triangles into a "seam map"
 (RG = src_uv) under the real charts (real texels always win) and lets the blurs follow it.
@@ -38,6 +41,9 @@ REACH_3D = 2.0  # extension triangles lie within this x the band's width (in 3D,
 # puts its corners within this fraction of their distance from the edge of where they are (curvature and
 # a parameterisation that changes across the seam make it differ; folded or mismatched charts, a lot)
 CONTINUATION_TOL = 0.5
+# a seam across which the UV scale jumps by more than this factor is not continued (the metric of
+# the two charts differs too much for a first-order continuation; and its band would span the chart)
+SCALE_LIMIT = 8.0
 
 
 @dataclass(frozen=True)
@@ -55,6 +61,8 @@ class SeamExtension:
     owner: np.ndarray  # (T,) the owner triangle (A) whose seam edge made it
     source: np.ndarray  # (T,) the source triangle (in B's chart)
     chart: np.ndarray  # (F,) chart id of every triangle of the mesh (charts())
+    border_uv: np.ndarray  # (K, 3, 2) every chart border's own strip of gutter (border_bands)
+    border_depth: np.ndarray  # (K, 3) distance from the border edge (UV units)
     _mesh: list = field(default_factory=list, repr=False, compare=False)
 
     @property
@@ -107,6 +115,41 @@ def charts(mesh: Mesh, pid: np.ndarray | None = None) -> np.ndarray:
     a, b = t[:-1][same], t[1:][same]
     g = coo_matrix((np.ones(len(a)), (a, b)), shape=(len(f), len(f)))
     return connected_components(g, directed=False)[1]
+
+
+def border_edges(mesh: Mesh, pid: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(triangles, local edges k: corners k, k+1) of every chart border edge: an edge no other
+    triangle shares in UV (a seam, or the mesh's own boundary)."""
+    f = mesh.indices.astype(np.int64)
+    pid = weld(mesh.positions) if pid is None else pid
+    key = np.concatenate([pid[:, None].astype(np.float64), mesh.uvs.astype(np.float64)], 1)
+    _, uvid = np.unique(key, axis=0, return_inverse=True)
+    t, k, lo, hi = _edge_table(f, uvid.ravel())
+    _, inv, count = np.unique(np.stack([lo, hi], 1), axis=0, return_inverse=True, return_counts=True)
+    single = count[inv.ravel()] == 1
+    return t[single], k[single]
+
+
+def border_bands(mesh: Mesh, band_uv: float, pid: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Every chart border edge's own strip of gutter: a quad `band_uv` wide outside the edge, as two
+    triangles (K, 3, 2) with their distance from the edge (K, 3). In the seam map they claim the
+    gutter nearest a chart's border for that chart (dilation, no fill) wherever no extension is nearer:
+    a border without an extension (or a chart too small to have one) keeps its own neighbourhood."""
+    f = mesh.indices.astype(np.int64)
+    uv = mesh.uvs.astype(np.float64)
+    t, k = border_edges(mesh, pid)
+    a0, a1, a2 = uv[f[t, k]], uv[f[t, (k + 1) % 3]], uv[f[t, (k + 2) % 3]]
+    e = a1 - a0
+    ln = np.linalg.norm(e, axis=1)
+    ok = ln > np.sqrt(EDGE_EPS)
+    a0, a1, a2, e, ln = a0[ok], a1[ok], a2[ok], e[ok], ln[ok]
+    nrm = np.stack([e[:, 1], -e[:, 0]], 1) / ln[:, None]
+    nrm = np.where((np.einsum("ij,ij->i", a2 - a0, nrm) > 0)[:, None], -nrm, nrm)  # away from the triangle
+    b0, b1 = a0 + band_uv * nrm, a1 + band_uv * nrm
+    quads = np.concatenate([np.stack([a0, a1, b1], 1), np.stack([a0, b1, b0], 1)])
+    zero, one = np.zeros(len(a0)), np.full(len(a0), band_uv)
+    depth = np.concatenate([np.stack([zero, zero, one], 1), np.stack([zero, one, one], 1)])
+    return quads, depth
 
 
 def seam_edges(mesh: Mesh):
@@ -214,6 +257,7 @@ def seam_extension(mesh: Mesh, band_uv: float) -> SeamExtension:
     uv = mesh.uvs.astype(np.float64)
     pairs, local, pids, pid = seam_edges(mesh)
     chart = charts(mesh, pid)
+    border = border_bands(mesh, band_uv, pid)
     tri_uv = uv[f]  # (T, 3, 2)
     cen = tri_uv.mean(1)
     reach = np.sqrt(((tri_uv - cen[:, None]) ** 2).sum(-1)).max() if len(f) else 0.0
@@ -238,6 +282,8 @@ def seam_extension(mesh: Mesh, band_uv: float) -> SeamExtension:
             d_uv = np.stack([uv[f[A, 1]] - uv[f[A, 0]], uv[f[A, 2]] - uv[f[A, 0]]], 1)
             jac = np.stack([pos[f[A, 1]] - pos[f[A, 0]], pos[f[A, 2]] - pos[f[A, 0]]], 1) @ np.linalg.inv(d_uv)
             scale = float(np.sqrt(abs(np.linalg.det(m))))
+            if not 1.0 / SCALE_LIMIT <= scale <= SCALE_LIMIT:
+                continue
             la = float(np.linalg.norm(a1 - a0))
             t_hat = (a1 - a0) / la
             n_hat = np.array([t_hat[1], -t_hat[0]])
@@ -327,4 +373,6 @@ def seam_extension(mesh: Mesh, band_uv: float) -> SeamExtension:
         owner=owner,
         source=np.rint(at[:, 0, 10]).astype(np.int64),
         chart=chart,
+        border_uv=border[0].astype(np.float32),
+        border_depth=border[1].astype(np.float32),
     )

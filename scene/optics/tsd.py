@@ -242,34 +242,17 @@ def seam_bilinear_reference(src: np.ndarray, uv: np.ndarray) -> np.ndarray:
     return lo + (hi - lo) * f[..., 1:2]
 
 
-def seam_tap_reference(src: np.ndarray, seam: np.ndarray, rows, cols, chart, across: bool) -> np.ndarray:
-    """Twin of shaders/lib/tsd_seams.glsl seam_tap at texels (rows, cols) for texels of `chart` (same
-    shape): seam (H, W, 4) the seam map (RG source UV, B chart, A extension)."""
-    s = seam[rows, cols]
-    plain = src[rows, cols]
-    out = plain
-    if across:
-        out = np.where((s[..., 3:4] > 0.5), seam_bilinear_reference(src, s[..., :2]), plain)
-    foreign = (s[..., 3] > 0.5) & (s[..., 2] != chart)
-    out = np.where((foreign & (chart != 0))[..., None], np.float32(0.0), out)
-    return np.where((chart == 0)[..., None], plain, out).astype(np.float32)
-
-
 def seam_fill_reference(src: np.ndarray, seam: np.ndarray) -> np.ndarray:
-    """Twin of shaders/passes/tsd_seam_fill.frag: uncovered texels the seam map marks take src at the
-    seam map's UV."""
+    """Twin of shaders/passes/tsd_seam_fill.frag: the texels the seam map (H, W, 4: RG source UV, A
+    marked) marks take src at the seam map's UV; the rest are copied."""
     src = np.asarray(src, np.float32)
     across = seam_bilinear_reference(src, seam[..., :2])
-    fill = (src[..., 3] <= COVERAGE_EPS) & (seam[..., 3] > 0.5)
-    return np.where(fill[..., None], across, src).astype(np.float32)
+    return np.where((seam[..., 3] > 0.5)[..., None], across, src).astype(np.float32)
 
 
-def blur_axis_reference(
-    src: np.ndarray, mm_per_texel: np.ndarray, sigma_mm: float, taps: int, axis: str, seam: np.ndarray | None = None
-) -> np.ndarray:
+def blur_axis_reference(src: np.ndarray, mm_per_texel: np.ndarray, sigma_mm: float, taps: int, axis: str) -> np.ndarray:
     """One 1-D pass of shaders/passes/tsd_blur.frag: src (H, W, 4) premultiplied, mm_per_texel
-    (H, W, 2) (u, v); axis 'u' (columns) or 'v' (rows); with `seam` (the seam map, variant TSD_SEAMS)
-    taps go through seam_tap_reference. float32 arithmetic like the shader."""
+    (H, W, 2) (u, v); axis 'u' (columns) or 'v' (rows). float32 arithmetic like the shader."""
     src = np.asarray(src, np.float32)
     H, W, _ = src.shape
     t, w = blur_taps(int(taps))
@@ -287,12 +270,7 @@ def blur_axis_reference(
             ra, ca, rb, cb = rows, np.clip(cols + i0, 0, W - 1), rows, np.clip(cols + i0 + 1, 0, W - 1)
         else:
             ra, ca, rb, cb = np.clip(rows + i0, 0, H - 1), cols, np.clip(rows + i0 + 1, 0, H - 1), cols
-        if seam is None:
-            a, b = src[ra, ca], src[rb, cb]
-        else:
-            chart = seam[..., 2]
-            a = seam_tap_reference(src, seam, ra, ca, chart, d == 0)
-            b = seam_tap_reference(src, seam, rb, cb, chart, d == 0)
+        a, b = src[ra, ca], src[rb, cb]
         out += wi * (a + (b - a) * f)
     return out
 
@@ -300,12 +278,15 @@ def blur_axis_reference(
 def diffuse_reference(irradiance: np.ndarray, stretch: np.ndarray, kernel: DiffusionKernel, seam=None):
     """The whole diffusion step in NumPy: returns (levels, diffused) where levels are the
     premultiplied blurred textures (like the GPU's) and diffused (H, W, 3) is I E + sum_k W_k level_k
-    (each level divided by its coverage). `seam`: the seam map (variant TSD_SEAMS)."""
+    (each level divided by its coverage). `seam`: the seam map; each level's gutter is then filled
+    across the seams (seam_fill_reference), as the blur pass does."""
     cur = np.asarray(irradiance, np.float32)
     levels = []
     for s in kernel.steps:
-        cur = blur_axis_reference(cur, stretch, s.sigma_mm, s.taps, "u", seam)
-        cur = blur_axis_reference(cur, stretch, s.sigma_mm, s.taps, "v", seam)
+        cur = blur_axis_reference(cur, stretch, s.sigma_mm, s.taps, "u")
+        cur = blur_axis_reference(cur, stretch, s.sigma_mm, s.taps, "v")
+        if seam is not None:
+            cur = seam_fill_reference(cur, seam)
         levels.append(cur)
     return levels, gather_reference(irradiance, levels, kernel)
 

@@ -17,18 +17,6 @@ vec4 seam_bilinear(sampler2D src, vec2 uv) {
     return lo + (hi - lo) * f.y;
 }
 
-// A blur's tap at texel q for a texel of chart `chart` (> 0): nothing where q is another chart's
-// extension (the surface across that chart's seams is not this chart's neighbourhood); where q is this
-// chart's extension, src at q - or, with `across`, at the seam map's UV (across the seam); elsewhere
-// (real texels of any chart, gutter nobody claims: dilated copies) src at q, as without seams. For a
-// texel of no chart (0): src at q, whatever it is.
-vec4 seam_tap(sampler2D src, sampler2D seam, ivec2 q, float chart, bool across) {
-    if (chart == 0.0) return texelFetch(src, q, 0);
-    vec4 s = texelFetch(seam, q, 0);
-    if (s.a > 0.5 && s.b != chart) return vec4(0.0);
-    return across && s.a > 0.5 ? seam_bilinear(src, s.rg) : texelFetch(src, q, 0);
-}
-
 // src's texel p, or across the seam where the seam map marks p.
 vec4 seam_fetch(sampler2D src, sampler2D seam, ivec2 p) {
     vec4 s = texelFetch(seam, p, 0);

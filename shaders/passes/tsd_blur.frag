@@ -4,15 +4,7 @@
 // Taps at t_i sigma with weights from scene/optics/tsd.py blur_taps(); linear interpolation between
 // the two nearest texels by hand (two fetches), so the NumPy twin (blur_axis_reference) agrees to
 // fp32 rounding. Input and output are premultiplied by coverage (rgb = E a, a = coverage).
-// Variant TSD_SEAMS (lib/tsd_seams.glsl seam_tap): the u pass reads the gutter that this texel's chart's
-// extension triangles claim (the seam map) across the UV seam, so every level sees the light on the
-// other side; the v pass reads the u pass's gutter texels as they are (the u blur in this chart's
-// frame, continued); other charts' extensions count as empty.
 #include "skinlab/constants.glsl"
-#ifdef TSD_SEAMS
-#include "lib/tsd_seams.glsl"
-uniform sampler2D u_seam;
-#endif
 #define MAX_TAPS 31
 uniform sampler2D u_src;
 uniform sampler2D u_stretch;
@@ -22,25 +14,12 @@ uniform int u_taps;
 uniform float u_tap_t[MAX_TAPS];
 uniform float u_tap_w[MAX_TAPS];
 out vec4 f_color;
-
-vec4 tap(ivec2 q, float chart) {
-#ifdef TSD_SEAMS
-    return seam_tap(u_src, u_seam, q, chart, u_axis == 0);
-#else
-    return texelFetch(u_src, q, 0);
-#endif
-}
-
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     ivec2 last = textureSize(u_src, 0) - 1;
     ivec2 dir = u_axis == 0 ? ivec2(1, 0) : ivec2(0, 1);
     float mm = max(texelFetch(u_stretch, p, 0)[u_axis], TSD_MIN_MM_PER_TEXEL);
     float step_texels = min(u_sigma_mm / mm, TSD_MAX_STEP_TEXELS);
-    float chart = 0.0;
-#ifdef TSD_SEAMS
-    chart = texelFetch(u_seam, p, 0).b;
-#endif
     vec4 sum = vec4(0.0);
     for (int i = 0; i < MAX_TAPS; ++i) {
         if (i >= u_taps) break;
@@ -48,8 +27,8 @@ void main() {
         float fl = floor(x);
         float f = x - fl;
         int i0 = int(fl);
-        vec4 a = tap(clamp(p + dir * i0, ivec2(0), last), chart);
-        vec4 b = tap(clamp(p + dir * (i0 + 1), ivec2(0), last), chart);
+        vec4 a = texelFetch(u_src, clamp(p + dir * i0, ivec2(0), last), 0);
+        vec4 b = texelFetch(u_src, clamp(p + dir * (i0 + 1), ivec2(0), last), 0);
         sum += u_tap_w[i] * (a + (b - a) * f);
     }
     f_color = sum;

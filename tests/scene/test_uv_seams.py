@@ -127,3 +127,27 @@ def test_seam_band_from_the_kernel():
     assert seam_band_texels(k, 1.0) == 8  # 3 x 2 mm / 1 mm + 2 = 8 texels
     assert seam_band_texels(k, 0.5) == 16  # 14 -> 16
     assert seam_band_texels(k, 1e-3) == SEAM_BAND_MAX_TEXELS
+
+
+def test_border_bands_lie_outside_their_charts():
+    """Every chart border edge (the plane's outline, and both sides of the cut) gets a strip of gutter
+    `band` wide outside it: depth 0 on the edge, `band` at the far side, never over a chart."""
+    from scene.uv_seams import border_bands, border_edges
+
+    n, band = 8, 4.0 / TEXELS
+    assert len(border_edges(plane_mesh(None, n=n))[0]) == 4 * n
+    m = plane_mesh("rotate", n=n)
+    assert len(border_edges(m)[0]) == 6 * n
+    quads, depth = border_bands(m, band)
+    assert quads.shape == (12 * n, 3, 2) and set(np.unique(depth)) == {0.0, band}
+    f = m.indices.astype(int)
+    uv = m.uvs.astype(np.float64)[f]
+    lo, hi = uv.min((0, 1)), uv.max((0, 1))
+    for c in quads.mean(1):
+        a, b, cc = uv[:, 0], uv[:, 1], uv[:, 2]
+        w1 = (b[:, 0] - a[:, 0]) * (c[1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[0] - a[:, 0])
+        w2 = (cc[:, 0] - b[:, 0]) * (c[1] - b[:, 1]) - (cc[:, 1] - b[:, 1]) * (c[0] - b[:, 0])
+        w3 = (a[:, 0] - cc[:, 0]) * (c[1] - cc[:, 1]) - (a[:, 1] - cc[:, 1]) * (c[0] - cc[:, 0])
+        inside = ((w1 > 0) & (w2 > 0) & (w3 > 0)) | ((w1 < 0) & (w2 < 0) & (w3 < 0))
+        assert not inside.any()
+    assert (quads.min((0, 1)) >= lo - band - 1e-7).all() and (quads.max((0, 1)) <= hi + band + 1e-7).all()

@@ -7,7 +7,7 @@
   tsd_dilate      the gutter across seams filled from the seam map, then irradiance pushed past the
                   remaining chart borders (a few one-texel rings)
   tsd_blur        one Gaussian level of the chain: separable u then v, taps in mm via the stretch map;
-                  the u pass reads across seams through the seam map
+                  then the level's gutter filled across seams
 
 The kernel (variances, weights, taps) comes from scene/optics/tsd.py, which also holds the NumPy
 twin of the blur and gather. The gather is the technique's forward hook
@@ -257,7 +257,7 @@ class TsdDilatePass(TsdPass):
 
     def run(self, frame, p) -> None:
         t = self.node_targets(p)
-        if p.params.seams is not None:
+        if p.params.seams is not None:  # the gutter across seams, then dilation for the rest
             seam_fill(self.r, t, t.raw, t.irradiance)
             dilate(self.r, t, t.irradiance, t.irradiance, p.params.dilate)
         else:
@@ -282,7 +282,8 @@ class TsdSeamPass(TsdPass):
 
 
 def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture) -> None:
-    """Gutter texels the seam map marks take `src` across the seam (shaders/passes/tsd_seam_fill.frag)."""
+    """`src` into `dst` (another texture), the texels the seam map marks read across the seam
+    (shaders/passes/tsd_seam_fill.frag)."""
     ctx = renderer.ctx
     prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_seam_fill.frag")
     t.fbo(ctx, dst).use()
@@ -308,16 +309,12 @@ class TsdBlurPass(TsdPass):
         t = self.node_targets(p)
         src = t.irradiance if step.level == 0 else t.level(ctx, step.level - 1)
         dst = t.level(ctx, step.level)
-        seams = prm.seams is not None
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag", {"TSD_SEAMS": 1} if seams else {})
+        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
         taps_t, taps_w = blur_taps(step.taps)
         set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
         set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)
         set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_sigma_mm": step.sigma_mm, "u_taps": step.taps})
         t.stretch.use(1)
-        if seams:
-            t.seam_map(ctx).texture.use(2)
-            set_uniform(prog, "u_seam", 2)
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         for axis, (a, b) in enumerate(((src, t.scratch), (t.scratch, dst))):
             t.fbo(ctx, b).use()
@@ -325,6 +322,9 @@ class TsdBlurPass(TsdPass):
             a.use(0)
             set_uniform(prog, "u_axis", axis)
             self.r.fullscreen(prog)
+        if prm.seams is not None:  # the level's gutter across the seams, for the next blur and the gather
+            seam_fill(self.r, t, dst, t.scratch)
+            ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, t.scratch))
         self.publish(frame, p)
 
 

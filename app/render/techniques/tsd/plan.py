@@ -228,7 +228,7 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 "tsd_seams",
                 res,
                 f"light crosses UV seams: {seams_summary(t.seams, t.seam_band)} (unfolded once per mesh, "
-                "cached); the gutter is filled across seams and every blur's u pass reads through it",
+                "cached); the irradiance's gutter and every blurred level's are filled from across the seams",
                 TsdNodeParams(**base),
                 inputs=(node.mesh.uid, node.mesh.version, seam_key),
             )
@@ -292,7 +292,7 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 f"tsd_level{s.level}",
                 res,
                 f"Gaussian v={s.variance_mm2:.4g} mm2 (step sigma {s.sigma_mm:.3g} mm, {s.taps} taps), "
-                f"weight RGB ({w})",
+                f"weight RGB ({w})" + ("; gutter filled across UV seams" if t.seams is not None else ""),
                 TsdBlurParams(**base, step=s),
                 inputs=(s.level, s.sigma_mm, s.taps, seam_key),
                 after=(previous, stretch, *seam_after),

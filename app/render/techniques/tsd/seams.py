@@ -7,13 +7,17 @@ the surface across every UV seam into the gutter of each chart ("extension trian
   stretch's 10th percentile, where the kernel is widest in texels), capped at SEAM_BAND_MAX_TEXELS;
 - ``node_seams``: the cached extension of a node's mesh for a band (None where the mesh has no seam);
 - the pass ``tsd_seams``: the seam map (RG = the UV in the other chart, A = 1 where the gutter stands
-  for the surface across a seam), drawn with a depth test (the nearest seam edge wins where bands
-  overlap) under the real charts (which always win). View- and light-independent: reused until the
+  for the surface across a seam), drawn with a depth test - the distance from the edge: where
+  bands overlap, the nearest seam edge's extension wins, and every chart border's own strip keeps
+  the gutter nearest it (not filled: dilation) where no extension is nearer - under the real
+  charts (which always win). View- and light-independent: reused until the
   mesh or the band changes.
 
 The stretch pass also draws the extension triangles (their own mm per texel in this chart's frame);
 the dilation pass first fills the gutter from the seam map (shaders/passes/tsd_seam_fill.frag), and
-every blur's u pass reads marked gutter texels across the seam (variant TSD_SEAMS of tsd_blur.frag).
+so does every blur pass after its v step: the next blur's u step then reads, in the gutter, the
+previous level across the seam (its v step reads the u step's gutter texels as they are: the u blur
+in this chart's frame, continued), and the gather's bilinear lookup at a border reads across too.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ from scene.optics.constants import TSD_TAP_RANGE
 from scene.uv_seams import SeamExtension, seam_extension
 
 SEAM_BAND_MAX_TEXELS = 64  # widest extension band past a seam (texels); wider kernels read dilation beyond
+BORDER_BIAS = 1e-3  # a border strip's depth offset (x the band): its own extension wins a tie
 SEAM_BAND_ROUND = 8  # bands are rounded up to a multiple of this (a small kernel change keeps the cache)
 
 _CACHE: dict = {}
@@ -84,19 +89,21 @@ class SeamMap:
         if self.source != key:
             self.release_vertices()
             real = mesh.uvs[mesh.indices.reshape(-1)]
-            n_ext = 3 * ext.triangles
-            data = np.zeros((n_ext + len(real), 6), np.float32)
+            n_ext, n_border = 3 * ext.triangles, ext.border_uv.shape[0] * 3
+            data = np.zeros((n_ext + n_border + len(real), 5), np.float32)
             data[:n_ext, 0:2] = ext.uv.reshape(-1, 2)
             data[:n_ext, 2:4] = ext.src_uv.reshape(-1, 2)
             data[:n_ext, 4] = np.maximum(ext.depth.reshape(-1), 0.0)
-            data[:n_ext, 5] = np.repeat(ext.chart[ext.owner] + 1, 3)
-            data[n_ext:, 0:2] = real
-            data[n_ext:, 4] = -1.0  # the real charts: always in front
-            data[n_ext:, 5] = np.repeat(ext.chart + 1, 3)
+            # the borders' own strips: no source (src < 0: not filled), a hair behind an extension
+            # at the same distance (an edge's own extension wins over its own strip)
+            b = slice(n_ext, n_ext + n_border)
+            data[b, 0:2] = ext.border_uv.reshape(-1, 2)
+            data[b, 2:4] = -1.0
+            data[b, 4] = ext.border_depth.reshape(-1) + BORDER_BIAS * ext.band_uv
+            data[n_ext + n_border :, 0:2] = real
+            data[n_ext + n_border :, 4] = -1.0  # the real charts: always in front
             self.vbo = self.ctx.buffer(data.tobytes())
-            self.vao = self.ctx.vertex_array(
-                prog, [(self.vbo, "2f 2f 1f 1f", "in_uv", "in_src", "in_depth", "in_chart")]
-            )
+            self.vao = self.ctx.vertex_array(prog, [(self.vbo, "2f 2f 1f", "in_uv", "in_src", "in_depth")])
             self.source = key
         size = self.texture.size[0]
         self.fbo.use()
