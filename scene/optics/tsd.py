@@ -224,6 +224,32 @@ def design_kernel(
 # Arrays are (rows = v, columns = u, channels), row 0 at v = 0 (as the GPU texture is read back).
 
 
+def seam_bilinear_reference(src: np.ndarray, uv: np.ndarray) -> np.ndarray:
+    """Twin of shaders/lib/tsd_seams.glsl seam_bilinear: src (H, W, C) read bilinearly at uv (..., 2)
+    (texel centres at (i + 0.5) / size, clamped at the edges), float32 like the shader."""
+    src = np.asarray(src, np.float32)
+    H, W, _ = src.shape
+    x = np.asarray(uv, np.float32) * np.array([W, H], np.float32) - np.float32(0.5)
+    fl = np.floor(x)
+    f = (x - fl).astype(np.float32)
+    i = fl.astype(np.int64)
+
+    def at(dx, dy):
+        return src[np.clip(i[..., 1] + dy, 0, H - 1), np.clip(i[..., 0] + dx, 0, W - 1)]
+
+    lo = at(0, 0) + (at(1, 0) - at(0, 0)) * f[..., 0:1]
+    hi = at(0, 1) + (at(1, 1) - at(0, 1)) * f[..., 0:1]
+    return lo + (hi - lo) * f[..., 1:2]
+
+
+def seam_fill_reference(src: np.ndarray, seam: np.ndarray) -> np.ndarray:
+    """Twin of shaders/passes/tsd_seam_fill.frag: the texels the seam map (H, W, 4: RG source UV, A
+    marked) marks take src at the seam map's UV; the rest are copied."""
+    src = np.asarray(src, np.float32)
+    across = seam_bilinear_reference(src, seam[..., :2])
+    return np.where((seam[..., 3] > 0.5)[..., None], across, src).astype(np.float32)
+
+
 def blur_axis_reference(src: np.ndarray, mm_per_texel: np.ndarray, sigma_mm: float, taps: int, axis: str) -> np.ndarray:
     """One 1-D pass of shaders/passes/tsd_blur.frag: src (H, W, 4) premultiplied, mm_per_texel
     (H, W, 2) (u, v); axis 'u' (columns) or 'v' (rows). float32 arithmetic like the shader."""
@@ -241,24 +267,26 @@ def blur_axis_reference(src: np.ndarray, mm_per_texel: np.ndarray, sigma_mm: flo
         f = (x - fl)[..., None]
         i0 = fl.astype(np.int64)
         if d == 0:
-            a = src[rows, np.clip(cols + i0, 0, W - 1)]
-            b = src[rows, np.clip(cols + i0 + 1, 0, W - 1)]
+            ra, ca, rb, cb = rows, np.clip(cols + i0, 0, W - 1), rows, np.clip(cols + i0 + 1, 0, W - 1)
         else:
-            a = src[np.clip(rows + i0, 0, H - 1), cols]
-            b = src[np.clip(rows + i0 + 1, 0, H - 1), cols]
+            ra, ca, rb, cb = np.clip(rows + i0, 0, H - 1), cols, np.clip(rows + i0 + 1, 0, H - 1), cols
+        a, b = src[ra, ca], src[rb, cb]
         out += wi * (a + (b - a) * f)
     return out
 
 
-def diffuse_reference(irradiance: np.ndarray, stretch: np.ndarray, kernel: DiffusionKernel):
+def diffuse_reference(irradiance: np.ndarray, stretch: np.ndarray, kernel: DiffusionKernel, seam=None):
     """The whole diffusion step in NumPy: returns (levels, diffused) where levels are the
     premultiplied blurred textures (like the GPU's) and diffused (H, W, 3) is I E + sum_k W_k level_k
-    (each level divided by its coverage)."""
+    (each level divided by its coverage). `seam`: the seam map; each level's gutter is then filled
+    across the seams (seam_fill_reference), as the blur pass does."""
     cur = np.asarray(irradiance, np.float32)
     levels = []
     for s in kernel.steps:
         cur = blur_axis_reference(cur, stretch, s.sigma_mm, s.taps, "u")
         cur = blur_axis_reference(cur, stretch, s.sigma_mm, s.taps, "v")
+        if seam is not None:
+            cur = seam_fill_reference(cur, seam)
         levels.append(cur)
     return levels, gather_reference(irradiance, levels, kernel)
 

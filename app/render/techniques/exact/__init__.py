@@ -31,6 +31,7 @@ class ExactSettings(TechniqueSettings):
         0.5, "pre-/post-scatter texturing: albedo^mix before the convolution", "float", range=(0, 1)
     )
     translucency: bool = option(True, "light through thin parts (needs a shadow-casting light)", "bool")
+    seams: bool = option(True, "light crosses UV seams (seam map; off: blurs stop at chart borders)", "bool")
 
 
 class ExactTechnique(Technique):
@@ -45,7 +46,7 @@ class ExactTechnique(Technique):
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options
         passes, nodes, translucency = plan_tsd(
-            ctx, o.size, FIT_GAUSSIANS, None, o.albedo_mix, o.translucency, exact=True
+            ctx, o.size, FIT_GAUSSIANS, None, o.albedo_mix, o.translucency, exact=True, seams=o.seams
         )
         return TechniquePlan(TsdForward(len(nodes)), before_forward=passes, shadow_distance=translucency)
 

@@ -13,12 +13,22 @@ from app.render.technique import LedgerStyle, PlanContext, Technique, TechniqueP
 from scene.optics.edges import gaussians_edge, step_edge
 
 from .forward import TsdForward
-from .passes import MAX_TAPS, STATE_KEY, TsdBlurPass, TsdDilatePass, TsdIrradiancePass, TsdStore, TsdStretchPass
+from .passes import (
+    MAX_TAPS,
+    STATE_KEY,
+    TsdBlurPass,
+    TsdDilatePass,
+    TsdIrradiancePass,
+    TsdSeamPass,
+    TsdStore,
+    TsdStretchPass,
+)
 from .plan import TsdBlurParams, TsdIrradianceParams, plan_tsd
 
 PASSES = {
     "tsd_stretch": TsdStretchPass,
     "tsd_irradiance": TsdIrradiancePass,
+    "tsd_seams": TsdSeamPass,
     "tsd_dilate": TsdDilatePass,
     "tsd_blur": TsdBlurPass,
 }
@@ -44,6 +54,7 @@ class TsdSettings(TechniqueSettings):
     )
     albedo_mix: float = option(0.5, "pre-/post-scatter texturing: albedo^mix before the blur", "float", range=(0, 1))
     translucency: bool = option(True, "light through thin parts (needs a shadow-casting light)", "bool")
+    seams: bool = option(True, "light crosses UV seams (seam map; off: blurs stop at chart borders)", "bool")
 
 
 class TsdTechnique(Technique):
@@ -58,7 +69,9 @@ class TsdTechnique(Technique):
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options
-        passes, nodes, translucency = plan_tsd(ctx, o.size, o.gaussians, o.taps, o.albedo_mix, o.translucency)
+        passes, nodes, translucency = plan_tsd(
+            ctx, o.size, o.gaussians, o.taps, o.albedo_mix, o.translucency, seams=o.seams
+        )
         return TechniquePlan(TsdForward(len(nodes)), before_forward=passes, shadow_distance=translucency)
 
     def edge_response(self, model, medium, plan: FramePlan):

@@ -2,8 +2,12 @@
 
   tsd_stretch     world mm per texel along u and v (only when the geometry or scene scale changes)
   tsd_irradiance  light entering the surface, rasterised at the UVs, x albedo^mix
-  tsd_dilate      irradiance pushed past chart borders (a few one-texel rings)
-  tsd_blur        one Gaussian level of the chain: separable u then v, taps in mm via the stretch map
+  tsd_seams       the seam map: the gutter across UV seams paired with texels of the other chart
+                  (seams.py; only for meshes with seams; when the mesh changes)
+  tsd_dilate      the gutter across seams filled from the seam map, then irradiance pushed past the
+                  remaining chart borders (a few one-texel rings)
+  tsd_blur        one Gaussian level of the chain: separable u then v, taps in mm via the stretch map;
+                  then the level's gutter filled across seams
 
 The kernel (variances, weights, taps) comes from scene/optics/tsd.py, which also holds the NumPy
 twin of the blur and gather. The gather is the technique's forward hook
@@ -26,6 +30,7 @@ from app.render.translucency import bind_translucency
 from scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
+from .seams import SeamMap
 
 STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
@@ -53,6 +58,7 @@ class TsdNodeTargets:
     raw: moderngl.Texture
     levels: list = field(default_factory=list)
     fbos: dict = field(default_factory=dict)
+    seam: SeamMap | None = None  # the seam map (meshes with UV seams)
 
     def fbo(self, ctx, tex: moderngl.Texture) -> moderngl.Framebuffer:
         f = self.fbos.get(id(tex))
@@ -65,11 +71,18 @@ class TsdNodeTargets:
             self.levels.append(_texture(ctx, self.size))
         return self.levels[k]
 
+    def seam_map(self, ctx) -> SeamMap:
+        if self.seam is None:
+            self.seam = SeamMap(ctx, self.size)
+        return self.seam
+
     def release(self) -> None:
         for f in self.fbos.values():
             f.release()
         for t in [self.irradiance, self.scratch, self.stretch, self.raw, *self.levels]:
             t.release()
+        if self.seam is not None:
+            self.seam.release()
 
 
 @dataclass
@@ -186,6 +199,8 @@ class TsdStretchPass(TsdPass):
         units = TextureUnits(ctx)
         for sampler, (path, cs) in radius_map.items():
             units.bind(prog, sampler, self.r.resources.texture(path, cs))
+        if prm.seams is not None:  # the surface across seams, in the gutter: drawn first, the charts win
+            self.r.resources.mesh(prm.seams.mesh()).vao(prog).render(moderngl.TRIANGLES)
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         dilate(self.r, t, t.stretch, t.stretch, prm.dilate)
         store(self.r).stretch_updates += 1
@@ -244,8 +259,42 @@ class TsdDilatePass(TsdPass):
 
     def run(self, frame, p) -> None:
         t = self.node_targets(p)
-        dilate(self.r, t, t.raw, t.irradiance, p.params.dilate)
+        if p.params.seams is not None:  # the gutter across seams, then dilation for the rest
+            seam_fill(self.r, t, t.raw, t.irradiance)
+            dilate(self.r, t, t.irradiance, t.irradiance, p.params.dilate)
+        else:
+            dilate(self.r, t, t.raw, t.irradiance, p.params.dilate)
         self.publish(frame, p)
+
+
+class TsdSeamPass(TsdPass):
+    """The seam map of one node (seams.py)."""
+
+    def output(self, t, p):
+        return t.seam_map(self.r.ctx).texture
+
+    def publish(self, frame, p) -> None:
+        frame.targets[f"tsd_seams[{p.params.node.name}]"] = self.output(self.node_targets(p), p)
+
+    def run(self, frame, p) -> None:
+        t = self.node_targets(p)
+        prog = self.r.programs.get("passes/tsd_seam.vert", "passes/tsd_seam.frag")
+        t.seam_map(self.r.ctx).draw(prog, p.params.seams, p.params.node.mesh)
+        self.publish(frame, p)
+
+
+def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture) -> None:
+    """`src` into `dst` (another texture), the texels the seam map marks read across the seam
+    (shaders/passes/tsd_seam_fill.frag)."""
+    ctx = renderer.ctx
+    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_seam_fill.frag")
+    t.fbo(ctx, dst).use()
+    ctx.viewport = (0, 0, t.size, t.size)
+    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+    src.use(0)
+    t.seam_map(ctx).texture.use(1)
+    set_uniforms(prog, {"u_src": 0, "u_seam": 1})
+    renderer.fullscreen(prog)
 
 
 class TsdBlurPass(TsdPass):
@@ -275,6 +324,9 @@ class TsdBlurPass(TsdPass):
             a.use(0)
             set_uniform(prog, "u_axis", axis)
             self.r.fullscreen(prog)
+        if prm.seams is not None:  # the level's gutter across the seams, for the next blur and the gather
+            seam_fill(self.r, t, dst, t.scratch)
+            ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, t.scratch))
         self.publish(frame, p)
 
 

@@ -22,6 +22,8 @@ from scene.optics.translucency_reach import REACH_EPS, translucency_reach_mm
 from scene.optics.tsd import BlurStep, DiffusionKernel, design_kernel, material_medium, profile_fit
 from scene.uv_checks import analyse_uvs
 
+from .seams import node_seams, seam_band_texels, seams_summary
+
 DILATE_RINGS = 4  # texels of dilation past chart borders (irradiance and stretch)
 
 
@@ -51,6 +53,8 @@ class TsdNodePlan:
     material: object
     kernel: DiffusionKernel
     size: int
+    seams: object = None  # the mesh's SeamExtension (scene/uv_seams.py), None: no seams or switched off
+    seam_band: int = 0  # texels the extension reaches past each seam
 
 
 # -- the passes' typed parameters ----------------------------------------------------------------------
@@ -65,6 +69,7 @@ class TsdNodeParams:
     material: object  # the effective material
     kernel: DiffusionKernel  # the Gaussian chain (and the translucency's Gaussians)
     dilate: int = DILATE_RINGS
+    seams: object = None  # SeamExtension: light crosses UV seams (seams.py); None: not used
 
 
 @dataclass
@@ -90,7 +95,7 @@ class TsdExactParams(TsdNodeParams):
 UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.zeros(3))
 
 
-def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None) -> TsdNodePlan | None:
+def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None, seams: bool = True) -> TsdNodePlan | None:
     """Decide TSD for one visible mesh node (PlanContext `ctx`); record skips and warnings in its plan."""
     label = f"tsd[{node.name}]"
     plan, scene = ctx.plan, ctx.scene
@@ -129,15 +134,31 @@ def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None) -> Tsd
             (label, "every Gaussian of the profile is narrower than a texel or negligible; plain diffuse")
         )
         return None
-    return TsdNodePlan(node, mat, kernel, size)
+    if not seams:
+        plan.skipped.append((f"tsd_seams[{node.name}]", "switched off in the settings: blurs stop at UV seams"))
+        return TsdNodePlan(node, mat, kernel, size)
+    band = seam_band_texels(kernel, p10)
+    ext = node_seams(mesh, band, size)
+    if ext is None:
+        plan.skipped.append((f"tsd_seams[{node.name}]", f"mesh {mesh.name!r} has no UV seam"))
+    return TsdNodePlan(node, mat, kernel, size, ext, band)
 
 
-def plan_tsd(ctx, size: int, gaussians: int, taps: int | None, mix: float, translucency: bool, exact: bool = False):
-    """The texture-space passes of every scattering mesh (stretch, irradiance, dilation, then the
-    Gaussian blurs, or with `exact` the brute-force convolution) and whether translucency runs;
-    (passes, node plans, translucency)."""
+def plan_tsd(
+    ctx,
+    size: int,
+    gaussians: int,
+    taps: int | None,
+    mix: float,
+    translucency: bool,
+    exact: bool = False,
+    seams: bool = True,
+):
+    """The texture-space passes of every scattering mesh (stretch, the seam map where the mesh has
+    UV seams and `seams` is on, irradiance, dilation, then the Gaussian blurs, or with `exact` the
+    brute-force convolution) and whether translucency runs; (passes, node plans, translucency)."""
     plan = ctx.plan
-    nodes = [t for t in (plan_tsd_node(n, ctx, size, gaussians, taps) for n in ctx.meshes) if t is not None]
+    nodes = [t for t in (plan_tsd_node(n, ctx, size, gaussians, taps, seams) for n in ctx.meshes) if t is not None]
     use_translucency = plan_translucency(ctx, bool(nodes), translucency)
     if not nodes:
         plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
@@ -210,9 +231,12 @@ def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tu
 
 def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
     node, n, k = t.node, t.size, t.kernel
-    base = dict(node=node, size=n, material=t.material, kernel=k, dilate=DILATE_RINGS)
+    base = dict(node=node, size=n, material=t.material, kernel=k, dilate=DILATE_RINGS, seams=t.seams)
     res = (n, n)
     stretch, irradiance, dilated = (f"tsd_{x}[{node.name}]" for x in ("stretch", "irradiance", "dilate"))
+    seam_key = (t.seam_band, t.seams.band_uv) if t.seams is not None else None
+    seam_pass = f"tsd_seams[{node.name}]"
+    seam_after = (seam_pass,) if t.seams is not None else ()
     out = [
         PlannedPass(
             stretch,
@@ -221,9 +245,22 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
             res,
             f"mm per texel of '{node.mesh.name}' (depends on the geometry and the scene scale)",
             TsdNodeParams(**base),
-            inputs=(stretch_inputs(node, ctx.scene), DILATE_RINGS),
+            inputs=(stretch_inputs(node, ctx.scene), DILATE_RINGS, seam_key),
         )
     ]
+    if t.seams is not None:
+        out.append(
+            PlannedPass(
+                seam_pass,
+                "tsd_seams",
+                "tsd_seams",
+                res,
+                f"light crosses UV seams: {seams_summary(t.seams, t.seam_band)} (unfolded once per mesh, "
+                "cached); the irradiance's gutter and every blurred level's are filled from across the seams",
+                TsdNodeParams(**base),
+                inputs=(node.mesh.uid, node.mesh.version, seam_key),
+            )
+        )
     out.append(
         PlannedPass(
             irradiance,
@@ -250,10 +287,11 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
             "tsd_dilate",
             "tsd_irradiance",
             res,
-            f"push irradiance {DILATE_RINGS} texels past UV chart borders (seams)",
+            ("fill the gutter across UV seams from the seam map, then push" if t.seams is not None else "push")
+            + f" irradiance {DILATE_RINGS} texels past UV chart borders",
             TsdNodeParams(**base),
-            inputs=(DILATE_RINGS,),
-            after=(irradiance,),
+            inputs=(DILATE_RINGS, seam_key),
+            after=(irradiance, *seam_after),
         )
     )
     if exact:
@@ -282,10 +320,10 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 f"tsd_level{s.level}",
                 res,
                 f"Gaussian v={s.variance_mm2:.4g} mm2 (step sigma {s.sigma_mm:.3g} mm, {s.taps} taps), "
-                f"weight RGB ({w})",
+                f"weight RGB ({w})" + ("; gutter filled across UV seams" if t.seams is not None else ""),
                 TsdBlurParams(**base, step=s),
-                inputs=(s.level, s.sigma_mm, s.taps),
-                after=(previous, stretch),
+                inputs=(s.level, s.sigma_mm, s.taps, seam_key),
+                after=(previous, stretch, *seam_after),
             )
         )
         previous = name
