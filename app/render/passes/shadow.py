@@ -13,7 +13,7 @@ from scene import transform as tf
 from scene.graph import LightNode
 
 # maps clip space [-1, 1] to texture space [0, 1]
-_BIAS = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1.0]])
+CLIP_TO_TEXTURE = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1.0]])
 
 
 FIT_MARGIN = 0.01  # the fitted box grows by this fraction of its size each side (no geometry on the clip planes)
@@ -105,7 +105,7 @@ class ShadowPass:
         frame.shadow_eyes[slot] = light_eye(light)
         if dist is not None:
             frame.targets[f"shadow_distance{slot}"] = dist
-        frame.shadow_matrices[slot] = _BIAS @ light_view_proj(light, *frame.scene.world_bounds())
+        frame.shadow_matrices[slot] = CLIP_TO_TEXTURE @ light_view_proj(light, *frame.scene.world_bounds())
 
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
