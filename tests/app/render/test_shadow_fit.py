@@ -109,6 +109,6 @@ def test_the_subsurface_frame_moves_the_shadow_edge_by_the_oblique_entry_offset(
 
     plain = edge("none")
     assert 0.6 < offset_px < 1.0  # skin1: z0 = 1 mm (luminance), 0.81 px
-    for technique in ("tsd", "ssss", "disk"):
+    for technique in ("tsd", "ssss", "disk", "preintegrated"):
         moved = plain - edge(technique)
         assert 0.3 < moved < offset_px, (technique, moved, offset_px)
