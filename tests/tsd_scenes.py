@@ -80,3 +80,22 @@ def exact_profile(model, medium):
     from scene.optics.tsd import MODEL_PROFILES
 
     return lambda r: get_profile(MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
+
+
+def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab") -> float:
+    """How far (mm, along +x) slab_scene's shadow edge moves for the light feeding the diffusion:
+    the light travels along (1, 0, -1), so the diffusion is centred sin(theta_t) z0 further along +x
+    than where the light entered (oblique entry, scene/optics/oblique.py; the frame looks the shadow
+    up at the entry point). Edge responses of the multiply scattered light are centred there. The
+    light is sampled at the centres of a grid of grid_mm (irradiance texels, or pixels for the
+    screen-space techniques) whose boundaries fall on x = 0: the sampled edge moves by the shift
+    rounded to whole cells."""
+    from scene.optics.boundary import slab_parameters
+    from scene.optics.oblique import entry_offset
+    from scene.optics.tsd import material_medium
+
+    medium = material_medium(scene.find(node).material.values)
+    z0 = slab_parameters(medium.alpha_arr, medium.mfp_arr, medium.eta)[1]
+    to_light = -scene.lights()[0].direction
+    off = entry_offset(np.array([[0.0, 0.0, 1.0]]), to_light[None], z0, medium.eta, 1.0)[0]
+    return float(np.round(-off[0] / grid_mm) * grid_mm)

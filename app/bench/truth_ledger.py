@@ -10,6 +10,10 @@ once more at that size (untimed), and records:
 * ``truth_energy``: the largest per-channel energy difference over the object;
 * ``truth_noise`` / ``truth_noise_block``: the reference's own noise floor (the same measures
   between the halves of its passes), printed beside each figure: differences below it are noise;
+* ``truth_blocks8_over`` / ``truth_blocks8_judged`` / ``truth_blocks8_over_frac``: issue 12's block
+  target, the 8 x 8 blocks more than 15 % off the truth among those its noise allows to judge
+  (app/truth/compare.py ``judged_blocks``: half-to-half block noise below 5 %, not dark), their
+  number and their fraction;
 * a signed relative-difference image per setting (red: brighter than the truth, blue: darker, one
   scale for all), and a contact sheet of them.
 """
@@ -22,7 +26,16 @@ from pathlib import Path
 
 import numpy as np
 
-from app.truth.compare import MAP_SCALE, error_map_rgb, image_error, relative_difference
+from app.truth.compare import (
+    JUDGE_BLOCK,
+    JUDGE_NOISE,
+    JUDGE_TOL,
+    MAP_SCALE,
+    error_map_rgb,
+    image_error,
+    judged_blocks,
+    relative_difference,
+)
 
 REFERENCE_SCENES = Path(__file__).resolve().parents[2] / "assets" / "scenes" / "reference"
 TRUTH_COLUMNS = [
@@ -31,6 +44,9 @@ TRUTH_COLUMNS = [
     "truth_energy",
     "truth_noise",
     "truth_noise_block",
+    "truth_blocks8_over",
+    "truth_blocks8_judged",
+    "truth_blocks8_over_frac",
 ]
 
 
@@ -71,12 +87,16 @@ def load_truth(scene, spec: TruthSpec, render: bool = False, progress: bool = Tr
 def truth_errors(img: np.ndarray, truth) -> dict:
     e = image_error(img, truth.image)
     finite = [abs(x) for x in e["energy"] if math.isfinite(x)]
+    j = judged_blocks(img, truth.image, truth.half_a, truth.half_b)
     return {
         "truth_rel_l1": e["rel_l1"],
         "truth_rel_l1_block": e["rel_l1_block"],
         "truth_energy": max(finite) if finite else math.nan,
         "truth_noise": truth.noise["rel_l1"],
         "truth_noise_block": truth.noise["rel_l1_block"],
+        "truth_blocks8_over": j["over"],
+        "truth_blocks8_judged": j["judged"],
+        "truth_blocks8_over_frac": j["over_fraction"],
     }
 
 
@@ -128,6 +148,13 @@ def _pct(v) -> str:
     return "" if v is None or not isinstance(v, (int, float)) or not math.isfinite(v) else f"{100 * v:.1f} %"
 
 
+def _blocks(r: dict) -> str:
+    over, judged = r.get("truth_blocks8_over"), r.get("truth_blocks8_judged")
+    if not isinstance(over, int) or not isinstance(judged, int):
+        return ""
+    return f"{over} / {judged}"
+
+
 def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
     """The ledger's section against the truth: a table of settings x scenes (error on 4x4 blocks,
     the reference's noise floor beside it), what is missing, and the error maps."""
@@ -164,6 +191,18 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
         ms = [m for m in ms if isinstance(m, (int, float)) and math.isfinite(m)]
         mean_ms = f"{sum(ms) / len(ms):.1f}" if ms else ""
         L.append(f"| {labl} | " + " | ".join(cells) + f" | {mean_ms} |")
+    L += [
+        "",
+        f"{JUDGE_BLOCK}x{JUDGE_BLOCK}-pixel blocks more than {100 * JUDGE_TOL:.0f} % off the truth (luminance) of "
+        f"those its noise allows to judge (half-to-half block noise below {100 * JUDGE_NOISE:.0f} %, not dark): "
+        "over / judged.",
+        "",
+        "| setting | " + " | ".join(scenes) + " |",
+        "|---|" + "---|" * len(scenes),
+    ]
+    for labl, per in by_label.items():
+        cells = [_blocks(per[s]) if s in per else "" for s in scenes]
+        L.append(f"| {labl} | " + " | ".join(cells) + " |")
     L += [
         "",
         "Error maps: `error_maps/SCENE-SETTING.png` for every setting, `error_maps.png` for one setting per "

@@ -179,3 +179,9 @@ GLSL_CONSTANTS.update(
         "COVERAGE_EPS": COVERAGE_EPS,
     }
 )
+
+# Luminance weights of linear Rec. 709 / sRGB primaries (ITU-R BT.709-6, item 3.2): one figure
+# from three channels where a single value must stand for all (the oblique entry offset,
+# scene/optics/oblique.py).
+LUMA_R, LUMA_G, LUMA_B = 0.2126, 0.7152, 0.0722
+GLSL_CONSTANTS.update({"LUMA_R": LUMA_R, "LUMA_G": LUMA_G, "LUMA_B": LUMA_B})

@@ -10,6 +10,7 @@
 // it leaves within about a mean free path of where it entered, so no technique blurs it.
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
+#include "lib/sss_oblique.glsl"
 #include "lib/lights.glsl"
 #include "skinlab/material.glsl"
 
@@ -67,7 +68,10 @@ void main() {
         vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
         color += e * vis * (diffuse + spec) * NoL;
         if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
-        sss_add_light(e, vis, NoL);
+        // the technique's diffusion: shadowed where it entered (oblique entry, lib/sss_oblique.glsl)
+        vec3 z0 = u_sss_z0 * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
+        vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
+        sss_add_light(e, u_light_shadow[i] >= 0 ? light_visibility(i, entry, dot(ng, l)) : 1.0, NoL);
     }
     color += u_ambient * occlusion * (base * ((1.0 - u_metallic) * plain) + f0);
     color += sss_radiance(base, NoV, occlusion, v_uv);

@@ -1,4 +1,6 @@
-"""Shadow maps: depth from a light, fitted to the scene's bounding sphere."""
+"""Shadow maps: depth from a light. A directional light's orthographic map is fitted to the scene's
+bounding box as the light sees it (the box's corners in light space), so that its texels are as
+small as the box allows; a point light's perspective map is fitted to the bounding sphere."""
 
 from __future__ import annotations
 
@@ -11,7 +13,15 @@ from scene import transform as tf
 from scene.graph import LightNode
 
 # maps clip space [-1, 1] to texture space [0, 1]
-_BIAS = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1.0]])
+CLIP_TO_TEXTURE = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1.0]])
+
+
+FIT_MARGIN = 0.01  # the fitted box grows by this fraction of its size each side (no geometry on the clip planes)
+
+
+def box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The 8 corners of an axis-aligned box, (8, 3)."""
+    return np.array([[(lo, hi)[i >> k & 1][k] for k in range(3)] for i in range(8)], np.float64)
 
 
 def light_view_proj(light: LightNode, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -21,7 +31,15 @@ def light_view_proj(light: LightNode, lo: np.ndarray, hi: np.ndarray) -> np.ndar
         d = light.direction
         eye = centre - d * 2 * radius
         view = np.linalg.inv(tf.compose(eye, tf.look_at_rotation(eye, centre), np.ones(3)))
-        return tf.orthographic(radius, radius, radius * 0.5, radius * 3.5) @ view
+        # the box's extent across and along the light: the map covers exactly that (plus a margin),
+        # not the bounding sphere's square (up to 1.7x smaller texels on a flat scene)
+        c = box_corners(lo, hi) @ view[:3, :3].T + view[:3, 3]
+        pad = FIT_MARGIN * (c.max(0) - c.min(0)) + 1e-6 * radius
+        x0, y0, z0 = c.min(0) - pad
+        x1, y1, z1 = c.max(0) + pad
+        shift = np.eye(4)
+        shift[:2, 3] = -(x0 + x1) / 2, -(y0 + y1) / 2
+        return tf.orthographic((x1 - x0) / 2, (y1 - y0) / 2, -z1, -z0) @ shift @ view
     pos = light.world_position
     dist = float(np.linalg.norm(centre - pos))
     if dist <= radius * 1.01:
@@ -87,7 +105,7 @@ class ShadowPass:
         frame.shadow_eyes[slot] = light_eye(light)
         if dist is not None:
             frame.targets[f"shadow_distance{slot}"] = dist
-        frame.shadow_matrices[slot] = _BIAS @ light_view_proj(light, *frame.scene.world_bounds())
+        frame.shadow_matrices[slot] = CLIP_TO_TEXTURE @ light_view_proj(light, *frame.scene.world_bounds())
 
     def run(self, frame, p) -> None:
         ctx = self.r.ctx

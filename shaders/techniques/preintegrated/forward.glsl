@@ -15,6 +15,7 @@
 #include "lib/sss_translucency.glsl"
 #endif
 #include "lib/sss_maps.glsl"
+#include "lib/sss_oblique.glsl"
 #include "lib/preintegrated.glsl"
 
 in float v_curvature;            // 1/scene unit (forward.vert)
@@ -51,7 +52,10 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
         float nlg = dot(ng, l);
         // shadow maps only where the light faces the surface; past the terminator the ring's light
         // comes from the lit side
-        float vis = (u_light_shadow[i] >= 0 && nlg > 0.0) ? light_visibility(i, v_world, nlg) : 1.0;
+        // (looked up where the light entered: oblique entry, lib/sss_oblique.glsl)
+        vec3 z0 = u_sss_z0 * sss_radius_scale_at(v_uv);
+        vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
+        float vis = (u_light_shadow[i] >= 0 && nlg > 0.0) ? light_visibility(i, entry, nlg) : 1.0;
 #ifdef HAS_NORMAL_MAP
         vec3 D = vec3(pis_lookup(u_pis_lut, u_pis_lut_size, dot(nr, l), t).r,
                       pis_lookup(u_pis_lut, u_pis_lut_size, dot(nG, l), t).g,

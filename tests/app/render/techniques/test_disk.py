@@ -10,7 +10,7 @@ from app.render.settings import RenderSettings
 from app.render.techniques.disk import DiskSettings
 from scene.graph import MeshNode
 from scene.optics import burley, disk, tsd
-from tests.tsd_scenes import exact_profile, pixel_x, quad_mesh, skin, slab_scene
+from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 
 def medium(radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5)):
@@ -83,7 +83,9 @@ def test_rendered_edge_follows_the_kernel_and_keeps_energy(renderer, multiple_on
     renormalised)."""
     n = 160
     scene = slab_scene(occluder=True, material=skin("burley"))
-    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit
+    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
+        scene, 2 * scene.mm_per_unit / n
+    )  # where the light entered
     for samples in (16, 64):
         res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, technique=DiskSettings(samples=samples)))
         assert [p.kind for p in res.plan.passes] == ["shadow", "forward", "disk_sss", "tonemap"]

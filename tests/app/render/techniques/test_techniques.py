@@ -10,7 +10,7 @@ from app.render.techniques.ssss import SsssSettings
 from app.render.techniques.tsd import TsdSettings
 from app.render.techniques.tsd.passes import frame_nodes, read_texture
 from scene.optics import ssss, tsd
-from tests.tsd_scenes import exact_profile, pixel_x, skin, slab_scene
+from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, skin, slab_scene
 
 
 def edge_row(res, n):
@@ -28,7 +28,9 @@ def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer
     t = frame_nodes(renderer.last_frame)[scene.find("slab").uid]
     medium = tsd.material_medium(t.material.values)
     row, lit = edge_row(res, n)
-    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit
+    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
+        scene, 2 * scene.mm_per_unit / n
+    )  # where the light entered
     edge = tsd.edge_response(-x_mm, exact_profile(model, medium), "profile")
     err = np.abs(row / lit - edge)
     assert err.max() < 0.03, (err.max(axis=0), int(err.argmax()) // 3)
@@ -56,7 +58,9 @@ def test_screen_space_sss_follows_its_separable_kernel(renderer, multiple_only):
         plan = res.plan.passes[2].params.ssss
         assert len(plan.offsets_mm) == taps
         row, lit = edge_row(res, n)
-        x_mm = pixel_x(n, 1.0) * scene.mm_per_unit
+        x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
+            scene, 2 * scene.mm_per_unit / n
+        )  # where the light entered
         own = ssss.separable_edge_response(-x_mm, plan.offsets_mm, plan.weights)
         err = np.abs(row / lit - own)
         assert err.max() < 0.02 + 1.0 / taps, (taps, err.max(axis=0))

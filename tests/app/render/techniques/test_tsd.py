@@ -10,7 +10,7 @@ from scene.mesh import Mesh
 from scene.optics import tsd
 from scene.optics.boundary import boundary_tables, slab_single_transmittance, slab_transmittance, table_lookup
 from scene.optics.single_scattering import single_scatter_brdf
-from tests.tsd_scenes import exact_profile, pixel_x, quad_mesh, skin, slab_scene
+from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 
 def tsd_node(renderer, scene, name="slab"):
@@ -94,7 +94,9 @@ def test_shadow_edge_follows_the_profile_edge_response(renderer, model, multiple
     t = tsd_node(renderer, scene)
     row = res.hdr[n // 2, :, :3].astype(np.float64)
     lit = row[-8:].mean(axis=0)
-    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit
+    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
+        scene, 2 * scene.mm_per_unit / n
+    )  # where the light entered
     edge = tsd.edge_response(-x_mm, exact_profile(model, tsd.material_medium(t.material.values)), "profile")
     err = np.abs(row / lit - edge)
     assert np.all(np.isfinite(err))
