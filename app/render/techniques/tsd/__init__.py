@@ -58,8 +58,8 @@ class TsdTechnique(Technique):
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options
-        passes, nodes, translucency = plan_tsd(ctx, o.size, o.gaussians, o.taps, o.albedo_mix, o.translucency)
-        return TechniquePlan(TsdForward(len(nodes)), before_forward=passes, shadow_distance=translucency)
+        passes, nodes, translucency, local = plan_tsd(ctx, o.size, o.gaussians, o.taps, o.albedo_mix, o.translucency)
+        return TechniquePlan(TsdForward(len(nodes), local), before_forward=passes, shadow_distance=translucency)
 
     def edge_response(self, model, medium, plan: FramePlan):
         """The Gaussian kernel the frame used (after the planner folded sub-texel Gaussians into the

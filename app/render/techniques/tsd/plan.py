@@ -2,7 +2,10 @@
 
 A mesh node gets TSD passes only when its (effective) material scatters below the surface: a
 subsurface weight above 0, a model other than "none" and a radius above 0, and a kernel wider than a
-texel. Everything decided here is recorded in the plan (pass reasons, skipped items, warnings).
+texel. A scattering mesh whose Gaussians are all narrower than a texel needs no blur: it is shaded
+locally (the light that enters leaves where it entered, with the same entry, exit and single
+scattering as the blurred case; shaders/techniques/tsd/local.glsl). Everything decided here is recorded
+in the plan (pass reasons, skipped items, warnings).
 """
 
 from __future__ import annotations
@@ -87,8 +90,11 @@ class TsdExactParams(TsdNodeParams):
 UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.zeros(3))
 
 
-def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None) -> TsdNodePlan | None:
-    """Decide TSD for one visible mesh node (PlanContext `ctx`); record skips and warnings in its plan."""
+def plan_tsd_node(
+    node, ctx, size: int, gaussians: int, taps: int | None, local: dict | None = None
+) -> TsdNodePlan | None:
+    """Decide TSD for one visible mesh node (PlanContext `ctx`); record skips and warnings in its plan.
+    A scattering node whose profile is narrower than a texel goes into `local` (uid -> material)."""
     label = f"tsd[{node.name}]"
     plan, scene = ctx.plan, ctx.scene
     mat = scattering_material(node, ctx.settings, plan, label)
@@ -123,8 +129,10 @@ def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None) -> Tsd
         plan.skipped.append((f"{label} {what}", why))
     if kernel.levels == 0:
         plan.skipped.append(
-            (label, "every Gaussian of the profile is narrower than a texel or negligible; plain diffuse")
+            (label, "every Gaussian of the profile is narrower than a texel or negligible; scattered locally")
         )
+        if local is not None:
+            local[node.uid] = mat
         return None
     return TsdNodePlan(node, mat, kernel, size)
 
@@ -132,20 +140,21 @@ def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None) -> Tsd
 def plan_tsd(ctx, size: int, gaussians: int, taps: int | None, mix: float, translucency: bool, exact: bool = False):
     """The texture-space passes of every scattering mesh (stretch, irradiance, dilation, then the
     Gaussian blurs, or with `exact` the brute-force convolution) and whether translucency runs;
-    (passes, node plans, translucency)."""
+    (passes, node plans, translucency, local: uid -> material of the meshes scattered locally)."""
     plan = ctx.plan
-    nodes = [t for t in (plan_tsd_node(n, ctx, size, gaussians, taps) for n in ctx.meshes) if t is not None]
+    local: dict = {}
+    nodes = [t for t in (plan_tsd_node(n, ctx, size, gaussians, taps, local) for n in ctx.meshes) if t is not None]
     use_translucency = bool(nodes) and translucency and bool(ctx.shadow_lights)
     if nodes and not use_translucency:
         plan.skipped.append(
             ("translucency", "disabled in the settings" if not translucency else "no shadow-casting light")
         )
-    if not nodes:
+    if not nodes and not local:
         plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
     passes = []
     for t in nodes:
         passes += _node_passes(t, ctx, mix, use_translucency, exact)
-    return passes, nodes, use_translucency
+    return passes, nodes, use_translucency, local
 
 
 def stretch_inputs(node, scene) -> tuple:
