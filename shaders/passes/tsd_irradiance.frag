@@ -3,11 +3,10 @@
 // enters the surface's multiple scattering - each light times the entry factor at its incidence
 // (lib/sss_boundary.glsl: A_ms(mu0) / A_colour), shadows, the normal map, ambient x occlusion
 // (pi L_ambient x A_ms_d / A_colour) - times albedo^mix (pre-scatter texturing). a = 1: covered.
-// Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts: the entry factor at the
-// light's incidence on the far side times the diffusion slab transmittance through the thickness
-// (lib/sss_boundary.glsl sss_slab_transmittance; the thickness along the light from the shadow
-// pass's distance map, times the cosine to the normal: a flat slab's own thickness), plus the light
-// scattered once inside the slab (sss_slab_single).
+// Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts: the exact diffuse
+// transmittance of a slab (all orders of scattering) at the light's incidence on the far side
+// (lib/sss_boundary.glsl sss_slab_through; the thickness along the light from the shadow pass's
+// distance map, times the cosine to the normal: a flat slab's own thickness).
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
@@ -74,11 +73,7 @@ void main() {
             float first;
             if (first_hit_distance(slot, v_world, first)) {
                 float d_mm = max(distance_from_light(slot, v_world) - first, 0.0) * u_mm_per_unit * back;
-                // multiple scattering (diffusion through the slab) + single scattering through it
-                float t_in = 1.0 - fresnel_dielectric(back, max(u_sss_eta, 1.0));
-                vec3 through = sss_entry(back) * sss_slab_transmittance(d_mm)
-                             + t_in * sss_slab_single(refract_cos(back, max(u_sss_eta, 1.0)), d_mm);
-                e_in += e * back * through;
+                e_in += e * back * sss_slab_through(back, d_mm);
             }
         }
 #endif
