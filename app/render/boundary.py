@@ -32,6 +32,7 @@ def bind_boundary(prog, material) -> None:
     if t is None:
         set_array(prog, "u_sss_entry", _ZERO_TABLE, ANGULAR_NODES)
         set_array(prog, "u_sss_exit", _ZERO_TABLE, ANGULAR_NODES)
+        set_array(prog, "u_sss_single_ambient", _ZERO_TABLE, ANGULAR_NODES)
         zero = (0.0, 0.0, 0.0)
         set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0})
         set_array(prog, "u_sss_slab", _DARK_SLAB, _SLAB_ROWS)
@@ -39,6 +40,7 @@ def bind_boundary(prog, material) -> None:
         return
     set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
     set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
+    set_array(prog, "u_sss_single_ambient", t.single_ambient, ANGULAR_NODES)
     set_uniforms(prog, {"u_sss_entry_diffuse": t.entry_diffuse, "u_sss_single": t.single, "u_sss_eta": t.eta})
     medium = material_medium(material.values)
     set_array(prog, "u_sss_slab", slab_table(medium.alpha_arr, material["subsurface_color"]), _SLAB_ROWS)

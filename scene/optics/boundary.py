@@ -127,6 +127,27 @@ def ms_albedo(a: float, eta: float, mu0) -> np.ndarray:
     return t_in * (x * (1.0 - rho) + (x + y) * rho * ad * (1.0 - rho) / (1.0 - rho * ad))
 
 
+def single_ambient_albedo(a: float, eta: float, mu) -> np.ndarray:
+    """Single scattering under a uniform sky of radiance 1, toward cosine mu: Jensen's term (isotropic
+    phase, 1/eta^2) integrated over the incident hemisphere, which by reciprocity is its directional
+    albedo, A_ss(mu) = a (1 - F(mu)) / (2 eta^2) int_0^1 (1 - F(m)) m / (mu_t(m) + mu_t(mu)) dm
+    (mu_t the refracted cosines); at eta = 1 Chandrasekhar's (a/2)(1 - mu ln(1 + 1/mu))."""
+    mu = np.clip(np.asarray(mu, np.float64), 0.0, 1.0)
+    eta = float(clamp_eta(eta))
+    m, w = _gl()
+
+    def t_and_ct(c):
+        ct = np.sqrt(np.maximum((eta - 1.0) * (eta + 1.0) + c * c, 0.0)) / eta
+        if eta == 1.0:  # no interface: nothing reflected, even at grazing incidence
+            return np.ones_like(c), ct
+        return 1.0 - fresnel_dielectric(c, eta), ct
+
+    tm, ctm = t_and_ct(m)
+    tu, ctu = t_and_ct(mu)
+    integral = np.sum(w * tm * m / np.maximum(ctm + ctu[..., None], 1e-12), axis=-1)
+    return float(a) * tu * integral / (2.0 * eta * eta)
+
+
 def hemispherical(f) -> float:
     """2 int_0^1 f(mu) mu dmu."""
     m, w = _gl()
@@ -157,6 +178,7 @@ class BoundaryTables:
     entry_diffuse: np.ndarray  # (3,) A_ms_d / A_colour: for uniform (ambient) light
     single: np.ndarray  # (3,) alpha / A_colour: Jensen's single-scattering term per base colour
     eta: float
+    single_ambient: np.ndarray  # (N, 3) A_ss(mu) / A_colour: single scattering of a uniform sky
     ms_diffuse: np.ndarray  # (3,) A_ms_d (for reports)
 
 
@@ -171,6 +193,7 @@ def _tables(alpha: tuple, colour: tuple, eta: float) -> BoundaryTables:
     exit_ = np.zeros((ANGULAR_NODES, 3))
     ent_d = np.zeros(3)
     single = np.zeros(3)
+    single_amb = np.zeros((ANGULAR_NODES, 3))
     msd = np.zeros(3)
     for c in range(3):
         a, col = float(alpha[c]), float(colour[c])
@@ -183,9 +206,10 @@ def _tables(alpha: tuple, colour: tuple, eta: float) -> BoundaryTables:
         entry[:, c] = table / col
         ent_d[c] = d / col
         single[c] = a / col
+        single_amb[:, c] = single_ambient_albedo(a, eta, mu) / col
         if d > 0:
             exit_[:, c] = table / d
-    return BoundaryTables(entry, exit_, ent_d, single, eta, msd)
+    return BoundaryTables(entry, exit_, ent_d, single, eta, single_amb, msd)
 
 
 def boundary_tables(alpha, colour, eta) -> BoundaryTables:

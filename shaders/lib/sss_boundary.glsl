@@ -12,6 +12,7 @@
 #define SSS_ANGULAR_NODES 17
 uniform vec3 u_sss_entry[SSS_ANGULAR_NODES];  // at cosines i / (SSS_ANGULAR_NODES - 1)
 uniform vec3 u_sss_exit[SSS_ANGULAR_NODES];
+uniform vec3 u_sss_single_ambient[SSS_ANGULAR_NODES];  // A_ss(mu) / A_colour: single scattering of a uniform sky
 uniform vec3 u_sss_entry_diffuse;  // A_ms_d / A_colour: uniform (ambient) light
 uniform vec3 u_sss_single;         // alpha / A_colour (0: no single-scattering term)
 uniform float u_sss_eta;           // relative index of the boundary (1: index-matched)
@@ -26,6 +27,14 @@ vec3 sss_exit(float mu) {
     float x = clamp(mu, 0.0, 1.0) * float(SSS_ANGULAR_NODES - 1);
     int i = min(int(floor(x)), SSS_ANGULAR_NODES - 2);
     return mix(u_sss_exit[i], u_sss_exit[i + 1], x - float(i));
+}
+
+// Single scattering of uniform (ambient) light of radiance 1 toward a view at cosine mu, per unit base
+// colour (NumPy twin: scene/optics/boundary.py single_ambient_albedo, table_lookup).
+vec3 sss_single_ambient(float mu) {
+    float x = clamp(mu, 0.0, 1.0) * float(SSS_ANGULAR_NODES - 1);
+    int i = min(int(floor(x)), SSS_ANGULAR_NODES - 2);
+    return mix(u_sss_single_ambient[i], u_sss_single_ambient[i + 1], x - float(i));
 }
 
 // Single scattering toward v of light from l (per unit irradiance on a surface facing the light,

@@ -6,8 +6,9 @@
 // shaders/techniques/<name>/forward.glsl; the contract is in app/render/technique.py): plain
 // Burley diffuse weighted by sss_plain_weight(), the hook told about each light, and its radiance
 // added after the lights. Specular and ambient specular as usual. Single scattering (Jensen 2001,
-// lib/sss_boundary.glsl) is added per light for a mesh whose technique scatters (u_sss_single > 0):
-// it leaves within about a mean free path of where it entered, so no technique blurs it.
+// lib/sss_boundary.glsl) is added per light, and for ambient light, for a mesh whose technique
+// scatters (u_sss_single > 0): it leaves within about a mean free path of where it entered, so no
+// technique blurs it.
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/lights.glsl"
@@ -70,6 +71,7 @@ void main() {
         sss_add_light(e, vis, NoL);
     }
     color += u_ambient * occlusion * (base * ((1.0 - u_metallic) * plain) + f0);
+    if (single) color += u_ambient * occlusion * single_w * sss_single_ambient(NoV);  // the sky's single scattering
     color += sss_radiance(base, NoV, occlusion, v_uv);
     f_color = vec4(color, 1.0);
 }

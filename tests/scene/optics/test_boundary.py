@@ -107,10 +107,11 @@ def test_boundary_glsl_twins(glsl):
 
             set_array(prog, "u_sss_entry", t.entry, b.ANGULAR_NODES)
             set_array(prog, "u_sss_exit", t.exit, b.ANGULAR_NODES)
+            set_array(prog, "u_sss_single_ambient", t.single_ambient, b.ANGULAR_NODES)
             set_uniforms(prog, {"u_sss_single": t.single, "u_sss_eta": eta, "u_sss_entry_diffuse": t.entry_diffuse})
 
         mu = np.array([-0.2, 0.0, 1e-6, 0.03, 0.0625, 0.2, 0.5, 0.77, 0.999, 1.0, 1.2])
-        for fn, table in (("sss_entry", t.entry), ("sss_exit", t.exit)):
+        for fn, table in (("sss_entry", t.entry), ("sss_exit", t.exit), ("sss_single_ambient", t.single_ambient)):
             gpu = glsl.evaluate("lib/sss_boundary.glsl", f"{fn}(c)", {"c": mu}, out_components=3, setup=setup)
             assert_close_fp32(gpu, b.table_lookup(table, mu), what=fn, atol=1e-4)
         # single scattering at the hard cases: grazing in and out, normal, behind
@@ -129,6 +130,29 @@ def test_boundary_glsl_twins(glsl):
         ref = single_scatter_brdf(n, wi, wo, t.single, np.full(len(wi), eta), 0.0)
         assert np.all(np.isfinite(gpu))
         assert_close_fp32(gpu, ref, what="sss_single_brdf", atol=1e-4)
+
+
+@pytest.mark.parametrize("a", ALBEDOS)
+def test_single_scattering_of_a_uniform_sky(a):
+    """Ambient light's single scattering toward mu: at eta 1 Chandrasekhar's directional single albedo
+    (a/2)(1 - mu ln(1 + 1/mu)); at eta 1.4 the frame's own Jensen term (single_scatter_brdf) integrated
+    over the incident hemisphere (azimuths and cosines); finite and >= 0 at the hard cases."""
+    mu = np.array([0.0, 1e-6, 0.1, 0.5, 0.9, 1.0])
+    np.testing.assert_allclose(b.single_ambient_albedo(a, 1.0, mu), b.single_albedo_isotropic(a, mu), atol=2e-5)
+    for eta in (1.0, 1.4, 2.5):
+        v = b.single_ambient_albedo(a, eta, mu)
+        assert np.all(np.isfinite(v)) and np.all(v >= 0)
+    x, w = np.polynomial.legendre.leggauss(64)
+    m, w = 0.5 * (x + 1), 0.5 * w
+    phi = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    n = np.array([0.0, 0.0, 1.0])
+    for mo in (0.2, 0.7, 1.0):
+        wo = np.array([np.sqrt(1 - mo * mo), 0.0, mo])
+        s = np.sqrt(1 - m * m)
+        wi = np.stack([s[:, None] * np.cos(phi), s[:, None] * np.sin(phi), np.broadcast_to(m[:, None], (64, 16))], -1)
+        f = single_scatter_brdf(np.broadcast_to(n, wi.shape), wi, np.broadcast_to(wo, wi.shape), [a], 1.4, 0.0)[..., 0]
+        want = np.sum(w * m * f.mean(axis=1)) * 2 * np.pi
+        assert float(b.single_ambient_albedo(a, 1.4, mo)) == pytest.approx(want, rel=1e-3, abs=1e-9)
 
 
 @pytest.mark.parametrize("a", (0.0, 1.0))

@@ -215,3 +215,22 @@ def test_translucency_through_thin_parts(renderer):
     assert thick.hdr[24, 24, 0] < 0.05 * c[0]
     assert none.hdr[24, 24, :3].max() == 0.0
     assert "translucency" in dict(none.plan.skipped)
+
+
+@pytest.mark.parametrize("technique", ["tsd", "ssss"])
+def test_uniform_sky_reflects_chandrasekhars_albedo(renderer, technique):
+    """An index-matched slab under a uniform sky of radiance 1 (no light), seen from above, returns
+    by reciprocity the directional albedo of all orders, 1 - H(1) sqrt(1 - a) (Chandrasekhar): the
+    multiple scattering through the entry/exit tables plus the sky's single scattering
+    (sss_single_ambient; without it the frame read 67 % dark in blue, a = 0.49)."""
+    from scene.optics.boundary import albedo_isotropic
+
+    colour = (0.46, 0.23, 0.126)
+    scene = slab_scene(material=skin(radius=(8.0, 4.0, 2.0), color=colour, base=colour), ambient=1.0)
+    scene.lights()[0].intensity = 0.0
+    opts = {"size": 128} if technique == "tsd" else {}
+    img = renderer.render(scene, RenderSettings.for_technique(technique, 48, 48, shadow_size=256, **opts)).hdr
+    medium = tsd.material_medium(scene.find("slab").material.values)
+    want = np.array([float(albedo_isotropic(a, 1.0)) for a in medium.alpha_arr])
+    got = img[22:26, 22:26, :3].reshape(-1, 3).mean(0)
+    np.testing.assert_allclose(got, want, rtol=0.01)
