@@ -41,7 +41,7 @@ SLAB_MU_NODES = 9  # table cosines i / 8 (GLSL SSS_SLAB_MU); 5 were up to 34 % o
 SLAB_TAU_NODES = 21  # table optical thicknesses 2^(LOG2_TAU_MIN + k / 2) (GLSL SSS_SLAB_TAU)
 LOG2_TAU_MIN = -4.0  # 1/16 mean free path
 LOG2_TAU_MAX = LOG2_TAU_MIN + (SLAB_TAU_NODES - 1) / 2  # 64 mean free paths
-_QUAD = 24  # Gauss-Legendre cosines of the doubling
+QUAD_NODES = 24  # Gauss-Legendre cosines of the doubling
 _LOG2_D0 = -30  # the first layer's optical thickness, 2^-30
 _MU_FLOOR = 1e-3  # a beam at cosine 0 is taken at this cosine
 
@@ -54,17 +54,17 @@ def slab_log2_tau_nodes() -> np.ndarray:
     return LOG2_TAU_MIN + 0.5 * np.arange(SLAB_TAU_NODES)
 
 
-def _doubling(a: float, log2_d0: float, steps: int, mu_probe: np.ndarray) -> list[np.ndarray]:
+def doubling_transmittance(a: float, log2_d0: float, steps: int, mu_probe: np.ndarray) -> list[np.ndarray]:
     """Diffuse transmittance (all orders of scattering, unscattered beam excluded) of slabs of
     optical thickness 2^(log2_d0 + k), k = 0..steps, for beams at the cosines mu_probe: (steps+1, P)."""
-    x, w = np.polynomial.legendre.leggauss(_QUAD)
+    x, w = np.polynomial.legendre.leggauss(QUAD_NODES)
     mu = np.concatenate([0.5 * (x + 1.0), np.maximum(mu_probe, _MU_FLOOR)])
     wt = np.concatenate([0.5 * w, np.zeros(len(mu_probe))])
     d = 2.0**log2_d0
     scat = a * d * wt[:, None] / (2.0 * mu[None, :])
     r, t = scat.copy(), np.diag(np.exp(-d / mu)) + scat
     eye = np.eye(len(mu))
-    probe = np.arange(_QUAD, len(mu))
+    probe = np.arange(QUAD_NODES, len(mu))
     out = []
     for k in range(steps + 1):
         tau = d * 2.0**k
@@ -85,7 +85,7 @@ def _transmittance_table(a: float) -> np.ndarray:
     for half in (0, 1):  # the integer and the half octaves
         start = _LOG2_D0 + 0.5 * half
         steps = int(round(LOG2_TAU_MAX - start))
-        seq = _doubling(a, start, steps, mu)
+        seq = doubling_transmittance(a, start, steps, mu)
         for k, v in enumerate(seq):
             lt = start + k
             j = (lt - LOG2_TAU_MIN) * 2.0
