@@ -6,8 +6,8 @@ plain dictionaries, no Mitsuba import, so the exporter is unit-tested without re
 
 What the reference models (docs/ground-truth.md):
 * every visible mesh node with its own vertex normals and UVs, in the reference frame: millimetres,
-  centred on the scene's bounds (x_ref = (x_world - centre) mm_per_unit; the camera, lights and media
-  follow). Mitsuba (float32) starts every ray that crosses a surface a distance
+  centred on the bounds of the meshes that scatter (x_ref = (x_world - centre) mm_per_unit; the
+  camera, lights and media follow). Mitsuba (float32) starts every ray that crosses a surface
   (1 + max|p|) 8.9e-5 scene units off it (``offset_p``, RayEpsilon = 1500 float epsilons): in metres
   that is 0.1 mm, a sixth of a dark medium's mean free path, and the camera ray that enters a null
   boundary skips that layer, so single scattering read 12-17 % dark (ketchup in metres against the
@@ -277,6 +277,22 @@ def _baked_base_color(values: dict) -> np.ndarray:
     return (tex * np.asarray(values["base_color"], np.float32)).astype(np.float32)
 
 
+def _scatters(values: dict) -> bool:
+    return values["subsurface"] > 0 and max(values["subsurface_radius"]) > 0
+
+
+def frame_origin(scene: Scene) -> np.ndarray:
+    """The world point at the reference frame's origin: the centre of the bounds of the meshes that
+    scatter below their surface (the ray offset matters where rays enter a medium: it grows with the
+    distance from the origin), of every mesh when none does."""
+    nodes = [n for n in scene.mesh_nodes() if n.material is not None and _scatters(n.material.values)]
+    nodes = nodes or list(scene.mesh_nodes())
+    if not nodes:
+        return np.zeros(3)
+    p = np.concatenate([n.mesh.bound_corners() @ n.world_matrix[:3, :3].T + n.world_matrix[:3, 3] for n in nodes])
+    return ((p.min(0) + p.max(0)) / 2).astype(np.float64).round(9)
+
+
 def _camera_frame(scene: Scene, origin: np.ndarray, scale: float) -> np.ndarray:
     w = scene.camera.world_matrix
     x, y, z = (w[:3, i] / np.linalg.norm(w[:3, i]) for i in range(3))
@@ -337,8 +353,8 @@ def describe(
     notes: list[str] = []
     shapes: list[ShapeDesc] = []
     lo, hi = scene.world_bounds()
-    origin = ((np.asarray(lo, np.float64) + np.asarray(hi, np.float64)) / 2).round(9)
-    scale = float(scene.mm_per_unit)  # the reference frame: millimetres, centred on the bounds
+    origin = frame_origin(scene)
+    scale = float(scene.mm_per_unit)  # the reference frame: millimetres, centred on the media
     for node in scene.mesh_nodes():
         mesh, mat = node.mesh, node.material
         if mesh is None or len(mesh.indices) == 0:
@@ -348,7 +364,7 @@ def describe(
             values["sss_model"] = sss_override
         pos, nrm = _world_geometry(node, origin, scale)
         uv = None if mesh.uvs is None else np.column_stack([mesh.uvs[:, 0], 1.0 - mesh.uvs[:, 1]]).astype(np.float32)
-        scatters = values["subsurface"] > 0 and max(values["subsurface_radius"]) > 0
+        scatters = _scatters(values)
         if scatters:
             interior = medium_dict(values)
             faces = mesh.indices

@@ -237,3 +237,18 @@ def test_the_whole_description_changes_the_cache_key():
     assert reference_key(ex.describe(s, 8, 8), req, "3.x") != k0
     assert reference_key(ex.describe(slab_scene(), 8, 8), ReferenceRequest(8, 8, spp=32, passes=2), "3.x") != k0
     assert reference_key(ex.describe(slab_scene(), 8, 8), req, "3.y") != k0
+
+
+def test_frame_is_centred_on_the_scattering_meshes():
+    """A far plain occluder does not move the origin off the medium (the ray offset grows with the
+    distance from it); with no scattering mesh every mesh counts."""
+    s = _box_scene(node_kw={"translation": (1.0, 2.0, 3.0)}, mm_per_unit=10.0)
+    plate = Material("black", {"base_color": (0.0, 0.0, 0.0)})
+    s.add(MeshNode("plate", box_mesh((2.0, 2.0, 0.1)), plate, translation=(40.0, 0.0, 0.0)))
+    d = ex.describe(s, 8, 8)
+    assert np.allclose(d.frame_origin, (1.0, 2.0, 3.0))
+    box = next(x for x in d.shapes if x.name == "box")
+    assert np.allclose(box.positions.max(0), -box.positions.min(0), atol=1e-4)  # the medium is centred
+    s.find("box").material = plate
+    lo, hi = s.world_bounds()
+    assert np.allclose(ex.describe(s, 8, 8).frame_origin, (lo + hi) / 2) and (lo + hi)[0] / 2 == 20.5
