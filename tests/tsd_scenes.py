@@ -90,12 +90,11 @@ def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab") -> float:
     light is sampled at the centres of a grid of grid_mm (irradiance texels, or pixels for the
     screen-space techniques) whose boundaries fall on x = 0: the sampled edge moves by the shift
     rounded to whole cells."""
-    from scene.optics.boundary import slab_parameters
     from scene.optics.oblique import entry_offset
     from scene.optics.tsd import material_medium
 
     medium = material_medium(scene.find(node).material.values)
-    z0 = slab_parameters(medium.alpha_arr, medium.mfp_arr, medium.eta)[1]
+    z0 = np.asarray(medium.mfp_arr)  # 1 / mu_t' (isotropic phase): the shaders' u_sss_mfp
     to_light = -scene.lights()[0].direction
     off = entry_offset(np.array([[0.0, 0.0, 1.0]]), to_light[None], z0, medium.eta, 1.0)[0]
     return float(np.round(-off[0] / grid_mm) * grid_mm)

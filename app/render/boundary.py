@@ -8,10 +8,14 @@ from __future__ import annotations
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
-from scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables, slab_parameters
+from scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables
+from scene.optics.fresnel import fdr
+from scene.optics.slab import LN_FLOOR, SLAB_MU_NODES, SLAB_TAU_NODES, slab_decay, slab_table
 from scene.optics.tsd import material_medium
 
 _ZERO_TABLE = np.zeros((ANGULAR_NODES, 3))
+_SLAB_ROWS = SLAB_MU_NODES * SLAB_TAU_NODES
+_DARK_SLAB = np.full((_SLAB_ROWS, 3), LN_FLOOR)
 
 
 def material_boundary(material) -> BoundaryTables | None:
@@ -28,13 +32,20 @@ def bind_boundary(prog, material) -> None:
     if t is None:
         set_array(prog, "u_sss_entry", _ZERO_TABLE, ANGULAR_NODES)
         set_array(prog, "u_sss_exit", _ZERO_TABLE, ANGULAR_NODES)
+        set_array(prog, "u_sss_single_ambient", _ZERO_TABLE, ANGULAR_NODES)
         zero = (0.0, 0.0, 0.0)
         set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0})
-        set_uniforms(prog, {"u_sss_sigma_tr": zero, "u_sss_z0": zero, "u_sss_zb": zero, "u_sss_mfp": zero})
+        set_array(prog, "u_sss_slab", _DARK_SLAB, _SLAB_ROWS)
+        set_uniforms(prog, {"u_sss_mfp": zero, "u_sss_slab_decay": zero, "u_sss_slab_out": 1.0})
         return
     set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
     set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
+    set_array(prog, "u_sss_single_ambient", t.single_ambient, ANGULAR_NODES)
     set_uniforms(prog, {"u_sss_entry_diffuse": t.entry_diffuse, "u_sss_single": t.single, "u_sss_eta": t.eta})
     medium = material_medium(material.values)
-    s, z0, zb = slab_parameters(medium.alpha_arr, medium.mfp_arr, medium.eta)
-    set_uniforms(prog, {"u_sss_sigma_tr": s, "u_sss_z0": z0, "u_sss_zb": zb, "u_sss_mfp": medium.mfp_arr})
+    set_array(prog, "u_sss_slab", slab_table(medium.alpha_arr, material["subsurface_color"]), _SLAB_ROWS)
+    out = 1.0 - float(fdr(medium.eta)) if medium.eta > 1.0 else 1.0
+    set_uniforms(
+        prog,
+        {"u_sss_mfp": medium.mfp_arr, "u_sss_slab_decay": slab_decay(medium.alpha_arr), "u_sss_slab_out": out},
+    )

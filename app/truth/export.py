@@ -5,16 +5,22 @@ plain dictionaries, no Mitsuba import, so the exporter is unit-tested without re
 :meth:`ReferenceDescription.to_mitsuba` builds the dictionary ``mitsuba.load_dict`` takes.
 
 What the reference models (docs/ground-truth.md):
-* every visible mesh node in world space with its own vertex normals and UVs;
+* every visible mesh node with its own vertex normals and UVs, in the reference frame: millimetres,
+  centred on the bounds of the meshes that scatter (x_ref = (x_world - centre) mm_per_unit; the
+  camera, lights and media follow). Mitsuba (float32) starts every ray that crosses a surface
+  (1 + max|p|) 8.9e-5 scene units off it (``offset_p``, RayEpsilon = 1500 float epsilons): in metres
+  that is 0.1 mm, a sixth of a dark medium's mean free path, and the camera ray that enters a null
+  boundary skips that layer, so single scattering read 12-17 % dark (ketchup in metres against the
+  same slab in millimetres, docs/ground-truth.md); in millimetres, centred, it is below 0.01 mm;
 * the camera: same vertical field of view, position, orientation and aspect;
 * directional lights with the same irradiance (Mitsuba ``directional`` ``irradiance``), point lights
   with the same intensity (Skinlab's falls off with the distance in metres: the Mitsuba intensity is
-  divided by (mm_per_unit / 1000)^2 since Mitsuba measures distances in scene units);
+  multiplied by 1000^2 since the reference frame measures distances in millimetres);
 * each subsurface material as a homogeneous medium inside its boundary, the medium Skinlab itself
   derives from the material (``scene.optics.tsd.material_medium``: subsurface_color is the surface
   albedo, subsurface_radius the artist radius R = 4 pi l, specular gives the index): reduced
   single-scattering albedo and reduced extinction 1/l per channel with an isotropic phase function
-  (similarity theory, as the diffusion profiles assume), in 1/scene-unit through mm_per_unit;
+  (similarity theory, as the diffusion profiles assume), in 1/mm (the reference frame's unit);
   Mitsuba's RGB values must lie in [0, 1], so sigma_t is passed normalised, with ``scale``;
 * the boundary: none at all (``null`` BSDF) where the material's index is 1 (specular 0), otherwise a
   rough dielectric with GGX alpha = roughness^2 (a smooth one below alpha 1e-3) and the index;
@@ -76,12 +82,16 @@ class ReferenceDescription:
     emitters: list[dict]
     integrator: dict
     notes: list[str] = field(default_factory=list)
+    # the reference frame: x_ref = (x_world - frame_origin) * frame_scale (millimetres, centred)
+    frame_origin: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    frame_scale: float = 1.0
 
     def content(self) -> dict:
         """Everything that determines the image, as JSON-able data plus arrays (for the cache key)."""
         return {
             "size": [self.width, self.height],
             "camera": np.round(self.camera_to_world, 9).tolist(),
+            "frame": [np.round(self.frame_origin, 9).tolist(), self.frame_scale],
             "fov": self.fov_y_deg,
             "clip": [self.near, self.far],
             "emitters": self.emitters,
@@ -137,8 +147,9 @@ def _rgb(v) -> dict:
     return {"type": "rgb", "value": [float(x) for x in np.asarray(v, np.float64).reshape(3)]}
 
 
-def medium_dict(values: dict, mm_per_unit: float) -> dict:
-    """The homogeneous medium of a subsurface material, coefficients in 1/scene-unit."""
+def medium_dict(values: dict, mm_per_unit: float = 1.0) -> dict:
+    """The homogeneous medium of a subsurface material, coefficients in 1/unit for a frame of
+    mm_per_unit millimetres per unit (the reference frame's: 1)."""
     m = material_medium(values)
     mfp = np.maximum(m.mfp_arr, REFERENCE_MIN_MFP_MM)
     sigma_t = mm_per_unit / mfp  # 1/mm -> 1/scene-unit
@@ -174,9 +185,11 @@ def surface_bsdf(values: dict, textured: bool) -> dict:
     return {"type": "twosided", "bsdf": inner}
 
 
-def _world_geometry(node: MeshNode) -> tuple[np.ndarray, np.ndarray]:
+def _world_geometry(node: MeshNode, origin: np.ndarray, scale: float) -> tuple[np.ndarray, np.ndarray]:
+    """Positions in the reference frame, (world - origin) * scale, computed in float64 before the
+    float32 Mitsuba takes; unit normals (a uniform scale leaves them as they are)."""
     w = node.world_matrix
-    p = node.mesh.positions.astype(np.float64) @ w[:3, :3].T + w[:3, 3]
+    p = (node.mesh.positions.astype(np.float64) @ w[:3, :3].T + w[:3, 3] - origin) * scale
     try:
         nm = np.linalg.inv(w[:3, :3]).T
     except np.linalg.LinAlgError:
@@ -264,15 +277,36 @@ def _baked_base_color(values: dict) -> np.ndarray:
     return (tex * np.asarray(values["base_color"], np.float32)).astype(np.float32)
 
 
-def _camera_frame(scene: Scene) -> np.ndarray:
+def _scatters(values: dict) -> bool:
+    return values["subsurface"] > 0 and max(values["subsurface_radius"]) > 0
+
+
+def frame_origin(scene: Scene) -> np.ndarray:
+    """The world point at the reference frame's origin: the centre of the bounds of the meshes that
+    scatter below their surface (the ray offset matters where rays enter a medium: it grows with the
+    distance from the origin), of every mesh when none does."""
+    nodes = [n for n in scene.mesh_nodes() if n.material is not None and _scatters(n.material.values)]
+    nodes = nodes or list(scene.mesh_nodes())
+    if not nodes:
+        return np.zeros(3)
+    p = np.concatenate([n.mesh.bound_corners() @ n.world_matrix[:3, :3].T + n.world_matrix[:3, 3] for n in nodes])
+    return ((p.min(0) + p.max(0)) / 2).astype(np.float64).round(9)
+
+
+def _camera_frame(scene: Scene, origin: np.ndarray, scale: float) -> np.ndarray:
     w = scene.camera.world_matrix
     x, y, z = (w[:3, i] / np.linalg.norm(w[:3, i]) for i in range(3))
     m = np.eye(4)
-    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = -x, y, -z, w[:3, 3]  # Skinlab looks down -Z, +X right
+    m[:3, 0], m[:3, 1], m[:3, 2] = -x, y, -z  # Skinlab looks down -Z, +X right
+    m[:3, 3] = (w[:3, 3] - origin) * scale
     return m
 
 
-def _emitter(light: LightNode, mm_per_unit: float, sun_deg: float, radius: float, centre: np.ndarray) -> dict:
+def _emitter(
+    light: LightNode, origin: np.ndarray, scale: float, sun_deg: float, radius: float, centre: np.ndarray
+) -> dict:
+    """The light in the reference frame (millimetres: `scale` mm per world unit, `origin` at 0);
+    radius and centre of the scene's bounds in that frame."""
     rad = np.asarray(light.radiance, np.float64)
     if light.kind == "directional":
         d = light.direction
@@ -291,10 +325,10 @@ def _emitter(light: LightNode, mm_per_unit: float, sun_deg: float, radius: float
             }
         return {"kind": "directional", "direction": d.tolist(), "irradiance": rad.tolist(), "light": light.name}
     if light.kind == "point":
-        metres = mm_per_unit * 1e-3  # Skinlab: E = I / d_m^2; Mitsuba: E = I / d_units^2
+        metres = 1e-3  # Skinlab: E = I / d_m^2; Mitsuba: E = I / d_units^2, units of the frame (mm)
         return {
             "kind": "point",
-            "position": light.world_position.tolist(),
+            "position": ((np.asarray(light.world_position, np.float64) - origin) * scale).tolist(),
             "intensity": (rad / metres**2).tolist(),
             "light": light.name,
         }
@@ -318,6 +352,9 @@ def describe(
         raise ReferenceError(f"sun_deg: expected an angular diameter in [0, 10] degrees, got {sun_deg}")
     notes: list[str] = []
     shapes: list[ShapeDesc] = []
+    lo, hi = scene.world_bounds()
+    origin = frame_origin(scene)
+    scale = float(scene.mm_per_unit)  # the reference frame: millimetres, centred on the media
     for node in scene.mesh_nodes():
         mesh, mat = node.mesh, node.material
         if mesh is None or len(mesh.indices) == 0:
@@ -325,11 +362,11 @@ def describe(
         values = dict(mat.values)
         if sss_override is not None:
             values["sss_model"] = sss_override
-        pos, nrm = _world_geometry(node)
+        pos, nrm = _world_geometry(node, origin, scale)
         uv = None if mesh.uvs is None else np.column_stack([mesh.uvs[:, 0], 1.0 - mesh.uvs[:, 1]]).astype(np.float32)
-        scatters = values["subsurface"] > 0 and max(values["subsurface_radius"]) > 0
+        scatters = _scatters(values)
         if scatters:
-            interior = medium_dict(values, scene.mm_per_unit)
+            interior = medium_dict(values)
             faces = mesh.indices
             pos, nrm, faces, closed = close_holes(pos, nrm, faces)
             if closed:
@@ -369,9 +406,8 @@ def describe(
             )  # fmt: skip
     if not shapes:
         raise ReferenceError(f"scene {scene.name!r}: no visible mesh")
-    lo, hi = scene.world_bounds()
-    centre, radius = (lo + hi) / 2, float(np.linalg.norm(hi - lo) / 2)
-    emitters = [_emitter(l, scene.mm_per_unit, sun_deg, radius, centre) for l in scene.lights()]
+    radius = float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)) / 2) * scale
+    emitters = [_emitter(l, origin, scale, sun_deg, radius, np.zeros(3)) for l in scene.lights()]
     if any(not l.cast_shadow for l in scene.lights()):
         names = ", ".join(l.name for l in scene.lights() if not l.cast_shadow)
         notes.append(f"lights without cast_shadow ({names}) are unshadowed in the realtime frame, shadowed here")
@@ -385,10 +421,10 @@ def describe(
     return ReferenceDescription(
         width=int(width),
         height=int(height),
-        camera_to_world=_camera_frame(scene),
+        camera_to_world=_camera_frame(scene, origin, scale),
         fov_y_deg=math.degrees(cam.yfov),
-        near=cam.znear,
-        far=cam.zfar,
+        near=cam.znear * scale,
+        far=cam.zfar * scale,
         shapes=shapes,
         emitters=emitters,
         # volpathmis: spectral MIS between the colour channels' free-flight distributions (Miller et al.
@@ -403,6 +439,8 @@ def describe(
             "hide_emitters": True,
         },
         notes=notes,
+        frame_origin=origin,
+        frame_scale=scale,
     )
 
 

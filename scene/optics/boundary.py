@@ -127,6 +127,27 @@ def ms_albedo(a: float, eta: float, mu0) -> np.ndarray:
     return t_in * (x * (1.0 - rho) + (x + y) * rho * ad * (1.0 - rho) / (1.0 - rho * ad))
 
 
+def single_ambient_albedo(a: float, eta: float, mu) -> np.ndarray:
+    """Single scattering under a uniform sky of radiance 1, toward cosine mu: Jensen's term (isotropic
+    phase, 1/eta^2) integrated over the incident hemisphere, which by reciprocity is its directional
+    albedo, A_ss(mu) = a (1 - F(mu)) / (2 eta^2) int_0^1 (1 - F(m)) m / (mu_t(m) + mu_t(mu)) dm
+    (mu_t the refracted cosines); at eta = 1 Chandrasekhar's (a/2)(1 - mu ln(1 + 1/mu))."""
+    mu = np.clip(np.asarray(mu, np.float64), 0.0, 1.0)
+    eta = float(clamp_eta(eta))
+    m, w = _gl()
+
+    def t_and_ct(c):
+        ct = np.sqrt(np.maximum((eta - 1.0) * (eta + 1.0) + c * c, 0.0)) / eta
+        if eta == 1.0:  # no interface: nothing reflected, even at grazing incidence
+            return np.ones_like(c), ct
+        return 1.0 - fresnel_dielectric(c, eta), ct
+
+    tm, ctm = t_and_ct(m)
+    tu, ctu = t_and_ct(mu)
+    integral = np.sum(w * tm * m / np.maximum(ctm + ctu[..., None], 1e-12), axis=-1)
+    return float(a) * tu * integral / (2.0 * eta * eta)
+
+
 def hemispherical(f) -> float:
     """2 int_0^1 f(mu) mu dmu."""
     m, w = _gl()
@@ -157,6 +178,7 @@ class BoundaryTables:
     entry_diffuse: np.ndarray  # (3,) A_ms_d / A_colour: for uniform (ambient) light
     single: np.ndarray  # (3,) alpha / A_colour: Jensen's single-scattering term per base colour
     eta: float
+    single_ambient: np.ndarray  # (N, 3) A_ss(mu) / A_colour: single scattering of a uniform sky
     ms_diffuse: np.ndarray  # (3,) A_ms_d (for reports)
 
 
@@ -171,6 +193,7 @@ def _tables(alpha: tuple, colour: tuple, eta: float) -> BoundaryTables:
     exit_ = np.zeros((ANGULAR_NODES, 3))
     ent_d = np.zeros(3)
     single = np.zeros(3)
+    single_amb = np.zeros((ANGULAR_NODES, 3))
     msd = np.zeros(3)
     for c in range(3):
         a, col = float(alpha[c]), float(colour[c])
@@ -183,9 +206,10 @@ def _tables(alpha: tuple, colour: tuple, eta: float) -> BoundaryTables:
         entry[:, c] = table / col
         ent_d[c] = d / col
         single[c] = a / col
+        single_amb[:, c] = single_ambient_albedo(a, eta, mu) / col
         if d > 0:
             exit_[:, c] = table / d
-    return BoundaryTables(entry, exit_, ent_d, single, eta, msd)
+    return BoundaryTables(entry, exit_, ent_d, single, eta, single_amb, msd)
 
 
 def boundary_tables(alpha, colour, eta) -> BoundaryTables:
@@ -204,73 +228,3 @@ def table_lookup(table: np.ndarray, mu) -> np.ndarray:
     i = np.minimum(np.floor(x).astype(int), ANGULAR_NODES - 2)
     f = (x - i)[..., None]
     return table[i] * (1.0 - f) + table[i + 1] * f
-
-
-# -- light through thin parts ----------------------------------------------------------------------
-
-
-def slab_parameters(alpha, mfp_mm, eta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(sigma_tr 1/mm, source depth z0 = l mm, extrapolation distance z_b = 2 A D mm) per channel for
-    the diffusion slab transmittance (Jensen 2001's A and D: docs/references.md#jensen-2001)."""
-    al = np.clip(np.asarray(alpha, np.float64).reshape(3), 0.0, 1.0)
-    l = np.maximum(np.asarray(mfp_mm, np.float64).reshape(3), 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.where(l > 0, np.sqrt(3.0 * (1.0 - al)) / np.where(l > 0, l, 1.0), 0.0)
-    f = float(fdr(eta))
-    a_bc = (1.0 + f) / (1.0 - f)
-    return s, l, 2.0 * a_bc * l / 3.0
-
-
-def slab_transmittance(d_mm, alpha, mfp_mm, eta) -> np.ndarray:
-    """Light that crosses a slab of thickness d and leaves through its far side, relative to what
-    the same medium, semi-infinite, returns through the lit side (the entry factor's amount): diffusion
-    from a plane source at depth z0 = l between extrapolated boundaries z_b outside each face, times
-    the fraction of the light that collides at all inside the slab, 1 - e^{-d/l} (-> 0 for a sheet
-    too thin to scatter),
-
-        T(d) / R_inf = (1 - e^{-d/l}) [sinh(s (z0 + z_b)) / sinh(s (d + 2 z_b))] / e^{-s (z0 + z_b)}
-                     = (1 - e^{-d/l}) e^{s (2a - b)} (1 - e^{-2 s a}) / (1 - e^{-2 s b}),
-                       a = z0 + z_b, b = d + 2 z_b
-
-    (-> a / b without absorption, s = 0; no overflow for any d). (N,) -> (N, 3). GLSL twin
-    sss_slab_transmittance."""
-    s, l, zb = slab_parameters(alpha, mfp_mm, eta)
-    d = np.maximum(np.atleast_1d(np.asarray(d_mm, np.float64)), 0.0)[:, None]
-    a = l[None, :] + zb[None, :]
-    b = d + 2.0 * zb[None, :]
-    hit = -np.expm1(-d / np.where(l > 0, l, 1.0)[None, :])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        num = np.where(s > 0, -np.expm1(-2.0 * s * a), 2.0 * a)
-        den = np.where(s > 0, -np.expm1(-2.0 * s * b), 2.0 * b)
-        out = hit * np.exp(s * (2.0 * a - b)) * np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
-    return np.where(l[None, :] > 0, out, 0.0)
-
-
-SLAB_SINGLE_NODES = 8  # Gauss-Legendre nodes over the exit cosine (GLSL SSS_SLAB_NODES)
-
-
-def slab_single_transmittance(mu_i, d_mm, alpha, mfp_mm) -> np.ndarray:
-    """Single scattering through a slab, index-matched: of the irradiance arriving at (refracted)
-    cosine mu_i on one face, the part scattered once inside and leaving through the far face (all
-    exit directions), with tau = d / l per channel (isotropic phase, Jensen's term's geometry):
-
-        T_ss = (alpha / 2) int_0^1 mu (e^{-tau/mu_i} - e^{-tau/mu}) / (mu_i - mu) dmu
-
-    (the ratio's limit tau e^{-tau/mu}/mu^2 where mu = mu_i). Gauss-Legendre with SLAB_SINGLE_NODES
-    nodes, as the shader. Scalars mu_i, d_mm -> (3,)."""
-    x, w = np.polynomial.legendre.leggauss(SLAB_SINGLE_NODES)
-    mu, w = 0.5 * (x + 1.0), 0.5 * w
-    al = np.clip(np.asarray(alpha, np.float64).reshape(3), 0.0, 1.0)
-    l = np.asarray(mfp_mm, np.float64).reshape(3)
-    mi = float(np.clip(mu_i, 1e-4, 1.0))
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        tau = np.where(l > 0, max(float(d_mm), 0.0) / np.where(l > 0, l, 1.0), np.inf)[:, None]
-        diff = mi - mu[None, :]
-        close = np.abs(diff) < 1e-3
-        ratio = np.where(
-            close,
-            tau * np.exp(-tau / mu) / (mu * mu),
-            (np.exp(-tau / mi) - np.exp(-tau / mu)) / np.where(close, 1.0, diff),
-        )
-    out = 0.5 * al * np.sum(w * mu * np.nan_to_num(ratio, nan=0.0, posinf=0.0), axis=-1)
-    return np.where(l > 0, out, 0.0)

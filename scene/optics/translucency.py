@@ -8,10 +8,9 @@ looked up at the point moved `shrink` inward along its normal, times the cosine 
 and the light (a flat slab's own thickness), plus the shrink (which a flat part's lookup lost); 0
 where the moved point is still in front of the first surface (a point that is itself the first
 surface reads 0, not the map's quantisation noise; so does a part thinner than the shrink). What
-crosses that thickness is the slab transmission of scene/optics/boundary.py: the entry factor at the
-far side's incidence times the diffusion slab transmittance, plus single scattering through the
-slab. Texture-space diffusion gathers it in its irradiance pass, the screen-space techniques in the
-forward pass; both call the same GLSL functions.
+crosses that thickness is the exact slab transmittance of scene/optics/slab.py (`slab_through`: all
+orders of scattering, Fresnel in and out). Texture-space diffusion gathers it in its irradiance pass,
+the screen-space techniques in the forward pass; both call the same GLSL functions.
 
 Distance maps are (H, W) with row 0 at texture v = 0 (GL order), read texel by texel (texelFetch:
 the bilinear weights are computed, not the sampler's, so the twin is exact to fp32)."""
@@ -20,9 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .boundary import BoundaryTables, slab_single_transmittance, slab_transmittance, table_lookup
-from .fresnel import fresnel_dielectric
-from .single_scattering import refract_cos
+from .boundary import BoundaryTables
+from .slab import slab_table, slab_through
 
 NO_SURFACE = 1e29  # a distance-map texel at or above this holds no surface (cleared to 1e30)
 
@@ -78,31 +76,24 @@ def thickness_mm(distance_map, shadow_matrix, eye, world, normal, back, shrink, 
     return np.where(hit, d, 0.0), hit
 
 
-def through(back, d_mm, tables: BoundaryTables, medium) -> np.ndarray:
+def through(back, d_mm, tables: BoundaryTables, medium, colour) -> np.ndarray:
     """(N, 3): of the irradiance on a surface facing the light, per unit base colour, what crosses a
-    slab d_mm thick lit at cosine `back` on its far side and leaves through this side: entry(back) x
-    slab_transmittance(d) + (1 - F(back)) x single scattering through the slab at the refracted
-    cosine (scene/optics/boundary.py; per unit base colour: x tables.single / alpha). `tables`: the
-    material's boundary tables, `medium` its medium (alpha_arr, mfp_arr, eta: what
-    app/render/boundary.py binds). GLSL sss_through."""
+    slab d_mm thick lit at cosine `back` on its far side and leaves through this side: the exact slab
+    transmittance (scene/optics/slab.py slab_through, at the boundary's index `tables.eta`). `medium`:
+    the material's medium (alpha_arr, mfp_arr), `colour` its subsurface_color (the table is per unit
+    of it): what app/render/boundary.py binds. GLSL sss_through."""
     back = np.atleast_1d(np.asarray(back, np.float64))
     d = np.broadcast_to(np.atleast_1d(np.asarray(d_mm, np.float64)), back.shape)
-    al = np.clip(np.asarray(medium.alpha_arr, np.float64).reshape(3), 0.0, 1.0)
-    mfp_mm = medium.mfp_arr
-    eta = max(float(tables.eta), 1.0)
-    per_colour = np.divide(np.asarray(tables.single, np.float64), al, out=np.zeros(3), where=al > 0)
-    multiple = table_lookup(tables.entry, back) * slab_transmittance(d, al, mfp_mm, medium.eta)
-    t_in = 1.0 - fresnel_dielectric(back, eta)
-    mu_t = refract_cos(back, eta)
-    single = np.stack([slab_single_transmittance(m, x, al, mfp_mm) for m, x in zip(mu_t, d)]) * per_colour
-    return multiple + t_in[:, None] * single
+    table = slab_table(medium.alpha_arr, colour)
+    out = [slab_through(c, x, table, medium.mfp_arr, medium.alpha_arr, tables.eta) for c, x in zip(back, d)]
+    return np.array(out, np.float64).reshape(-1, 3)
 
 
-def translucent_irradiance(e, back, d_mm, hit, tables: BoundaryTables, medium) -> np.ndarray:
+def translucent_irradiance(e, back, d_mm, hit, tables: BoundaryTables, medium, colour) -> np.ndarray:
     """(N, 3) irradiance entering through thin parts from one light of irradiance e (3,) on a surface
     facing it: e back through(back, d) where the light is behind the surface (back > 0) and the map
     has a surface in front (hit); 0 elsewhere. GLSL sss_translucent_light."""
     back = np.atleast_1d(np.asarray(back, np.float64))
     ok = (back > 0) & np.asarray(hit, bool)
-    t = through(np.where(ok, back, 1.0), np.where(ok, d_mm, 0.0), tables, medium)
+    t = through(np.where(ok, back, 1.0), np.where(ok, d_mm, 0.0), tables, medium, colour)
     return np.where(ok[:, None], np.asarray(e, np.float64).reshape(1, 3) * back[:, None] * t, 0.0)

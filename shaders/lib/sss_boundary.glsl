@@ -12,6 +12,7 @@
 #define SSS_ANGULAR_NODES 17
 uniform vec3 u_sss_entry[SSS_ANGULAR_NODES];  // at cosines i / (SSS_ANGULAR_NODES - 1)
 uniform vec3 u_sss_exit[SSS_ANGULAR_NODES];
+uniform vec3 u_sss_single_ambient[SSS_ANGULAR_NODES];  // A_ss(mu) / A_colour: single scattering of a uniform sky
 uniform vec3 u_sss_entry_diffuse;  // A_ms_d / A_colour: uniform (ambient) light
 uniform vec3 u_sss_single;         // alpha / A_colour (0: no single-scattering term)
 uniform float u_sss_eta;           // relative index of the boundary (1: index-matched)
@@ -28,53 +29,69 @@ vec3 sss_exit(float mu) {
     return mix(u_sss_exit[i], u_sss_exit[i + 1], x - float(i));
 }
 
+// Single scattering of uniform (ambient) light of radiance 1 toward a view at cosine mu, per unit base
+// colour (NumPy twin: scene/optics/boundary.py single_ambient_albedo, table_lookup).
+vec3 sss_single_ambient(float mu) {
+    float x = clamp(mu, 0.0, 1.0) * float(SSS_ANGULAR_NODES - 1);
+    int i = min(int(floor(x)), SSS_ANGULAR_NODES - 2);
+    return mix(u_sss_single_ambient[i], u_sss_single_ambient[i + 1], x - float(i));
+}
+
 // Single scattering toward v of light from l (per unit irradiance on a surface facing the light,
 // i.e. multiply by e NoL), per unit base colour.
 vec3 sss_single_brdf(vec3 n, vec3 l, vec3 v) {
     return single_scatter_brdf(n, l, v, u_sss_single, max(u_sss_eta, 1.0), 0.0);
 }
 
-// Light through thin parts (NumPy twin: scene/optics/boundary.py slab_transmittance): what crosses a
-// slab d mm thick and leaves through its far side, relative to what the entry factor says a
-// semi-infinite medium returns (diffusion between extrapolated boundaries, times 1 - e^{-d/l}).
-uniform vec3 u_sss_sigma_tr;  // 1/mm
-uniform vec3 u_sss_z0;        // source depth: the mean free path, mm
-uniform vec3 u_sss_zb;        // extrapolation distance 2 A D, mm
+// Light through thin parts (NumPy twin: scene/optics/slab.py slab_through): of the irradiance (normal
+// to the light) arriving at cosine `back` on the far face of a part d_mm thick, what leaves the near
+// face after scattering inside, per unit base colour: the exact diffuse transmittance of the
+// index-matched slab (doubling method, all orders) from a table in the cosine (i / 8) and the optical
+// thickness tau = d / l (half octaves from 1/16 to 64 mean free paths; ln T linear in tau, T linear in
+// the cosine); thinner: linear in tau to 0, thicker: e^{-k (tau - 64)} 64 / tau. At eta > 1 Fresnel
+// transmission in, the table at the refracted cosine, and u_sss_slab_out = 1 - F_dr out.
+#define SSS_SLAB_MU 9
+#define SSS_SLAB_TAU 21
+#define SSS_SLAB_LOG2_TAU_MIN (-4.0)
+uniform vec3 u_sss_slab[SSS_SLAB_MU * SSS_SLAB_TAU];  // ln(T / A_colour), row i * SSS_SLAB_TAU + j
+uniform vec3 u_sss_mfp;         // mean free path l per channel, mm (0: no scattering)
+uniform vec3 u_sss_slab_decay;  // k = sqrt(3 (1 - a)) per mean free path beyond the table
+uniform float u_sss_slab_out;   // 1 - F_dr(eta): diffuse Fresnel transmission out (1 at eta 1)
 
-vec3 sss_slab_transmittance(float d_mm) {
-    float d = max(d_mm, 0.0);
-    vec3 a = u_sss_z0 + u_sss_zb;
-    vec3 b = vec3(d) + 2.0 * u_sss_zb;
-    vec3 s = u_sss_sigma_tr;
-    vec3 num = vec3(s.x > 0.0 ? -em1(-2.0 * s.x * a.x) : 2.0 * a.x, s.y > 0.0 ? -em1(-2.0 * s.y * a.y) : 2.0 * a.y,
-                    s.z > 0.0 ? -em1(-2.0 * s.z * a.z) : 2.0 * a.z);
-    vec3 den = vec3(s.x > 0.0 ? -em1(-2.0 * s.x * b.x) : 2.0 * b.x, s.y > 0.0 ? -em1(-2.0 * s.y * b.y) : 2.0 * b.y,
-                    s.z > 0.0 ? -em1(-2.0 * s.z * b.z) : 2.0 * b.z);
-    vec3 hit = -em1(-d / max(u_sss_z0, vec3(1e-30)));  // the light that collides in the slab at all
-    vec3 t = hit * exp(s * (2.0 * a - b)) * vec3(den.x > 0.0 ? num.x / den.x : 0.0, den.y > 0.0 ? num.y / den.y : 0.0,
-                                           den.z > 0.0 ? num.z / den.z : 0.0);
-    return vec3(u_sss_z0.x > 0.0 ? t.x : 0.0, u_sss_z0.y > 0.0 ? t.y : 0.0, u_sss_z0.z > 0.0 ? t.z : 0.0);
+float sss_slab_channel(int i, float fm, float tau, int c, float k) {
+    float tmin = exp2(SSS_SLAB_LOG2_TAU_MIN);
+    float tmax = exp2(SSS_SLAB_LOG2_TAU_MIN + 0.5 * float(SSS_SLAB_TAU - 1));
+    float tc = clamp(tau, tmin, tmax);
+    int j = min(int(floor((log2(tc) - SSS_SLAB_LOG2_TAU_MIN) * 2.0)), SSS_SLAB_TAU - 2);
+    j = max(j, 0);
+    float t0 = exp2(SSS_SLAB_LOG2_TAU_MIN + 0.5 * float(j));
+    float ft = clamp((tc - t0) / (t0 * (sqrt(2.0) - 1.0)), 0.0, 1.0);
+    int r0 = i * SSS_SLAB_TAU + j;
+    int r1 = r0 + SSS_SLAB_TAU;
+    float v0 = exp(mix(u_sss_slab[r0][c], u_sss_slab[r0 + 1][c], ft));
+    float v1 = exp(mix(u_sss_slab[r1][c], u_sss_slab[r1 + 1][c], ft));
+    float v = mix(v0, v1, fm);
+    if (tau < tmin) v *= tau / tmin;
+    else if (tau > tmax) v *= exp(-k * (tau - tmax)) * tmax / tau;
+    return v;
 }
 
-// Single scattering through a slab d mm thick, index-matched, for light at (refracted) cosine mu_i,
-// per unit base colour (u_sss_single = alpha / A_colour), over all exit directions. NumPy twin:
-// scene/optics/boundary.py slab_single_transmittance (same 8 Gauss-Legendre nodes).
-uniform vec3 u_sss_mfp;  // mean free path l per channel, mm (0: no scattering)
-const float SLAB_MU[8] = float[8](0.019855071751231912, 0.10166676129318664, 0.2372337950418355, 0.4082826787521751,
-                                  0.5917173212478248, 0.7627662049581645, 0.8983332387068134, 0.9801449282487681);
-const float SLAB_W[8] = float[8](0.05061426814518853, 0.11119051722668721, 0.15685332293894344, 0.18134189168918083,
-                                 0.18134189168918083, 0.15685332293894344, 0.11119051722668721, 0.05061426814518853);
-
-vec3 sss_slab_single(float mu_i, float d_mm) {
-    float mi = clamp(mu_i, 1e-4, 1.0);
-    vec3 valid = vec3(greaterThan(u_sss_mfp, vec3(0.0)));
-    vec3 tau = max(d_mm, 0.0) / max(u_sss_mfp, vec3(1e-30));
-    vec3 acc = vec3(0.0);
-    for (int k = 0; k < 8; ++k) {
-        float mu = SLAB_MU[k];
-        float diff = mi - mu;
-        vec3 r = abs(diff) < 1e-3 ? tau * exp(-tau / mu) / (mu * mu) : (exp(-tau / mi) - exp(-tau / mu)) / diff;
-        acc += SLAB_W[k] * mu * r;
+vec3 sss_slab_through(float back, float d_mm) {
+    float eta = max(u_sss_eta, 1.0);
+    float b = clamp(back, 0.0, 1.0);
+    float t_in = 1.0;
+    if (eta > 1.0) {
+        t_in = 1.0 - fresnel_dielectric(b, eta);
+        b = refract_cos(b, eta);
     }
-    return valid * 0.5 * u_sss_single * acc;
+    float xm = b * float(SSS_SLAB_MU - 1);
+    int i = min(int(floor(xm)), SSS_SLAB_MU - 2);
+    float fm = xm - float(i);
+    float d = max(d_mm, 0.0);
+    vec3 out_ = vec3(0.0);
+    for (int c = 0; c < 3; ++c) {
+        float l = u_sss_mfp[c];
+        if (l > 0.0 && d > 0.0) out_[c] = sss_slab_channel(i, fm, d / l, c, u_sss_slab_decay[c]);
+    }
+    return (t_in * u_sss_slab_out) * out_;
 }

@@ -4,8 +4,8 @@
 // manner of Jimenez, Whelan, Sundstedt & Gutierrez 2010 ("Real-Time Realistic Skin Translucency"):
 // the distance the light travelled inside the object is its distance from the light minus the
 // distance of the first surface it met there (the shadow pass's distance map, passes/shadow.frag),
-// looked up at the position shrunk a little along the normal; what comes through is the slab
-// transmission of lib/sss_boundary.glsl (diffusion plus single scattering through that thickness).
+// looked up at the position shrunk a little along the normal; what comes through is the exact slab
+// transmittance of lib/sss_boundary.glsl (sss_slab_through).
 // NumPy twin: scene/optics/translucency.py. Bound by app/render/translucency.py.
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
@@ -68,13 +68,11 @@ bool sss_thickness_mm(int slot, vec3 world, vec3 ng, float back, out float d_mm)
 }
 
 // What crosses a slab d_mm thick from its far side, lit there at cosine `back`, and leaves through
-// this side, per unit irradiance on a surface facing the light and per unit base colour: the entry
-// factor at that incidence times the diffusion slab transmittance, plus the light scattered once in
-// the slab (Fresnel transmission in, refracted cosine).
+// this side, per unit irradiance on a surface facing the light and per unit base colour: the exact
+// slab transmittance (lib/sss_boundary.glsl sss_slab_through: all orders of scattering, Fresnel in
+// and out; NumPy scene/optics/slab.py slab_through).
 vec3 sss_through(float back, float d_mm) {
-    float eta = max(u_sss_eta, 1.0);
-    float t_in = 1.0 - fresnel_dielectric(back, eta);
-    return sss_entry(back) * sss_slab_transmittance(d_mm) + t_in * sss_slab_single(refract_cos(back, eta), d_mm);
+    return sss_slab_through(back, d_mm);
 }
 
 // Irradiance entering the medium at world through thin parts from light i (direction to it l, its

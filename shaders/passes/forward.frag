@@ -6,8 +6,9 @@
 // shaders/techniques/<name>/forward.glsl; the contract is in app/render/technique.py): plain
 // Burley diffuse weighted by sss_plain_weight(), the hook told about each light, and its radiance
 // added after the lights. Specular and ambient specular as usual. Single scattering (Jensen 2001,
-// lib/sss_boundary.glsl) is added per light for a mesh whose technique scatters (u_sss_single > 0):
-// it leaves within about a mean free path of where it entered, so no technique blurs it.
+// lib/sss_boundary.glsl) is added per light, and for ambient light, for a mesh whose technique
+// scatters (u_sss_single > 0): it leaves within about a mean free path of where it entered, so no
+// technique blurs it.
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
@@ -69,11 +70,12 @@ void main() {
         color += e * vis * (diffuse + spec) * NoL;
         if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
         // the technique's diffusion: shadowed where it entered (oblique entry, lib/sss_oblique.glsl)
-        vec3 z0 = u_sss_z0 * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
+        vec3 z0 = u_sss_mfp * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
         vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
         sss_add_light(e, u_light_shadow[i] >= 0 ? light_visibility(i, entry, dot(ng, l)) : 1.0, NoL);
     }
     color += u_ambient * occlusion * (base * ((1.0 - u_metallic) * plain) + f0);
+    if (single) color += u_ambient * occlusion * single_w * sss_single_ambient(NoV);  // the sky's single scattering
     color += sss_radiance(base, NoV, occlusion, v_uv);
     f_color = vec4(color, 1.0);
 }

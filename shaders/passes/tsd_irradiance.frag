@@ -5,12 +5,11 @@
 // (pi L_ambient x A_ms_d / A_colour) - times albedo^mix (pre-scatter texturing). a = 1: covered.
 // Each light's shadow is looked up where the diffusion that leaves at the texel entered (oblique
 // incidence, lib/sss_oblique.glsl: about 0.7 mm toward the light on skin lit at 45 degrees).
-// Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts: the entry factor at the
-// light's incidence on the far side times the diffusion slab transmittance through the thickness
-// (lib/sss_boundary.glsl sss_slab_transmittance; the thickness along the light from the shadow
-// pass's distance map, times the cosine to the normal: a flat slab's own thickness), plus the light
-// scattered once inside the slab (sss_slab_single); lib/sss_translucency.glsl, shared with the
-// forward hooks of the screen-space techniques.
+// Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts: the exact diffuse
+// transmittance of a slab (all orders of scattering) at the light's incidence on the far side
+// (lib/sss_boundary.glsl sss_slab_through; the thickness along the light from the shadow pass's
+// distance map, times the cosine to the normal: a flat slab's own thickness); lib/sss_translucency.glsl,
+// shared with the forward hooks of the screen-space techniques.
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
@@ -44,7 +43,7 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
     float NoL = dot(n, l);
     if (NoL > 0.0) {
         // the shadow where this texel's diffusion entered: oblique entry (lib/sss_oblique.glsl)
-        vec3 z0 = u_sss_z0 * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
+        vec3 z0 = u_sss_mfp * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
         vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
         sum += e * (light_visibility(i, entry, dot(ng, l)) * NoL) * sss_entry(NoL);
     }

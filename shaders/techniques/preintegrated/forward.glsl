@@ -53,7 +53,7 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
         // shadow maps only where the light faces the surface; past the terminator the ring's light
         // comes from the lit side
         // (looked up where the light entered: oblique entry, lib/sss_oblique.glsl)
-        vec3 z0 = u_sss_z0 * sss_radius_scale_at(v_uv);
+        vec3 z0 = u_sss_mfp * sss_radius_scale_at(v_uv);
         vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
         float vis = (u_light_shadow[i] >= 0 && nlg > 0.0) ? light_visibility(i, entry, nlg) : 1.0;
 #ifdef HAS_NORMAL_MAP

@@ -90,7 +90,6 @@ def test_the_subsurface_frame_moves_the_shadow_edge_by_the_oblique_entry_offset(
     puts it 0.57 px above the plain frame's at this size (rows 42.84 and 43.41 at 1024 texels)."""
     from app.bench.truth_ledger import REFERENCE_SCENES
     from app.render.settings import RenderSettings
-    from scene.optics.boundary import slab_parameters
     from scene.optics.oblique import LUMA
     from scene.optics.tsd import material_medium
     from scene.scenefile import load_scene
@@ -100,7 +99,7 @@ def test_the_subsurface_frame_moves_the_shadow_edge_by_the_oblique_entry_offset(
     mm_per_px = 2 * 300 * math.tan(math.radians(8)) / size
     slab = next(n.material for n in scene.mesh_nodes() if n.material.name == "skin")
     medium = material_medium(slab.values)
-    z0 = slab_parameters(medium.alpha_arr, medium.mfp_arr, medium.eta)[1]  # the shaders' u_sss_z0
+    z0 = np.asarray(medium.mfp_arr)  # 1 / mu_t' (isotropic phase): the shaders' u_sss_mfp
     offset_px = float(np.asarray(z0) @ LUMA) * math.sin(math.radians(45)) / medium.eta / mm_per_px
 
     def edge(technique):

@@ -29,14 +29,15 @@ def _box_scene(mat=None, mm_per_unit=1.0, node_kw=None) -> Scene:
     return s
 
 
-def test_medium_is_the_one_skinlab_derives_in_scene_units():
+def test_medium_is_the_one_skinlab_derives_in_millimetres():
     mat = skin(radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5))
     for mm in (1.0, 20.0, 45.0):
         d = ex.describe(_box_scene(mat, mm), 8, 8)
         med = d.shapes[0].interior
         m = material_medium(mat.values)
         sigma_t = np.asarray(med["sigma_t"]["value"]) * med["scale"]
-        assert np.allclose(sigma_t, mm / m.mfp_arr)  # 1/mm -> 1/scene unit
+        assert np.allclose(sigma_t, 1.0 / m.mfp_arr)  # the reference frame's unit is the millimetre
+        assert d.frame_scale == mm
         assert np.allclose(med["albedo"]["value"], m.alpha_arr)
         assert max(med["sigma_t"]["value"]) == pytest.approx(1.0)  # Mitsuba wants RGB in [0, 1]
         assert med["phase"] == {"type": "isotropic"}
@@ -86,14 +87,18 @@ def test_surfaces_without_scattering_are_two_sided_principled():
     assert (inner["roughness"], inner["metallic"], inner["specular"]) == pytest.approx((0.3, 0.1, 0.6))
 
 
-def test_geometry_is_in_world_space_with_transformed_normals():
+def test_geometry_is_in_the_centred_millimetre_frame_with_transformed_normals():
     kw = {"translation": (1.0, 2.0, 3.0), "scale": (2.0, 1.0, 0.5)}
-    s = _box_scene(node_kw=kw)
+    s = _box_scene(node_kw=kw, mm_per_unit=45.0)
     node = s.find("box")
     d = ex.describe(s, 8, 8)
     w = node.world_matrix
     p = node.mesh.positions @ w[:3, :3].T + w[:3, 3]
-    assert np.allclose(d.shapes[0].positions, p, atol=1e-5)
+    assert np.allclose(d.frame_origin, (1.0, 2.0, 3.0)) and d.frame_scale == 45.0
+    assert np.allclose(d.shapes[0].positions, (p - (1.0, 2.0, 3.0)) * 45.0, atol=1e-4)
+    # centred: the bounds are symmetric about 0, in millimetres (the box is 4 x 2 x 1 units)
+    q = d.shapes[0].positions
+    assert np.allclose(q.max(0), -q.min(0), atol=1e-4) and np.allclose(q.max(0) - q.min(0), (180.0, 90.0, 45.0))
     n = d.shapes[0].normals
     assert np.allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-5)
     # each face's normal stays perpendicular to the (scaled) face
@@ -103,15 +108,16 @@ def test_geometry_is_in_world_space_with_transformed_normals():
 
 
 def test_camera_frame_looks_down_skinlab_minus_z_with_x_mirrored():
-    s = _box_scene()
+    s = _box_scene(mm_per_unit=2.0)
     s.camera.look_at((3.0, 1.0, 10.0), (0.0, 0.0, 0.0))
     d = ex.describe(s, 32, 16)
     m = d.camera_to_world
     fwd = -s.camera.world_matrix[:3, 2]
     assert np.allclose(m[:3, 2], fwd / np.linalg.norm(fwd))  # Mitsuba looks along +Z
     assert np.allclose(m[:3, 0], -s.camera.world_matrix[:3, 0])  # Mitsuba's +X points left
-    assert np.allclose(m[:3, 3], (3.0, 1.0, 10.0))
+    assert np.allclose(m[:3, 3], (6.0, 2.0, 20.0))  # the box is centred at 0: millimetres
     assert d.fov_y_deg == pytest.approx(40.0) and (d.width, d.height) == (32, 16)
+    assert (d.near, d.far) == pytest.approx((0.2, 200.0))
 
 
 def test_lights_keep_their_irradiance_and_intensity():
@@ -119,14 +125,15 @@ def test_lights_keep_their_irradiance_and_intensity():
     point = LightNode("bulb", "point", color=(1.0, 0.5, 0.25), intensity=4.0)
     point.translation = (0.0, 5.0, 0.0)
     s.add(point)
+    s.find("box").translation = (1.0, 0.0, 0.0)  # the frame's origin: the box's centre
     d = ex.describe(s, 8, 8)
     sun, bulb = d.emitters
     key = s.find("sun")
     assert sun["kind"] == "directional" and np.allclose(sun["direction"], key.direction)
     assert np.allclose(sun["irradiance"], key.radiance)
-    # Skinlab: E = I / d_m^2; Mitsuba measures d in scene units (0.045 m each)
-    assert np.allclose(bulb["intensity"], np.array([4.0, 2.0, 1.0]) / 0.045**2)
-    assert np.allclose(bulb["position"], (0.0, 5.0, 0.0))
+    # Skinlab: E = I / d_m^2; Mitsuba measures d in the frame's millimetres
+    assert np.allclose(bulb["intensity"], np.array([4.0, 2.0, 1.0]) / 0.001**2)
+    assert np.allclose(bulb["position"], (-45.0, 225.0, 0.0))
 
 
 def test_sun_disk_keeps_the_irradiance():
@@ -230,3 +237,18 @@ def test_the_whole_description_changes_the_cache_key():
     assert reference_key(ex.describe(s, 8, 8), req, "3.x") != k0
     assert reference_key(ex.describe(slab_scene(), 8, 8), ReferenceRequest(8, 8, spp=32, passes=2), "3.x") != k0
     assert reference_key(ex.describe(slab_scene(), 8, 8), req, "3.y") != k0
+
+
+def test_frame_is_centred_on_the_scattering_meshes():
+    """A far plain occluder does not move the origin off the medium (the ray offset grows with the
+    distance from it); with no scattering mesh every mesh counts."""
+    s = _box_scene(node_kw={"translation": (1.0, 2.0, 3.0)}, mm_per_unit=10.0)
+    plate = Material("black", {"base_color": (0.0, 0.0, 0.0)})
+    s.add(MeshNode("plate", box_mesh((2.0, 2.0, 0.1)), plate, translation=(40.0, 0.0, 0.0)))
+    d = ex.describe(s, 8, 8)
+    assert np.allclose(d.frame_origin, (1.0, 2.0, 3.0))
+    box = next(x for x in d.shapes if x.name == "box")
+    assert np.allclose(box.positions.max(0), -box.positions.min(0), atol=1e-4)  # the medium is centred
+    s.find("box").material = plate
+    lo, hi = s.world_bounds()
+    assert np.allclose(ex.describe(s, 8, 8).frame_origin, (lo + hi) / 2) and (lo + hi)[0] / 2 == 20.5

@@ -107,10 +107,11 @@ def test_boundary_glsl_twins(glsl):
 
             set_array(prog, "u_sss_entry", t.entry, b.ANGULAR_NODES)
             set_array(prog, "u_sss_exit", t.exit, b.ANGULAR_NODES)
+            set_array(prog, "u_sss_single_ambient", t.single_ambient, b.ANGULAR_NODES)
             set_uniforms(prog, {"u_sss_single": t.single, "u_sss_eta": eta, "u_sss_entry_diffuse": t.entry_diffuse})
 
         mu = np.array([-0.2, 0.0, 1e-6, 0.03, 0.0625, 0.2, 0.5, 0.77, 0.999, 1.0, 1.2])
-        for fn, table in (("sss_entry", t.entry), ("sss_exit", t.exit)):
+        for fn, table in (("sss_entry", t.entry), ("sss_exit", t.exit), ("sss_single_ambient", t.single_ambient)):
             gpu = glsl.evaluate("lib/sss_boundary.glsl", f"{fn}(c)", {"c": mu}, out_components=3, setup=setup)
             assert_close_fp32(gpu, b.table_lookup(table, mu), what=fn, atol=1e-4)
         # single scattering at the hard cases: grazing in and out, normal, behind
@@ -129,6 +130,29 @@ def test_boundary_glsl_twins(glsl):
         ref = single_scatter_brdf(n, wi, wo, t.single, np.full(len(wi), eta), 0.0)
         assert np.all(np.isfinite(gpu))
         assert_close_fp32(gpu, ref, what="sss_single_brdf", atol=1e-4)
+
+
+@pytest.mark.parametrize("a", ALBEDOS)
+def test_single_scattering_of_a_uniform_sky(a):
+    """Ambient light's single scattering toward mu: at eta 1 Chandrasekhar's directional single albedo
+    (a/2)(1 - mu ln(1 + 1/mu)); at eta 1.4 the frame's own Jensen term (single_scatter_brdf) integrated
+    over the incident hemisphere (azimuths and cosines); finite and >= 0 at the hard cases."""
+    mu = np.array([0.0, 1e-6, 0.1, 0.5, 0.9, 1.0])
+    np.testing.assert_allclose(b.single_ambient_albedo(a, 1.0, mu), b.single_albedo_isotropic(a, mu), atol=2e-5)
+    for eta in (1.0, 1.4, 2.5):
+        v = b.single_ambient_albedo(a, eta, mu)
+        assert np.all(np.isfinite(v)) and np.all(v >= 0)
+    x, w = np.polynomial.legendre.leggauss(64)
+    m, w = 0.5 * (x + 1), 0.5 * w
+    phi = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    n = np.array([0.0, 0.0, 1.0])
+    for mo in (0.2, 0.7, 1.0):
+        wo = np.array([np.sqrt(1 - mo * mo), 0.0, mo])
+        s = np.sqrt(1 - m * m)
+        wi = np.stack([s[:, None] * np.cos(phi), s[:, None] * np.sin(phi), np.broadcast_to(m[:, None], (64, 16))], -1)
+        f = single_scatter_brdf(np.broadcast_to(n, wi.shape), wi, np.broadcast_to(wo, wi.shape), [a], 1.4, 0.0)[..., 0]
+        want = np.sum(w * m * f.mean(axis=1)) * 2 * np.pi
+        assert float(b.single_ambient_albedo(a, 1.4, mo)) == pytest.approx(want, rel=1e-3, abs=1e-9)
 
 
 @pytest.mark.parametrize("a", (0.0, 1.0))
@@ -176,56 +200,3 @@ def test_multiple_scattering_matches_monte_carlo(eta, incidence, tol):
     else:
         model = b.hemispherical(lambda m: b.ms_albedo(a, eta, m))
     assert abs(model - ms) < 4 * r.total_se + 2e-3 + tol * ms, (model, ms, r.total_se)
-
-
-def test_slab_transmittance_limits_and_glsl_twins(glsl):
-    """Light through thin parts: thicker passes less, an infinitely thick slab nothing, no absorption
-    a / b; single scattering through the slab against a fine quadrature; the GLSL twins within 1e-4."""
-    alpha, mfp = np.array([0.894, 0.687, 0.0]), np.array([1.3, 0.95, 0.67])
-    d = np.array([0.0, 1e-4, 0.5, 3.0, 10.0, 1e4])
-    t = b.slab_transmittance(d, alpha, mfp, 1.0)
-    assert np.all(np.isfinite(t)) and np.all(t >= 0)
-    assert np.all(t[0] == 0) and np.all(t[1] < 1e-2)  # too thin to scatter
-    assert np.all(np.diff(t[3:], axis=0) <= 1e-12)  # beyond a few mean free paths: thicker passes less
-    assert np.all(t[-1] < 1e-12)
-    s, z0, zb = b.slab_parameters([1.0, 1.0, 1.0], mfp, 1.0)
-    assert np.all(s == 0)
-    np.testing.assert_allclose(
-        b.slab_transmittance(3.0, [1.0] * 3, mfp, 1.0)[0], -np.expm1(-3.0 / mfp) * (z0 + zb) / (3.0 + 2 * zb)
-    )
-    # single scattering through a slab: the 8-node rule against 4000 nodes, and the hard cases
-    x, w = np.polynomial.legendre.leggauss(4000)
-    mu, w = 0.5 * (x + 1), 0.5 * w
-    for mu_i, dd in ((0.866, 3.0), (0.3, 0.5), (1.0, 1.0)):
-        fine = [
-            0.5 * a * np.sum(w * mu * (np.exp(-dd / l / mu_i) - np.exp(-dd / l / mu)) / (mu_i - mu))
-            for a, l in zip(alpha, mfp)
-        ]
-        np.testing.assert_allclose(b.slab_single_transmittance(mu_i, dd, alpha, mfp), fine, rtol=0.03, atol=1e-5)
-    for mu_i in (0.0, 1e-6, 0.5, 1.0):
-        for dd in (0.0, 1e-6, 2.0, 1e5):
-            v = b.slab_single_transmittance(mu_i, dd, alpha, mfp)
-            assert np.all(np.isfinite(v)) and np.all(v >= 0) and v[2] == 0
-    assert np.all(b.slab_single_transmittance(0.7, 0.0, alpha, mfp) == 0)  # nothing to scatter in
-
-    tabs = b.boundary_tables(alpha, (0.46, 0.23, 0.1), 1.0)
-    sp = b.slab_parameters(alpha, mfp, 1.0)
-
-    def setup(prog):
-        from app.gl.uniforms import set_uniforms
-
-        set_uniforms(prog, {"u_sss_sigma_tr": sp[0], "u_sss_z0": sp[1], "u_sss_zb": sp[2], "u_sss_mfp": mfp})
-        set_uniforms(prog, {"u_sss_single": tabs.single})
-
-    gpu = glsl.evaluate("lib/sss_boundary.glsl", "sss_slab_transmittance(d)", {"d": d}, 3, setup=setup)
-    assert_close_fp32(gpu, t, what="sss_slab_transmittance", atol=1e-4)
-    mus = np.array([0.0, 0.1, 0.5, 0.866, 0.8983, 1.0])
-    dd = np.array([0.0, 0.5, 3.0, 3.0, 1.0, 1e4])
-    gpu = glsl.evaluate("lib/sss_boundary.glsl", "sss_slab_single(m, d)", {"m": mus, "d": dd}, 3, setup=setup)
-    ref = np.array(
-        [
-            b.slab_single_transmittance(m, x, alpha, mfp) * tabs.single / np.where(alpha > 0, alpha, 1)
-            for m, x in zip(mus, dd)
-        ]
-    )
-    assert_close_fp32(gpu, ref, what="sss_slab_single", atol=1e-4)

@@ -1,5 +1,7 @@
 """The forward pass's part of texture-space diffusion: the gather of the irradiance and its blurred
-levels (shaders/techniques/tsd/forward.glsl) for every mesh whose irradiance pass ran this frame."""
+levels (shaders/techniques/tsd/forward.glsl) for every mesh whose irradiance pass ran this frame, and
+local scattering (shaders/techniques/tsd/local.glsl: entry, exit and single scattering without a
+blur) for a scattering mesh whose profile is narrower than a texel."""
 
 from __future__ import annotations
 
@@ -9,16 +11,21 @@ from app.render.technique import ForwardHook, NodeShading
 from .passes import frame_nodes
 
 HOOK = "techniques/tsd/forward.glsl"
+LOCAL_HOOK = "techniques/tsd/local.glsl"
 
 
 class TsdForward(ForwardHook):
-    def __init__(self, nodes: int, reason: str = "; gather diffusion for {n}"):
+    def __init__(self, nodes: int, local: dict | None = None, reason: str = "; gather diffusion for {n}"):
+        self.local = dict(local or {})  # uid -> effective material, scattered locally
         self.reason = reason.format(n=nodes) if nodes else ""
+        if self.local:
+            self.reason += f"; local scattering (profile narrower than a texel) for {len(self.local)}"
 
     def shading(self, node, frame):
         t = frame_nodes(frame).get(node.uid)
         if t is None:
-            return None
+            mat = self.local.get(node.uid)
+            return None if mat is None else NodeShading(mat, LOCAL_HOOK)
         return NodeShading(
             t.material, HOOK, {"TSD_LEVELS": t.kernel.levels}, lambda prog, units: bind_gather(prog, t, units)
         )

@@ -2,7 +2,10 @@
 
 A mesh node gets TSD passes only when its (effective) material scatters below the surface: a
 subsurface weight above 0, a model other than "none" and a radius above 0, and a kernel wider than a
-texel. Everything decided here is recorded in the plan (pass reasons, skipped items, warnings).
+texel. A scattering mesh whose Gaussians are all narrower than a texel needs no blur: it is shaded
+locally (the light that enters leaves where it entered, with the same entry, exit and single
+scattering as the blurred case; shaders/techniques/tsd/local.glsl). Everything decided here is recorded
+in the plan (pass reasons, skipped items, warnings).
 """
 
 from __future__ import annotations
@@ -95,8 +98,11 @@ class TsdExactParams(TsdNodeParams):
 UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.zeros(3))
 
 
-def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None, seams: bool = True) -> TsdNodePlan | None:
-    """Decide TSD for one visible mesh node (PlanContext `ctx`); record skips and warnings in its plan."""
+def plan_tsd_node(
+    node, ctx, size: int, gaussians: int, taps: int | None, seams: bool = True, local: dict | None = None
+) -> TsdNodePlan | None:
+    """Decide TSD for one visible mesh node (PlanContext `ctx`); record skips and warnings in its plan.
+    A scattering node whose profile is narrower than a texel goes into `local` (uid -> material)."""
     label = f"tsd[{node.name}]"
     plan, scene = ctx.plan, ctx.scene
     mat = scattering_material(node, ctx.settings, plan, label)
@@ -131,8 +137,10 @@ def plan_tsd_node(node, ctx, size: int, gaussians: int, taps: int | None, seams:
         plan.skipped.append((f"{label} {what}", why))
     if kernel.levels == 0:
         plan.skipped.append(
-            (label, "every Gaussian of the profile is narrower than a texel or negligible; plain diffuse")
+            (label, "every Gaussian of the profile is narrower than a texel or negligible; scattered locally")
         )
+        if local is not None:
+            local[node.uid] = mat
         return None
     if not seams:
         plan.skipped.append((f"tsd_seams[{node.name}]", "switched off in the settings: blurs stop at UV seams"))
@@ -156,18 +164,22 @@ def plan_tsd(
 ):
     """The texture-space passes of every scattering mesh (stretch, the seam map where the mesh has
     UV seams and `seams` is on, irradiance, dilation, then the Gaussian blurs, or with `exact` the
-    brute-force convolution) and whether translucency runs; (passes, node plans, translucency)."""
+    brute-force convolution) and whether translucency runs; (passes, node plans, translucency,
+    local: uid -> material of the meshes scattered locally)."""
     plan = ctx.plan
-    nodes = [t for t in (plan_tsd_node(n, ctx, size, gaussians, taps, seams) for n in ctx.meshes) if t is not None]
+    local: dict = {}
+    nodes = [
+        t for t in (plan_tsd_node(n, ctx, size, gaussians, taps, seams, local) for n in ctx.meshes) if t is not None
+    ]
     use_translucency = plan_translucency(ctx, bool(nodes), translucency)
-    if not nodes:
+    if not nodes and not local:
         plan.skipped.append(("texture-space diffusion", "no visible material needs it"))
     passes, any_translucent = [], False
     for t in nodes:
         node_translucency = use_translucency and can_shine_through(t, ctx.scene, plan)
         any_translucent |= node_translucency
         passes += _node_passes(t, ctx, mix, node_translucency, exact)
-    return passes, nodes, any_translucent
+    return passes, nodes, any_translucent, local
 
 
 def can_shine_through(t: TsdNodePlan, scene, plan) -> bool:

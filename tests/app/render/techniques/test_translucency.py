@@ -42,7 +42,8 @@ def expected_radiance(thickness_mm):
     1) leaving toward a viewer straight in front: through(1, d) x exit(1) / pi."""
     mat = skin(radius=(8.0, 4.0, 2.0))
     tabs, medium = material_boundary(mat), material_medium(mat.values)
-    return tr.through([1.0], [thickness_mm], tabs, medium)[0] * table_lookup(tabs.exit, 1.0) / np.pi
+    through = tr.through([1.0], [thickness_mm], tabs, medium, mat["subsurface_color"])[0]
+    return through * table_lookup(tabs.exit, 1.0) / np.pi
 
 
 @pytest.mark.parametrize("technique", SCREEN)
@@ -144,7 +145,7 @@ def test_reference_back_lit_slab_matches_tsd_and_numpy(renderer):
         np.asarray(mat["base_color"])
         * light.radiance
         * back
-        * tr.through([back], [3.0], tabs, medium)[0]
+        * tr.through([back], [3.0], tabs, medium, mat["subsurface_color"])[0]
         * table_lookup(tabs.exit, nov)
         / np.pi
     )

@@ -199,3 +199,30 @@ def test_bunny_preset_scene_generates_uvs_and_scatters(renderer, tmp_path):
     bad.write_text('[materials.m]\npreset = "jam"\n[[meshes]]\nfile = "x.ply"\nmaterial = "m"\n')
     with pytest.raises(ValueError, match=r"\[materials.m\].preset: preset: unknown material 'jam'"):
         load_scene(bad)
+
+
+@pytest.mark.parametrize("technique", ["tsd", "exact"])
+def test_sub_texel_profile_is_scattered_locally_with_the_boundary(renderer, technique):
+    """A profile narrower than a texel needs no blur, but the light still enters and leaves through
+    the medium's boundary: the slab lit at 45 degrees and seen from above reads
+    E mu0 base (entry(mu0) exit(mu) / pi + Jensen's single scattering), from the NumPy tables (not
+    the plain Burley diffuse the planner used to fall back to)."""
+    from scene.optics.boundary import boundary_tables, table_lookup
+    from scene.optics.single_scattering import single_scatter_brdf
+
+    mat = skin(radius=(0.05, 0.05, 0.05), color=(0.8, 0.5, 0.2))
+    scene = slab_scene(material=mat, light_dir=(1.0, 0.0, -1.0))
+    rs = RenderSettings.for_technique(technique, 48, 48, shadow_size=256, size=64)
+    res = renderer.render(scene, rs)
+    assert not any(k.startswith("tsd") for k in kinds(res.plan))  # nothing to blur
+    assert any("scattered locally" in why for _, why in res.plan.skipped), res.plan.skipped
+    m = tsd.material_medium(mat.values)
+    t = boundary_tables(m.alpha_arr, mat["subsurface_color"], m.eta)
+    mu0 = np.sqrt(0.5)
+    n, l, v = np.array([0.0, 0.0, 1.0]), np.array([-mu0, 0.0, mu0]), np.array([0.0, 0.0, 1.0])
+    ss = single_scatter_brdf(n, l, v, t.single, m.eta, 0.0)
+    want = mu0 * (table_lookup(t.entry, mu0) * table_lookup(t.exit, 1.0) / np.pi + ss)
+    got = res.hdr[23:25, 23:25, :3].reshape(-1, 3).mean(0)
+    np.testing.assert_allclose(got, want, rtol=2e-3)
+    plain = renderer.render(scene, RenderSettings.for_technique("none", 48, 48)).hdr[23:25, 23:25, :3]
+    assert np.abs(plain.reshape(-1, 3).mean(0) / want - 1).max() > 0.05  # the old fallback was off

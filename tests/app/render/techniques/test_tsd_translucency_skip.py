@@ -18,7 +18,7 @@ from scene import transform as tf
 from scene.graph import LightNode
 from scene.mesh import Mesh
 from scene.mesh_thickness import is_closed, thinner_than
-from scene.optics.boundary import slab_single_transmittance
+from scene.optics.slab import slab_table, slab_through
 from scene.optics.translucency_reach import REACH_EPS, translucency_reach_mm, transmission_bound
 from scene.optics.tsd import material_medium
 from scene.scenefile import load_scene
@@ -107,14 +107,23 @@ def test_reach_bounds_the_transmission():
     assert before.max() >= REACH_EPS  # the grid's previous point is still above: reach is not loose by more
 
 
-def test_single_scattering_bound_holds():
-    """(alpha / 2) (1 + tau) e^{-tau} bounds single scattering through a slab at every incidence."""
-    alpha, mfp = np.array([0.9, 0.5, 0.99]), np.array([1.0, 0.5, 2.0])
-    for mu in np.linspace(0.001, 1.0, 25):
-        for d in np.geomspace(1e-4, 60.0, 40):
-            s = slab_single_transmittance(mu, d, alpha, mfp)
-            tau = d / mfp
-            assert (s <= 0.5 * alpha * (1 + tau) * np.exp(-tau) * (1 + 1e-9)).all(), (mu, d)
+@pytest.mark.parametrize("eta", [1.0, 1.4])
+def test_the_bound_holds_at_every_incidence(eta):
+    """back T(back, d) / E(1) <= transmission_bound(d) for every cosine, not only the table's nodes."""
+    med, colour = _skin1()
+    table = slab_table(med.alpha_arr, colour)
+    front = material_boundary_front(med, colour, eta)
+    d = np.geomspace(1e-3, 60.0, 30)
+    bound = transmission_bound(d, med.alpha_arr, med.mfp_arr, eta, colour)
+    for back in np.linspace(0.0, 1.0, 37):
+        got = np.array([back * slab_through(back, x, table, med.mfp_arr, med.alpha_arr, eta) for x in d]) / front
+        assert (got <= bound * (1 + 1e-9) + 1e-300).all(), back
+
+
+def material_boundary_front(med, colour, eta):
+    from scene.optics.boundary import boundary_tables
+
+    return boundary_tables(med.alpha_arr, colour, eta).entry[-1]
 
 
 @pytest.mark.parametrize(
