@@ -152,7 +152,7 @@ def test_flat_slab_keeps_its_thickness():
 def test_through_matches_slab_transmission_and_glsl(glsl):
     """sss_through(back, d) against its twin (the exact slab transmittance, scene/optics/slab.py
     slab_through) within 1e-4, for skin at eta 1 and 1.4, at the hard cases: zero thickness (nothing
-    collides: 0), grazing light (finite), very thick (0); thinner passes more."""
+    collides: 0), grazing light (finite), very thick (0); past a few mean free paths thicker passes less."""
     backs = np.array([1.0, 0.866, 0.5, 1e-3, 0.0, 1.0, 0.3, 1.0])
     dd = np.array([0.5, 3.0, 1.0, 2.0, 2.0, 0.0, 1e-5, 1e4])
     for eta in (1.0, 1.4):
@@ -163,7 +163,8 @@ def test_through_matches_slab_transmission_and_glsl(glsl):
         ref = tr.through(backs, dd, tabs, med, mat["subsurface_color"])
         assert np.all(np.isfinite(ref)) and np.all(ref >= 0)
         assert np.all(ref[5] == 0) and np.all(ref[-1] < 1e-12)
-        assert np.all(ref[0] > tr.through([1.0], [3.0], tabs, med, mat["subsurface_color"])[0])
+        thick = tr.through([1.0, 1.0], [3.0, 10.0], tabs, med, mat["subsurface_color"])
+        assert np.all(thick[0] > thick[1])  # past a few mean free paths, thicker lets less through
         gpu = glsl.evaluate(
             "lib/sss_translucency.glsl",
             "sss_through(c, d)",
@@ -205,7 +206,7 @@ def test_translucent_light_matches_numpy(ctx, glsl):
     d_mm, hit = tr.thickness_mm(dist, m, eye, world, ng, back, shrink, mm)
     ref = tr.translucent_irradiance(e, back, d_mm, hit, tabs, med, mat["subsurface_color"])
     assert_close_fp32(gpu, ref, atol=1e-4, what="sss_translucent_light")
-    assert ref[0].min() > 0 and ref[1].min() > 0 and ref[0, 0] > ref[1, 0]  # thinner passes more (red)
+    assert ref[0].min() > 0 and ref[1].min() > 0 and ref[0, 2] > ref[1, 2]  # thinner passes more (blue)
     assert np.all(ref[2] == 0) and np.all(ref[3] == 0)  # light in front; no surface in the map
     assert np.all(np.isfinite(ref[4])) and ref[4].max() < 1e-2 * ref[1].max()  # grazing: back ~ 0.001
     tex.release()
