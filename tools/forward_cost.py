@@ -49,8 +49,9 @@ def main(argv=None) -> int:
     ap.add_argument("--size", type=int, default=640, help="frame width and height (default 640)")
     ap.add_argument("--rounds", type=int, default=7, help="timed rounds (default 7)")
     args = ap.parse_args(argv)
+    from app.bench.shader_variants import edited_shader_root
     from app.gl.context import create_headless_context, describe
-    from app.gl.shader_source import SHADER_ROOT, ShaderLibrary
+    from app.gl.shader_source import ShaderLibrary
     from app.render.renderer import Renderer
     from app.render.settings import RenderSettings
     from scene.scenefile import load_scene
@@ -65,15 +66,7 @@ def main(argv=None) -> int:
     runs = {}
 
     def renderer(name, edits=()):
-        root = tmp / name
-        shutil.copytree(SHADER_ROOT, root)
-        for rel, old, new in edits:
-            f = root / rel
-            text = f.read_text()
-            if old not in text:
-                raise SystemExit(f"{rel}: the variant {name!r} no longer matches the shader; update this tool")
-            f.write_text(text.replace(old, new))
-        r = Renderer(ctx, ShaderLibrary(root=root))
+        r = Renderer(ctx, ShaderLibrary(root=edited_shader_root(tmp / name, name, edits)))
         r.reuse = False
         r.timer.sync = False
         return r

@@ -106,6 +106,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.coverage:
         return coverage(args.rounds)
+    from app.bench.shader_variants import edited_shader_root
     from app.gl.context import create_headless_context, describe
     from app.gl.shader_source import SHADER_ROOT, ShaderLibrary
     from app.render.renderer import Renderer
@@ -134,13 +135,7 @@ def main(argv=None) -> int:
                 subprocess.run(["tar", "-x", "-C", str(root)], input=archive.stdout, check=True)
                 root, edits = root / "shaders", []
             else:
-                shutil.copytree(SHADER_ROOT, root)
-            for rel, old, new in edits:
-                f = root / rel
-                text = f.read_text()
-                if old not in text:
-                    raise SystemExit(f"{rel}: the variant {name!r} no longer matches the shader; update this tool")
-                f.write_text(text.replace(old, new))
+                edited_shader_root(root, name, edits)
             r = Renderer(ctx, ShaderLibrary(root=root))
             r.reuse = False
             res = r.render(scene, st, readback=False)
