@@ -29,7 +29,7 @@ class RenderSettings:
     depth_prepass: bool = True
     # antialiasing by supersampling: the screen-space targets are N x the output size and each
     # output pixel is the box filter (mean) of its N x N samples of linear radiance, tone-mapped after
-    # filtering (shaders/passes/tonemap.frag); what the path-traced truth's box pixel filter does
+    # filtering (shaders/passes/tonemap_supersample.frag); what the path-traced truth's box pixel filter does
     supersample: int = option(
         1,
         "antialiasing: shade N x N samples per output pixel and average them (box filter, before tone "

@@ -1,5 +1,5 @@
 """Antialiasing by supersampling (``RenderSettings.supersample``): NumPy twins of the tone-mapping
-pass's box filter (shaders/passes/tonemap.frag) and the depth read-back's reduction.
+pass's box filter (shaders/passes/tonemap_supersample.frag) and the depth read-back's reduction.
 
 An output pixel's value is the mean of its N x N samples, the box pixel filter the path-traced truth
 uses (each pixel averaged over its area; app/truth/, docs/ground-truth.md)."""

@@ -2,8 +2,8 @@
 
 With ``RenderSettings.supersample`` N > 1 the forward HDR holds N x N samples per output pixel: this
 pass box-filters them (the mean of linear radiance and coverage) into ``hdr_filtered`` at the output
-size, what the ``hdr`` read-back returns, and tone-maps the filtered radiance (NumPy twin:
-app/render/supersample.py)."""
+size, what the ``hdr`` read-back returns, and tone-maps the filtered radiance
+(shaders/passes/tonemap_supersample.frag; NumPy twin: app/render/supersample.py)."""
 
 from __future__ import annotations
 
@@ -38,8 +38,10 @@ class TonemapPass:
         ctx = self.r.ctx
         n = frame.settings.supersample
         tex, fbo, hdr = self.targets(p.resolution, n > 1)
-        defines = {"SUPERSAMPLE": n} if n > 1 else None
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap.frag", defines)
+        if n > 1:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap_supersample.frag", {"SUPERSAMPLE": n})
+        else:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap.frag")
         fbo.use()
         ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         frame.targets["hdr_color"].use(0)
