@@ -12,7 +12,7 @@
     print(frame.timings.table())
 
 ``render(...)`` takes the fields of :class:`app.render.settings.RenderSettings` as keywords
-(``technique``, ``sss_model``, ``shadow_size``, ...) and the chosen technique's own settings
+(``technique``, ``sss_model``, ``shadow_size``, ``supersample``, ...) and the chosen technique's own settings
 (``size=256`` for tsd's irradiance texels; `skinlab render --help` lists them per technique; an
 unknown one is an error naming it), plus ``exposure`` (a linear
 multiplier, as ``[environment] exposure``) and ``camera_orbit`` (degrees about the vertical axis

@@ -7,6 +7,8 @@ app/truth/compare.py judged_blocks), the truth's noise.
     python tools/truth_table.py [SCENES] [TECHNIQUES]      # comma-separated; default all
 
 SKINLAB_SSS_MODEL=<model> overrides every material's sss_model (burley, dipole, pbd, ...).
+SKINLAB_SUPERSAMPLE=N renders the frames at N x N samples per pixel (default: the ledger's,
+app/bench/truth_ledger.py TRUTH_SUPERSAMPLE; 1 = each pixel's centre only).
 Used for the before/after tables in docs/ground-truth.md."""
 
 from __future__ import annotations
@@ -17,7 +19,13 @@ import sys
 import numpy as np
 
 from app.bench.sweep import QUICK
-from app.bench.truth_ledger import REFERENCE_SCENES, TruthSpec, load_truth, reference_scene_names
+from app.bench.truth_ledger import (
+    REFERENCE_SCENES,
+    TRUTH_SUPERSAMPLE,
+    TruthSpec,
+    load_truth,
+    reference_scene_names,
+)
 from app.gl.context import create_headless_context
 from app.render.renderer import Renderer
 from app.render.settings import RenderSettings
@@ -29,6 +37,11 @@ def main(argv: list[str]) -> int:
     scenes = argv[0].split(",") if argv and argv[0] else reference_scene_names()
     techs = argv[1].split(",") if len(argv) > 1 else ["none", "tint", "tsd", "exact", "ssss"]
     model = os.environ.get("SKINLAB_SSS_MODEL") or None
+    raw = os.environ.get("SKINLAB_SUPERSAMPLE") or str(TRUTH_SUPERSAMPLE)
+    if not raw.isdigit():
+        raise SystemExit(f"SKINLAB_SUPERSAMPLE: expected an integer in [1, 8], got {raw!r}")
+    n = int(raw)
+    print(f"frames at {n} x {n} samples per pixel, box-filtered", flush=True)
     r = Renderer(create_headless_context())
     for s in scenes:
         scene = load_scene(REFERENCE_SCENES / f"{s}.toml")
@@ -37,7 +50,7 @@ def main(argv: list[str]) -> int:
             print(f"{s}: no cached 96x96 reference (skinlab bench accuracy --quick --references)")
             continue
         for t in techs:
-            rs = RenderSettings.for_technique(t, 96, 96, shadow_size=QUICK.shadow_size, sss_model=model)
+            rs = RenderSettings.for_technique(t, 96, 96, shadow_size=QUICK.shadow_size, sss_model=model, supersample=n)
             img = r.render(scene, rs, readback=("hdr",)).hdr
             e = image_error(img, truth.image)
             d = relative_difference(img, truth.image, block=8)

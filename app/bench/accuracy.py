@@ -228,8 +228,9 @@ def run_sweep(
                     row["passes"] = m["passes"]
                     hdrs[st] = m["hdr"]
                     if truth is not None:
-                        # an untimed frame at the reference's size, compared with the truth
-                        small_rs = st.render_settings(sweep, truth.image.shape[1::-1])
+                        # an untimed frame at the reference's size, supersampled like the truth's
+                        # box-filtered pixels, compared with the truth
+                        small_rs = st.render_settings(sweep, truth.image.shape[1::-1], sweep.truth.supersample)
                         small = renderer.render(scene, small_rs, readback=("hdr",)).hdr
                         row.update(truth_errors(small, truth))
                         safe = st.label.replace(" ", "-")
@@ -310,6 +311,7 @@ def run_sweep(
             "size": list(sweep.truth.size),
             "spp": sweep.truth.spp,
             "passes": sweep.truth.passes,
+            "supersample": sweep.truth.supersample,
             "missing": truth_notes,
         },
         "sweep_s": sweep_s,

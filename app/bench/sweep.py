@@ -125,13 +125,17 @@ class Setting:
     def _columns(self) -> dict:
         return {c: getattr(self, c) for c in self._style().columns}
 
-    def render_settings(self, sweep: Sweep, size=None):
+    def render_settings(self, sweep: Sweep, size=None, supersample: int = 1):
+        """The setting's render settings at the sweep's size (the timed frames) or at `size` with
+        `supersample` (the frames compared with the truth)."""
         from app.render.settings import RenderSettings
 
         w, h = size or sweep.size
         cols = self._style().columns
         opts = {f: getattr(self, c) for c, f in cols.items() if getattr(self, c) is not None}
-        return RenderSettings.for_technique(self.technique, w, h, shadow_size=sweep.shadow_size, **opts)
+        return RenderSettings.for_technique(
+            self.technique, w, h, shadow_size=sweep.shadow_size, supersample=supersample, **opts
+        )
 
     def cells(self) -> dict:
         """The parameter columns; empty where the parameter does not apply to the technique."""

@@ -14,6 +14,10 @@ once more at that size (untimed), and records:
   target, the 8 x 8 blocks more than 15 % off the truth among those its noise allows to judge
   (app/truth/compare.py ``judged_blocks``: half-to-half block noise below 5 %, not dark), their
   number and their fraction;
+* the frames compared with the truth are supersampled (``TruthSpec.supersample``, default
+  ``TRUTH_SUPERSAMPLE``; ``RenderSettings.supersample``): the truth averages each pixel over its area
+  (Mitsuba's box pixel filter), a frame without antialiasing samples each pixel's centre, which
+  differs on the object's outline by far more than the scattering errors the ledger is for;
 * a signed relative-difference image per setting (red: brighter than the truth, blue: darker, one
   scale for all), and a contact sheet of them.
 """
@@ -50,11 +54,18 @@ TRUTH_COLUMNS = [
 ]
 
 
+# samples per pixel side of the frames compared with the truth (box-filtered like the truth's pixels;
+# docs/ground-truth.md "The truth's pixel filter" has the measured effect of 1, 2 and 4)
+TRUTH_SUPERSAMPLE = 4
+
+
 @dataclass(frozen=True)
 class TruthSpec:
     size: tuple[int, int]  # reference (and comparison frame) size
     spp: int  # samples per pixel of the reference
     passes: int = 4
+    # RenderSettings.supersample of the frames compared with the reference (not part of its cache key)
+    supersample: int = TRUTH_SUPERSAMPLE
 
     def request(self):
         from app.truth.reference import ReferenceRequest
@@ -164,7 +175,13 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
     L = [
         "## Against the path-traced truth",
         "",
-        f"Each setting rendered once more at {t['size'][0]}x{t['size'][1]} (untimed) and compared with the scene "
+        f"Each setting rendered once more at {t['size'][0]}x{t['size'][1]} (untimed; "
+        + (
+            f"{t['supersample']} x {t['supersample']} samples per pixel, box-filtered like the truth's pixels"
+            if t.get("supersample", 1) > 1
+            else "one sample at each pixel's centre"
+        )
+        + ") and compared with the scene "
         f"path-traced by Mitsuba 3 (volpathmis, {t['spp']} spp in {t['passes']} passes; `skinlab reference`, "
         "docs/ground-truth.md): relative L1 of linear radiance over the object on 4x4-pixel blocks (per pixel in "
         "the per-scene tables). `noise` is the reference's own noise floor: the same measure between the halves "
@@ -180,7 +197,10 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
         s: next((r.get("truth_noise_block") for r in rows if r["scene"] == s and r.get("truth_noise_block")), None)
         for s in scenes
     }
-    L.append("| setting | " + " | ".join(f"{s} (noise {_pct(noise[s])})" for s in scenes) + " | mean ms |")
+    # the time is the timed frames' (at the ledger's size, as users render them: no supersampling)
+    L.append(
+        "| setting | " + " | ".join(f"{s} (noise {_pct(noise[s])})" for s in scenes) + " | mean ms (timed, 1 spp) |"
+    )
     L.append("|---|" + "---|" * (len(scenes) + 1))
     by_label: dict[str, dict] = {}
     for r in rows:

@@ -1,5 +1,6 @@
-"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--technique NAME] [--json] [--explain] [--reuse]`: the
-technique options come from the registered techniques (app/commands/technique_options.py)."""
+"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--supersample N] [--technique NAME] [--json] [--explain]
+[--reuse]`: the technique options come from the registered techniques and --supersample from RenderSettings'
+declaration (app/commands/technique_options.py)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,12 @@ import json
 import sys
 from pathlib import Path
 
-from app.commands.technique_options import add_technique_options, technique_from_args
+from app.commands.technique_options import (
+    add_render_options,
+    add_technique_options,
+    render_options_from_args,
+    technique_from_args,
+)
 from app.render.settings import RenderSettings, parse_size
 from scene.materials import SSS_MODELS
 
@@ -28,6 +34,7 @@ def register(sub) -> None:
     )
     p.add_argument("--size", default="640x640", help="image size WIDTHxHEIGHT in pixels (default 640x640)")
     p.add_argument("--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)")
+    add_render_options(p)  # --supersample N, from RenderSettings' declarations
     p.add_argument(
         "--exposure",
         type=float,
@@ -90,7 +97,14 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, p
 
 
 def settings_from_args(args, w: int, h: int) -> RenderSettings:
-    return RenderSettings(w, h, shadow_size=args.shadow_size, sss_model=args.sss, technique=technique_from_args(args))
+    return RenderSettings(
+        w,
+        h,
+        shadow_size=args.shadow_size,
+        sss_model=args.sss,
+        technique=technique_from_args(args),
+        **render_options_from_args(args),
+    )
 
 
 def run(args) -> int:

@@ -66,3 +66,36 @@ def _parse(raw, kind: str, flag: str, o):
         return int(raw) if kind == "int" else float(raw)
     except ValueError:
         raise ValueError(f"{flag}: expected {o.expected()}, got {raw!r}") from None
+
+
+def _render_dest(field: str) -> str:
+    return f"render_opt__{field}"
+
+
+def add_render_options(parser: argparse.ArgumentParser) -> None:
+    """One option per render setting declared with ``option`` (RenderSettings.options():
+    ``--supersample N``), help and checks from the declaration."""
+    from app.render.settings import RenderSettings
+
+    for name, o in RenderSettings.options().items():
+        flag = "--" + name.replace("_", "-")
+        default = RenderSettings.__dataclass_fields__[name].default
+        kw = dict(dest=_render_dest(name), default=None, help=o.help(default))
+        if o.kind == "bool":
+            parser.add_argument(flag, action=argparse.BooleanOptionalAction, **kw)
+        else:
+            parser.add_argument(flag, type=str, metavar="N" if o.kind == "int" else "X", **kw)
+
+
+def render_options_from_args(args) -> dict:
+    """The declared render settings given on the command line (keywords for RenderSettings); a bad
+    value is an error naming the option."""
+    from app.render.settings import RenderSettings
+
+    values = {}
+    for name, o in RenderSettings.options().items():
+        raw = getattr(args, _render_dest(name), None)
+        if raw is not None:
+            flag = "--" + name.replace("_", "-")
+            values[name] = o.check(_parse(raw, o.kind, flag, o), flag)
+    return values

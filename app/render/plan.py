@@ -23,6 +23,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
     caches, e.g. texture-space diffusion's stretch maps); None plans as if nothing were cached."""
     meshes = scene.mesh_nodes()
     lights = scene.lights()
+    n = settings.supersample
     plan = FramePlan([])
     if len(lights) > settings.max_lights:
         plan.skipped.append(
@@ -65,8 +66,9 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
             "forward",
             "forward",
             "+".join(["hdr_color", "depth", *hook.outputs]),
-            settings.size,
-            ("depth pre-pass, then " if settings.depth_prepass else "")
+            settings.render_size,
+            (f"{n} x {n} samples per output pixel (supersample); " if n > 1 else "")
+            + ("depth pre-pass, then " if settings.depth_prepass else "")
             + f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)"
             + hook.reason,
             ForwardParams(lights, shadow_lights[:2], hook),
@@ -75,7 +77,12 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
     plan.passes += tp.after_forward
     plan.passes.append(
         PlannedPass(
-            "tonemap", "tonemap", "ldr_color", settings.size, "ACES tone mapping and sRGB encoding for display/PNG"
+            "tonemap",
+            "tonemap",
+            "ldr_color" + ("+hdr_filtered" if n > 1 else ""),
+            settings.size,
+            (f"box filter of each pixel's {n} x {n} samples (linear radiance), then " if n > 1 else "")
+            + "ACES tone mapping and sRGB encoding for display/PNG",
         )
     )
     return plan

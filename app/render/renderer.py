@@ -22,13 +22,14 @@ from .plan import plan_frame
 from .registry import get_technique, pass_class
 from .reuse import ReuseRecord, pass_key
 from .settings import RenderSettings
+from .supersample import nearest_depth
 from .technique import RenderPass
 from .timing import FrameTimings, PassTimer
 
 
 @dataclass
 class FrameResult:
-    hdr: np.ndarray  # (H, W, 4) float32 linear radiance, alpha = coverage; row 0 = top
+    hdr: np.ndarray  # (H, W, 4) float32 linear radiance, alpha = coverage; row 0 = top (supersampled: box-filtered)
     ldr: np.ndarray  # (H, W, 4) uint8 sRGB, tone mapped
     depth: np.ndarray  # (H, W) float32 eye-space distance along -Z (scene units), inf = background
     timings: FrameTimings
@@ -157,15 +158,21 @@ class Renderer:
         self.reuse_record.clear()
 
     def read_targets(self, frame: Frame, wanted=("hdr", "ldr", "depth")):
+        """hdr, ldr and depth at the output size (None where not wanted). With supersampling the hdr
+        is the box-filtered linear radiance (the tone-mapping pass's ``hdr_filtered``) and the depth
+        each pixel's nearest sample (app/render/supersample.py)."""
         w, h = frame.settings.size
+        n = frame.settings.supersample
         hdr = ldr = depth = None
         if "hdr" in wanted:
-            hdr = np.frombuffer(frame.targets["hdr_color"].read(), np.float32).reshape(h, w, 4)[::-1].copy()
+            src = frame.targets["hdr_filtered" if n > 1 else "hdr_color"]
+            hdr = np.frombuffer(src.read(), np.float32).reshape(h, w, 4)[::-1].copy()
         if "ldr" in wanted:
             ldr = np.frombuffer(frame.targets["ldr_color"].read(), np.uint8).reshape(h, w, 4)[::-1].copy()
         if "depth" not in wanted:
             return hdr, ldr, None
-        zbuf = np.frombuffer(frame.targets["depth"].read(), np.float32).reshape(h, w)[::-1]
+        zbuf = np.frombuffer(frame.targets["depth"].read(), np.float32).reshape(h * n, w * n)[::-1]
+        zbuf = nearest_depth(zbuf, n)
         cam = frame.scene.camera
         n, f = cam.znear, cam.zfar
         zn = zbuf.astype(np.float64) * 2.0 - 1.0

@@ -6,7 +6,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
-from .options import TechniqueSettings
+from .options import Option, TechniqueSettings, option
 from .registry import DEFAULT_TECHNIQUE, get_technique
 
 
@@ -27,12 +27,30 @@ class RenderSettings:
     technique: TechniqueSettings | str = DEFAULT_TECHNIQUE
     # draw depth first, then shade each visible pixel once (app/render/passes/forward.py)
     depth_prepass: bool = True
+    # antialiasing by supersampling: the screen-space targets are N x the output size and each
+    # output pixel is the box filter (mean) of its N x N samples of linear radiance, tone-mapped after
+    # filtering (shaders/passes/tonemap_supersample.frag); what the path-traced truth's box pixel filter does
+    supersample: int = option(
+        1,
+        "antialiasing: shade N x N samples per output pixel and average them (box filter, before tone "
+        "mapping); screen-space passes run at N x the size, texture-space passes and shadow maps do not change",
+        "int",
+        range=(1, 8),
+        unit="samples per pixel side",
+    )
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):
             v = getattr(self, name)
-            if not isinstance(v, int) or v < 1 or v > 16384:
+            if not isinstance(v, int) or isinstance(v, bool) or v < 1 or v > 16384:
                 raise ValueError(f"render setting {name}: expected an integer in [1, 16384], got {v!r}")
+        for name, opt in self.options().items():
+            setattr(self, name, opt.check(getattr(self, name), f"render setting {name}"))
+        if max(self.width, self.height) * self.supersample > 16384:
+            raise ValueError(
+                f"render setting supersample: {self.width}x{self.height} at {self.supersample} x "
+                f"{self.supersample} samples per pixel exceeds 16384 samples per side"
+            )
         if self.sss_model is not None:
             from scene.materials import SSS_MODELS
 
@@ -63,13 +81,25 @@ class RenderSettings:
         base = {k: v for k, v in kw.items() if k in own}
         return cls(width, height, **base, technique=st(**opts))
 
+    @classmethod
+    def options(cls) -> dict[str, Option]:
+        """The render settings declared with :func:`option` (meaning, unit, default, range): the
+        `skinlab render` options come from these."""
+        return {f.name: f.metadata["option"] for f in dataclasses.fields(cls) if "option" in f.metadata}
+
     @property
     def technique_name(self) -> str:
         return self.technique.technique
 
     @property
     def size(self) -> tuple[int, int]:
+        """The output image's size in pixels."""
         return self.width, self.height
+
+    @property
+    def render_size(self) -> tuple[int, int]:
+        """The screen-space targets' size: the output size times ``supersample``."""
+        return self.width * self.supersample, self.height * self.supersample
 
 
 def parse_size(text: str) -> tuple[int, int]:

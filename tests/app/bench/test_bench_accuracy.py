@@ -100,6 +100,9 @@ def test_markdown_json_and_figures(tiny):
         "## Against the path-traced truth",
         "truth 4x4",
         "8x8-pixel blocks more than 15 % off the truth",
+        # the compared frames are box-filtered like the truth's pixels; the times are the 1-spp frames'
+        f"{acc.TINY.truth.supersample} x {acc.TINY.truth.supersample} samples per pixel, box-filtered",
+        "mean ms (timed, 1 spp)",
         "| setting | technique | model |",
         "## Cost slopes",
         "frame vs texels",
@@ -115,6 +118,7 @@ def test_markdown_json_and_figures(tiny):
     doc = json.loads((out / "ledger.json").read_text())
     assert len(doc["rows"]) == 5 and doc["meta"]["sweep"] == "tiny" and HEAD in doc["pareto"]
     assert doc["error_axis"] == "truth_rel_l1_block" and doc["meta"]["truth"]["missing"] == {}
+    assert doc["meta"]["truth"]["supersample"] == acc.TINY.truth.supersample > 1
     from app.image_output import read_image
 
     for name in ("pareto.png", "cost.png", "error_maps.png"):
@@ -126,6 +130,16 @@ def test_markdown_json_and_figures(tiny):
     assert not [p for p in out.rglob(".*") if p.is_file()]  # no temporary files left behind
     for name in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png", "error_maps.png"):
         assert str((out / name).resolve()) in res.stdout
+
+
+def test_truth_section_says_how_the_compared_frames_were_sampled():
+    from app.bench.truth_ledger import truth_markdown
+
+    rows = [{"scene": "a", "setting": "none", "truth_rel_l1_block": 0.1, "frame_ms_median": 2.0}]
+    meta = {"truth": {"size": [32, 32], "spp": 16, "passes": 2, "missing": {}}}
+    for n, says in ((1, "one sample at each pixel's centre"), (2, "2 x 2 samples per pixel, box-filtered")):
+        text = "\n".join(truth_markdown(rows, {"truth": {**meta["truth"], "supersample": n}}))
+        assert says in text and "| none | 10.0 % | 2.0 |" in text
 
 
 def test_without_a_cached_reference_the_ledger_says_how_to_make_it(ctx, tmp_path, monkeypatch):

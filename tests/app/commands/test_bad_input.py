@@ -164,6 +164,14 @@ CASES = [
         ["[camera]"],
     ),
     ("command-unknown", {}, ["rendr"], ["rendr"]),
+    ("supersample-zero", scene(MESH), [*RENDER, "--supersample", "0"], ["--supersample", "[1, 8]"]),
+    ("supersample-fraction", scene(MESH), [*RENDER, "--supersample", "1.5"], ["--supersample", "1.5"]),
+    (
+        "supersample-too-many",
+        scene(MESH),
+        [*RENDER, "--size", "4096x8", "--supersample", "8"],
+        ["supersample", "16384"],
+    ),
     ("peer-frames", {}, ["bench", "peer", "--frames", "0", "--no-progress"], ["--frames"]),
     ("peer-rounds", {}, ["bench", "peer", "--rounds", "0", "--no-progress"], ["--rounds"]),
 ]

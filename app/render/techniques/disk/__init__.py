@@ -106,7 +106,7 @@ class DiskTechnique(Technique):
             "disk_sss",
             "disk_sss",
             "hdr_color",
-            ctx.settings.size,
+            ctx.settings.render_size,
             f"Burley disk SSS (Golubev 2018): {o.samples} samples per pixel"
             f"{', rotated per pixel' if o.rotate else ''}, depth-aware; {len(keys)} profile(s): {names}",
             DiskParams(o.samples, o.rotate, kernels, labels),

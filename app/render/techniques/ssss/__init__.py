@@ -80,7 +80,7 @@ class SsssTechnique(Technique):
             "ssss_blur",
             "ssss_blur",
             "hdr_color",
-            ctx.settings.size,
+            ctx.settings.render_size,
             f"screen-space separable SSS (Jimenez et al.): {o.taps}-tap kernel per pixel's profile "
             f"({len(ssss.kernels)}: {names}), horizontal then vertical, depth-aware",
             SsssBlurParams(ssss, o.gaussians),

@@ -1,0 +1,56 @@
+"""What antialiasing by supersampling costs (RenderSettings.supersample): the plain (no scattering)
+head frame at 640x640 with N = 1, 2, 4, interleaved rounds, every pass run each frame (reuse off);
+median frame time and the forward, tone-mapping and shadow passes, with the load average.
+
+    python tools/supersample_cost.py [ROUNDS] [FRAMES_PER_ROUND]      # default 5 3
+
+Used for the README's timing table."""
+
+from __future__ import annotations
+
+import os
+import statistics
+import sys
+
+from app.gl.context import create_headless_context
+from app.render.renderer import Renderer
+from app.render.settings import RenderSettings
+from scene.scenefile import load_scene
+
+FACTORS = (1, 2, 4)
+PASSES = ("forward", "tonemap", "shadow[key]")
+
+
+def main(argv: list[str]) -> int:
+    rounds = int(argv[0]) if argv else 5
+    per_round = int(argv[1]) if len(argv) > 1 else 3
+    r = Renderer(create_headless_context())
+    r.reuse = False
+    scene = load_scene(None)
+    sts = {n: RenderSettings.for_technique("none", 640, 640, supersample=n) for n in FACTORS}
+    for st in sts.values():
+        r.render(scene, st, readback=False)  # compiles and uploads are not frame time
+    load0 = os.getloadavg()[0]
+    ms = {n: {k: [] for k in ("frame", *PASSES)} for n in sts}
+    for _ in range(rounds):
+        for n, st in sts.items():
+            for _ in range(per_round):
+                d = r.render(scene, st, readback=False).timings.as_dict()
+                ms[n]["frame"].append(d["frame_ms"])
+                for k in PASSES:
+                    ms[n][k].append(d["passes"][k]["cpu_ms"])
+    load1 = os.getloadavg()[0]
+    base = statistics.median(ms[1]["frame"])
+    for n in sts:
+        m = {k: statistics.median(v) for k, v in ms[n].items()}
+        print(
+            f"N={n}: frame {m['frame']:.1f} ms (x{m['frame'] / base:.2f} of N=1): forward {m['forward']:.1f}, "
+            f"tonemap {m['tonemap']:.1f}, shadow {m['shadow[key]']:.1f}; {len(ms[n]['frame'])} frames"
+        )
+    print(f"load average {load0:.2f} -> {load1:.2f} (1 min); {rounds} interleaved rounds of {per_round} frames")
+    r.release()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
