@@ -50,8 +50,9 @@ def expected_radiance(thickness_mm):
 def test_back_lit_sheet_transmits_what_tsd_and_numpy_say(renderer, technique):
     """Through 0.5 mm and 3 mm of skin lit from behind: black without translucency; with it the
     centre pixel is the NumPy slab transmission (the exact slab transmittance and the exit factor)
-    and texture-space diffusion's pixel within 1e-4 relative. The tolerance: measured agreement is 4e-7 (fp32); the camera's 2-degree field moves the exit factor by 1.5e-5 across
-    the view; the blur of a uniform region returns it (weights sum to 1)."""
+    and texture-space diffusion's pixel within 1e-4 relative. The tolerance: measured agreement is
+    4e-7 (fp32); the camera's 2-degree field moves the exit factor by 1.5e-5 across the view; the
+    blur of a uniform region returns it (weights sum to 1)."""
     for d_mm in (0.5, 3.0):
         off = renderer.render(sheet(d_mm), settings(technique, translucency=False))
         assert off.hdr[24, 24, :3].max() == 0.0  # the far side is all the light there is
