@@ -1,11 +1,21 @@
 // Subsurface hook of technique "tsd" (and "exact"): the texture-space diffusion gather (d'Eon &
 // Luebke 2007): the subsurface diffuse term is the weighted sum of the blurred irradiance levels x
 // albedo^(1-mix) (post-scatter texturing), mixed with plain Burley diffuse by the subsurface weight
-// (x its map, lib/sss_maps.glsl). Variant: TSD_LEVELS = n (0..6) blurred levels. Contract:
-// app/render/technique.py.
+// (x its map, lib/sss_maps.glsl). Variant: TSD_LEVELS = n (0..6) blurred levels. Variant
+// SSS_TRANSLUCENCY (the mesh's irradiance pass gathered light through thin parts): the blurred light
+// left with the reflected light's exit factor sss_exit, but light that came through leaves with its
+// own (lib/sss_boundary.glsl sss_slab_exit: more along the normal through a few mean free paths), so
+// the hook adds the difference for the light through this pixel, unblurred (recomputed as the
+// irradiance pass gathered it, lib/sss_translucency.glsl): exact where that light varies slowly across
+// the profile (a flat part), linear in the lights; at a sharp edge of the light through (a rim where
+// the thickness drops) it can take a little more than the blur brought there (at least 0).
+// Contract: app/render/technique.py.
 #include "lib/sss_boundary.glsl"
 #include "skinlab/constants.glsl"
 #include "lib/sss_maps.glsl"
+#ifdef SSS_TRANSLUCENCY
+#include "lib/sss_translucency.glsl"
+#endif
 
 uniform float u_tsd_mix;
 uniform vec3 u_tsd_identity;         // weight of the unblurred irradiance per channel
@@ -64,5 +74,13 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
     // the diffused light leaving toward the viewer: the angular distribution of what leaves the
     // medium (lib/sss_boundary.glsl; the irradiance pass applied the entry factor)
     vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
-    return (1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI * post * tsd_diffused(uv) * sss_exit(abs(NoV));
+    vec3 exit_ = sss_exit(abs(NoV));
+    vec3 leaving = post * tsd_diffused(uv) * exit_;
+#ifdef SSS_TRANSLUCENCY
+    vec3 through_in;
+    vec3 ng = gl_FrontFacing ? normalize(v_normal) : -normalize(v_normal);
+    vec3 through_exit = sss_translucent_toward(v_world, ng, abs(NoV), through_in);
+    leaving = max(leaving + max(base, vec3(0.0)) * (through_exit - through_in * exit_), vec3(0.0));
+#endif
+    return (1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI * leaving;
 }

@@ -7,17 +7,29 @@ from __future__ import annotations
 
 from app.gl.uniforms import set_array, set_uniforms
 from app.render.technique import ForwardHook, NodeShading
+from app.render.translucency import DEFINE, bind_translucency
 
 from .passes import frame_nodes
 
 HOOK = "techniques/tsd/forward.glsl"
 LOCAL_HOOK = "techniques/tsd/local.glsl"
+# light through thin parts leaves with its own angular distribution (shaders/techniques/tsd/forward.glsl)
+EXIT_REASON = "light through thin parts leaves with its own angular distribution (per pixel)"
 
 
 class TsdForward(ForwardHook):
-    def __init__(self, nodes: int, local: dict | None = None, reason: str = "; gather diffusion for {n}"):
+    def __init__(
+        self,
+        nodes: int,
+        local: dict | None = None,
+        reason: str = "; gather diffusion for {n}",
+        translucency: bool = False,
+    ):
         self.local = dict(local or {})  # uid -> effective material, scattered locally
+        self.translucency = translucency  # some node's irradiance gathered light through thin parts
         self.reason = reason.format(n=nodes) if nodes else ""
+        if nodes and translucency:
+            self.reason += f"; {EXIT_REASON}"
         if self.local:
             self.reason += f"; local scattering (profile narrower than a texel) for {len(self.local)}"
 
@@ -26,9 +38,16 @@ class TsdForward(ForwardHook):
         if t is None:
             mat = self.local.get(node.uid)
             return None if mat is None else NodeShading(mat, LOCAL_HOOK)
-        return NodeShading(
-            t.material, HOOK, {"TSD_LEVELS": t.kernel.levels}, lambda prog, units: bind_gather(prog, t, units)
-        )
+        defines = {"TSD_LEVELS": t.kernel.levels}
+        if t.translucency:
+            defines[DEFINE] = 1
+
+        def bind(prog, units):
+            bind_gather(prog, t, units)
+            if t.translucency:
+                bind_translucency(prog, frame, units)
+
+        return NodeShading(t.material, HOOK, defines, bind)
 
 
 def bind_gather(prog, t, units) -> None:

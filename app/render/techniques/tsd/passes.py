@@ -93,6 +93,7 @@ class TsdFrameNode:
     kernel: DiffusionKernel  # the gather's weights (UNIT_KERNEL after the exact convolution)
     material: object
     mix: float
+    translucency: bool = False  # the irradiance gathered light through thin parts
 
 
 class TsdStore:
@@ -214,7 +215,7 @@ class TsdIrradiancePass(TsdPass):
         prm: TsdIrradianceParams = p.params
         t = self.node_targets(p)
         gather = prm.gather if prm.gather is not None else prm.kernel
-        frame_nodes(frame)[prm.node.uid] = TsdFrameNode(t, gather, prm.material, prm.mix)
+        frame_nodes(frame)[prm.node.uid] = TsdFrameNode(t, gather, prm.material, prm.mix, prm.translucency)
         frame.targets[f"tsd_irradiance_raw[{prm.node.name}]"] = t.raw
 
     def run(self, frame, p) -> None:
