@@ -7,14 +7,13 @@ from __future__ import annotations
 
 from app.gl.uniforms import set_array, set_uniforms
 from app.render.technique import ForwardHook, NodeShading
-from app.render.translucency import DEFINE, bind_translucency
 
 from .passes import frame_nodes
 
 HOOK = "techniques/tsd/forward.glsl"
 LOCAL_HOOK = "techniques/tsd/local.glsl"
 # light through thin parts leaves with its own angular distribution (shaders/techniques/tsd/forward.glsl)
-EXIT_REASON = "light through thin parts leaves with its own angular distribution (per pixel)"
+EXIT_REASON = "light through thin parts leaves with its own angular distribution (per texel record)"
 
 
 class TsdForward(ForwardHook):
@@ -39,13 +38,11 @@ class TsdForward(ForwardHook):
             mat = self.local.get(node.uid)
             return None if mat is None else NodeShading(mat, LOCAL_HOOK)
         defines = {"TSD_LEVELS": t.kernel.levels}
-        if t.translucency:
-            defines[DEFINE] = 1
+        if t.translucency and t.through_slots > 0:
+            defines["TSD_THROUGH"] = t.through_slots
 
         def bind(prog, units):
             bind_gather(prog, t, units)
-            if t.translucency:
-                bind_translucency(prog, frame, units)
 
         return NodeShading(t.material, HOOK, defines, bind)
 
@@ -56,5 +53,10 @@ def bind_gather(prog, t, units) -> None:
     units.bind(prog, "u_tsd_irradiance", targets.irradiance)
     for i in range(k.levels):
         units.bind(prog, f"u_tsd_level{i}", targets.levels[i])
+    if t.translucency and t.through_slots > 0:  # the irradiance pass's record of the light through thin parts
+        if not targets.through:
+            raise RuntimeError("tsd gather: the irradiance pass wrote no light-through record for this mesh")
+        for name, tex in zip(("u_tsd_through0", "u_tsd_through1", "u_tsd_through_cos"), targets.through):
+            units.bind(prog, name, tex)
     set_array(prog, "u_tsd_w", k.weights(), 6)
     set_uniforms(prog, {"u_tsd_identity": k.identity, "u_tsd_mix": t.mix})

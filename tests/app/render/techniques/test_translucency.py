@@ -96,7 +96,7 @@ def test_front_lit_scene_is_unchanged(renderer, technique):
     np.testing.assert_allclose(on.hdr[..., :3], off, rtol=0, atol=1e-6)
 
 
-@pytest.mark.parametrize("technique", SCREEN)
+@pytest.mark.parametrize("technique", (*SCREEN, "tsd"))
 def test_hard_cases_stay_finite(renderer, technique):
     """Zero thickness (a skin square alone, lit from behind) and light grazing the far face (1 degree):
     finite, non-negative, and far darker than 0.5 mm at normal incidence (nothing collides in no

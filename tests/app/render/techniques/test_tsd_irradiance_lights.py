@@ -60,8 +60,4 @@ def test_translucency_runs_for_the_slot_of_the_back_light(renderer, names):
     on = _render(renderer, names)
     off = _render(renderer, names, translucency=False)
     assert (on - off).max() > 0.01 * on.max()  # light through the slab (none of it reaches the front otherwise)
-    # the light through adds nothing negative, except where the forward pass's unblurred exit factor of
-    # light that came through (shaders/techniques/tsd/forward.glsl) meets the sharp edge of the light
-    # through at the slab's rim: 3 pixels of one column there, at most 1.9 % of the peak (measured)
-    dark = ((on - off) < -1e-6).any(axis=-1)
-    assert dark.sum() <= 4 and (on - off).min() > -0.025 * on.max()
+    assert (on - off).min() > -1e-6
