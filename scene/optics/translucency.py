@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from .boundary import BoundaryTables
-from .slab import slab_table, slab_through
+from .slab import slab_exit, slab_exit_tables, slab_table, slab_through
 
 NO_SURFACE = 1e29  # a distance-map texel at or above this holds no surface (cleared to 1e30)
 
@@ -97,3 +97,18 @@ def translucent_irradiance(e, back, d_mm, hit, tables: BoundaryTables, medium, c
     ok = (back > 0) & np.asarray(hit, bool)
     t = through(np.where(ok, back, 1.0), np.where(ok, d_mm, 0.0), tables, medium, colour)
     return np.where(ok[:, None], np.asarray(e, np.float64).reshape(1, 3) * back[:, None] * t, 0.0)
+
+
+def translucent_exit(mu, back, d_mm, tables: BoundaryTables, medium, colour) -> np.ndarray:
+    """(N, 3) the exit factor of the light through thin parts toward a viewer at cosine mu (light that
+    arrived at cosine `back` on the far face of a part d_mm thick): scene/optics/slab.py slab_exit with
+    the material's tables (what app/render/boundary.py binds). Radiance: base colour / pi x
+    translucent_irradiance x this (the reflected light's exit(mu) is boundary.py's). GLSL: the factor
+    sss_translucent_light_toward applies (sss_slab_exit(mu, back, d_mm))."""
+    mu = np.atleast_1d(np.asarray(mu, np.float64))
+    back = np.broadcast_to(np.atleast_1d(np.asarray(back, np.float64)), mu.shape)
+    d = np.broadcast_to(np.atleast_1d(np.asarray(d_mm, np.float64)), mu.shape)
+    table = slab_table(medium.alpha_arr, colour)
+    ex = slab_exit_tables(medium.alpha_arr, table, tables.eta)
+    out = [slab_exit(m, b, x, table, ex, medium.mfp_arr, tables.eta) for m, b, x in zip(mu, back, d)]
+    return np.array(out, np.float64).reshape(-1, 3)

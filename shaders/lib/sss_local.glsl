@@ -19,8 +19,11 @@ void sss_add_light(vec3 e, float vis, float NoL) {
 // The radiance leaving the medium toward the viewer for subsurface weight sss_w (ambient included).
 vec3 sss_local_radiance(vec3 base, float NoV, float occlusion, float sss_w) {
     vec3 entering = sss_in + PI * u_ambient * occlusion * u_sss_entry_diffuse;
+    vec3 leaving = entering * sss_exit(abs(NoV));
 #ifdef SSS_TRANSLUCENCY
-    entering += sss_translucent_irradiance(v_world, gl_FrontFacing ? normalize(v_normal) : -normalize(v_normal));
+    // light through thin parts leaves with its own angular distribution (lib/sss_boundary.glsl sss_slab_exit)
+    vec3 through_in;
+    leaving += sss_translucent_toward(v_world, gl_FrontFacing ? normalize(v_normal) : -normalize(v_normal), abs(NoV), through_in);
 #endif
-    return base * entering * sss_exit(abs(NoV)) * ((1.0 - u_metallic) * sss_w * INV_PI);
+    return base * leaving * ((1.0 - u_metallic) * sss_w * INV_PI);
 }

@@ -86,6 +86,22 @@ vec3 sss_translucent_light(int i, vec3 world, vec3 ng, vec3 l, vec3 e) {
     return e * back * sss_through(back, d_mm);
 }
 
+// The same light leaving toward a viewer at cosine mu, times the exit factor of light that came
+// through (lib/sss_boundary.glsl sss_slab_exit, at the light's cosine `back` on the far face;
+// reflected light leaves with sss_exit instead): times base colour / pi it is radiance, as the
+// reflected light's entering x sss_exit. `through_exit` returns it; the value is the light entering
+// (as sss_translucent_light). NumPy twin: scene/optics/translucency.py translucent_exit.
+vec3 sss_translucent_light_toward(int i, vec3 world, vec3 ng, vec3 l, vec3 e, float mu, out vec3 through_exit) {
+    int slot = u_light_shadow[i];
+    float back = -dot(ng, l);
+    float d_mm;
+    through_exit = vec3(0.0);
+    if (slot < 0 || back <= 0.0 || !sss_thickness_mm(slot, world, ng, back, d_mm)) return vec3(0.0);
+    vec3 entering = e * back * sss_through(back, d_mm);
+    through_exit = entering * sss_slab_exit(mu, back, d_mm);
+    return entering;
+}
+
 // The sum over the lights (for a hook that does not run its own light loop).
 vec3 sss_translucent_irradiance(vec3 world, vec3 ng) {
     vec3 acc = vec3(0.0);
@@ -94,6 +110,21 @@ vec3 sss_translucent_irradiance(vec3 world, vec3 ng) {
         vec3 l, e;
         light_incidence(i, world, ng, l, e);
         acc += sss_translucent_light(i, world, ng, l, e);
+    }
+    return acc;
+}
+
+// The sum over the lights of the light through thin parts leaving toward a viewer at cosine mu
+// (sss_translucent_light_toward's through_exit); `entering` gets the light entering.
+vec3 sss_translucent_toward(vec3 world, vec3 ng, float mu, out vec3 entering) {
+    vec3 acc = vec3(0.0);
+    entering = vec3(0.0);
+    for (int i = 0; i < MAX_LIGHTS; ++i) {
+        if (i >= u_num_lights) break;
+        vec3 l, e, te;
+        light_incidence(i, world, ng, l, e);
+        entering += sss_translucent_light_toward(i, world, ng, l, e, mu, te);
+        acc += te;
     }
     return acc;
 }

@@ -9,7 +9,9 @@
 // transmittance of a slab (all orders of scattering) at the light's incidence on the far side
 // (lib/sss_boundary.glsl sss_slab_through; the thickness along the light from the shadow pass's
 // distance map, times the cosine to the normal: a flat slab's own thickness); lib/sss_translucency.glsl,
-// shared with the forward hooks of the screen-space techniques.
+// shared with the forward hooks of the screen-space techniques. It also records that light per texel
+// and shadow slot, unblurred, with its thickness and cosine (f_through0/1, f_through_cos): the gather
+// gives it the exit factor of light that came through.
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
@@ -30,6 +32,16 @@ uniform int u_slot_light[2];              // the light each shadow slot holds (l
 #endif
 
 out vec4 f_irradiance;
+#ifdef TSD_TRANSLUCENCY
+// the light through thin parts per shadow slot, unblurred, for the gather's exit factor
+// (techniques/tsd/forward.glsl): rgb the light entering through, a the thickness (mm); f_through_cos
+// each slot's cosine on the far face
+layout(location = 1) out vec4 f_through0;
+layout(location = 2) out vec4 f_through1;
+layout(location = 3) out vec2 f_through_cos;
+vec4 through_rec[2] = vec4[2](vec4(0.0), vec4(0.0));
+vec2 through_back = vec2(0.0);
+#endif
 
 // What the light in shadow slot `slot` (a compile-time constant) brings: direct light through the
 // shadow map, and with TSD_TRANSLUCENCY the light through thin parts. Only shadow-casting lights
@@ -50,7 +62,12 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
 #ifdef TSD_TRANSLUCENCY
     float back = -dot(ng, l);
     float d_mm;
-    if (back > 0.0 && sss_thickness_mm(slot, v_world, ng, back, d_mm)) sum += e * back * sss_through(back, d_mm);
+    if (back > 0.0 && sss_thickness_mm(slot, v_world, ng, back, d_mm)) {
+        vec3 through = e * back * sss_through(back, d_mm);
+        sum += through;
+        through_rec[slot] = vec4(through, d_mm);
+        through_back[slot] = back;
+    }
 #endif
     return sum;
 }
@@ -86,4 +103,9 @@ void main() {
 #endif
     e_in += PI * u_ambient * occlusion * u_sss_entry_diffuse;
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
+#ifdef TSD_TRANSLUCENCY
+    f_through0 = through_rec[0];
+    f_through1 = through_rec[1];
+    f_through_cos = through_back;
+#endif
 }

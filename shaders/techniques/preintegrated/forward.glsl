@@ -44,7 +44,7 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
     vec3 nG = normalize(mix(n, ng, u_pis_soften.g));
     vec3 nb = normalize(mix(n, ng, u_pis_soften.b));
 #endif
-    vec3 entering = vec3(0.0);
+    vec3 entering = vec3(0.0), through_exit = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, e;
@@ -66,9 +66,11 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
         float flat_nl = max(nlg, 0.0);
         entering += e * vis * (flat_nl * sss_entry(flat_nl) + (D - flat_nl) * u_sss_entry_diffuse);
 #ifdef SSS_TRANSLUCENCY
-        entering += sss_translucent_light(i, v_world, ng, l, e);
+        vec3 te;  // light through thin parts leaves with its own angular distribution
+        sss_translucent_light_toward(i, v_world, ng, l, e, abs(NoV), te);
+        through_exit += te;
 #endif
     }
     entering += PI * u_ambient * occlusion * u_sss_entry_diffuse;
-    return base * entering * sss_exit(abs(NoV)) * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI);
+    return base * (entering * sss_exit(abs(NoV)) + through_exit) * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI);
 }

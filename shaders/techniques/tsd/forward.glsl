@@ -1,8 +1,15 @@
 // Subsurface hook of technique "tsd" (and "exact"): the texture-space diffusion gather (d'Eon &
 // Luebke 2007): the subsurface diffuse term is the weighted sum of the blurred irradiance levels x
 // albedo^(1-mix) (post-scatter texturing), mixed with plain Burley diffuse by the subsurface weight
-// (x its map, lib/sss_maps.glsl). Variant: TSD_LEVELS = n (0..6) blurred levels. Contract:
-// app/render/technique.py.
+// (x its map, lib/sss_maps.glsl). Variant: TSD_LEVELS = n (0..6) blurred levels. Variant
+// TSD_THROUGH (the mesh's irradiance pass gathered light through thin parts): the blurred light left
+// with the reflected light's exit factor sss_exit, but light that came through leaves with its own
+// (lib/sss_boundary.glsl sss_slab_exit: more along the normal through a few mean free paths), so the
+// hook adds the difference for the light through this texel, unblurred, from the irradiance pass's
+// record (per shadow slot: the light through, its thickness and cosine; TSD_THROUGH = slots):
+// exact where that light varies slowly across the profile (a flat part), linear in the lights; at a
+// sharp edge of the light through (a rim where the thickness drops) it can take a little more than
+// the blur brought there (at least 0). Contract: app/render/technique.py.
 #include "lib/sss_boundary.glsl"
 #include "skinlab/constants.glsl"
 #include "lib/sss_maps.glsl"
@@ -11,6 +18,16 @@ uniform float u_tsd_mix;
 uniform vec3 u_tsd_identity;         // weight of the unblurred irradiance per channel
 uniform vec3 u_tsd_w[6];             // weight of each blurred level per channel
 uniform sampler2D u_tsd_irradiance;  // premultiplied by coverage: rgb / a
+#ifdef TSD_THROUGH
+uniform sampler2D u_tsd_through0;     // slot 0's light through (rgb), its thickness in mm (a); nearest
+uniform sampler2D u_tsd_through1;     // slot 1's
+uniform sampler2D u_tsd_through_cos;  // their cosines on the far face (r, g)
+
+// The difference the exit factor of light that came through makes for one slot's record.
+vec3 tsd_through_exit(vec4 rec, float back, float mu, vec3 exit_) {
+    return rec.rgb * (sss_slab_exit(mu, back, rec.a) - exit_);
+}
+#endif
 #if TSD_LEVELS > 0
 uniform sampler2D u_tsd_level0;
 #endif
@@ -64,5 +81,15 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
     // the diffused light leaving toward the viewer: the angular distribution of what leaves the
     // medium (lib/sss_boundary.glsl; the irradiance pass applied the entry factor)
     vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
-    return (1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI * post * tsd_diffused(uv) * sss_exit(abs(NoV));
+    vec3 exit_ = sss_exit(abs(NoV));
+    vec3 leaving = post * tsd_diffused(uv) * exit_;
+#ifdef TSD_THROUGH
+    vec2 backs = texture(u_tsd_through_cos, uv).rg;
+    vec3 diff = tsd_through_exit(texture(u_tsd_through0, uv), backs.r, abs(NoV), exit_);
+#if TSD_THROUGH > 1
+    diff += tsd_through_exit(texture(u_tsd_through1, uv), backs.g, abs(NoV), exit_);
+#endif
+    leaving = max(leaving + max(base, vec3(0.0)) * diff, vec3(0.0));
+#endif
+    return (1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI * leaving;
 }

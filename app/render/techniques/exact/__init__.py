@@ -48,7 +48,11 @@ class ExactTechnique(Technique):
         passes, nodes, translucency, local = plan_tsd(
             ctx, o.size, FIT_GAUSSIANS, None, o.albedo_mix, o.translucency, exact=True, seams=o.seams
         )
-        return TechniquePlan(TsdForward(len(nodes), local), before_forward=passes, shadow_distance=translucency)
+        return TechniquePlan(
+            TsdForward(len(nodes), local, translucency=translucency),
+            before_forward=passes,
+            shadow_distance=translucency,
+        )
 
     def edge_response(self, model, medium, plan: FramePlan):
         """The material's exact model profile, where the convolution ran."""

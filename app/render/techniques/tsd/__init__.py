@@ -72,7 +72,11 @@ class TsdTechnique(Technique):
         passes, nodes, translucency, local = plan_tsd(
             ctx, o.size, o.gaussians, o.taps, o.albedo_mix, o.translucency, seams=o.seams
         )
-        return TechniquePlan(TsdForward(len(nodes), local), before_forward=passes, shadow_distance=translucency)
+        return TechniquePlan(
+            TsdForward(len(nodes), local, translucency=translucency),
+            before_forward=passes,
+            shadow_distance=translucency,
+        )
 
     def edge_response(self, model, medium, plan: FramePlan):
         """The Gaussian kernel the frame used (after the planner folded sub-texel Gaussians into the

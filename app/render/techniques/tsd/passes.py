@@ -24,7 +24,7 @@ import numpy as np
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
 from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
-from app.render.lights import bind_shadow_maps, light_defines, set_light_uniforms
+from app.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
 from app.render.texture_units import TextureUnits
 from app.render.translucency import bind_translucency
 from scene.optics.tsd import DiffusionKernel, blur_taps
@@ -59,12 +59,27 @@ class TsdNodeTargets:
     levels: list = field(default_factory=list)
     fbos: dict = field(default_factory=dict)
     seam: SeamMap | None = None  # the seam map (meshes with UV seams)
+    through: list = field(default_factory=list)  # the light-through record (through_record)
 
-    def fbo(self, ctx, tex: moderngl.Texture) -> moderngl.Framebuffer:
-        f = self.fbos.get(id(tex))
+    def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture) -> moderngl.Framebuffer:
+        key = (id(tex), *(id(m) for m in more))
+        f = self.fbos.get(key)
         if f is None:
-            f = self.fbos[id(tex)] = ctx.framebuffer([tex])
+            f = self.fbos[key] = ctx.framebuffer([tex, *more])
         return f
+
+    def through_record(self, ctx) -> list:
+        """The irradiance pass's record of the light through thin parts, per texel and shadow slot,
+        unblurred (for the gather's exit factor of that light, shaders/techniques/tsd/forward.glsl):
+        RGBA per slot (the light entering through, the thickness in mm) and RG (each slot's cosine on
+        the far face). Nearest filtering: a texel's record belongs to it alone."""
+        if not self.through:
+            for comps in (4, 4, 2):
+                t = ctx.texture((self.size, self.size), comps, dtype="f4")
+                t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                t.repeat_x = t.repeat_y = False
+                self.through.append(t)
+        return self.through
 
     def level(self, ctx, k: int) -> moderngl.Texture:
         while len(self.levels) <= k:
@@ -79,7 +94,7 @@ class TsdNodeTargets:
     def release(self) -> None:
         for f in self.fbos.values():
             f.release()
-        for t in [self.irradiance, self.scratch, self.stretch, self.raw, *self.levels]:
+        for t in [self.irradiance, self.scratch, self.stretch, self.raw, *self.levels, *self.through]:
             t.release()
         if self.seam is not None:
             self.seam.release()
@@ -93,6 +108,8 @@ class TsdFrameNode:
     kernel: DiffusionKernel  # the gather's weights (UNIT_KERNEL after the exact convolution)
     material: object
     mix: float
+    translucency: bool = False  # the irradiance gathered light through thin parts
+    through_slots: int = 0  # the shadow slots whose light through it recorded (TsdNodeTargets.through_record)
 
 
 class TsdStore:
@@ -214,14 +231,16 @@ class TsdIrradiancePass(TsdPass):
         prm: TsdIrradianceParams = p.params
         t = self.node_targets(p)
         gather = prm.gather if prm.gather is not None else prm.kernel
-        frame_nodes(frame)[prm.node.uid] = TsdFrameNode(t, gather, prm.material, prm.mix)
+        frame_nodes(frame)[prm.node.uid] = TsdFrameNode(
+            t, gather, prm.material, prm.mix, prm.translucency, min(len(prm.shadow_lights), SHADOW_SLOTS)
+        )
         frame.targets[f"tsd_irradiance_raw[{prm.node.name}]"] = t.raw
 
     def run(self, frame, p) -> None:
         prm: TsdIrradianceParams = p.params
         ctx, node, size, mat = self.r.ctx, prm.node, prm.size, prm.material
         t = self.node_targets(p)
-        fbo = t.fbo(ctx, t.raw)
+        fbo = t.fbo(ctx, t.raw, *(t.through_record(ctx) if prm.translucency else ()))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights

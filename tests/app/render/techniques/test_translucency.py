@@ -12,7 +12,6 @@ from app.render.settings import RenderSettings
 from scene.graph import MeshNode
 from scene.materials import Material
 from scene.optics import translucency as tr
-from scene.optics.boundary import table_lookup
 from scene.optics.tsd import material_medium
 from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
@@ -39,20 +38,21 @@ def settings(technique, **kw):
 
 def expected_radiance(thickness_mm):
     """NumPy: the light through the sheet at normal incidence (irradiance 1, base colour 1, subsurface
-    1) leaving toward a viewer straight in front: through(1, d) x exit(1) / pi."""
+    1) leaving toward a viewer straight in front: through(1, d) x exit_T(1; 1, d) / pi, the exit factor
+    of light that came through (scene/optics/slab.py slab_exit)."""
     mat = skin(radius=(8.0, 4.0, 2.0))
     tabs, medium = material_boundary(mat), material_medium(mat.values)
     through = tr.through([1.0], [thickness_mm], tabs, medium, mat["subsurface_color"])[0]
-    return through * table_lookup(tabs.exit, 1.0) / np.pi
+    return through * tr.translucent_exit(1.0, 1.0, thickness_mm, tabs, medium, mat["subsurface_color"])[0] / np.pi
 
 
 @pytest.mark.parametrize("technique", SCREEN)
 def test_back_lit_sheet_transmits_what_tsd_and_numpy_say(renderer, technique):
     """Through 0.5 mm and 3 mm of skin lit from behind: black without translucency; with it the
-    centre pixel is the NumPy slab transmission (the exact slab transmittance and the exit factor)
-    and texture-space diffusion's pixel within 1e-4 relative. The tolerance: measured agreement is
-    4e-7 (fp32); the camera's 2-degree field moves the exit factor by 1.5e-5 across the view; the
-    blur of a uniform region returns it (weights sum to 1)."""
+    centre pixel is the NumPy slab transmission (the exact slab transmittance and the exit factor of
+    light that came through) and texture-space diffusion's pixel within 1e-4 relative. The tolerance:
+    measured agreement is 4e-7 (fp32); the camera's 2-degree field moves the exit factor by 1.5e-5
+    across the view; the blur of a uniform region returns it (weights sum to 1)."""
     for d_mm in (0.5, 3.0):
         off = renderer.render(sheet(d_mm), settings(technique, translucency=False))
         assert off.hdr[24, 24, :3].max() == 0.0  # the far side is all the light there is
@@ -96,7 +96,7 @@ def test_front_lit_scene_is_unchanged(renderer, technique):
     np.testing.assert_allclose(on.hdr[..., :3], off, rtol=0, atol=1e-6)
 
 
-@pytest.mark.parametrize("technique", SCREEN)
+@pytest.mark.parametrize("technique", (*SCREEN, "tsd"))
 def test_hard_cases_stay_finite(renderer, technique):
     """Zero thickness (a skin square alone, lit from behind) and light grazing the far face (1 degree):
     finite, non-negative, and far darker than 0.5 mm at normal incidence (nothing collides in no
@@ -132,7 +132,8 @@ def test_planned_only_where_needed(renderer, technique):
 def test_reference_back_lit_slab_matches_tsd_and_numpy(renderer):
     """The path-traced reference scene slab-thin-backlit-skin1 (a closed 60 x 60 x 3 mm box of skin1
     lit from behind at 30 degrees, the camera off-axis): the middle 4 x 4 pixels of every technique
-    equal e back through(back, 3 mm) exit(NoV) / pi x base colour, NoV at the slab's middle, within
+    equal e back through(back, 3 mm) exit_T(NoV; back, 3 mm) / pi x base colour (the exit factor of light
+    that came through, not the reflected light's exit(NoV)), NoV at the slab's middle, within
     1e-3 relative (measured 3e-4: the block's pixels see the face at NoV within 0.003 of the middle's),
     and texture-space diffusion's block within 1e-3."""
     from app.bench.truth_ledger import REFERENCE_SCENES
@@ -149,7 +150,7 @@ def test_reference_back_lit_slab_matches_tsd_and_numpy(renderer):
         * light.radiance
         * back
         * tr.through([back], [3.0], tabs, medium, mat["subsurface_color"])[0]
-        * table_lookup(tabs.exit, nov)
+        * tr.translucent_exit(nov, back, 3.0, tabs, medium, mat["subsurface_color"])[0]
         / np.pi
     )
     blocks = {}
