@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniforms
+from app.render.technique import NodeShading
 
 DEFINE = "SSS_TRANSLUCENCY"  # the forward hooks' variant (shaders/techniques/<name>/forward.glsl)
 REASON = "translucency through thin parts"  # in the frame plan's reasons
@@ -53,3 +54,16 @@ def bind_translucency(prog, frame, units, fallback=None) -> None:
     eyes = np.stack([frame.shadow_eyes.get(s, np.zeros(4)) for s in (0, 1)])
     set_array(prog, "u_light_eye", eyes, 2)
     set_uniforms(prog, {"u_thickness_shrink": thickness_shrink(frame)})
+
+
+def translucent_shading(material, hook: str, frame, through: bool, bind, subsurface: bool = True) -> NodeShading:
+    """A forward hook's NodeShading that adds the light through thin parts where `through`: the
+    hook's SSS_TRANSLUCENCY variant, and the distance maps bound after the hook's own `bind(prog,
+    units)`. Shared by the hooks of screen-space SSS, the disk technique and pre-integrated skin."""
+
+    def bind_all(prog, units):
+        bind(prog, units)
+        if through:
+            bind_translucency(prog, frame, units)
+
+    return NodeShading(material, hook, {DEFINE: 1} if through else {}, bind_all, subsurface=subsurface)

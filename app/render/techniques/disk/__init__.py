@@ -16,8 +16,8 @@ from app.gl.uniforms import set_uniform
 from app.render.frame_plan import FramePlan, PlannedPass
 from app.render.options import TechniqueSettings, option
 from app.render.scattering import scattering_material
-from app.render.technique import ForwardHook, LedgerStyle, NodeShading, PlanContext, Technique, TechniquePlan
-from app.render.translucency import DEFINE, OPTION_DOC, REASON, bind_translucency, plan_translucency
+from app.render.technique import ForwardHook, LedgerStyle, PlanContext, Technique, TechniquePlan
+from app.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from scene.optics.disk import MAX_DISK_PROFILES, MAX_DISK_SAMPLES, disk_edge_response, disk_kernel
 from scene.optics.tsd import material_medium
 
@@ -59,10 +59,8 @@ class DiskForward(ForwardHook):
 
         def bind(prog, units):
             set_uniform(prog, "u_disk_profile", value)
-            if through:
-                bind_translucency(prog, frame, units)
 
-        return NodeShading(mat, HOOK, {DEFINE: 1} if through else {}, bind, subsurface=index >= 0)
+        return translucent_shading(mat, HOOK, frame, through, bind, subsurface=index >= 0)
 
 
 def plan_profiles(ctx: PlanContext):

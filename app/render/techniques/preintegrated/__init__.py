@@ -16,8 +16,8 @@ import numpy as np
 from app.gl.uniforms import set_uniforms
 from app.render.options import TechniqueSettings, option
 from app.render.scattering import scattering_material
-from app.render.technique import ForwardHook, LedgerStyle, NodeShading, PlanContext, Technique, TechniquePlan
-from app.render.translucency import DEFINE, OPTION_DOC, REASON, bind_translucency, plan_translucency
+from app.render.technique import ForwardHook, LedgerStyle, PlanContext, Technique, TechniquePlan
+from app.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from scene.optics.preintegrated import LUT_CURV, LUT_NOL, preintegrated_lut
 from scene.optics.tsd import material_medium, profile_fit
 
@@ -97,8 +97,6 @@ class PreintegratedForward(ForwardHook):
         state, through = self.state, self.translucency
 
         def bind(prog, units):
-            if through:
-                bind_translucency(prog, frame, units)
             tex = state.get(key, lut) if state is not None else None
             if tex is not None:
                 units.bind(prog, "u_pis_lut", tex)
@@ -112,7 +110,7 @@ class PreintegratedForward(ForwardHook):
                 },
             )
 
-        return NodeShading(mat, HOOK, {DEFINE: 1} if through else {}, bind)
+        return translucent_shading(mat, HOOK, frame, through, bind)
 
 
 class PreintegratedTechnique(Technique):

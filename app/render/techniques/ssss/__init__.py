@@ -13,8 +13,8 @@ from dataclasses import dataclass
 from app.gl.uniforms import set_uniform
 from app.render.frame_plan import FramePlan, PlannedPass
 from app.render.options import TechniqueSettings, option
-from app.render.technique import ForwardHook, LedgerStyle, NodeShading, PlanContext, Technique, TechniquePlan
-from app.render.translucency import DEFINE, OPTION_DOC, REASON, bind_translucency, plan_translucency
+from app.render.technique import ForwardHook, LedgerStyle, PlanContext, Technique, TechniquePlan
+from app.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from scene.optics.edges import separable_edge
 
 from .passes import MAX_SSSS_TAPS, SsssBlurParams, SsssBlurPass
@@ -57,10 +57,8 @@ class SsssForward(ForwardHook):
 
         def bind(prog, units):
             set_uniform(prog, "u_ssss_profile", index)
-            if through:
-                bind_translucency(prog, frame, units)
 
-        return NodeShading(node.material, HOOK, {DEFINE: 1} if through else {}, bind, subsurface=index > 0)
+        return translucent_shading(node.material, HOOK, frame, through, bind, subsurface=index > 0)
 
 
 class SsssTechnique(Technique):
