@@ -9,6 +9,7 @@ app/truth/compare.py judged_blocks), the truth's noise.
 SKINLAB_SSS_MODEL=<model> overrides every material's sss_model (burley, dipole, pbd, ...).
 SKINLAB_SUPERSAMPLE=N renders the frames at N x N samples per pixel (default: the ledger's,
 app/bench/truth_ledger.py TRUTH_SUPERSAMPLE; 1 = each pixel's centre only).
+SKINLAB_BOUNCES=N sets the orders of interreflection (RenderSettings.bounces; 0 = off).
 Used for the before/after tables in docs/ground-truth.md."""
 
 from __future__ import annotations
@@ -41,6 +42,9 @@ def main(argv: list[str]) -> int:
     if not raw.isdigit():
         raise SystemExit(f"SKINLAB_SUPERSAMPLE: expected an integer in [1, 8], got {raw!r}")
     n = int(raw)
+    extra = {}
+    if os.environ.get("SKINLAB_BOUNCES"):
+        extra["bounces"] = int(os.environ["SKINLAB_BOUNCES"])
     print(f"frames at {n} x {n} samples per pixel, box-filtered", flush=True)
     r = Renderer(create_headless_context())
     for s in scenes:
@@ -50,7 +54,9 @@ def main(argv: list[str]) -> int:
             print(f"{s}: no cached 96x96 reference (skinlab bench accuracy --quick --references)")
             continue
         for t in techs:
-            rs = RenderSettings.for_technique(t, 96, 96, shadow_size=QUICK.shadow_size, sss_model=model, supersample=n)
+            rs = RenderSettings.for_technique(
+                t, 96, 96, shadow_size=QUICK.shadow_size, sss_model=model, supersample=n, **extra
+            )
             img = r.render(scene, rs, readback=("hdr",)).hdr
             e = image_error(img, truth.image)
             d = relative_difference(img, truth.image, block=8)
