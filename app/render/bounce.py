@@ -119,7 +119,8 @@ def uv_footprint(mesh: Mesh) -> float:
     if mesh.uvs is None:
         return 0.0
     uv = mesh.uvs.astype(np.float64)[mesh.indices.astype(np.int64)]
-    area = 0.5 * np.abs(np.cross(uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0])).sum()
+    a, b = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum()
     return math.sqrt(area / len(mesh.positions))
 
 

@@ -1,5 +1,6 @@
 // Interreflection (app/render/bounce.py, NumPy twin scene/interreflection.py): what a surface sends
-// back out of the light it receives, as the bounce counts it. Needs lib/brdf.glsl.
+// back out of the light it receives, as the bounce counts it.
+#include "lib/brdf.glsl"
 
 // Diffuse albedo plus the specular reflectance at normal incidence, both as if Lambertian
 // (scene/interreflection.py sender_albedo).
