@@ -15,6 +15,11 @@ Humphreys, "Physically Based Rendering", 4th ed., sec. 13.6; the gathering of ra
 vertices as in Cohen & Wallace, "Radiosity and Realistic Image Synthesis", 1993, ch. 4). Repeating
 it with M = albedo x (direct + bounce) gives the next order.
 
+Copies of one vertex (the same position and normal, split along UV seams) share one set of rays,
+so the bounce light is continuous across seams. The estimate is then averaged over each vertex's
+one-ring (area-weighted, on the welded mesh): bounce light varies slowly, and the average of 7 or so
+independent estimates has about a third of the variance of one (a bias of about an edge length).
+
 The GPU twin is app/render/bounce.py with shaders/passes/bounce_exitance.{vert,frag} (M per vertex)
 and shaders/passes/bounce_gather.frag (the sum above); the records are computed here once per
 geometry and cached (ray casting with trimesh, through Embree when ``embreex`` is installed).
@@ -50,6 +55,11 @@ class BounceTransfer:
     weights: np.ndarray  # (V * rays, 3) float32
     key: str = ""  # what the records were computed from (geometry, rays, seed): a cache key
     hit_fraction: dict[int, float] = field(default_factory=dict)  # node uid -> front hits / rays
+    # the one-ring average: vertex i's estimate is sum_j ring_weights[j] E[ring_vertices[j]] over
+    # j in ring_offsets[i] .. ring_offsets[i + 1] (itself and its neighbours, weights summing to 1)
+    ring_offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))  # (V + 1,)
+    ring_vertices: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    ring_weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
 
     @property
     def total_vertices(self) -> int:
@@ -106,7 +116,7 @@ def geometry_key(nodes: list[MeshNode], rays: int, seed: int) -> str:
     return h.hexdigest()
 
 
-_CACHE: dict[str, tuple[np.ndarray, np.ndarray, list[float]]] = {}  # key -> vertices, weights, hit fractions
+_CACHE: dict[str, tuple] = {}  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights
 _CACHE_SIZE = 8
 
 
@@ -126,15 +136,66 @@ def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> Boun
         if len(_CACHE) >= _CACHE_SIZE:
             _CACHE.pop(next(iter(_CACHE)))
         _CACHE[key] = hit
-    vertices, weights, fractions = hit
-    return BounceTransfer(rays, offsets, counts, vertices, weights, key, {n.uid: f for n, f in zip(nodes, fractions)})
+    vertices, weights, fractions, r_off, r_vert, r_w = hit
+    return BounceTransfer(
+        rays,
+        offsets,
+        counts,
+        vertices,
+        weights,
+        key,
+        {n.uid: f for n, f in zip(nodes, fractions)},
+        r_off,
+        r_vert,
+        r_w,
+    )
+
+
+def weld(positions: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(first, inverse): copies of a vertex (bit-identical position and normal) map to one welded
+    vertex; ``first[w]`` is its first copy, ``inverse[i]`` vertex i's welded index."""
+    key = np.ascontiguousarray(np.concatenate([positions, normals], 1).astype(np.float64))
+    _, first, inverse = np.unique(key.view(np.dtype((np.void, key.itemsize * 6))).ravel(), True, True)
+    return first.astype(np.int64), inverse.ravel().astype(np.int64)
+
+
+def one_rings(positions, faces, first, inverse) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each vertex's one-ring on the welded mesh, as CSR (offsets, vertices, weights): itself and
+    its edge neighbours (as their first copies), weighted by their area (a third of the incident
+    triangles'), the weights of a ring summing to 1."""
+    nw = len(first)
+    f = inverse[faces]
+    tri_area = 0.5 * np.linalg.norm(
+        np.cross(positions[faces[:, 1]] - positions[faces[:, 0]], positions[faces[:, 2]] - positions[faces[:, 0]]),
+        axis=1,
+    )
+    area = np.bincount(f.ravel(), np.repeat(tri_area / 3.0, 3), minlength=nw)
+    edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]], np.stack([np.arange(nw)] * 2, 1)])
+    edges = np.unique(np.sort(np.concatenate([edges, edges[:, ::-1]]), axis=1), axis=0)
+    pairs = np.concatenate([edges, edges[edges[:, 0] != edges[:, 1]][:, ::-1]])  # both directions, self once
+    pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+    w = area[pairs[:, 1]]
+    total = np.bincount(pairs[:, 0], w, minlength=nw)
+    w = np.where(total[pairs[:, 0]] > 0, w / np.maximum(total[pairs[:, 0]], 1e-300), 0.0)
+    # a welded vertex no triangle uses (area 0): its own estimate alone
+    lonely = total == 0
+    w[lonely[pairs[:, 0]] & (pairs[:, 0] == pairs[:, 1])] = 1.0
+    counts_w = np.bincount(pairs[:, 0], minlength=nw)
+    start_w = np.concatenate([[0], np.cumsum(counts_w)])
+    # every copy of a welded vertex has its ring
+    counts = counts_w[inverse]
+    offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    idx = np.concatenate([np.arange(start_w[u], start_w[u + 1]) for u in inverse]) if len(inverse) else np.zeros(0, int)
+    return offsets, first[pairs[idx, 1]], w[idx].astype(np.float32)
 
 
 def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
     import trimesh
 
     if total == 0:
-        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), []
+        z = np.zeros(0, np.int64)
+        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), [], np.zeros(1, np.int64), z, z
+
     pos, nrm, faces = [], [], []
     start = 0
     for node in nodes:
@@ -154,11 +215,13 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
         ) from None
     mesh.ray = RayMeshIntersector(mesh)
     diag = float(np.linalg.norm(p_all.max(0) - p_all.min(0))) or 1.0
-    dirs = cosine_directions(n_all, rays, seed).reshape(-1, 3)
-    origins = np.repeat(p_all + n_all * (RAY_OFFSET * diag), rays, axis=0)
+    first, inverse = weld(p_all, n_all)
+    nw = len(first)
+    dirs = cosine_directions(n_all[first], rays, seed).reshape(-1, 3)
+    origins = np.repeat(p_all[first] + n_all[first] * (RAY_OFFSET * diag), rays, axis=0)
     tri, ray, loc = mesh.ray.intersects_id(origins, dirs, multiple_hits=False, return_locations=True)
-    vertices = np.zeros((total * rays, 3), np.int64)
-    weights = np.zeros((total * rays, 3), np.float32)
+    vertices = np.zeros((nw * rays, 3), np.int64)
+    weights = np.zeros((nw * rays, 3), np.float32)
     if len(tri):
         front = np.einsum("ij,ij->i", mesh.face_normals[tri], dirs[ray]) < 0.0
         tri, ray, loc = tri[front], ray[front], loc[front]
@@ -168,15 +231,18 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
         bary /= np.maximum(bary.sum(1, keepdims=True), 1e-12)
         vertices[ray] = corners
         weights[ray] = (bary / rays).astype(np.float32)
-    no_normal = np.repeat(np.concatenate([np.linalg.norm(n.mesh.normals, axis=1) == 0 for n in nodes]), rays)
-    weights[no_normal] = 0.0  # a vertex without a normal (no triangle uses it) receives nothing
+    no_normal = np.concatenate([np.linalg.norm(n.mesh.normals, axis=1) == 0 for n in nodes])
+    weights[np.repeat(no_normal[first], rays)] = 0.0  # a vertex without a normal (no triangle uses it) receives nothing
+    # every copy of a welded vertex gets its records
+    rows = (inverse[:, None] * rays + np.arange(rays)[None, :]).ravel()
+    vertices, weights = vertices[rows], weights[rows]
     hit_rays = (weights.sum(1) > 0).reshape(total, rays).mean(1)
     fractions, start = [], 0
     for node in nodes:
         k = len(node.mesh.positions)
         fractions.append(float(hit_rays[start : start + k].mean()))
         start += k
-    return vertices, weights, fractions
+    return vertices, weights, fractions, *one_rings(p_all, f_all, first, inverse)
 
 
 def gather(transfer: BounceTransfer, exitance: np.ndarray) -> np.ndarray:
@@ -191,13 +257,23 @@ def gather(transfer: BounceTransfer, exitance: np.ndarray) -> np.ndarray:
     return per_ray.reshape(transfer.total_vertices, transfer.rays, -1).sum(1)
 
 
+def smooth(transfer: BounceTransfer, irradiance: np.ndarray) -> np.ndarray:
+    """The one-ring average of per-vertex estimates (module docstring)."""
+    e = np.asarray(irradiance, np.float64)
+    per = transfer.ring_weights.astype(np.float64)[:, None] * e[transfer.ring_vertices]
+    owner = np.repeat(np.arange(transfer.total_vertices), np.diff(transfer.ring_offsets))
+    out = np.zeros_like(e)
+    np.add.at(out, owner, per)
+    return out
+
+
 def bounce_irradiance(transfer: BounceTransfer, direct: np.ndarray, albedo: np.ndarray, bounces: int) -> np.ndarray:
     """Irradiance from interreflection up to order `bounces` (0: none), per global vertex: each
     order's senders leave albedo x (direct + the previous orders' bounce light)."""
     direct = np.asarray(direct, np.float64)
     e = np.zeros_like(direct)
     for _ in range(bounces):
-        e = gather(transfer, np.asarray(albedo, np.float64) * (direct + e))
+        e = smooth(transfer, gather(transfer, np.asarray(albedo, np.float64) * (direct + e)))
     return e
 
 

@@ -2,13 +2,14 @@
 
 Planned by the core (app/render/plan.py) when ``RenderSettings.bounces`` > 0 and some ray from some
 vertex meets the front of a surface (a convex mesh alone has nothing to gather: the pass is skipped
-and the plan says so). Each order is one pass, ``bounce[N]``, in two draws on small vertex-space
+and the plan says so). Each order is one pass, ``bounce[N]``, in three draws on small vertex-space
 targets (vertex i of the frame's meshes at texel (i % 1024, i / 1024)):
 
 1. radiant exitance per vertex (shaders/passes/bounce_exitance.{vert,frag}: one point per vertex):
    sender albedo x (the lights with their shadow maps + the sky + the previous order's bounce);
 2. gather (shaders/passes/bounce_gather.frag): each vertex's irradiance from what its rays met, with
-   the ray records of scene/interreflection.py (computed once per geometry on the CPU, cached).
+   the ray records of scene/interreflection.py (computed once per geometry on the CPU, cached);
+3. the one-ring average of those estimates (shaders/passes/bounce_smooth.frag).
 
 The last order's target holds all orders' light (each order's senders carry the previous ones). The
 passes that shade ambient light read it per vertex (lib/bounce_vertex.glsl in forward.vert and
@@ -131,12 +132,15 @@ class BouncePass:
         self.r = renderer
         self.targets: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer]] = {}  # order -> irradiance
         self.exitance: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
-        self.records: tuple[str, moderngl.Texture, moderngl.Texture] | None = None  # (transfer key, vertices, weights)
+        self.gathered: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None  # before the one-ring average
+        # (transfer key, ray vertices, ray weights, ring index, ring entries)
+        self.records: tuple | None = None
         self._point_vaos: dict[tuple[int, int], moderngl.VertexArray] = {}
 
     # -- GPU objects ---------------------------------------------------------------------
-    def _target(self, size, order: int | None):
-        held = self.exitance if order is None else self.targets.get(order)
+    def _target(self, size, order: int | str):
+        """The vertex-space target of an order (int), or the scratch "exitance" / "gathered" one."""
+        held = self.targets.get(order) if isinstance(order, int) else getattr(self, order)
         if held is None or held[0].size != tuple(size):
             if held is not None:
                 held[1].release()
@@ -144,28 +148,35 @@ class BouncePass:
             tex = self.r.ctx.texture(size, 4, dtype="f4")
             tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
             held = (tex, self.r.ctx.framebuffer([tex]))
-            if order is None:
-                self.exitance = held
-            else:
+            if isinstance(order, int):
                 self.targets[order] = held
+            else:
+                setattr(self, order, held)
         return held
 
+    def _upload(self, rows: np.ndarray, width: int) -> moderngl.Texture:
+        """Rows of 2 or 3 floats as a float texture, row r at texel (r % width, r / width)."""
+        n, c = rows.shape
+        height = max(1, math.ceil(n / width))
+        padded = np.zeros((height * width, c), np.float32)
+        padded[:n] = rows
+        tex = self.r.ctx.texture((width, height), c, padded.tobytes(), dtype="f4")
+        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        return tex
+
     def _records(self, transfer: BounceTransfer):
+        """The transfer's ray records and one-rings on the GPU (uploaded once per transfer)."""
         if self.records is None or self.records[0] != transfer.key:
             self._release_records()
-            n = len(transfer.vertices)
-            rows = max(1, math.ceil(n / RECORD_TEXTURE_WIDTH))
-            size = (RECORD_TEXTURE_WIDTH, rows)
-            padded = np.zeros((rows * RECORD_TEXTURE_WIDTH, 3), np.float32)
-            padded[:n] = transfer.vertices
-            verts = self.r.ctx.texture(size, 3, padded.tobytes(), dtype="f4")
-            padded[:] = 0.0
-            padded[:n] = transfer.weights
-            weights = self.r.ctx.texture(size, 3, padded.tobytes(), dtype="f4")
-            for t in (verts, weights):
-                t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            self.records = (transfer.key, verts, weights)
-        return self.records[1], self.records[2]
+            ring = np.stack([transfer.ring_offsets[:-1], np.diff(transfer.ring_offsets)], 1)
+            self.records = (
+                transfer.key,
+                self._upload(transfer.vertices, RECORD_TEXTURE_WIDTH),
+                self._upload(transfer.weights, RECORD_TEXTURE_WIDTH),
+                self._upload(ring, VERTEX_TEXTURE_WIDTH),
+                self._upload(np.stack([transfer.ring_vertices, transfer.ring_weights], 1), RECORD_TEXTURE_WIDTH),
+            )
+        return self.records[1:]
 
     def _points(self, node, prog) -> moderngl.VertexArray:
         """A mesh's vertices as points, without its index buffer (gl_VertexID = the vertex)."""
@@ -180,16 +191,16 @@ class BouncePass:
 
     def _release_records(self) -> None:
         if self.records is not None:
-            self.records[1].release()
-            self.records[2].release()
+            for tex in self.records[1:]:
+                tex.release()
             self.records = None
 
     def release(self) -> None:
-        for tex, fbo in [*self.targets.values(), *([self.exitance] if self.exitance else [])]:
+        for tex, fbo in [*self.targets.values(), *(x for x in (self.exitance, self.gathered) if x is not None)]:
             fbo.release()
             tex.release()
         self.targets.clear()
-        self.exitance = None
+        self.exitance = self.gathered = None
         self._release_records()
         for vao in self._point_vaos.values():
             vao.release()
@@ -209,7 +220,7 @@ class BouncePass:
         prm: BounceParams = p.params
         tr = prm.transfer
         ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-        exitance, efbo = self._target(p.resolution, None)
+        exitance, efbo = self._target(p.resolution, "exitance")
         efbo.use()
         efbo.clear(0.0, 0.0, 0.0, 0.0)
         previous = self.targets.get(prm.order - 1) if prm.order > 1 else None
@@ -240,16 +251,24 @@ class BouncePass:
                 },
             )
             self._points(node, prog).render(moderngl.POINTS)
-        irr, fbo = self._target(p.resolution, prm.order)
-        fbo.use()
-        fbo.clear(0.0, 0.0, 0.0, 0.0)
-        verts, weights = self._records(tr)
+        verts, weights, ring_index, ring_entries = self._records(tr)
+        gathered, gfbo = self._target(p.resolution, "gathered")
+        gfbo.use()
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/bounce_gather.frag")
         units = TextureUnits(ctx)
         units.bind(prog, "u_exitance", exitance)
         units.bind(prog, "u_ray_vertices", verts)
         units.bind(prog, "u_ray_weights", weights)
         set_uniforms(prog, {"u_rays": tr.rays, "u_vertices": tr.total_vertices})
+        self.r.fullscreen(prog)
+        _, fbo = self._target(p.resolution, prm.order)
+        fbo.use()
+        prog = self.r.programs.get("passes/fullscreen.vert", "passes/bounce_smooth.frag")
+        units = TextureUnits(ctx)
+        units.bind(prog, "u_gathered", gathered)
+        units.bind(prog, "u_ring_index", ring_index)
+        units.bind(prog, "u_ring_entries", ring_entries)
+        set_uniforms(prog, {"u_vertices": tr.total_vertices})
         self.r.fullscreen(prog)
         self.publish(frame, p)
 

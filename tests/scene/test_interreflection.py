@@ -13,6 +13,8 @@ from scene.interreflection import (
     cosine_directions,
     gather,
     sender_albedo,
+    smooth,
+    weld,
 )
 from scene.materials import Material
 from scene.mesh import Mesh
@@ -163,3 +165,40 @@ def test_sender_albedo():
     assert np.allclose(sender_albedo(base, 0.0, 0.5), base + 0.04)
     assert np.allclose(sender_albedo(base, 1.0, 0.5), base)
     assert np.allclose(sender_albedo(base, 0.0, 0.0), base)
+
+
+def test_copies_along_a_seam_share_their_rays_and_rings():
+    """A plate cut along x = 0.5 into two charts (the vertices on the cut duplicated, as a UV seam
+    does): the copies get the same records and the same one-ring, so bounce light is continuous."""
+    n = 8
+    a, b = open_book(n)
+    m = a.mesh
+    cut = np.where(np.isclose(m.positions[:, 0], 0.5))[0]
+    copies = np.arange(len(m.positions), len(m.positions) + len(cut))
+    remap = np.arange(len(m.positions))
+    remap[cut] = copies
+    faces = m.indices.astype(np.int64).copy()
+    right = m.positions[faces].mean(1)[:, 0] > 0.5
+    faces[right] = remap[faces[right]]  # the right chart uses the copies
+    pos = np.vstack([m.positions, m.positions[cut]])
+    split = MeshNode("A-cut", Mesh("A-cut", pos, faces, np.vstack([m.normals, m.normals[cut]])), Material())
+    first, inverse = weld(split.mesh.positions, split.mesh.normals)
+    assert len(first) == len(m.positions) and np.all(inverse[cut] == inverse[copies])
+    tr = build_transfer([split, b], 16)
+    k = tr.rays
+    for c, d in zip(cut, copies):
+        assert np.array_equal(tr.vertices[c * k : (c + 1) * k], tr.vertices[d * k : (d + 1) * k])
+    rng = np.random.default_rng(0)
+    e = smooth(tr, rng.random((tr.total_vertices, 3)))
+    assert np.allclose(e[cut], e[copies])
+
+
+def test_one_ring_average_keeps_constants_and_sums_to_one():
+    a, b = open_book(6)
+    tr = build_transfer([a, b], 8)
+    sums = np.add.reduceat(tr.ring_weights.astype(np.float64), tr.ring_offsets[:-1])
+    assert np.allclose(sums, 1.0, atol=1e-6)
+    assert np.allclose(smooth(tr, np.full((tr.total_vertices, 2), 3.0)), 3.0)
+    # an interior grid vertex averages itself and its 6 neighbours; a corner fewer
+    counts = np.diff(tr.ring_offsets)
+    assert counts.max() == 7 and counts.min() >= 3

@@ -10,7 +10,7 @@ import pytest
 from app.gl.glsl_eval import assert_close_fp32
 from app.render.settings import RenderSettings
 from scene.graph import CameraNode, MeshNode, Scene
-from scene.interreflection import build_transfer, gather, sender_albedo, world_geometry
+from scene.interreflection import build_transfer, gather, sender_albedo, smooth, world_geometry
 from scene.materials import Material
 from scene.primitives import box_mesh
 from tests.scene.test_interreflection import grid_mesh
@@ -41,7 +41,7 @@ def settings(technique="none", **kw) -> RenderSettings:
 
 def test_exitance_and_gather_passes_match_numpy(renderer):
     """The exitance pass leaves sender albedo x irradiance per vertex, the gather sums the ray records
-    over it: both within 1e-4 of NumPy."""
+    over it, the one-ring average smooths that: each within 1e-4 of NumPy."""
     s = open_book_scene()
     renderer.render(s, settings(bounces=1))
     bp = renderer.passes["bounce"]
@@ -56,10 +56,14 @@ def test_exitance_and_gather_passes_match_numpy(renderer):
         cos = np.maximum(nrm @ -sun.direction, 0.0)
         want.append(cos[:, None] * sun.radiance * sender_albedo(GREY["base_color"], 0.0, GREY["specular"]))
     assert_close_fp32(gpu_m, np.concatenate(want), rtol=1e-4, atol=1e-6, what="bounce exitance")
-    gpu_e = np.frombuffer(bp.targets[1][0].read(), np.float32).reshape(-1, 4)[:v, :3].astype(np.float64)
+    gpu_g = np.frombuffer(bp.gathered[0].read(), np.float32).reshape(-1, 4)[:v, :3].astype(np.float64)
     ref = gather(tr, gpu_m)
     assert ref[tr.offsets[nodes[1].uid] :].max() > 0.1  # B receives A's light
-    assert_close_fp32(gpu_e, ref, rtol=1e-4, atol=1e-5 * ref.max(), what="bounce gather")
+    assert_close_fp32(gpu_g, ref, rtol=1e-4, atol=1e-5 * ref.max(), what="bounce gather")
+    gpu_e = np.frombuffer(bp.targets[1][0].read(), np.float32).reshape(-1, 4)[:v, :3].astype(np.float64)
+    ref = smooth(tr, gpu_g)
+    assert not np.allclose(ref, gpu_g)  # the average changes something
+    assert_close_fp32(gpu_e, ref, rtol=1e-4, atol=1e-5 * ref.max(), what="bounce one-ring average")
 
 
 def test_plain_frame_shows_bounce_light_where_no_light_reaches(renderer):
@@ -78,7 +82,7 @@ def test_plain_frame_shows_bounce_light_where_no_light_reaches(renderer):
     m = np.zeros((tr.total_vertices, 3))
     a = s.find("A")
     m[: tr.counts[a.uid]] = -sun.direction[2] * sun.radiance * sender_albedo(GREY["base_color"], 0.0, 0.5)
-    e = gather(tr, m)[tr.offsets[b.uid] + i * (N + 1) + j]
+    e = smooth(tr, gather(tr, m))[tr.offsets[b.uid] + i * (N + 1) + j]
     want = e * sender_albedo(GREY["base_color"], 0.0, GREY["specular"]) / math.pi
     centre = on[14:18, 14:18, :3].reshape(-1, 3).mean(0)
     assert np.allclose(centre, want, rtol=0.03), (centre, want)
