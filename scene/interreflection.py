@@ -20,9 +20,10 @@ so the bounce light is continuous across seams. The estimate is then averaged ov
 one-ring (area-weighted, on the welded mesh): bounce light varies slowly, and the average of 7 or so
 independent estimates has about a third of the variance of one (a bias of about an edge length).
 
-Sources: docs/references.md#interreflection. The GPU twin is app/render/bounce.py with shaders/passes/bounce_exitance.{vert,frag} (M per vertex)
-and shaders/passes/bounce_gather.frag (the sum above); the records are computed here once per
-geometry and cached (ray casting with trimesh, through Embree when ``embreex`` is installed).
+Sources: docs/references.md#interreflection. The GPU twin is app/render/bounce.py with
+shaders/passes/bounce_exitance.{vert,frag} (M per vertex), bounce_gather.frag (the sum above) and
+bounce_smooth.frag (the one-ring average); the records are computed here once per geometry and cached
+(ray casting with trimesh through Embree, the ``embreex`` package).
 """
 
 from __future__ import annotations
