@@ -9,6 +9,10 @@ app/truth/compare.py judged_blocks), the truth's noise.
 SKINLAB_SSS_MODEL=<model> overrides every material's sss_model (burley, dipole, pbd, ...).
 SKINLAB_SUPERSAMPLE=N renders the frames at N x N samples per pixel (default: the ledger's,
 app/bench/truth_ledger.py TRUTH_SUPERSAMPLE; 1 = each pixel's centre only).
+SKINLAB_TRUTH=192 compares with the 192x192, 1024-spp references instead (frames at 192x192; the
+references must be cached: `skinlab reference SCENE --size 192x192 --spp 1024`).
+SKINLAB_BOUNCES=N sets the orders of interreflection (RenderSettings.bounces; 0 = off), and
+SKINLAB_BOUNCE_RAYS=N the rays per vertex (RenderSettings.bounce_rays).
 Used for the before/after tables in docs/ground-truth.md."""
 
 from __future__ import annotations
@@ -41,16 +45,24 @@ def main(argv: list[str]) -> int:
     if not raw.isdigit():
         raise SystemExit(f"SKINLAB_SUPERSAMPLE: expected an integer in [1, 8], got {raw!r}")
     n = int(raw)
+    extra = {}
+    if os.environ.get("SKINLAB_BOUNCES"):
+        extra["bounces"] = int(os.environ["SKINLAB_BOUNCES"])
+    if os.environ.get("SKINLAB_BOUNCE_RAYS"):
+        extra["bounce_rays"] = int(os.environ["SKINLAB_BOUNCE_RAYS"])
     print(f"frames at {n} x {n} samples per pixel, box-filtered", flush=True)
+    size, spp = (192, 1024) if os.environ.get("SKINLAB_TRUTH") == "192" else (96, 256)
     r = Renderer(create_headless_context())
     for s in scenes:
         scene = load_scene(REFERENCE_SCENES / f"{s}.toml")
-        truth = load_truth(scene, TruthSpec((96, 96), 256), progress=False)
+        truth = load_truth(scene, TruthSpec((size, size), spp), progress=False)
         if truth is None:
-            print(f"{s}: no cached 96x96 reference (skinlab bench accuracy --quick --references)")
+            print(f"{s}: no cached {size}x{size}, {spp}-spp reference")
             continue
         for t in techs:
-            rs = RenderSettings.for_technique(t, 96, 96, shadow_size=QUICK.shadow_size, sss_model=model, supersample=n)
+            rs = RenderSettings.for_technique(
+                t, size, size, shadow_size=QUICK.shadow_size, sss_model=model, supersample=n, **extra
+            )
             img = r.render(scene, rs, readback=("hdr",)).hdr
             e = image_error(img, truth.image)
             d = relative_difference(img, truth.image, block=8)

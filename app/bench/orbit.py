@@ -8,7 +8,7 @@ renderer, interleaved so that a change of machine load hits all three alike:
 - ``orbit``: the default settings (texture-space diffusion) with reuse on, as the viewer renders: the
   shadow maps and texture-space passes keep their results, forward shading and tone mapping run;
 - ``full``: the same frame with reuse off (every pass runs every frame);
-- ``plain``: the plain frame (``--sss none``: no subsurface scattering), reuse off;
+- ``plain``: the plain frame (``--sss none --bounces 0``: no subsurface scattering, no interreflection), reuse off;
 - ``plain_orbit``: the plain frame with reuse on (its shadow map is kept).
 
 Frame time is wall time of ``render(readback=False)`` followed by ``glFinish`` (the viewer reads
@@ -61,8 +61,8 @@ def orbit_scene(name: str, path, size, frames: int, ctx, progress=None) -> dict:
     settings = {
         "orbit": RenderSettings(w, h),
         "full": RenderSettings(w, h),
-        "plain": RenderSettings(w, h, sss_model="none"),
-        "plain_orbit": RenderSettings(w, h, sss_model="none"),
+        "plain": RenderSettings(w, h, sss_model="none", bounces=0),
+        "plain_orbit": RenderSettings(w, h, sss_model="none", bounces=0),
     }
     for m, r in renderers.items():
         r.timer.sync = False  # whole frames are timed

@@ -24,7 +24,8 @@ def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False, rounds
     interleaved: `rounds` rounds, each timing its share of the `frames` of every Skinlab setting and
     then as many of pyrender's (kept alive in a child process), so that a change of machine load
     hits both alike; ``ratio_skinlab_over_pyrender`` is the median of the rounds' ratios.
-    ``skinlab_ms`` is the plain-PBR frame (sss_model none, like pyrender's: no subsurface scattering);
+    ``skinlab_ms`` is the plain-PBR frame (sss_model none and bounces 0, like pyrender's: no subsurface
+    scattering, no interreflection);
     ``skinlab_default_ms`` the frame with the default RenderSettings (the head's skin scatters, so
     texture-space diffusion runs); ``skinlab_no_prepass_ms`` the plain frame without the depth
     pre-pass; ``skinlab_passes_ms`` where the plain frame's time goes (glFinish after each pass; "readback":
@@ -52,8 +53,8 @@ def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False, rounds
     r.timer.sync = False  # no glFinish between passes: whole frames are timed here
     r.reuse = False  # full frames (skinlab bench orbit times frames that reuse)
     settings = {
-        "plain": RenderSettings(w, h, sss_model="none"),
-        "no_prepass": RenderSettings(w, h, sss_model="none", depth_prepass=False),
+        "plain": RenderSettings(w, h, sss_model="none", bounces=0),
+        "no_prepass": RenderSettings(w, h, sss_model="none", bounces=0, depth_prepass=False),
         "default": RenderSettings(w, h),
     }
     # 2 warm-up frames per Skinlab setting, then per round: its frames of each setting and pyrender's

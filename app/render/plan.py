@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from .bounce import plan_bounce
 from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams, shadow_pass_name
 from .registry import get_technique
 from .reuse import light_placement, scene_geometry
@@ -18,7 +19,8 @@ __all__ = ["FramePlan", "PlannedPass", "ShadowParams", "ForwardParams", "plan_fr
 
 
 def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
-    """Passes for this frame: shadow maps, the technique's passes (registry), the forward pass with
+    """Passes for this frame: shadow maps, interreflection (app/render/bounce.py), the technique's
+    passes (registry), the forward pass with
     the technique's shading hook, tone mapping. ``state``: the technique's renderer-side state (its
     caches, e.g. texture-space diffusion's stretch maps); None plans as if nothing were cached."""
     meshes = scene.mesh_nodes()
@@ -59,6 +61,12 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
         )
     for l in shadow_lights[2:]:
         plan.skipped.append((f"shadow[{l.name}]", "at most 2 shadow-casting lights"))
+    bounce = plan_bounce(scene, settings, meshes, lights, shadow_lights[:2], plan)
+    plan.passes += bounce
+    if bounce:  # bounce light is ambient light: every pass of the technique that is kept across frames reads it
+        for p in tp.before_forward:
+            if p.inputs is not None:
+                p.after = (*p.after, bounce[-1].name)
     plan.passes += tp.before_forward
     hook = tp.forward
     plan.passes.append(

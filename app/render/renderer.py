@@ -12,6 +12,7 @@ from app.gl.programs import ProgramCache
 from app.gl.shader_source import ShaderLibrary
 from scene.graph import Scene
 
+from .bounce import BouncePass
 from .frame import Frame
 from .frame_plan import FramePlan
 from .gpu_resources import GpuResources
@@ -46,6 +47,7 @@ class Renderer:
         # the core's passes; a technique's are made on first use (pass_for)
         self.passes: dict[str, RenderPass] = {
             "shadow": ShadowPass(self),
+            "bounce": BouncePass(self),
             "forward": ForwardPass(self),
             "tonemap": TonemapPass(self),
         }

@@ -38,6 +38,23 @@ class RenderSettings:
         range=(1, 8),
         unit="samples per pixel side",
     )
+    # interreflection (app/render/bounce.py): light the scene's surfaces throw onto each other
+    bounces: int = option(
+        2,
+        "interreflection: orders of light the scene's surfaces throw onto each other (0: off); gathered "
+        "per vertex from cosine-weighted rays, for every technique",
+        "int",
+        range=(0, 8),
+        unit="bounces",
+    )
+    bounce_rays: int = option(
+        64,
+        "interreflection: rays each vertex casts to find the surfaces it sees (more: less noise, a longer "
+        "first frame after the geometry changes)",
+        "int",
+        range=(4, 4096),
+        unit="rays per vertex",
+    )
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):

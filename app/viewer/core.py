@@ -176,6 +176,17 @@ class ViewerCore:
         self.invalidate()
         return getattr(self.settings.technique, name)
 
+    def set_render_option(self, name: str, value) -> object:
+        """Change one declared render setting (RenderSettings.options(): supersample, bounces, ...),
+        checked against its declaration."""
+        opts = self.settings.options()
+        if name not in opts:
+            raise ValueError(f"render setting {name!r}: unknown; the declared ones: {', '.join(opts)}")
+        self.settings = dataclasses.replace(self.settings, **{name: value})  # validated again
+        self.note("info", f"{name}: {getattr(self.settings, name)}")
+        self.invalidate()
+        return getattr(self.settings, name)
+
     def reset_camera(self) -> None:
         self.orbit.reset()
         self.invalidate()

@@ -20,6 +20,7 @@ from .inspector import display_mode
 from .panel import (
     angles_from_direction,
     direction_from_angles,
+    render_widgets,
     sss_override_note,
     technique_value,
     technique_widgets,
@@ -133,18 +134,27 @@ class Gui:
                     core.set_technique(t.name)
             imgui.end_combo()
         self._technique_options()
+        self._render_options()
         if imgui.button("Reset camera (R)"):
             core.reset_camera()
 
     def _technique_options(self) -> None:
         """The current technique's settings (panel.technique_widgets: from its declaration)."""
+        st = self.core.settings.technique
+        self._option_widgets(technique_widgets(st), st, st.technique, self.core.set_technique_option)
+
+    def _render_options(self) -> None:
+        """The declared render settings (panel.render_widgets): supersampling, interreflection."""
+        st = self.core.settings
+        self._option_widgets(render_widgets(st), st, "render", self.core.set_render_option)
+
+    def _option_widgets(self, widgets, st, scope: str, apply) -> None:
         core = self.core
-        st = core.settings.technique
-        for w in technique_widgets(st):
-            label = f"{widget_label(w)}##{st.technique}"
+        for w in widgets:
+            label = f"{widget_label(w)}##{scope}"
             new = w.value
             if w.widget.endswith("_or_auto"):
-                changed, auto = imgui.checkbox(f"{w.param} automatic##{st.technique}", w.value is None)
+                changed, auto = imgui.checkbox(f"{w.param} automatic##{scope}", w.value is None)
                 new = None if auto else (w.value if w.value is not None else w.range[0])
             else:
                 changed = False
@@ -160,7 +170,7 @@ class Gui:
                 imgui.set_tooltip(w.doc)
             if changed:
                 try:
-                    core.set_technique_option(w.param, technique_value(st, w.param, new))
+                    apply(w.param, technique_value(st, w.param, new))
                 except ValueError as exc:
                     core.note("error", str(exc))
 

@@ -314,7 +314,19 @@ TECHNIQUE_WIDGETS = {"bool": "checkbox", "int": "slider_int", "float": "slider_f
 
 def technique_widgets(settings) -> list[Widget]:
     """One widget per field of a technique's settings, from its declaration (range, meaning, default)."""
-    defaults = settings.defaults()
+    return option_widgets(settings, settings.defaults())
+
+
+def render_widgets(settings) -> list[Widget]:
+    """One widget per declared render setting (RenderSettings.options(): supersampling,
+    interreflection), from its declaration like a technique's."""
+    import dataclasses
+
+    fields = {f.name: f.default for f in dataclasses.fields(settings)}
+    return option_widgets(settings, {name: fields[name] for name in settings.options()})
+
+
+def option_widgets(settings, defaults: dict) -> list[Widget]:
     out = []
     for name, o in settings.options().items():
         kind = TECHNIQUE_WIDGETS[o.kind] + ("_or_auto" if o.none else "")

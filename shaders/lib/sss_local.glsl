@@ -2,10 +2,11 @@
 // scatter locally or in screen space (tint, ssss): the same entry/exit model as texture-space
 // diffusion (lib/sss_boundary.glsl: the multiple-scattering albedo at the light's incidence in, its
 // angular distribution out) so that only the convolution differs between the techniques. Needs the
-// material uniforms and u_ambient. Variant SSS_TRANSLUCENCY: plus the light through thin parts
+// material uniforms and lib/ambient.glsl. Variant SSS_TRANSLUCENCY: plus the light through thin parts
 // (lib/sss_translucency.glsl, the same term texture-space diffusion gathers in its irradiance
 // pass), entering with the rest, so a screen-space blur spreads it as texture-space diffusion's does.
 #include "lib/sss_boundary.glsl"
+#include "lib/ambient.glsl"
 #ifdef SSS_TRANSLUCENCY
 #include "lib/sss_translucency.glsl"
 #endif
@@ -18,7 +19,7 @@ void sss_add_light(vec3 e, float vis, float NoL) {
 
 // The radiance leaving the medium toward the viewer for subsurface weight sss_w (ambient included).
 vec3 sss_local_radiance(vec3 base, float NoV, float occlusion, float sss_w) {
-    vec3 entering = sss_in + PI * u_ambient * occlusion * u_sss_entry_diffuse;
+    vec3 entering = sss_in + PI * ambient_radiance(occlusion) * u_sss_entry_diffuse;
     vec3 leaving = entering * sss_exit(abs(NoV));
 #ifdef SSS_TRANSLUCENCY
     // light through thin parts leaves with its own angular distribution (lib/sss_boundary.glsl sss_slab_exit)

@@ -8,11 +8,13 @@
 // added after the lights. Specular and ambient specular as usual. Single scattering (Jensen 2001,
 // lib/sss_boundary.glsl) is added per light, and for ambient light, for a mesh whose technique
 // scatters (u_sss_single > 0): it leaves within about a mean free path of where it entered, so no
-// technique blurs it.
+// technique blurs it. Ambient light is the sky and, with variant BOUNCE, the light the scene's
+// surfaces throw onto this one (interreflection, lib/ambient.glsl).
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
 #include "lib/lights.glsl"
+#include "lib/ambient.glsl"
 #include "skinlab/material.glsl"
 
 in vec3 v_world;
@@ -21,7 +23,6 @@ in vec2 v_uv;
 in vec4 v_tangent;
 
 uniform vec3 u_camera_pos;
-uniform vec3 u_ambient;
 
 layout(location = 0) out vec4 f_color;
 
@@ -74,8 +75,9 @@ void main() {
         vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
         sss_add_light(e, u_light_shadow[i] >= 0 ? light_visibility(i, entry, dot(ng, l)) : 1.0, NoL);
     }
-    color += u_ambient * occlusion * (base * ((1.0 - u_metallic) * plain) + f0);
-    if (single) color += u_ambient * occlusion * single_w * sss_single_ambient(NoV);  // the sky's single scattering
+    vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
+    color += ambient * (base * ((1.0 - u_metallic) * plain) + f0);
+    if (single) color += ambient * single_w * sss_single_ambient(NoV);  // its single scattering
     color += sss_radiance(base, NoV, occlusion, v_uv);
     f_color = vec4(color, 1.0);
 }

@@ -5,6 +5,7 @@ in vec3 in_normal;
 in vec2 in_uv;
 in vec4 in_tangent;
 in float in_curvature;  // per-vertex mean curvature, 1/scene unit (pre-integrated skin)
+#include "lib/bounce_vertex.glsl"
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 uniform mat4 u_view_proj;
@@ -20,5 +21,6 @@ void main() {
     v_tangent = vec4(mat3(u_model) * in_tangent.xyz, in_tangent.w);
     v_uv = in_uv;
     v_curvature = in_curvature;
+    bounce_vertex();
     gl_Position = u_view_proj * w;
 }

@@ -2,7 +2,7 @@
 // Texture-space irradiance (d'Eon & Luebke 2007): per texel of the mesh's UV layout, the light that
 // enters the surface's multiple scattering - each light times the entry factor at its incidence
 // (lib/sss_boundary.glsl: A_ms(mu0) / A_colour), shadows, the normal map, ambient x occlusion
-// (pi L_ambient x A_ms_d / A_colour) - times albedo^mix (pre-scatter texturing). a = 1: covered.
+// (pi L_ambient x A_ms_d / A_colour; variant BOUNCE: the scene's bounce light too, lib/ambient.glsl) - times albedo^mix (pre-scatter texturing). a = 1: covered.
 // Each light's shadow is looked up where the diffusion that leaves at the texel entered (oblique
 // incidence, lib/sss_oblique.glsl: about 0.7 mm toward the light on skin lit at 45 degrees).
 // Variant TSD_TRANSLUCENCY: light reaching back faces through thin parts: the exact diffuse
@@ -14,6 +14,7 @@
 // gives it the exit factor of light that came through.
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
+#include "lib/ambient.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
 #include "skinlab/material.glsl"
@@ -24,7 +25,6 @@ in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_tangent;
 
-uniform vec3 u_ambient;
 uniform float u_tsd_mix;
 uniform int u_slot_light[2];              // the light each shadow slot holds (lib/lights.glsl slots)
 #ifdef TSD_TRANSLUCENCY
@@ -101,7 +101,7 @@ void main() {
 #if SHADOW_SLOTS > 1
     e_in += shadowed_light(1, n, ng);
 #endif
-    e_in += PI * u_ambient * occlusion * u_sss_entry_diffuse;
+    e_in += PI * ambient_radiance(occlusion) * u_sss_entry_diffuse;  // the sky and bounce light
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 #ifdef TSD_TRANSLUCENCY
     f_through0 = through_rec[0];

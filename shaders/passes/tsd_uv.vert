@@ -5,6 +5,7 @@ in vec3 in_position;
 in vec3 in_normal;
 in vec2 in_uv;
 in vec4 in_tangent;
+#include "lib/bounce_vertex.glsl"
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 out vec3 v_world;
@@ -17,5 +18,6 @@ void main() {
     v_normal = u_normal_matrix * in_normal;
     v_tangent = vec4(mat3(u_model) * in_tangent.xyz, in_tangent.w);
     v_uv = in_uv;
+    bounce_vertex();
     gl_Position = vec4(in_uv * 2.0 - 1.0, 0.0, 1.0);
 }

@@ -15,6 +15,7 @@ from __future__ import annotations
 import moderngl
 
 from app.gl.uniforms import set_uniforms
+from app.render.bounce import bind_bounce, bounce_defines
 from app.render.boundary import bind_boundary
 from app.render.frame_plan import ForwardParams
 from app.render.gpu_resources import node_uniforms
@@ -99,7 +100,12 @@ class ForwardPass:
         ctx, hook, nmax = self.r.ctx, prm.hook, frame.settings.max_lights
         for node in frame.scene.mesh_nodes():
             sh = hook.shading(node, frame) or NodeShading(node.material)
-            defines = {**sh.material.defines(), **light_defines(prm.shadow_lights, nmax), **sh.defines}
+            defines = {
+                **sh.material.defines(),
+                **light_defines(prm.shadow_lights, nmax),
+                **bounce_defines(frame, node),
+                **sh.defines,
+            }
             prog = self.r.programs.get(
                 "passes/forward.vert", "passes/forward.frag", defines, includes={HOOK_INCLUDE: sh.hook}
             )
@@ -108,6 +114,7 @@ class ForwardPass:
             bind_shadow_maps(self.r, frame, prog, units)
             set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
             set_uniforms(prog, node_uniforms(node))
+            bind_bounce(frame, node, prog, units)
             self.r.resources.bind_material(prog, sh.material, units)
             scatters = sh.hook != PLAIN_HOOK and sh.subsurface
             bind_boundary(prog, sh.material if scatters else None)

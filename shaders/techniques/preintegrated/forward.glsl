@@ -11,6 +11,7 @@
 // parts per light (lib/sss_translucency.glsl, as texture-space diffusion gathers it). Contract:
 // app/render/technique.py.
 #include "lib/sss_boundary.glsl"
+#include "lib/ambient.glsl"
 #ifdef SSS_TRANSLUCENCY
 #include "lib/sss_translucency.glsl"
 #endif
@@ -71,6 +72,6 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
         through_exit += te;
 #endif
     }
-    entering += PI * u_ambient * occlusion * u_sss_entry_diffuse;
+    entering += PI * ambient_radiance(occlusion) * u_sss_entry_diffuse;
     return base * (entering * sss_exit(abs(NoV)) + through_exit) * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI);
 }

@@ -55,7 +55,7 @@ def test_render_sss_override(tmp_path):
     p = skinlab("render", "--out", str(tmp_path / "n.png"), "--size", "32x32", "--sss", "none", "--json")
     assert p.returncode == 0, p.stderr
     d = json.loads(p.stdout)
-    assert set(d["timings"]["passes"]) == {"shadow[key]", "forward", "tonemap"}
+    assert set(d["timings"]["passes"]) == {"shadow[key]", "bounce[1]", "bounce[2]", "forward", "tonemap"}
     assert any("sss_model is none" in s["why"] for s in d["plan"]["skipped"])
     p = skinlab(
         "render",

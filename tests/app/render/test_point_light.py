@@ -32,7 +32,7 @@ def test_point_light_shadow_and_inverse_square(ctx, tmp_path):
     r = Renderer(ctx)
     st = RenderSettings(96, 96, shadow_size=256)
     near = r.render(scene(tmp_path, [0.0, 0.3, 0.3]), st)
-    assert near.plan.names() == ["shadow[light1]", "forward", "tonemap"]
+    assert near.plan.names() == ["shadow[light1]", "bounce[1]", "bounce[2]", "forward", "tonemap"]
     assert np.isfinite(near.hdr).all() and near.hdr[..., :3].max() > 0
     unshadowed = r.render(scene(tmp_path, [0.0, 0.3, 0.3], shadow=False), st)
     assert (unshadowed.hdr[..., :3].sum(-1) >= near.hdr[..., :3].sum(-1) - 1e-6).all()

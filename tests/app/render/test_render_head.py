@@ -56,11 +56,11 @@ def test_key_light_shadow_darkens_and_plan_skips_unneeded_shadow_passes(renderer
     # plain diffuse (no translucency, which needs the shadow map): a shadow only removes light
     st = RenderSettings(*SIZE, shadow_size=512, sss_model="none")
     a = renderer.render(s, st)
-    assert a.plan.names() == ["shadow[key]", "forward", "tonemap"]
+    assert a.plan.names() == ["shadow[key]", "bounce[1]", "bounce[2]", "forward", "tonemap"]
     s.find("key").cast_shadow = False
     b = renderer.render(s, st)
     s.find("key").cast_shadow = True
-    assert b.plan.names() == ["forward", "tonemap"]
+    assert b.plan.names() == ["bounce[1]", "bounce[2]", "forward", "tonemap"]
     diff = b.hdr[..., :3].sum(-1) - a.hdr[..., :3].sum(-1)
     assert (diff >= -1e-6).all()  # a shadow only removes light
     assert (diff > 0.05).mean() > 0.01  # and it does remove some (nose, neck)

@@ -579,6 +579,27 @@ def test_core_reloads_a_changed_texture_file(ctx, tmp_path):
         c.close()
 
 
+def test_render_settings_widgets_come_from_the_declaration(core):
+    """The panel's render settings (interreflection, supersampling) come from RenderSettings'
+    declarations, and the core applies a widget's value (checked)."""
+    from app.render.settings import RenderSettings
+    from app.viewer.panel import render_widgets, technique_value
+
+    c, _ = core
+    ws = {w.param: w for w in render_widgets(c.settings)}
+    assert list(ws) == list(RenderSettings.options())
+    assert ws["bounces"].widget == "slider_int" and ws["bounces"].range == (0.0, 8.0)
+    assert "default: 2 bounces" in ws["bounces"].doc and "rays per vertex" in ws["bounce_rays"].doc
+    assert c.set_render_option("bounces", technique_value(c.settings, "bounces", 0)) == 0
+    assert c.render()
+    assert not any(n.startswith("bounce") for n in c.result.plan.names())
+    assert c.set_render_option("bounces", technique_value(c.settings, "bounces", 9.4)) == 8
+    with pytest.raises(ValueError, match="render setting 'width'"):
+        c.set_render_option("width", 10)
+    with pytest.raises(ValueError, match="render setting bounces"):
+        c.set_render_option("bounces", -1)
+
+
 def test_technique_settings_widgets_come_from_the_declaration():
     from app.render.techniques.ssss import SsssSettings
     from app.viewer.panel import technique_value, technique_widgets

@@ -22,6 +22,7 @@ import moderngl
 import numpy as np
 
 from app.gl.uniforms import set_array, set_uniform, set_uniforms
+from app.render.bounce import bind_bounce, bounce_defines
 from app.render.boundary import bind_boundary
 from app.render.gpu_resources import node_uniforms
 from app.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
@@ -244,7 +245,7 @@ class TsdIrradiancePass(TsdPass):
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights
-        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax)}
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **bounce_defines(frame, node)}
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
@@ -253,6 +254,7 @@ class TsdIrradiancePass(TsdPass):
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units)
+        bind_bounce(frame, node, prog, units)
         bind_boundary(prog, mat)
         if "u_slot_light" in prog:  # the light each filled shadow slot holds (its lights are shaded per slot)
             slot_light = np.full(2, -1, np.int32)

@@ -1,0 +1,204 @@
+"""Interreflection's NumPy reference (scene/interreflection.py): ray directions, records and gather
+against analytic form factors and a furnace."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from scene.graph import MeshNode
+from scene.interreflection import (
+    bounce_irradiance,
+    build_transfer,
+    clear_cache,
+    cosine_directions,
+    gather,
+    sender_albedo,
+    smooth,
+    weld,
+)
+from scene.materials import Material
+from scene.mesh import Mesh
+from scene.primitives import box_mesh
+
+# Form factor between two unit squares sharing an edge at a right angle (Howell, "A Catalog of
+# Radiation Heat Transfer Configuration Factors", C-14; Hottel's value 0.20004)
+PERPENDICULAR_SQUARES = 0.2000438
+
+
+def grid_mesh(n, origin, du, dv, name="grid") -> Mesh:
+    """An n x n grid of quads spanning origin + [0, 1] du + [0, 1] dv, normal du x dv."""
+    u, v = np.meshgrid(np.linspace(0, 1, n + 1), np.linspace(0, 1, n + 1), indexing="ij")
+    p = np.asarray(origin, float) + u[..., None] * np.asarray(du, float) + v[..., None] * np.asarray(dv, float)
+    idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    a, b, c, d = idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]
+    faces = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
+    nrm = np.cross(du, dv) / np.linalg.norm(np.cross(du, dv))
+    return Mesh(name, p.reshape(-1, 3), faces, np.tile(nrm, ((n + 1) ** 2, 1)), np.stack([u, v], -1).reshape(-1, 2))
+
+
+def open_book(n=24):
+    """Plate A in z = 0 (normal +z) and plate B in x = 0 (normal +x), sharing the edge along y."""
+    a = MeshNode("A", grid_mesh(n, (0, 0, 0), (1, 0, 0), (0, 1, 0), "A"), Material())
+    b = MeshNode("B", grid_mesh(n, (0, 0, 0), (0, 1, 0), (0, 0, 1), "B"), Material())
+    return a, b
+
+
+def area_mean(values, n):
+    """Mean over a grid's area of per-vertex values (trapezoid weights)."""
+    w = np.ones(n + 1)
+    w[0] = w[-1] = 0.5
+    ww = np.outer(w, w).reshape(-1)
+    return float((values * ww).sum() / ww.sum())
+
+
+@pytest.mark.parametrize("rays", [16, 64])
+def test_perpendicular_plates_receive_their_form_factor(rays):
+    """Plate A leaving exitance 1, plate B receives on average F_BA x 1 = 0.20004 (reciprocity, equal
+    areas): the gather is the one-bounce estimator of the rendering equation."""
+    n = 24
+    a, b = open_book(n)
+    tr = build_transfer([a, b], rays)
+    m = np.zeros((tr.total_vertices, 1))
+    m[tr.offsets[a.uid] : tr.offsets[a.uid] + tr.counts[a.uid]] = 1.0
+    e = gather(tr, m)
+    on_b = e[tr.offsets[b.uid] :, 0]
+    assert area_mean(on_b, n) == pytest.approx(PERPENDICULAR_SQUARES, abs=0.006)
+    # A sees only B, which sends nothing; B's light falls off away from the shared edge
+    assert np.all(e[: tr.counts[a.uid]] == 0.0)
+    rows = on_b.reshape(n + 1, n + 1).mean(0)  # by height above A
+    assert rows[0] > 0.4 and rows[-1] < 0.15
+    # every ray of A's vertices that meets B is counted in A's hit fraction, and the fraction is the form factor
+    assert tr.hit_fraction[a.uid] == pytest.approx(PERPENDICULAR_SQUARES, abs=0.02)
+
+
+def test_cosine_directions_are_unit_in_the_hemisphere_and_cosine_weighted():
+    rng = np.random.default_rng(3)
+    nrm = rng.normal(size=(200, 3))
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    nrm[0] = (0, 0, -1)  # the frame's singular direction
+    nrm[1] = (0, 0, 1)
+    d = cosine_directions(nrm, 64, seed=1)
+    assert np.allclose(np.linalg.norm(d, axis=-1), 1.0, atol=1e-9)
+    cos = np.einsum("vkc,vc->vk", d, nrm)
+    assert cos.min() >= 0.0
+    # cosine-weighted: E[cos] = 2/3 and E[cos^2] = 1/2 (stratified, so close per vertex)
+    assert np.abs(cos.mean(1) - 2 / 3).max() < 0.02
+    assert np.abs((cos**2).mean(1) - 0.5).max() < 0.03
+
+
+def test_convex_mesh_sees_nothing_of_itself():
+    node = MeshNode("box", box_mesh((1.0, 2.0, 3.0)), Material())
+    tr = build_transfer([node], 32)
+    assert not tr.any_hit
+    assert tr.hit_fraction[node.uid] == 0.0
+    assert np.all(gather(tr, np.ones((tr.total_vertices, 3))) == 0.0)
+
+
+def closed_sphere_inside() -> MeshNode:
+    """An icosphere with its normals (and windings) turned inward: every ray meets its front."""
+    ico = trimesh.creation.icosphere(subdivisions=3, radius=1.0)
+    faces = ico.faces[:, ::-1].copy()
+    return MeshNode("inside", Mesh("inside", ico.vertices, faces, -ico.vertex_normals), Material())
+
+
+@pytest.mark.parametrize("albedo", [0.0, 0.5, 1.0])
+def test_furnace_inside_a_closed_sphere(albedo):
+    """Inside a closed sphere every ray meets the wall: a uniform exitance M comes back as
+    irradiance M everywhere, and N orders of bounce light from a uniform direct irradiance E0 sum to
+    E0 (a + a^2 + ... + a^N), finite at albedo 0 and 1."""
+    node = closed_sphere_inside()
+    tr = build_transfer([node], 16)
+    assert tr.hit_fraction[node.uid] == pytest.approx(1.0)
+    v = tr.total_vertices
+    assert np.allclose(gather(tr, np.full((v, 3), 2.5)), 2.5, rtol=1e-5)
+    e0 = np.ones((v, 1))
+    for bounces in (1, 3):
+        got = bounce_irradiance(tr, e0, np.full((v, 1), albedo), bounces)
+        want = sum(albedo**k for k in range(1, bounces + 1))
+        assert np.all(np.isfinite(got))
+        assert np.allclose(got, want, rtol=1e-5, atol=1e-12)
+
+
+def test_back_faces_and_vertices_without_normals_send_and_receive_nothing():
+    """A ray that meets the back of a surface (the inside of an open mesh) records nothing; a vertex
+    no triangle uses (zero normal) casts no rays."""
+    a, b = open_book(8)
+    gap = np.array([-0.01, 0.0, 0.0])  # A's edge vertices must not lie on B's plane (a degenerate ray start)
+    flipped = Mesh("B-back", b.mesh.positions + gap, b.mesh.indices[:, ::-1].copy(), -b.mesh.normals, b.mesh.uvs)
+    back = MeshNode("B-back", flipped, Material())
+    tr = build_transfer([a, back], 32)
+    assert tr.hit_fraction[a.uid] == 0.0  # A's rays meet B's back
+    pos = np.vstack([a.mesh.positions, [[0.5, 0.5, 0.5]]])
+    nrm = np.vstack([a.mesh.normals, [[0.0, 0.0, 0.0]]])
+    lone = MeshNode("lone", Mesh("lone", pos, a.mesh.indices, nrm), Material())
+    tr = build_transfer([lone, b], 16)
+    last = tr.offsets[lone.uid] + tr.counts[lone.uid] - 1
+    assert np.all(tr.weights[last * 16 : (last + 1) * 16] == 0.0)
+    assert np.all(np.isfinite(gather(tr, np.ones((tr.total_vertices, 3)))))
+
+
+def test_transfer_is_cached_by_geometry_not_by_node():
+    clear_cache()
+    a, b = open_book(6)
+    first = build_transfer([a, b], 8)
+    a2, b2 = open_book(6)  # new nodes, the same geometry
+    second = build_transfer([a2, b2], 8)
+    assert second.vertices is first.vertices
+    assert set(second.offsets) == {a2.uid, b2.uid}
+    b2.translation = (0.0, 0.0, 0.5)  # moved: new records
+    third = build_transfer([a2, b2], 8)
+    assert third.key != first.key and third.vertices is not first.vertices
+
+
+def test_bad_input_names_what_was_expected():
+    a, b = open_book(2)
+    with pytest.raises(ValueError, match="rays per vertex"):
+        build_transfer([a, b], 0)
+    tr = build_transfer([a, b], 4)
+    with pytest.raises(ValueError, match="exitance has 3 vertices"):
+        gather(tr, np.ones((3, 3)))
+
+
+def test_sender_albedo():
+    """Diffuse albedo plus principled F0 (0.08 x specular for a dielectric, the base colour for a metal)."""
+    base = np.array([0.5, 0.2, 0.1])
+    assert np.allclose(sender_albedo(base, 0.0, 0.5), base + 0.04)
+    assert np.allclose(sender_albedo(base, 1.0, 0.5), base)
+    assert np.allclose(sender_albedo(base, 0.0, 0.0), base)
+
+
+def test_copies_along_a_seam_share_their_rays_and_rings():
+    """A plate cut along x = 0.5 into two charts (the vertices on the cut duplicated, as a UV seam
+    does): the copies get the same records and the same one-ring, so bounce light is continuous."""
+    n = 8
+    a, b = open_book(n)
+    m = a.mesh
+    cut = np.where(np.isclose(m.positions[:, 0], 0.5))[0]
+    copies = np.arange(len(m.positions), len(m.positions) + len(cut))
+    remap = np.arange(len(m.positions))
+    remap[cut] = copies
+    faces = m.indices.astype(np.int64).copy()
+    right = m.positions[faces].mean(1)[:, 0] > 0.5
+    faces[right] = remap[faces[right]]  # the right chart uses the copies
+    pos = np.vstack([m.positions, m.positions[cut]])
+    split = MeshNode("A-cut", Mesh("A-cut", pos, faces, np.vstack([m.normals, m.normals[cut]])), Material())
+    first, inverse = weld(split.mesh.positions, split.mesh.normals)
+    assert len(first) == len(m.positions) and np.all(inverse[cut] == inverse[copies])
+    tr = build_transfer([split, b], 16)
+    k = tr.rays
+    for c, d in zip(cut, copies):
+        assert np.array_equal(tr.vertices[c * k : (c + 1) * k], tr.vertices[d * k : (d + 1) * k])
+    rng = np.random.default_rng(0)
+    e = smooth(tr, rng.random((tr.total_vertices, 3)))
+    assert np.allclose(e[cut], e[copies])
+
+
+def test_one_ring_average_keeps_constants_and_sums_to_one():
+    a, b = open_book(6)
+    tr = build_transfer([a, b], 8)
+    sums = np.add.reduceat(tr.ring_weights.astype(np.float64), tr.ring_offsets[:-1])
+    assert np.allclose(sums, 1.0, atol=1e-6)
+    assert np.allclose(smooth(tr, np.full((tr.total_vertices, 2), 3.0)), 3.0)
+    # an interior grid vertex averages itself and its 6 neighbours; a corner fewer
+    counts = np.diff(tr.ring_offsets)
+    assert counts.max() == 7 and counts.min() >= 3
