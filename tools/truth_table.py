@@ -10,7 +10,8 @@ SKINLAB_SSS_MODEL=<model> overrides every material's sss_model (burley, dipole, 
 SKINLAB_SUPERSAMPLE=N renders the frames at N x N samples per pixel (default: the ledger's,
 app/bench/truth_ledger.py TRUTH_SUPERSAMPLE; 1 = each pixel's centre only).
 SKINLAB_TRUTH=192 compares with the 192x192, 1024-spp references instead (frames at 192x192; the
-references must be cached: `skinlab reference SCENE --size 192x192 --spp 1024`).
+references must be cached: `skinlab reference SCENE --size 192x192 --spp 1024`), and
+SKINLAB_TRUTH=SIZE:SPP:VARIANT:SEED with a reference rendered elsewhere (tools/gpu_reference.py).
 SKINLAB_BOUNCES=N sets the orders of interreflection (RenderSettings.bounces; 0 = off), and
 SKINLAB_BOUNCE_RAYS=N the rays per vertex (RenderSettings.bounce_rays).
 Used for the before/after tables in docs/ground-truth.md."""
@@ -37,6 +38,20 @@ from app.truth.compare import image_error, judged_blocks, relative_difference
 from scene.scenefile import load_scene
 
 
+def truth_spec(text: str) -> TruthSpec:
+    """SKINLAB_TRUTH: "" (96x96, 256 spp), "192" (192x192, 1024 spp) or SIZE:SPP:VARIANT:SEED (a
+    reference rendered elsewhere, e.g. 96:131072:cuda_ad_rgb:1 by tools/gpu_reference.py)."""
+    if not text:
+        return TruthSpec((96, 96), 256)
+    if text == "192":
+        return TruthSpec((192, 192), 1024)
+    try:
+        size, spp, variant, seed = text.split(":")
+        return TruthSpec((int(size), int(size)), int(spp), variant=variant, seed=int(seed))
+    except ValueError:
+        raise SystemExit(f"SKINLAB_TRUTH: expected 192 or SIZE:SPP:VARIANT:SEED, got {text!r}") from None
+
+
 def main(argv: list[str]) -> int:
     scenes = argv[0].split(",") if argv and argv[0] else reference_scene_names()
     techs = argv[1].split(",") if len(argv) > 1 else ["none", "tint", "tsd", "exact", "ssss"]
@@ -51,13 +66,14 @@ def main(argv: list[str]) -> int:
     if os.environ.get("SKINLAB_BOUNCE_RAYS"):
         extra["bounce_rays"] = int(os.environ["SKINLAB_BOUNCE_RAYS"])
     print(f"frames at {n} x {n} samples per pixel, box-filtered", flush=True)
-    size, spp = (192, 1024) if os.environ.get("SKINLAB_TRUTH") == "192" else (96, 256)
+    spec = truth_spec(os.environ.get("SKINLAB_TRUTH", ""))
+    size = spec.size[0]
     r = Renderer(create_headless_context())
     for s in scenes:
         scene = load_scene(REFERENCE_SCENES / f"{s}.toml")
-        truth = load_truth(scene, TruthSpec((size, size), spp), progress=False)
+        truth = load_truth(scene, spec, progress=False)
         if truth is None:
-            print(f"{s}: no cached {size}x{size}, {spp}-spp reference")
+            print(f"{s}: no cached {size}x{size}, {spec.spp}-spp {spec.variant} reference (seed {spec.seed})")
             continue
         for t in techs:
             rs = RenderSettings.for_technique(

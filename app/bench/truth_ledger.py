@@ -66,11 +66,15 @@ class TruthSpec:
     passes: int = 4
     # RenderSettings.supersample of the frames compared with the reference (not part of its cache key)
     supersample: int = TRUTH_SUPERSAMPLE
+    variant: str = "scalar_rgb"  # Mitsuba variant it was rendered with (cuda_ad_rgb: tools/gpu_reference.py)
+    seed: int = 0
 
     def request(self):
         from app.truth.reference import ReferenceRequest
 
-        return ReferenceRequest(self.size[0], self.size[1], spp=self.spp, passes=self.passes)
+        return ReferenceRequest(
+            self.size[0], self.size[1], spp=self.spp, passes=self.passes, seed=self.seed, variant=self.variant
+        )
 
 
 def reference_scene_names() -> list[str]:

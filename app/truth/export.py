@@ -38,13 +38,16 @@ Every way the reference differs from the realtime frame is listed in ``notes``.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from scene.graph import LightNode, MeshNode, Scene
 from scene.optics.constants import MIN_MFP_MM
 from scene.optics.tsd import eta_from_specular, material_medium
+
+# the description and its Mitsuba objects live in a module that needs no scene (it runs where only
+# numpy and Mitsuba are installed: a GPU machine rendering a saved description); re-exported here
+from .description import ReferenceDescription, ShapeDesc, _rgb  # noqa: F401
 
 # below this GGX alpha the boundary is a smooth dielectric (Mitsuba's rough one degenerates)
 SMOOTH_ALPHA = 1e-3
@@ -57,94 +60,7 @@ class ReferenceError(ValueError):
     """The scene cannot be represented for the reference renderer (the message names what)."""
 
 
-@dataclass
-class ShapeDesc:
-    name: str
-    material: str
-    positions: np.ndarray  # (N, 3) float32, world units
-    normals: np.ndarray  # (N, 3) float32, world, unit length
-    faces: np.ndarray  # (M, 3) uint32
-    texcoords: np.ndarray | None  # (N, 2) float32, Mitsuba convention (v = 0 at the image's top row)
-    bsdf: dict
-    interior: dict | None = None  # homogeneous medium, for subsurface materials
-    texture: np.ndarray | None = None  # baked linear base colour (H, W, 3), row 0 at the top
-
-
-@dataclass
-class ReferenceDescription:
-    width: int
-    height: int
-    camera_to_world: np.ndarray  # (4, 4) Mitsuba camera frame: +X left, +Y up, +Z forward
-    fov_y_deg: float
-    near: float
-    far: float
-    shapes: list[ShapeDesc]
-    emitters: list[dict]
-    integrator: dict
-    notes: list[str] = field(default_factory=list)
-    # the reference frame: x_ref = (x_world - frame_origin) * frame_scale (millimetres, centred)
-    frame_origin: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    frame_scale: float = 1.0
-
-    def content(self) -> dict:
-        """Everything that determines the image, as JSON-able data plus arrays (for the cache key)."""
-        return {
-            "size": [self.width, self.height],
-            "camera": np.round(self.camera_to_world, 9).tolist(),
-            "frame": [np.round(self.frame_origin, 9).tolist(), self.frame_scale],
-            "fov": self.fov_y_deg,
-            "clip": [self.near, self.far],
-            "emitters": self.emitters,
-            "integrator": self.integrator,
-            "shapes": [
-                {"name": s.name, "bsdf": s.bsdf, "interior": s.interior, "material": s.material} for s in self.shapes
-            ],
-        }
-
-    def arrays(self) -> list[np.ndarray]:
-        out = []
-        for s in self.shapes:
-            out += [s.positions, s.normals, s.faces]
-            if s.texcoords is not None:
-                out.append(s.texcoords)
-            if s.texture is not None:
-                out.append(s.texture)
-        return out
-
-    def to_mitsuba(self, spp: int, seed: int = 0) -> dict:
-        """The dictionary for ``mitsuba.load_dict`` (a Mitsuba variant must be set)."""
-        import mitsuba as mi
-
-        scene: dict = {"type": "scene", "integrator": dict(self.integrator)}
-        scene["sensor"] = {
-            "type": "perspective",
-            "fov": self.fov_y_deg,
-            "fov_axis": "y",
-            "near_clip": self.near,
-            "far_clip": self.far,
-            "to_world": mi.ScalarTransform4f(self.camera_to_world.tolist()),
-            "sampler": {"type": "independent", "sample_count": int(spp), "seed": int(seed)},
-            "film": {
-                "type": "hdrfilm",
-                "width": self.width,
-                "height": self.height,
-                "pixel_format": "rgba",
-                "component_format": "float32",
-                "rfilter": {"type": "box"},
-            },
-        }
-        for i, e in enumerate(self.emitters):
-            scene[f"emitter{i}"] = _mitsuba_emitter(mi, e)
-        for i, s in enumerate(self.shapes):
-            scene[f"shape{i}"] = _mitsuba_mesh(mi, s)
-        return scene
-
-
 # -- the description -------------------------------------------------------------------------------
-
-
-def _rgb(v) -> dict:
-    return {"type": "rgb", "value": [float(x) for x in np.asarray(v, np.float64).reshape(3)]}
 
 
 def medium_dict(values: dict, mm_per_unit: float = 1.0) -> dict:
@@ -442,56 +358,3 @@ def describe(
         frame_origin=origin,
         frame_scale=scale,
     )
-
-
-# -- Mitsuba objects ------------------------------------------------------------------------------------
-
-
-def _mitsuba_emitter(mi, e: dict) -> dict:
-    if e["kind"] == "directional":
-        return {"type": "directional", "direction": e["direction"], "irradiance": _rgb(e["irradiance"])}
-    if e["kind"] == "point":
-        return {"type": "point", "position": e["position"], "intensity": _rgb(e["intensity"])}
-    if e["kind"] == "constant":
-        return {"type": "constant", "radiance": _rgb(e["radiance"])}
-    if e["kind"] == "sun_disk":
-        c, n = np.asarray(e["centre"]), np.asarray(e["normal"])
-        # Mitsuba's disk lies in z = 0 facing +z: scale by the radius, turn +z onto n, move to c
-        to_world = mi.ScalarTransform4f().look_at(origin=c.tolist(), target=(c + n).tolist(), up=_any_up(n))
-        to_world = to_world @ mi.ScalarTransform4f().scale([e["radius"]] * 3)
-        return {"type": "disk", "to_world": to_world, "emitter": {"type": "area", "radiance": _rgb(e["radiance"])}}
-    raise ReferenceError(f"emitter kind {e['kind']!r} unknown")
-
-
-def _any_up(n: np.ndarray) -> list[float]:
-    return [0.0, 0.0, 1.0] if abs(n[1]) > 0.9 else [0.0, 1.0, 0.0]
-
-
-def _mitsuba_bsdf(mi, s: ShapeDesc) -> dict:
-    b = dict(s.bsdf)
-    if b["type"] == "twosided" and b["bsdf"].get("base_color", {}).get("type") == "texture_ref":
-        inner = dict(b["bsdf"])
-        inner["base_color"] = {"type": "bitmap", "bitmap": mi.Bitmap(np.ascontiguousarray(s.texture)), "raw": True}
-        b = {"type": "twosided", "bsdf": inner}
-    return b
-
-
-def _mitsuba_mesh(mi, s: ShapeDesc):
-    has_uv = s.texcoords is not None
-    props = mi.Properties()
-    props["bsdf"] = mi.load_dict(_mitsuba_bsdf(mi, s))
-    if s.interior is not None:
-        props["interior"] = mi.load_dict(s.interior)
-    mesh = mi.Mesh(
-        s.name, vertex_count=len(s.positions), face_count=len(s.faces), props=props,
-        has_vertex_normals=True, has_vertex_texcoords=has_uv,
-    )  # fmt: skip
-    p = mi.traverse(mesh)
-    fl, ui = type(p["vertex_positions"]), type(p["faces"])
-    p["vertex_positions"] = fl(np.ascontiguousarray(s.positions, np.float32).ravel())
-    p["vertex_normals"] = fl(np.ascontiguousarray(s.normals, np.float32).ravel())
-    p["faces"] = ui(np.ascontiguousarray(s.faces, np.uint32).ravel())
-    if has_uv:
-        p["vertex_texcoords"] = fl(np.ascontiguousarray(s.texcoords, np.float32).ravel())
-    p.update()
-    return mesh

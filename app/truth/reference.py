@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -28,10 +27,10 @@ from app.atomic_write import atomic_path, write_text_atomic
 from scene.graph import Scene
 
 from .compare import image_error, object_mask
+from .description import CHUNK_SPP, chunk_plan, path_trace  # noqa: F401  (chunk_plan: part of this module's API)
 from .export import ReferenceDescription, describe
 
 EXPORT_VERSION = 2  # bump when the exporter changes what a scene renders as
-CHUNK_SPP = 32
 VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
 INSTALL_HINT = "install it with `.venv/bin/pip install 'mitsuba>=3.5'` (make setup does: the 'truth' extra)"
 
@@ -147,17 +146,6 @@ def _store(ref: Reference) -> None:
     write_text_atomic(d / f"{ref.key}.json", json.dumps(ref.meta, indent=1))
 
 
-def chunk_plan(spp: int, passes: int) -> list[tuple[int, int]]:
-    """(pass index, samples) per render call: each pass gets spp // passes samples (the first
-    spp % passes passes one more), split into chunks of at most CHUNK_SPP."""
-    out = []
-    for p in range(passes):
-        n = spp // passes + (1 if p < spp % passes else 0)
-        k = max(1, math.ceil(n / CHUNK_SPP))
-        out += [(p, n // k + (1 if i < n % k else 0)) for i in range(k)]
-    return out
-
-
 def render_reference(
     scene: Scene,
     req: ReferenceRequest,
@@ -176,23 +164,9 @@ def render_reference(
         return hit
     from tqdm import tqdm
 
-    t0 = time.perf_counter()
-    mscene = mi.load_dict(desc.to_mitsuba(CHUNK_SPP, req.seed))
-    sums = np.zeros((req.passes, req.height, req.width, 4), np.float64)
-    counts = np.zeros(req.passes, np.int64)
-    plan = chunk_plan(req.spp, req.passes)
     bar = tqdm(total=req.spp, unit="spp", desc=f"path tracing {scene.name}", disable=not progress, leave=False)
-    for i, (p, n) in enumerate(plan):
-        img = np.asarray(mi.render(mscene, spp=n, seed=req.seed * 1_000_003 + i), np.float64)
-        sums[p] += img * n
-        counts[p] += n
-        bar.update(n)
+    mean, a, b, seconds = path_trace(desc, req.spp, req.passes, req.seed, bar.update)
     bar.close()
-    seconds = time.perf_counter() - t0
-    half = req.passes // 2
-    mean = (sums.sum(0) / counts.sum()).astype(np.float32)
-    a = (sums[:half].sum(0) / counts[:half].sum()).astype(np.float32)
-    b = (sums[half:].sum(0) / counts[half:].sum()).astype(np.float32)
     if not np.isfinite(mean).all():
         raise RuntimeError(f"scene {scene.name!r}: the path tracer returned NaN or Inf")
     noise = image_error(a, b, object_mask(mean))
