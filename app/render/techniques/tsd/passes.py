@@ -1,7 +1,9 @@
 """Texture-space diffusion passes (d'Eon & Luebke 2007, GPU Gems 3 ch. 14), per subsurface mesh:
 
   tsd_stretch     world mm per texel along u and v (only when the geometry or scene scale changes)
-  tsd_irradiance  light entering the surface, rasterised at the UVs, x albedo^mix
+  tsd_irradiance  light entering the surface, rasterised at the UVs, x albedo^mix; with translucency
+                  also the record of the light through thin parts, its gutter then filled across
+                  seams and one ring past the other chart borders (through_fill)
   tsd_seams       the seam map: the gutter across UV seams paired with texels of the other chart
                   (seams.py; only for meshes with seams; when the mesh changes)
   tsd_dilate      the gutter across seams filled from the seam map, then irradiance pushed past the
@@ -44,6 +46,17 @@ def _texture(ctx, size: int) -> moderngl.Texture:
     return t
 
 
+def _record_textures(ctx, size: int) -> list:
+    """The light-through record's textures (TsdNodeTargets.through_record): RGBA, RGBA, RG, nearest."""
+    out = []
+    for comps in (4, 4, 2):
+        t = ctx.texture((size, size), comps, dtype="f4")
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        t.repeat_x = t.repeat_y = False
+        out.append(t)
+    return out
+
+
 @dataclass
 class TsdNodeTargets:
     """The GPU textures of one subsurface mesh node (float32 RGBA, premultiplied by coverage): the
@@ -59,7 +72,8 @@ class TsdNodeTargets:
     levels: list = field(default_factory=list)
     fbos: dict = field(default_factory=dict)
     seam: SeamMap | None = None  # the seam map (meshes with UV seams)
-    through: list = field(default_factory=list)  # the light-through record (through_record)
+    through: list = field(default_factory=list)  # the light-through record, filled (through_record)
+    through_raw: list = field(default_factory=list)  # as the irradiance pass wrote it
 
     def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture) -> moderngl.Framebuffer:
         key = (id(tex), *(id(m) for m in more))
@@ -72,14 +86,17 @@ class TsdNodeTargets:
         """The irradiance pass's record of the light through thin parts, per texel and shadow slot,
         unblurred (for the gather's exit factor of that light, shaders/techniques/tsd/forward.glsl):
         RGBA per slot (the light entering through, the thickness in mm) and RG (each slot's cosine on
-        the far face). Nearest filtering: a texel's record belongs to it alone."""
+        the far face), its gutter filled (through_fill). Nearest filtering: a texel's record belongs
+        to it alone."""
         if not self.through:
-            for comps in (4, 4, 2):
-                t = ctx.texture((self.size, self.size), comps, dtype="f4")
-                t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                t.repeat_x = t.repeat_y = False
-                self.through.append(t)
+            self.through = _record_textures(ctx, self.size)
         return self.through
+
+    def through_raw_record(self, ctx) -> list:
+        """The same record as the irradiance pass rasterised it (empty in the gutter)."""
+        if not self.through_raw:
+            self.through_raw = _record_textures(ctx, self.size)
+        return self.through_raw
 
     def level(self, ctx, k: int) -> moderngl.Texture:
         while len(self.levels) <= k:
@@ -94,7 +111,15 @@ class TsdNodeTargets:
     def release(self) -> None:
         for f in self.fbos.values():
             f.release()
-        for t in [self.irradiance, self.scratch, self.stretch, self.raw, *self.levels, *self.through]:
+        for t in [
+            self.irradiance,
+            self.scratch,
+            self.stretch,
+            self.raw,
+            *self.levels,
+            *self.through,
+            *self.through_raw,
+        ]:
             t.release()
         if self.seam is not None:
             self.seam.release()
@@ -227,6 +252,10 @@ class TsdIrradiancePass(TsdPass):
     def output(self, t, p):
         return t.raw
 
+    def outputs(self, frame, p) -> tuple:
+        t = self.node_targets(p)
+        return (t.raw, *(t.through_record(self.r.ctx) if p.params.translucency else ()))
+
     def publish(self, frame, p) -> None:
         prm: TsdIrradianceParams = p.params
         t = self.node_targets(p)
@@ -240,7 +269,7 @@ class TsdIrradiancePass(TsdPass):
         prm: TsdIrradianceParams = p.params
         ctx, node, size, mat = self.r.ctx, prm.node, prm.size, prm.material
         t = self.node_targets(p)
-        fbo = t.fbo(ctx, t.raw, *(t.through_record(ctx) if prm.translucency else ()))
+        fbo = t.fbo(ctx, t.raw, *(t.through_raw_record(ctx) if prm.translucency else ()))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights
@@ -262,7 +291,30 @@ class TsdIrradiancePass(TsdPass):
         if prm.translucency:
             bind_translucency(prog, frame, units, self.r.dummy_texture())
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        if prm.translucency:  # the record's gutter: across the seams, one ring past the other borders
+            through_fill(self.r, t, seams=prm.seams is not None)
         self.publish(frame, p)
+
+
+def through_fill(renderer, t: TsdNodeTargets, seams: bool) -> None:
+    """The irradiance pass's light-through record (t.through_raw_record, read with t.raw's coverage)
+    into t.through_record with its gutter filled (shaders/passes/tsd_through_fill.frag): the texels
+    the seam map marks from across the seam (`seams`: the node's seam map is drawn), the rest of the
+    gutter next to a chart one ring from its covered neighbours. The gather reads the record with
+    nearest filtering, so a fragment by a chart border may read a gutter texel: without the fill a
+    one-texel ring along every border left the light through with the reflected light's exit."""
+    ctx = renderer.ctx
+    defines = {"TSD_SEAMS": 1} if seams else {}
+    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_through_fill.frag", defines)
+    t.fbo(ctx, *t.through_record(ctx)).use()
+    ctx.viewport = (0, 0, t.size, t.size)
+    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+    units = TextureUnits(ctx)
+    for name, tex in zip(("u_raw", "u_through0", "u_through1", "u_through_cos"), (t.raw, *t.through_raw_record(ctx))):
+        units.bind(prog, name, tex)
+    if seams:
+        units.bind(prog, "u_seam", t.seam_map(ctx).texture)
+    renderer.fullscreen(prog)
 
 
 class TsdDilatePass(TsdPass):
