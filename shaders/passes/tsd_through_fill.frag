@@ -3,8 +3,9 @@
 // f_through_cos: per texel and shadow slot the light through thin parts, its thickness, its cosine
 // on the far face) with their gutter filled like the irradiance's, so that the gather's nearest
 // lookup at a chart border (techniques/tsd/forward.glsl) never reads an empty record where the
-// surface continues:
-// - a texel a triangle covers (u_raw's a > 0) keeps its record;
+// surface continues. Drawn over thin strips around the chart borders (app/render/techniques/tsd/
+// passes.py through_fill, after the records were copied), or over every texel:
+// - a texel a triangle covers (u_raw's a > 0) is discarded: it keeps its record;
 // - variant TSD_SEAMS: a gutter texel the seam map marks (lib/tsd_seams.glsl: the surface across a
 //   UV seam) takes the record at the seam map's UV in the other chart: the four texels of the
 //   bilinear footprint, weighted like seam_bilinear but only the covered ones;
@@ -46,12 +47,7 @@ void add_record(ivec2 q, float weight) {
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    if (texelFetch(u_raw, p, 0).a > COVERAGE_EPS) {
-        f_through0 = texelFetch(u_through0, p, 0);
-        f_through1 = texelFetch(u_through1, p, 0);
-        f_through_cos = texelFetch(u_through_cos, p, 0).rg;
-        return;
-    }
+    if (texelFetch(u_raw, p, 0).a > COVERAGE_EPS) discard;  // covered: the copy of its record stays
     s0 = s1 = vec4(0.0);
     sc = vec2(0.0);
     w = vec3(0.0);

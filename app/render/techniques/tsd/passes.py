@@ -32,7 +32,7 @@ from app.render.translucency import bind_translucency
 from scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
-from .seams import SeamMap
+from .seams import SeamMap, node_border_strips
 
 STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
@@ -74,6 +74,7 @@ class TsdNodeTargets:
     seam: SeamMap | None = None  # the seam map (meshes with UV seams)
     through: list = field(default_factory=list)  # the light-through record, filled (through_record)
     through_raw: list = field(default_factory=list)  # as the irradiance pass wrote it
+    strips: tuple = ()  # (source array, buffer): the chart border strips the record's fill draws
 
     def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture) -> moderngl.Framebuffer:
         key = (id(tex), *(id(m) for m in more))
@@ -81,6 +82,14 @@ class TsdNodeTargets:
         if f is None:
             f = self.fbos[key] = ctx.framebuffer([tex, *more])
         return f
+
+    def strip_buffer(self, ctx, strips: np.ndarray) -> moderngl.Buffer:
+        """`strips` (seams.node_border_strips) in a vertex buffer, kept until they change."""
+        if not self.strips or self.strips[0] is not strips:
+            if self.strips:
+                self.strips[1].release()
+            self.strips = (strips, ctx.buffer(strips.tobytes()))
+        return self.strips[1]
 
     def through_record(self, ctx) -> list:
         """The irradiance pass's record of the light through thin parts, per texel and shadow slot,
@@ -123,6 +132,8 @@ class TsdNodeTargets:
             t.release()
         if self.seam is not None:
             self.seam.release()
+        if self.strips:
+            self.strips[1].release()
 
 
 @dataclass
@@ -291,19 +302,28 @@ class TsdIrradiancePass(TsdPass):
         if prm.translucency:
             bind_translucency(prog, frame, units, self.r.dummy_texture())
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
-        if prm.translucency:  # the record's gutter: across the seams, one ring past the other borders
-            through_fill(self.r, t, seams=prm.seams is not None)
+        if prm.translucency:  # the record's gutter by the chart borders: across the seams, else dilated
+            slots = min(len(prm.shadow_lights), SHADOW_SLOTS)
+            through_fill(self.r, t, prm.seams is not None, node_border_strips(node.mesh, size), slots)
         self.publish(frame, p)
 
 
-def through_fill(renderer, t: TsdNodeTargets, seams: bool) -> None:
+def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | None = None, slots: int = 2) -> None:
     """The irradiance pass's light-through record (t.through_raw_record, read with t.raw's coverage)
     into t.through_record with its gutter filled (shaders/passes/tsd_through_fill.frag): the texels
-    the seam map marks from across the seam (`seams`: the node's seam map is drawn), the rest of the
-    gutter next to a chart one ring from its covered neighbours. The gather reads the record with
-    nearest filtering, so a fragment by a chart border may read a gutter texel: without the fill a
-    one-texel ring along every border left the light through with the reflected light's exit."""
+    the seam map marks from across the seam (`seams`: the node's seam map is drawn), the others one
+    ring from their covered neighbours. The gather reads the record with nearest filtering, so a
+    fragment by a chart border reads the gutter texels whose square overlaps the chart: without the
+    fill, a ring along every border left the light through with the reflected light's exit.
+    The covered texels' records are copied (blits; slot 1's only for `slots` > 1: the gather reads
+    only the slots the frame filled); the fill runs on `strips` (seams.node_border_strips:
+    every texel a fragment inside a chart can read, and a few more), or on every texel (None). On
+    llvmpipe every texel cost 20 % of the irradiance pass on the head and 2.6x it on the back-lit
+    slab (a sparse layout), so the fill runs on the strips only."""
     ctx = renderer.ctx
+    for k, (src, dst) in enumerate(zip(t.through_raw_record(ctx), t.through_record(ctx))):
+        if k != 1 or slots > 1:  # the covered texels' records
+            ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, src))
     defines = {"TSD_SEAMS": 1} if seams else {}
     prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_through_fill.frag", defines)
     t.fbo(ctx, *t.through_record(ctx)).use()
@@ -314,7 +334,12 @@ def through_fill(renderer, t: TsdNodeTargets, seams: bool) -> None:
         units.bind(prog, name, tex)
     if seams:
         units.bind(prog, "u_seam", t.seam_map(ctx).texture)
-    renderer.fullscreen(prog)
+    if strips is None:
+        renderer.fullscreen(prog)
+    elif len(strips):
+        vao = ctx.vertex_array(prog, [(t.strip_buffer(ctx, strips), "2f", "in_pos")])
+        vao.render(moderngl.TRIANGLES)
+        vao.release()
 
 
 class TsdDilatePass(TsdPass):

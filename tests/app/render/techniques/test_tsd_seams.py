@@ -163,7 +163,7 @@ def test_through_fill_matches_its_numpy_twin(renderer):
         tex.write(data.tobytes())
     t.seam_map(renderer.ctx).texture.write(seam.tobytes())
     for seams in (True, False):
-        through_fill(renderer, t, seams)
+        through_fill(renderer, t, seams)  # on every texel (the pass draws only the chart borders' strips)
         got = [read_texture(x) for x in t.through_record(renderer.ctx)]
         want = tsd.through_fill_reference(img, *recs, cos, seam if seams else None)
         for g, w in zip(got, want):
@@ -221,15 +221,55 @@ def test_light_through_a_cut_plate_matches_the_uncut_plate(renderer, monkeypatch
         assert l1 < 0.02 and worst < 0.02, (cut, l1, worst)
     fill = passes.through_fill
     if case:  # one ring of dilation only: the step's other side is not read
-        monkeypatch.setattr(passes, "through_fill", lambda r, t, seams: fill(r, t, False))
+        monkeypatch.setattr(passes, "through_fill", lambda r, t, seams, strips, slots: fill(r, t, False, strips, slots))
         l1, worst = _worst(_plate(renderer, "rotate", **case), ref)
         assert worst > 0.05, worst
     else:  # the record as the irradiance pass rasterised it (before the fill)
 
-        def unfilled(r, t, seams):
+        def unfilled(r, t, seams, strips, slots):
             for src, dst in zip(t.through_raw_record(r.ctx), t.through_record(r.ctx)):
-                r.ctx.copy_framebuffer(dst, t.fbo(r.ctx, src))
+                r.ctx.copy_framebuffer(t.fbo(r.ctx, dst), t.fbo(r.ctx, src))
 
         monkeypatch.setattr(passes, "through_fill", unfilled)
         l1, worst = _worst(_plate(renderer, "rotate", **case), ref)
         assert worst > 0.1, worst
+
+
+def _touched(mesh, n: int, sub: int = 8) -> np.ndarray:
+    """(n, n) texels whose square overlaps a UV triangle of `mesh` (sub x sub samples per texel, on
+    the texels within one of a covered centre), row = v."""
+    uv = mesh.uvs[mesh.indices.astype(np.int64)].astype(np.float64) * n  # (F, 3, 2) in texels
+    s = (np.arange(sub) + 0.5) / sub
+    out = np.zeros((n, n), bool)
+    for a, b, c in uv:
+        lo = np.floor(np.minimum(np.minimum(a, b), c)).astype(int).clip(0, n - 1)
+        hi = np.ceil(np.maximum(np.maximum(a, b), c)).astype(int).clip(0, n)
+        xs = (np.arange(lo[0], hi[0])[:, None] + s[None, :]).ravel()
+        ys = (np.arange(lo[1], hi[1])[:, None] + s[None, :]).ravel()
+        px, py = np.meshgrid(xs, ys)
+        d = np.stack([(q[0] - p[0]) * (py - p[1]) - (q[1] - p[1]) * (px - p[0]) for p, q in ((a, b), (b, c), (c, a))])
+        inside = (d >= 0).all(0) | (d <= 0).all(0)
+        iy, ix = np.nonzero(inside)
+        out[(py[iy, ix]).astype(int), (px[iy, ix]).astype(int)] = True
+    return out
+
+
+def test_the_record_is_filled_wherever_a_fragment_can_read_it(renderer):
+    """On the back-lit slab (a box: six charts, twelve seam edges) the pass's record equals its NumPy
+    twin (filled across the seams) on every gutter texel whose square overlaps a chart - the texels
+    the gather's nearest lookup inside a chart can read, which the fill's border strips must cover -
+    and such texels exist that the irradiance pass itself left empty."""
+    scene = load_scene("assets/scenes/reference/slab-thin-backlit-skin1.toml")
+    renderer.render(scene, RenderSettings(48, 48), readback=False)
+    node = scene.mesh_nodes()[0]
+    t = frame_nodes(renderer.last_frame)[node.uid].targets
+    raw = read_texture(t.raw)
+    rec = [read_texture(x) for x in t.through_raw_record(renderer.ctx)]
+    got = [read_texture(x) for x in t.through_record(renderer.ctx)]
+    want = tsd.through_fill_reference(raw, *rec, read_texture(t.seam.texture))
+    n = raw.shape[0]
+    reads = _touched(node.mesh, n) & (raw[..., 3] <= 0)
+    lit = reads & (want[2][..., 0] > 0)
+    assert lit.sum() > 100 and (rec[2][lit, 0] == 0).all()  # gutter texels a fragment reads, empty as rasterised
+    for k in (0, 2):  # (slot 1 holds no light here)
+        np.testing.assert_allclose(got[k][reads], want[k][reads], rtol=1e-4, atol=1e-6 * np.abs(want[k]).max())
