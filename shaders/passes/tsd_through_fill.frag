@@ -5,7 +5,7 @@
 // lookup at a chart border (techniques/tsd/forward.glsl) never reads an empty record where the
 // surface continues. Drawn over thin strips around the chart borders (app/render/techniques/tsd/
 // passes.py through_fill, after the records were copied), or over every texel:
-// - a texel a triangle covers (u_raw's a > 0) is discarded: it keeps its record;
+// - a texel a triangle covers (u_raw's a > 0) keeps its record (copied before; discarded here);
 // - variant TSD_SEAMS: a gutter texel the seam map marks (lib/tsd_seams.glsl: the surface across a
 //   UV seam) takes the record at the seam map's UV in the other chart: the four texels of the
 //   bilinear footprint, weighted like seam_bilinear but only the covered ones;
@@ -13,7 +13,8 @@
 //   takes its covered 8-neighbours, equally weighted: one ring of dilation, as the irradiance has.
 // The light through (rgb) is averaged over the covered texels (zero where no light came through);
 // the thickness and the cosine of a slot only over the texels whose record holds light of that slot
-// (cosine > 0), so a rim is not made thinner by the texels beside it. NumPy twin:
+// (cosine > 0), so a rim is not made thinner by the texels beside it. Variant TSD_THROUGH_SLOTS = 1:
+// slot 1 is not read (its record holds no light; written as zero). NumPy twin:
 // scene/optics/tsd.py through_fill_reference.
 #include "skinlab/constants.glsl"
 uniform sampler2D u_raw;          // the raw irradiance: a > 0 where a triangle covers the texel
@@ -36,7 +37,11 @@ vec3 w;
 void add_record(ivec2 q, float weight) {
     if (texelFetch(u_raw, q, 0).a <= COVERAGE_EPS) return;
     vec4 r0 = texelFetch(u_through0, q, 0);
+#if TSD_THROUGH_SLOTS > 1
     vec4 r1 = texelFetch(u_through1, q, 0);
+#else
+    vec4 r1 = vec4(0.0);  // (slot 1 holds no light this frame: the gather does not read it)
+#endif
     vec2 c = texelFetch(u_through_cos, q, 0).rg;
     vec2 lit = vec2(greaterThan(c, vec2(0.0))) * weight;
     s0 += vec4(r0.rgb * weight, r0.a * lit.x);
@@ -47,7 +52,7 @@ void add_record(ivec2 q, float weight) {
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
-    if (texelFetch(u_raw, p, 0).a > COVERAGE_EPS) discard;  // covered: the copy of its record stays
+    if (texelFetch(u_raw, p, 0).a > COVERAGE_EPS) discard;  // covered: keeps its record (copied)
     s0 = s1 = vec4(0.0);
     sc = vec2(0.0);
     w = vec3(0.0);

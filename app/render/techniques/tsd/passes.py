@@ -74,21 +74,42 @@ class TsdNodeTargets:
     seam: SeamMap | None = None  # the seam map (meshes with UV seams)
     through: list = field(default_factory=list)  # the light-through record, filled (through_record)
     through_raw: list = field(default_factory=list)  # as the irradiance pass wrote it
-    strips: tuple = ()  # (source array, buffer): the chart border strips the record's fill draws
+    strips: tuple = ()  # (source array, depth renderbuffer): where the record's fill runs (strip_mask)
 
-    def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture) -> moderngl.Framebuffer:
-        key = (id(tex), *(id(m) for m in more))
+    def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture, depth=None) -> moderngl.Framebuffer:
+        key = (id(tex), *(id(m) for m in more), id(depth))
         f = self.fbos.get(key)
         if f is None:
-            f = self.fbos[key] = ctx.framebuffer([tex, *more])
+            f = self.fbos[key] = ctx.framebuffer([tex, *more], depth)
         return f
 
-    def strip_buffer(self, ctx, strips: np.ndarray) -> moderngl.Buffer:
-        """`strips` (seams.node_border_strips) in a vertex buffer, kept until they change."""
+    def strip_mask(self, renderer, strips: np.ndarray):
+        """`strips` (seams.node_border_strips) drawn once into a depth renderbuffer (0.5 on them, 0
+        elsewhere), kept until they change (a new mesh version or size): a fullscreen pass tested
+        against it with "<=" shades only the strips. One draw of the strips per frame cost more on
+        llvmpipe (thousands of sliver triangles: 20 ms on the bunny) than the early depth test of
+        every texel."""
         if not self.strips or self.strips[0] is not strips:
-            if self.strips:
-                self.strips[1].release()
-            self.strips = (strips, ctx.buffer(strips.tobytes()))
+            ctx = renderer.ctx
+            mask = self.strips[1] if self.strips else ctx.depth_renderbuffer((self.size, self.size))
+            fbo = ctx.framebuffer(depth_attachment=mask)
+            fbo.use()
+            ctx.viewport = (0, 0, self.size, self.size)
+            fbo.clear(depth=0.0)
+            ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
+            ctx.enable(moderngl.DEPTH_TEST)
+            ctx.depth_func = "1"  # always: every strip texel gets depth 0.5
+            if len(strips):
+                prog = renderer.programs.get("passes/fullscreen.vert", "passes/depth_only.frag")
+                vbo = ctx.buffer(strips.tobytes())
+                vao = ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
+                vao.render(moderngl.TRIANGLES)
+                vao.release()
+                vbo.release()
+            ctx.depth_func = "<"
+            ctx.disable(moderngl.DEPTH_TEST)
+            fbo.release()
+            self.strips = (strips, mask)
         return self.strips[1]
 
     def through_record(self, ctx) -> list:
@@ -316,17 +337,22 @@ def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | 
     fragment by a chart border reads the gutter texels whose square overlaps the chart: without the
     fill, a ring along every border left the light through with the reflected light's exit.
     The covered texels' records are copied (blits; slot 1's only for `slots` > 1: the gather reads
-    only the slots the frame filled); the fill runs on `strips` (seams.node_border_strips:
-    every texel a fragment inside a chart can read, and a few more), or on every texel (None). On
-    llvmpipe every texel cost 20 % of the irradiance pass on the head and 2.6x it on the back-lit
-    slab (a sparse layout), so the fill runs on the strips only."""
+    only the slots the frame filled, variant TSD_THROUGH_SLOTS); the fill shades only `strips`
+    (seams.node_border_strips: every texel a fragment inside a chart can read, and a few more),
+    through an early depth test against their mask (TsdNodeTargets.strip_mask, drawn once per mesh),
+    or every texel (None). On llvmpipe a fill of every texel cost 20 % of the irradiance pass on the
+    head and 2.6x it on the back-lit slab (a sparse layout), drawing the strips every frame 20 ms
+    on the bunny (thousands of sliver triangles); docs/tsd.md has the cost as shipped."""
     ctx = renderer.ctx
     for k, (src, dst) in enumerate(zip(t.through_raw_record(ctx), t.through_record(ctx))):
         if k != 1 or slots > 1:  # the covered texels' records
             ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, src))
-    defines = {"TSD_SEAMS": 1} if seams else {}
+    defines = {"TSD_THROUGH_SLOTS": 2 if slots > 1 else 1, **({"TSD_SEAMS": 1} if seams else {})}
     prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_through_fill.frag", defines)
-    t.fbo(ctx, *t.through_record(ctx)).use()
+    mask = t.strip_mask(renderer, strips) if strips is not None else None
+    fbo = t.fbo(ctx, *t.through_record(ctx), depth=mask)
+    fbo.depth_mask = False
+    fbo.use()
     ctx.viewport = (0, 0, t.size, t.size)
     ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
     units = TextureUnits(ctx)
@@ -334,12 +360,14 @@ def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | 
         units.bind(prog, name, tex)
     if seams:
         units.bind(prog, "u_seam", t.seam_map(ctx).texture)
-    if strips is None:
+    if mask is not None:  # only the strips (0.5 <= their depth 0.5; 0 elsewhere): an early depth test
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+    try:
         renderer.fullscreen(prog)
-    elif len(strips):
-        vao = ctx.vertex_array(prog, [(t.strip_buffer(ctx, strips), "2f", "in_pos")])
-        vao.render(moderngl.TRIANGLES)
-        vao.release()
+    finally:
+        ctx.depth_func = "<"
+        ctx.disable(moderngl.DEPTH_TEST)
 
 
 class TsdDilatePass(TsdPass):
