@@ -9,7 +9,8 @@ under a temporary folder); none of them is what the renderer runs.
     .venv/bin/python tools/irradiance_cost.py --against 9f5625f [--rounds 7]
 
 --against REV[,REV...]: the pass as shipped against the shaders/ of git revisions (the same Python
-code drives them), interleaved: what a change of the shaders saved.
+code drives them; a revision without passes/tsd_through_fill.frag gets today's), interleaved: what a
+change of the shaders saved.
 
 --coverage: the pass on a square whose UVs cover 100 %, 25 %, 6.25 % and 1 % of a 512x512 layout
 (tests/tsd_scenes.py slab_scene), interleaved: the time follows the covered texels (the pass
@@ -138,6 +139,9 @@ def main(argv=None) -> int:
                     raise SystemExit(f"--against: git archive {name} failed: {archive.stderr.decode().strip()}")
                 subprocess.run(["tar", "-x", "-C", str(root)], input=archive.stdout, check=True)
                 root, edits = root / "shaders", []
+                fill = "passes/tsd_through_fill.frag"  # (older revisions: the pass ends with today's record fill)
+                if not (root / fill).exists() and (SHADER_ROOT / fill).exists():
+                    shutil.copy(SHADER_ROOT / fill, root / fill)
             else:
                 edited_shader_root(root, name, edits)
             r = Renderer(ctx, ShaderLibrary(root=root))

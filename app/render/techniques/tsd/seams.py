@@ -65,10 +65,9 @@ def node_seams(mesh, band_texels: int, size: int) -> SeamExtension | None:
 
 def node_border_strips(mesh, size: int) -> np.ndarray:
     """The thin rectangles around every chart border of the mesh (scene/uv_seams.py border_strips:
-    0.75 texel outside (over half a texel's diagonal), a quarter inside, of a `size` texture) as
-    float32 clip-space triangle
-    corners (K * 3, 2): where the light-through record's fill runs (passes.through_fill). Cached by
-    mesh identity, geometry version and size."""
+    0.75 texel outside, over half a texel's diagonal, and a quarter inside, of a `size` texture) as
+    float32 clip-space triangle corners (K * 3, 2): where the light-through record's fill runs
+    (passes.through_fill). Cached by mesh identity, geometry version and size."""
     key = ("strips", mesh.uid, mesh.version, size)
     hit = _CACHE.get(key)
     if hit is None:
