@@ -152,6 +152,29 @@ def border_bands(mesh: Mesh, band_uv: float, pid: np.ndarray | None = None) -> t
     return quads, depth
 
 
+def border_strips(mesh: Mesh, out_uv: float, in_uv: float = 0.0, pid: np.ndarray | None = None) -> np.ndarray:
+    """A thin rectangle around every chart border edge, as two triangles (K, 3, 2) in UV: from `in_uv`
+    inside the edge to `out_uv` outside it, and `out_uv` past both ends. Together they cover every
+    point within `out_uv` of a chart's border outside the chart (past a convex corner too: such a point
+    lies in the rectangle of an edge it is outside of). With out_uv >= half a texel's diagonal they hold
+    every gutter texel whose square overlaps a chart: the texels a nearest lookup inside the chart can
+    read (texture-space diffusion's light-through record, app/render/techniques/tsd/passes.py)."""
+    f = mesh.indices.astype(np.int64)
+    uv = mesh.uvs.astype(np.float64)
+    t, k = border_edges(mesh, pid)
+    a0, a1, a2 = uv[f[t, k]], uv[f[t, (k + 1) % 3]], uv[f[t, (k + 2) % 3]]
+    e = a1 - a0
+    ln = np.linalg.norm(e, axis=1)
+    ok = ln > np.sqrt(EDGE_EPS)
+    a0, a1, a2, e, ln = a0[ok], a1[ok], a2[ok], e[ok], ln[ok]
+    e = e / ln[:, None]
+    nrm = np.stack([e[:, 1], -e[:, 0]], 1)
+    nrm = np.where((np.einsum("ij,ij->i", a2 - a0, nrm) > 0)[:, None], -nrm, nrm)  # away from the triangle
+    p0, p1 = a0 - out_uv * e, a1 + out_uv * e
+    c = [p0 - in_uv * nrm, p1 - in_uv * nrm, p1 + out_uv * nrm, p0 + out_uv * nrm]
+    return np.concatenate([np.stack([c[0], c[1], c[2]], 1), np.stack([c[0], c[2], c[3]], 1)])
+
+
 def seam_edges(mesh: Mesh):
     """(pairs (S, 2) triangles, local edges (S, 2), endpoint position ids (S, 2), pid per vertex): every
     manifold 3D edge whose two triangles' UVs along it differ."""

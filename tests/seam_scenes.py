@@ -20,10 +20,13 @@ def _t(n: int) -> float:
     return n / TEXELS
 
 
-def plane_mesh(cut: str | None = None, n: int = 32) -> Mesh:
+def plane_mesh(cut: str | None = None, n: int = 32, phase: float = 0.0) -> Mesh:
     """A 2 x 2 plane in z = 0 tessellated into n x n quads (n even). cut None: one chart at
     u, v in [0.25, 0.75]. cut "rotate" / "mirror": the left half (x < 0) at u in [26/512, ...], the right
-    half rotated by -90 degrees / mirrored about u = v, placed in the lower right of the layout."""
+    half rotated by -90 degrees / mirrored about u = v, placed in the lower right of the layout.
+    phase: every chart moved by `phase` texels across the cut (along +x, in its own UV frame), so that
+    every layout still samples the surface at the same points, and the cut x = 0 crosses texels
+    `phase` of a texel from their left edge (0: it runs along texel edges)."""
     xs = np.linspace(-1.0, 1.0, n + 1)
     gx, gy = np.meshgrid(xs, xs, indexing="xy")  # [row = y][col = x]
     pos = np.stack([gx, gy, np.zeros_like(gx)], -1).reshape(-1, 3)
@@ -31,7 +34,7 @@ def plane_mesh(cut: str | None = None, n: int = 32) -> Mesh:
     quads = [(vid[j, i], vid[j, i + 1], vid[j + 1, i + 1], vid[j + 1, i]) for j in range(n) for i in range(n)]
     tris = np.array([t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))], np.int64)
     if cut is None:
-        uv = np.stack([_t(128) + UV_SCALE * (pos[:, 0] + 1), _t(128) + UV_SCALE * (pos[:, 1] + 1)], 1)
+        uv = np.stack([_t(128 + phase) + UV_SCALE * (pos[:, 0] + 1), _t(128) + UV_SCALE * (pos[:, 1] + 1)], 1)
         return Mesh("plane", pos, tris, normals=np.tile([0, 0, 1.0], (len(pos), 1)), uvs=uv)
     # duplicate the vertices on x = 0 for the right half's triangles
     mid = n // 2
@@ -45,11 +48,11 @@ def plane_mesh(cut: str | None = None, n: int = 32) -> Mesh:
     right_v = np.zeros(len(pos2), bool)
     right_v[np.unique(tris2[right_tri])] = True
     x, y = pos2[:, 0], pos2[:, 1]
-    uv = np.stack([_t(26) + UV_SCALE * (x + 1), _t(128) + UV_SCALE * (y + 1)], 1)  # left half: u in [26/512, 154/512]
+    uv = np.stack([_t(26 + phase) + UV_SCALE * (x + 1), _t(128) + UV_SCALE * (y + 1)], 1)  # left half: u from 26/512
     if cut == "rotate":  # (x, y) -> (y, -x): a proper rotation
-        ur, vr = _t(230) + UV_SCALE * (y + 1), _t(154) - UV_SCALE * x
+        ur, vr = _t(230) + UV_SCALE * (y + 1), _t(154 - phase) - UV_SCALE * x
     elif cut == "mirror":  # (x, y) -> (y, x): a reflection
-        ur, vr = _t(230) + UV_SCALE * (y + 1), _t(26) + UV_SCALE * x
+        ur, vr = _t(230) + UV_SCALE * (y + 1), _t(26 + phase) + UV_SCALE * x
     else:
         raise ValueError(f"cut: expected None, 'rotate' or 'mirror', got {cut!r}")
     uv[right_v] = np.stack([ur, vr], 1)[right_v]
@@ -82,6 +85,35 @@ def stripe_scene(mesh: Mesh, material: Material | None = None, angle_deg: float 
     s.add(MeshNode("occluder_bottom", _quad("occluder_bottom", bottom, h), black))
     s.add(light_from((1.0, 0.0, -1.0), shadow=True))
     dist = 1.0 / np.tan(np.radians(1.0))
+    cam = CameraNode("cam", yfov=np.radians(2.0), znear=0.5 * dist, zfar=2.0 * dist)
+    cam.look_at((0, 0, dist), (0, 0, 0))
+    s.add(cam)
+    return s
+
+
+def backlit_plate_scene(
+    mesh: Mesh,
+    material: Material | None = None,
+    thickness_mm: tuple = (1.0, 1.0),
+    light: tuple = (0.5, 0.0, 0.866),
+    view: float = 0.1,
+) -> Scene:
+    """`mesh` (the plane, 20 mm per unit) as the front of a thin plate lit only from behind: grey
+    opaque sheets below it (separate nodes, hidden behind the plane), thickness_mm = (x < 0, x > 0)
+    below, are where the light enters, so the plane's translucency sees a plate of that thickness
+    (from the shadow pass's distance map; a step at the cut x = 0 when the two differ); the light
+    travels along `light`, toward the camera. Seen straight from above, zoomed on the cut: the view
+    spans x, y in [-view, view]."""
+    s = Scene("backlit_plate", 20.0)
+    s.environment.ambient = np.zeros(3)
+    s.add(MeshNode("plane", mesh, material or skin(radius=(2.0, 1.0, 0.5))))
+    for name, (x0, x1), t in (("back_left", (-1.5, 0.0), thickness_mm[0]), ("back_right", (0.0, 1.5), thickness_mm[1])):
+        z = -t / s.mm_per_unit
+        corners = np.array([[x0, 1.5, z], [x1, 1.5, z], [x1, -1.5, z], [x0, -1.5, z]], np.float32)
+        back = Mesh(name, corners, np.array([[0, 1, 2], [0, 2, 3]], np.uint32), normals=np.tile([0, 0, -1.0], (4, 1)))
+        s.add(MeshNode(name, back, Material("back", {"specular": 0.0})))  # facing -z, the light
+    s.add(light_from(light, shadow=True))
+    dist = view / np.tan(np.radians(1.0))
     cam = CameraNode("cam", yfov=np.radians(2.0), znear=0.5 * dist, zfar=2.0 * dist)
     cam.look_at((0, 0, dist), (0, 0, 0))
     s.add(cam)

@@ -9,11 +9,16 @@ under a temporary folder); none of them is what the renderer runs.
     .venv/bin/python tools/irradiance_cost.py --against 9f5625f [--rounds 7]
 
 --against REV[,REV...]: the pass as shipped against the shaders/ of git revisions (the same Python
-code drives them), interleaved: what a change of the shaders saved.
+code drives them; a revision without passes/tsd_through_fill.frag gets today's), interleaved: what a
+change of the shaders saved.
 
 --coverage: the pass on a square whose UVs cover 100 %, 25 %, 6.25 % and 1 % of a 512x512 layout
 (tests/tsd_scenes.py slab_scene), interleaved: the time follows the covered texels (the pass
 rasterises the mesh's triangles in UV space; texels no triangle covers are only cleared).
+
+With translucency, the pass ends with the fill of its light-through record's gutter (across UV seams
+and one ring past the other chart borders, app/render/techniques/tsd/passes.py through_fill); that
+fill is also timed alone, interleaved, and printed as its part of the base pass.
 
 Variants: base (as shipped), pcf_1tap (one shadow
 compare instead of the 3x3 PCF), no_translucency, no_maps (no normal, colour or occlusion map
@@ -134,6 +139,9 @@ def main(argv=None) -> int:
                     raise SystemExit(f"--against: git archive {name} failed: {archive.stderr.decode().strip()}")
                 subprocess.run(["tar", "-x", "-C", str(root)], input=archive.stdout, check=True)
                 root, edits = root / "shaders", []
+                fill = "passes/tsd_through_fill.frag"  # (older revisions: the pass ends with today's record fill)
+                if not (root / fill).exists() and (SHADER_ROOT / fill).exists():
+                    shutil.copy(SHADER_ROOT / fill, root / fill)
             else:
                 edited_shader_root(root, name, edits)
             r = Renderer(ctx, ShaderLibrary(root=root))
@@ -142,10 +150,26 @@ def main(argv=None) -> int:
             irr = next(p for p in res.plan.passes if p.kind == "tsd_irradiance")
             fwd = next(p for p in res.plan.passes if p.kind == "forward")
             runs[name] = (r, r.last_frame, irr, fwd)
+        from app.render.lights import SHADOW_SLOTS
+        from app.render.techniques.tsd.passes import store, through_fill
+        from app.render.techniques.tsd.seams import node_border_strips
+
+        base_irr = runs["base"][2]
+        fill_times = []
         load0 = os.getloadavg()
         times = {k: [] for k in runs}
         fwd_times = []
         for _ in range(args.rounds):
+            if base_irr.params.translucency:  # the record's fill alone (the base pass runs it last)
+                r = runs["base"][0]
+                t = store(r).targets(base_irr.params.node, base_irr.params.size)
+                ctx.finish()
+                t0 = time.perf_counter()
+                prm = base_irr.params
+                slots = min(len(prm.shadow_lights), SHADOW_SLOTS)
+                through_fill(r, t, prm.seams is not None, node_border_strips(prm.node.mesh, prm.size), slots)
+                ctx.finish()
+                fill_times.append((time.perf_counter() - t0) * 1e3)
             for name, (r, frame, irr, _fwd) in runs.items():
                 ctx.finish()
                 t0 = time.perf_counter()
@@ -169,6 +193,9 @@ def main(argv=None) -> int:
         for name, v in times.items():
             m = statistics.median(v)
             print(f"  {name:<16} {m:8.1f} ms  ({m / base:5.0%} of base; {m * 1e6 / texels:6.0f} ns per texel)")
+        if fill_times:
+            m = statistics.median(fill_times)
+            print(f"  of which the light-through record's fill {m:5.1f} ms  ({m / base:5.1%} of base)")
         f = statistics.median(fwd_times)
         print(f"  forward pass     {f:8.1f} ms  ({f * 1e6 / args.size**2:6.0f} ns per pixel)")
     finally:

@@ -435,3 +435,72 @@ def dilate_reference(img: np.ndarray, rings: int) -> np.ndarray:
         fill = np.where(n[..., None] > 0, s / np.maximum(n, 1)[..., None], 0.0)
         cur = np.where(cov[..., None], cur, fill).astype(np.float32)
     return cur
+
+
+def through_fill_reference(raw, through0, through1, through_cos, seam=None):
+    """Twin of shaders/passes/tsd_through_fill.frag: the irradiance pass's light-through records
+    (through0/1 (H, W, 4): a slot's light through and its thickness; through_cos (H, W, 2): the
+    slots' cosines on the far face) with the gutter filled. A covered texel (raw's alpha >
+    COVERAGE_EPS) keeps its record; a gutter texel the seam map marks takes the covered texels of the
+    bilinear footprint at the seam map's UV (seam_bilinear_reference's weights, renormalised); any
+    other gutter texel, or a marked one with no covered texel there, its covered 8-neighbours with
+    equal weights. The light (rgb) is averaged over the covered texels; a slot's thickness and cosine
+    over those whose cosine is > 0 (the ones holding light of that slot). Returns the three arrays,
+    float32."""
+    raw = np.asarray(raw, np.float32)
+    r0, r1 = np.asarray(through0, np.float32), np.asarray(through1, np.float32)
+    rc = np.asarray(through_cos, np.float32)[..., :2]
+    H, W, _ = raw.shape
+    cov = raw[..., 3] > COVERAGE_EPS
+    s0 = np.zeros((H, W, 4), np.float32)
+    s1 = np.zeros((H, W, 4), np.float32)
+    sc = np.zeros((H, W, 2), np.float32)
+    w = np.zeros((H, W, 3), np.float32)
+
+    def add(rows, cols, weight, where):
+        """Accumulate the records at (rows, cols) with `weight` where `where` (H, W) holds."""
+        weight = np.where(where & cov[rows, cols], weight, np.float32(0.0)).astype(np.float32)
+        c = rc[rows, cols]
+        lit = (c > 0).astype(np.float32) * weight[..., None]
+        s0[..., :3] += r0[rows, cols, :3] * weight[..., None]
+        s0[..., 3] += r0[rows, cols, 3] * lit[..., 0]
+        s1[..., :3] += r1[rows, cols, :3] * weight[..., None]
+        s1[..., 3] += r1[rows, cols, 3] * lit[..., 1]
+        sc[...] += c * lit
+        w[...] += np.concatenate([weight[..., None], lit], -1)
+
+    rows, cols = np.mgrid[0:H, 0:W]
+    gutter = ~cov
+    if seam is not None:
+        marked = gutter & (np.asarray(seam)[..., 3] > 0.5)
+        x = np.asarray(seam, np.float32)[..., :2] * np.array([W, H], np.float32) - np.float32(0.5)
+        fl = np.floor(x)
+        f = (x - fl).astype(np.float32)
+        i = fl.astype(np.int64)
+        fx, fy = f[..., 0], f[..., 1]
+        one = np.float32(1.0)
+        for dx, dy, wt in (
+            (0, 0, (one - fx) * (one - fy)),
+            (1, 0, fx * (one - fy)),
+            (0, 1, (one - fx) * fy),
+            (1, 1, fx * fy),
+        ):
+            add(np.clip(i[..., 1] + dy, 0, H - 1), np.clip(i[..., 0] + dx, 0, W - 1), wt, marked)
+    ring = gutter & (w[..., 0] <= 0)
+    for dy in (-1, 0, 1):
+        for dx in (-1, 0, 1):
+            if dx == 0 and dy == 0:
+                continue
+            inside = (rows + dy >= 0) & (rows + dy < H) & (cols + dx >= 0) & (cols + dx < W)
+            add(np.clip(rows + dy, 0, H - 1), np.clip(cols + dx, 0, W - 1), np.float32(1.0), ring & inside)
+    inv = (np.float32(1.0) / np.maximum(w, np.float32(1e-30))).astype(np.float32)
+    has = (w[..., 0] > 0)[..., None]
+    f0 = np.where(has, np.concatenate([s0[..., :3] * inv[..., 0:1], s0[..., 3:] * inv[..., 1:2]], -1), 0.0)
+    f1 = np.where(has, np.concatenate([s1[..., :3] * inv[..., 0:1], s1[..., 3:] * inv[..., 2:3]], -1), 0.0)
+    fc = sc * inv[..., 1:3]
+    keep = cov[..., None]
+    return (
+        np.where(keep, r0, f0).astype(np.float32),
+        np.where(keep, r1, f1).astype(np.float32),
+        np.where(keep, rc, fc).astype(np.float32),
+    )

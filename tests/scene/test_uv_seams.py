@@ -151,3 +151,44 @@ def test_border_bands_lie_outside_their_charts():
         inside = ((w1 > 0) & (w2 > 0) & (w3 > 0)) | ((w1 < 0) & (w2 < 0) & (w3 < 0))
         assert not inside.any()
     assert (quads.min((0, 1)) >= lo - band - 1e-7).all() and (quads.max((0, 1)) <= hi + band + 1e-7).all()
+
+
+def _in_triangles(tri: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """(P,) whether each point p (P, 2) lies in some triangle tri (T, 3, 2) (edges included)."""
+    a, b, c = (tri[None, :, k] for k in range(3))
+    q = p[:, None, :]
+
+    def side(u, v):
+        return (v[..., 0] - u[..., 0]) * (q[..., 1] - u[..., 1]) - (v[..., 1] - u[..., 1]) * (q[..., 0] - u[..., 0])
+
+    d = np.stack([side(a, b), side(b, c), side(c, a)])
+    return ((d >= -1e-12).all(0) | (d <= 1e-12).all(0)).any(1)
+
+
+def test_border_strips_hold_every_point_near_a_chart_outside_it():
+    """border_strips (the light-through record's fill, app/render/techniques/tsd/passes.py) covers
+    every point outside the charts within `out` of one - beside an edge and past a convex corner - and
+    nothing farther than out (plus its inner margin: it reaches `inside` into the chart)."""
+    from scene.uv_seams import border_edges, border_strips
+
+    m = plane_mesh("rotate", n=4)
+    out, inside = 3.0 / TEXELS, 1.0 / TEXELS
+    strips = border_strips(m, out, inside)
+    assert strips.shape == (2 * len(border_edges(m)[0]), 3, 2)
+    charts_uv = m.uvs.astype(np.float64)[m.indices.astype(int)]
+    f = m.indices.astype(int)
+    t, k = border_edges(m)
+    e0, e1 = m.uvs[f[t, k]].astype(np.float64), m.uvs[f[t, (k + 1) % 3]].astype(np.float64)
+    rng = np.random.default_rng(2)
+    lo, hi = charts_uv.min((0, 1)) - 2 * out, charts_uv.max((0, 1)) + 2 * out
+    p = rng.uniform(lo, hi, (20000, 2))
+    # distance from each point to the nearest border edge (segment)
+    d = e1 - e0
+    s = np.clip(np.einsum("pij,ij->pi", p[:, None] - e0[None], d) / np.einsum("ij,ij->i", d, d), 0, 1)
+    dist = np.linalg.norm(p[:, None] - (e0[None] + s[..., None] * d[None]), axis=2).min(1)
+    outside = ~_in_triangles(charts_uv, p)
+    held = _in_triangles(strips, p)
+    near = outside & (dist < out * 0.999)
+    assert near.sum() > 500 and held[near].all()
+    assert not held[outside & (dist > out * 1.001 * np.sqrt(2))].any()  # (a corner's square reaches sqrt 2 out)
+    assert not held[~outside & (dist > inside * 1.001 * np.sqrt(2))].any()

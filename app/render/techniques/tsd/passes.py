@@ -1,7 +1,9 @@
 """Texture-space diffusion passes (d'Eon & Luebke 2007, GPU Gems 3 ch. 14), per subsurface mesh:
 
   tsd_stretch     world mm per texel along u and v (only when the geometry or scene scale changes)
-  tsd_irradiance  light entering the surface, rasterised at the UVs, x albedo^mix
+  tsd_irradiance  light entering the surface, rasterised at the UVs, x albedo^mix; with translucency
+                  also the record of the light through thin parts, its gutter then filled across
+                  seams and one ring past the other chart borders (through_fill)
   tsd_seams       the seam map: the gutter across UV seams paired with texels of the other chart
                   (seams.py; only for meshes with seams; when the mesh changes)
   tsd_dilate      the gutter across seams filled from the seam map, then irradiance pushed past the
@@ -31,7 +33,7 @@ from app.render.translucency import bind_translucency
 from scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
-from .seams import SeamMap
+from .seams import SeamMap, node_border_strips
 
 STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
@@ -43,6 +45,17 @@ def _texture(ctx, size: int) -> moderngl.Texture:
     t.filter = (moderngl.LINEAR, moderngl.LINEAR)
     t.repeat_x = t.repeat_y = False
     return t
+
+
+def _record_textures(ctx, size: int) -> list:
+    """The light-through record's textures (TsdNodeTargets.through_record): RGBA, RGBA, RG, nearest."""
+    out = []
+    for comps in (4, 4, 2):
+        t = ctx.texture((size, size), comps, dtype="f4")
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        t.repeat_x = t.repeat_y = False
+        out.append(t)
+    return out
 
 
 @dataclass
@@ -60,27 +73,61 @@ class TsdNodeTargets:
     levels: list = field(default_factory=list)
     fbos: dict = field(default_factory=dict)
     seam: SeamMap | None = None  # the seam map (meshes with UV seams)
-    through: list = field(default_factory=list)  # the light-through record (through_record)
+    through: list = field(default_factory=list)  # the light-through record, filled (through_record)
+    through_raw: list = field(default_factory=list)  # as the irradiance pass wrote it
+    strips: tuple = ()  # (source array, depth renderbuffer): where the record's fill runs (strip_mask)
 
-    def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture) -> moderngl.Framebuffer:
-        key = (id(tex), *(id(m) for m in more))
+    def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture, depth=None) -> moderngl.Framebuffer:
+        key = (id(tex), *(id(m) for m in more), id(depth))
         f = self.fbos.get(key)
         if f is None:
-            f = self.fbos[key] = ctx.framebuffer([tex, *more])
+            f = self.fbos[key] = ctx.framebuffer([tex, *more], depth)
         return f
+
+    def strip_mask(self, renderer, strips: np.ndarray):
+        """`strips` (seams.node_border_strips) drawn once into a depth renderbuffer (0.5 on them, 0
+        elsewhere), kept until they change (a new mesh version or size): a fullscreen pass tested
+        against it with "<=" shades only the strips. One draw of the strips per frame cost more on
+        llvmpipe (thousands of sliver triangles: 20 ms on the bunny) than the early depth test of
+        every texel."""
+        if not self.strips or self.strips[0] is not strips:
+            ctx = renderer.ctx
+            mask = self.strips[1] if self.strips else ctx.depth_renderbuffer((self.size, self.size))
+            fbo = ctx.framebuffer(depth_attachment=mask)
+            fbo.use()
+            ctx.viewport = (0, 0, self.size, self.size)
+            fbo.clear(depth=0.0)
+            ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
+            ctx.enable(moderngl.DEPTH_TEST)
+            ctx.depth_func = "1"  # always: every strip texel gets depth 0.5
+            if len(strips):
+                prog = renderer.programs.get("passes/fullscreen.vert", "passes/depth_only.frag")
+                vbo = ctx.buffer(strips.tobytes())
+                vao = ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
+                vao.render(moderngl.TRIANGLES)
+                vao.release()
+                vbo.release()
+            ctx.depth_func = "<"
+            ctx.disable(moderngl.DEPTH_TEST)
+            fbo.release()
+            self.strips = (strips, mask)
+        return self.strips[1]
 
     def through_record(self, ctx) -> list:
         """The irradiance pass's record of the light through thin parts, per texel and shadow slot,
         unblurred (for the gather's exit factor of that light, shaders/techniques/tsd/forward.glsl):
         RGBA per slot (the light entering through, the thickness in mm) and RG (each slot's cosine on
-        the far face). Nearest filtering: a texel's record belongs to it alone."""
+        the far face), its gutter filled (through_fill). Nearest filtering: a texel's record belongs
+        to it alone."""
         if not self.through:
-            for comps in (4, 4, 2):
-                t = ctx.texture((self.size, self.size), comps, dtype="f4")
-                t.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                t.repeat_x = t.repeat_y = False
-                self.through.append(t)
+            self.through = _record_textures(ctx, self.size)
         return self.through
+
+    def through_raw_record(self, ctx) -> list:
+        """The same record as the irradiance pass rasterised it (empty in the gutter)."""
+        if not self.through_raw:
+            self.through_raw = _record_textures(ctx, self.size)
+        return self.through_raw
 
     def level(self, ctx, k: int) -> moderngl.Texture:
         while len(self.levels) <= k:
@@ -95,10 +142,20 @@ class TsdNodeTargets:
     def release(self) -> None:
         for f in self.fbos.values():
             f.release()
-        for t in [self.irradiance, self.scratch, self.stretch, self.raw, *self.levels, *self.through]:
+        for t in [
+            self.irradiance,
+            self.scratch,
+            self.stretch,
+            self.raw,
+            *self.levels,
+            *self.through,
+            *self.through_raw,
+        ]:
             t.release()
         if self.seam is not None:
             self.seam.release()
+        if self.strips:
+            self.strips[1].release()
 
 
 @dataclass
@@ -228,6 +285,10 @@ class TsdIrradiancePass(TsdPass):
     def output(self, t, p):
         return t.raw
 
+    def outputs(self, frame, p) -> tuple:
+        t = self.node_targets(p)
+        return (t.raw, *(t.through_record(self.r.ctx) if p.params.translucency else ()))
+
     def publish(self, frame, p) -> None:
         prm: TsdIrradianceParams = p.params
         t = self.node_targets(p)
@@ -241,7 +302,7 @@ class TsdIrradiancePass(TsdPass):
         prm: TsdIrradianceParams = p.params
         ctx, node, size, mat = self.r.ctx, prm.node, prm.size, prm.material
         t = self.node_targets(p)
-        fbo = t.fbo(ctx, t.raw, *(t.through_record(ctx) if prm.translucency else ()))
+        fbo = t.fbo(ctx, t.raw, *(t.through_raw_record(ctx) if prm.translucency else ()))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights
@@ -264,7 +325,51 @@ class TsdIrradiancePass(TsdPass):
         if prm.translucency:
             bind_translucency(prog, frame, units, self.r.dummy_texture())
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        if prm.translucency:  # the record's gutter by the chart borders: across the seams, else dilated
+            slots = min(len(prm.shadow_lights), SHADOW_SLOTS)
+            through_fill(self.r, t, prm.seams is not None, node_border_strips(node.mesh, size), slots)
         self.publish(frame, p)
+
+
+def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | None = None, slots: int = 2) -> None:
+    """The irradiance pass's light-through record (t.through_raw_record, read with t.raw's coverage)
+    into t.through_record with its gutter filled (shaders/passes/tsd_through_fill.frag): the texels
+    the seam map marks from across the seam (`seams`: the node's seam map is drawn), the others one
+    ring from their covered neighbours. The gather reads the record with nearest filtering, so a
+    fragment by a chart border reads the gutter texels whose square overlaps the chart: without the
+    fill, a ring along every border left the light through with the reflected light's exit.
+    The covered texels' records are copied (blits; slot 1's only for `slots` > 1: the gather reads
+    only the slots the frame filled, variant TSD_THROUGH_SLOTS); the fill shades only `strips`
+    (seams.node_border_strips: every texel a fragment inside a chart can read, and a few more),
+    through an early depth test against their mask (TsdNodeTargets.strip_mask, drawn once per mesh),
+    or every texel (None). On llvmpipe a fill of every texel cost 20 % of the irradiance pass on the
+    head and 2.6x it on the back-lit slab (a sparse layout), drawing the strips every frame 20 ms
+    on the bunny (thousands of sliver triangles); docs/tsd.md has the cost as shipped."""
+    ctx = renderer.ctx
+    for k, (src, dst) in enumerate(zip(t.through_raw_record(ctx), t.through_record(ctx))):
+        if k != 1 or slots > 1:  # the covered texels' records
+            ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, src))
+    defines = {"TSD_THROUGH_SLOTS": 2 if slots > 1 else 1, **({"TSD_SEAMS": 1} if seams else {})}
+    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_through_fill.frag", defines)
+    mask = t.strip_mask(renderer, strips) if strips is not None else None
+    fbo = t.fbo(ctx, *t.through_record(ctx), depth=mask)
+    fbo.depth_mask = False
+    fbo.use()
+    ctx.viewport = (0, 0, t.size, t.size)
+    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+    units = TextureUnits(ctx)
+    for name, tex in zip(("u_raw", "u_through0", "u_through1", "u_through_cos"), (t.raw, *t.through_raw_record(ctx))):
+        units.bind(prog, name, tex)
+    if seams:
+        units.bind(prog, "u_seam", t.seam_map(ctx).texture)
+    if mask is not None:  # only the strips (0.5 <= their depth 0.5; 0 elsewhere): an early depth test
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+    try:
+        renderer.fullscreen(prog)
+    finally:
+        ctx.depth_func = "<"
+        ctx.disable(moderngl.DEPTH_TEST)
 
 
 class TsdDilatePass(TsdPass):

@@ -280,7 +280,13 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
             "tsd_irradiance",
             res,
             f"material '{t.material.name}' scatters ({t.material['sss_model']}): light entering the surface in UV space"
-            + (", translucency through thin parts" if translucency else ""),
+            + (
+                ", translucency through thin parts (its record's gutter filled "
+                + ("across UV seams and " if t.seams is not None else "")
+                + "one texel past chart borders)"
+                if translucency
+                else ""
+            ),
             TsdIrradianceParams(
                 **base,
                 lights=ctx.lights,
@@ -290,7 +296,8 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 gather=UNIT_KERNEL if exact else k,
             ),
             inputs=irradiance_inputs(t, ctx, mix, translucency),
-            after=tuple(shadow_pass_name(l) for l in ctx.shadow_lights),
+            # the light-through record is filled across the seams from the seam map
+            after=(*(shadow_pass_name(l) for l in ctx.shadow_lights), *(seam_after if translucency else ())),
         )
     )
     out.append(

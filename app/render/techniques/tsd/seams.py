@@ -29,7 +29,7 @@ import numpy as np
 
 from app.gl.uniforms import set_uniforms
 from scene.optics.constants import TSD_TAP_RANGE
-from scene.uv_seams import SeamExtension, seam_extension
+from scene.uv_seams import SeamExtension, border_strips, seam_extension
 
 SEAM_BAND_MAX_TEXELS = 64  # widest extension band past a seam (texels); wider kernels read dilation beyond
 BORDER_BIAS = 1e-3  # a border strip's depth offset (x the band): its own extension wins a tie
@@ -60,6 +60,21 @@ def node_seams(mesh, band_texels: int, size: int) -> SeamExtension | None:
             _CACHE.clear()
         ext = seam_extension(mesh, band_uv)
         hit = _CACHE[key] = ext if ext.triangles else None
+    return hit
+
+
+def node_border_strips(mesh, size: int) -> np.ndarray:
+    """The thin rectangles around every chart border of the mesh (scene/uv_seams.py border_strips:
+    0.75 texel outside, over half a texel's diagonal, and a quarter inside, of a `size` texture) as
+    float32 clip-space triangle corners (K * 3, 2): where the light-through record's fill runs
+    (passes.through_fill). Cached by mesh identity, geometry version and size."""
+    key = ("strips", mesh.uid, mesh.version, size)
+    hit = _CACHE.get(key)
+    if hit is None:
+        if len(_CACHE) > 32:
+            _CACHE.clear()
+        tri = border_strips(mesh, 0.75 / size, 0.25 / size)
+        hit = _CACHE[key] = np.ascontiguousarray((tri * 2.0 - 1.0).reshape(-1, 2), np.float32)
     return hit
 
 
