@@ -36,7 +36,12 @@ def material_boundary(material) -> BoundaryTables | None:
     if material is None or not material.has_subsurface:
         return None
     medium = material_medium(material.values)
-    return boundary_tables(medium.alpha_arr, material["subsurface_color"], medium.eta)
+    return boundary_tables(medium.alpha_arr, material["subsurface_color"], medium.eta, boundary_ggx_alpha(material))
+
+
+def boundary_ggx_alpha(material) -> float:
+    """GGX alpha of the material's boundary, roughness^2 (as the truth exporter's rough dielectric)."""
+    return float(material["roughness"]) ** 2
 
 
 def bind_boundary(prog, material) -> None:

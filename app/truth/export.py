@@ -43,14 +43,13 @@ import numpy as np
 
 from scene.graph import LightNode, MeshNode, Scene
 from scene.optics.constants import MIN_MFP_MM
+from scene.optics.rough_dielectric import SMOOTH_ALPHA  # below it a smooth dielectric (rough one degenerates)
 from scene.optics.tsd import eta_from_specular, material_medium
 
 # the description and its Mitsuba objects live in a module that needs no scene (it runs where only
 # numpy and Mitsuba are installed: a GPU machine rendering a saved description); re-exported here
 from .description import ReferenceDescription, ShapeDesc, _rgb  # noqa: F401
 
-# below this GGX alpha the boundary is a smooth dielectric (Mitsuba's rough one degenerates)
-SMOOTH_ALPHA = 1e-3
 # a mean free path is at least this (mm): a channel that does not scatter becomes a dense medium
 # whose surface albedo is the colour (Mitsuba needs finite coefficients)
 REFERENCE_MIN_MFP_MM = max(MIN_MFP_MM, 1e-3)
