@@ -85,13 +85,13 @@ def load_truth(scene, spec: TruthSpec, render: bool = False, progress: bool = Tr
     """The scene's reference at `spec`: from the cache, or rendered (and cached) when `render`.
     None when it is not cached and not to be rendered, or Mitsuba is missing."""
     from app.truth.export import describe
-    from app.truth.reference import ReferenceUnavailable, load_cached, reference_key, render_reference, set_variant
+    from app.truth.reference import ReferenceUnavailable, _mitsuba, load_cached, reference_key, render_reference
 
     req = spec.request()
     try:
         if render:
             return render_reference(scene, req, progress=progress)
-        mi = set_variant(req.variant)
+        mi = _mitsuba()  # its version is part of the key; the variant need not run here (a GPU's reference)
         desc = describe(scene, req.width, req.height, sun_deg=req.sun_deg, max_depth=req.max_depth,
                         rr_depth=req.rr_depth)  # fmt: skip
         return load_cached(reference_key(desc, req, mi.__version__))
