@@ -106,14 +106,32 @@ def world_geometry(node: MeshNode) -> tuple[np.ndarray, np.ndarray]:
     return p, nrm
 
 
+_DIGESTS: dict[tuple[int, int], bytes] = {}  # (mesh uid, version) -> digest of its arrays
+
+
+def _mesh_digest(mesh) -> bytes:
+    """A digest of a mesh's positions, triangles and normals, computed once per mesh version (the
+    frame plan asks every frame; hashing 10k vertices each time cost a millisecond or two)."""
+    key = (mesh.uid, mesh.version)
+    d = _DIGESTS.get(key)
+    if d is None:
+        h = hashlib.sha1()
+        for a in (mesh.positions, mesh.indices, mesh.normals):
+            h.update(np.ascontiguousarray(a).tobytes())
+        d = _DIGESTS[key] = h.digest()
+        if len(_DIGESTS) > 256:
+            _DIGESTS.pop(next(iter(_DIGESTS)))
+    return d
+
+
 def geometry_key(nodes: list[MeshNode], rays: int, seed: int) -> str:
+    """What the records depend on: each mesh's arrays (by content: the same mesh loaded twice shares
+    its records) and world transform, the rays and the seed."""
     h = hashlib.sha1()
     h.update(np.array([rays, seed], np.int64).tobytes())
     for node in nodes:
         h.update(np.asarray(node.world_matrix, np.float64).tobytes())
-        h.update(node.mesh.positions.tobytes())
-        h.update(node.mesh.indices.tobytes())
-        h.update(node.mesh.normals.tobytes())
+        h.update(_mesh_digest(node.mesh))
     return h.hexdigest()
 
 
