@@ -13,7 +13,8 @@ SKINLAB_TRUTH=192 compares with the 192x192, 1024-spp references instead (frames
 references must be cached: `skinlab reference SCENE --size 192x192 --spp 1024`), and
 SKINLAB_TRUTH=SIZE:SPP:VARIANT:SEED with a reference rendered elsewhere (tools/gpu_reference.py).
 SKINLAB_BOUNCES=N sets the orders of interreflection (RenderSettings.bounces; 0 = off), and
-SKINLAB_BOUNCE_RAYS=N the rays per vertex (RenderSettings.bounce_rays).
+SKINLAB_BOUNCE_RAYS=N the rays per vertex (RenderSettings.bounce_rays); SKINLAB_TSD_SIZE=N the
+irradiance texels of texture-space diffusion (tsd's `size`; the other techniques as they are).
 Used for the before/after tables in docs/ground-truth.md."""
 
 from __future__ import annotations
@@ -76,8 +77,10 @@ def main(argv: list[str]) -> int:
             print(f"{s}: no cached {size}x{size}, {spec.spp}-spp {spec.variant} reference (seed {spec.seed})")
             continue
         for t in techs:
+            tsd_size = os.environ.get("SKINLAB_TSD_SIZE") if t == "tsd" else None
+            own = {"size": int(tsd_size)} if tsd_size else {}
             rs = RenderSettings.for_technique(
-                t, size, size, shadow_size=QUICK.shadow_size, sss_model=model, supersample=n, **extra
+                t, size, size, shadow_size=QUICK.shadow_size, sss_model=model, supersample=n, **extra, **own
             )
             img = r.render(scene, rs, readback=("hdr",)).hdr
             e = image_error(img, truth.image)

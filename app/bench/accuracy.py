@@ -146,6 +146,7 @@ def run_sweep(
     renderer.reuse = False  # each setting's cost is that of a full frame (no pass kept from the last)
     rows: list[dict] = []
     truth_notes: dict[str, str] = {}
+    truth_quiet: dict[str, str] = {}  # scenes compared with a quieter reference than the sweep's
     sheet: dict[str, dict[str, np.ndarray]] = {}
     on_sheet = set(sheet_settings(settings))
     bar = tqdm(
@@ -181,6 +182,11 @@ def run_sweep(
                     truth = load_truth(scene, sweep.truth, render=references, progress=progress)
                 except Exception as exc:
                     truth_notes[label] = f"the path-traced reference failed: {_first_line(exc)}"
+                if truth is not None and truth.meta.get("variant", "scalar_rgb") != "scalar_rgb":
+                    truth_quiet[label] = (
+                        f"compared with a quieter reference rendered elsewhere ({truth.meta.get('spp')} spp, "
+                        f"{truth.meta.get('variant')}; `QUIET_REFERENCES`, tools/gpu_reference.py)"
+                    )
                 if truth is None and label not in truth_notes:
                     truth_notes[label] = (
                         "no cached path-traced reference at "
@@ -313,6 +319,7 @@ def run_sweep(
             "passes": sweep.truth.passes,
             "supersample": sweep.truth.supersample,
             "missing": truth_notes,
+            "quiet": truth_quiet,
         },
         "sweep_s": sweep_s,
         "total_s": time.perf_counter() - t_start,
