@@ -68,8 +68,9 @@ class BounceTransfer:
 
     @property
     def any_hit(self) -> bool:
-        """True when some ray met the front of a surface (else there is nothing to gather)."""
-        return bool(np.any(self.weights > 0.0))
+        """True when some ray met the front of a surface (else there is nothing to gather); from the
+        hit fractions, not the records (the plan asks every frame)."""
+        return any(f > 0.0 for f in self.hit_fraction.values())
 
 
 def cosine_directions(normals: np.ndarray, rays: int, seed: int = 0) -> np.ndarray:

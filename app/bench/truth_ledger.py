@@ -214,6 +214,8 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
         L.append(f"- **{scene}**: {why}")
     for scene, what in (t.get("quiet") or {}).items():
         L.append(f"- **{scene}**: {what}")
+    if t.get("missing") or t.get("quiet"):
+        L.append("")
     scenes = [s for s in dict.fromkeys(r["scene"] for r in rows) if s not in (t.get("missing") or {})]
     if not scenes:
         return [*L, ""]

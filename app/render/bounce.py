@@ -137,6 +137,7 @@ class BouncePass:
         # (transfer key, ray vertices, ray weights, ring index, ring entries)
         self.records: tuple | None = None
         self._point_vaos: dict[tuple[int, int], moderngl.VertexArray] = {}
+        self._footprints: dict[tuple[int, int], float] = {}  # (mesh uid, version) -> uv_footprint
 
     # -- GPU objects ---------------------------------------------------------------------
     def _target(self, size, order: int | str):
@@ -238,7 +239,10 @@ class BouncePass:
             maps = mat.textures()
             if "u_base_color_map" in maps:
                 tex = self.r.resources.texture(*maps["u_base_color_map"])
-                lod = max(0.0, math.log2(max(max(tex.size) * uv_footprint(node.mesh), 1e-30)))
+                key = (node.mesh.uid, node.mesh.version)
+                if key not in self._footprints:
+                    self._footprints[key] = uv_footprint(node.mesh)
+                lod = max(0.0, math.log2(max(max(tex.size) * self._footprints[key], 1e-30)))
             units.bind(prog, "u_bounce_previous", previous[0] if previous is not None else self.r.dummy_texture())
             set_uniforms(
                 prog,
