@@ -76,7 +76,7 @@ def render(args) -> int:
 def store(args) -> int:
     from app.truth.compare import image_error, object_mask
     from app.truth.export import describe
-    from app.truth.reference import Reference, ReferenceRequest, _store, reference_key
+    from app.truth.reference import Reference, ReferenceRequest, reference_key, store_reference
     from scene.scenefile import load_scene
 
     with np.load(args.result) as z:
@@ -87,7 +87,7 @@ def store(args) -> int:
     req = ReferenceRequest(w, h, spp=meta["spp"], passes=meta["passes"], seed=meta["seed"], variant=meta["variant"])
     key = reference_key(describe(scene, w, h), req, meta["mitsuba"])
     noise = image_error(a, b, object_mask(image))
-    _store(Reference(image, a, b, key, {**meta, "scene": scene.name, "noise_floor": noise}, cached=False))
+    store_reference(Reference(image, a, b, key, {**meta, "scene": scene.name, "noise_floor": noise}, cached=False))
     floor = f"{100 * noise['rel_l1_block']:.2f} % on 4x4 blocks, {100 * noise['rel_l1']:.2f} % per pixel"
     print(f"{key}: noise floor {floor}")
     return 0

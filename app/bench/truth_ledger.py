@@ -103,13 +103,13 @@ def load_truth(scene, spec: TruthSpec, render: bool = False, progress: bool = Tr
                 if hit is not None:
                     return hit
     from app.truth.export import describe
-    from app.truth.reference import ReferenceUnavailable, _mitsuba, load_cached, reference_key, render_reference
+    from app.truth.reference import ReferenceUnavailable, load_cached, mitsuba_module, reference_key, render_reference
 
     req = spec.request()
     try:
         if render:
             return render_reference(scene, req, progress=progress)
-        mi = _mitsuba()  # its version is part of the key; the variant need not run here (a GPU's reference)
+        mi = mitsuba_module()  # its version is part of the key; the variant need not run here (a GPU's reference)
         desc = describe(scene, req.width, req.height, sun_deg=req.sun_deg, max_depth=req.max_depth,
                         rr_depth=req.rr_depth)  # fmt: skip
         return load_cached(reference_key(desc, req, mi.__version__))

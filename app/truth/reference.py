@@ -91,7 +91,8 @@ def cache_dir() -> Path:
     return Path(base) / "reference"
 
 
-def _mitsuba():
+def mitsuba_module():
+    """The mitsuba package (any variant), or ReferenceUnavailable saying how to install it."""
     try:
         import mitsuba as mi
     except ImportError:
@@ -102,7 +103,7 @@ def _mitsuba():
 
 
 def set_variant(variant: str):
-    mi = _mitsuba()
+    mi = mitsuba_module()
     try:
         mi.set_variant(variant)
     except Exception as exc:  # Dr.Jit raises ImportError/RuntimeError/AttributeError by backend
@@ -139,7 +140,8 @@ def load_cached(key: str) -> Reference | None:
     return Reference(img, a, b, key, meta, cached=True)
 
 
-def _store(ref: Reference) -> None:
+def store_reference(ref: Reference) -> None:
+    """File a reference in the cache under its key (atomically: a temporary name, then renamed)."""
     d = cache_dir()
     with atomic_path(d / f"{ref.key}.npz") as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, image=ref.image, half_a=ref.half_a, half_b=ref.half_b)
@@ -182,5 +184,5 @@ def render_reference(
     }
     ref = Reference(mean, a, b, key, meta, cached=False)
     if use_cache:
-        _store(ref)
+        store_reference(ref)
     return ref

@@ -50,14 +50,14 @@ def test_rendered_elsewhere_stored_and_preferred_by_the_ledger(tmp_path, monkeyp
         assert z["image"].shape == (8, 8, 4) and np.isfinite(z["image"]).all() and z["image"][..., 3].max() == 1.0
     # filing needs the scene itself: store's part, done here in-process (the tool loads a scene file)
     from app.truth.compare import image_error, object_mask
-    from app.truth.reference import Reference, _store
+    from app.truth.reference import Reference, store_reference
 
     with np.load(res) as z:
         image, a, b = z["image"], z["half_a"], z["half_b"]
         meta = json.loads(bytes(z["meta"]).decode())
     quiet = TruthSpec((8, 8), 8, passes=2, variant=meta["variant"], seed=3)
     key = reference_key(describe(scene, 8, 8), quiet.request(), meta["mitsuba"])
-    _store(Reference(image, a, b, key, {**meta, "noise_floor": image_error(a, b, object_mask(image))}, False))
+    store_reference(Reference(image, a, b, key, {**meta, "noise_floor": image_error(a, b, object_mask(image))}, False))
     assert load_truth(scene, quiet) is not None
     plain = TruthSpec((8, 8), 256, passes=2)
     assert load_truth(scene, plain) is None  # nothing of this request cached, no quiet one known
