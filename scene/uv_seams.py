@@ -130,11 +130,9 @@ def border_edges(mesh: Mesh, pid: np.ndarray | None = None) -> tuple[np.ndarray,
     return t[single], k[single]
 
 
-def border_bands(mesh: Mesh, band_uv: float, pid: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Every chart border edge's own strip of gutter: a quad `band_uv` wide outside the edge, as two
-    triangles (K, 3, 2) with their distance from the edge (K, 3). In the seam map they claim the
-    gutter nearest a chart's border for that chart (dilation, no fill) wherever no extension is nearer:
-    a border without an extension (or a chart too small to have one) keeps its own neighbourhood."""
+def _border_frames(mesh: Mesh, pid: np.ndarray | None = None):
+    """Each chart border edge (degenerate ones left out) in UV: its ends a0, a1, its unit direction and
+    its unit normal pointing away from its triangle, each (K, 2)."""
     f = mesh.indices.astype(np.int64)
     uv = mesh.uvs.astype(np.float64)
     t, k = border_edges(mesh, pid)
@@ -142,9 +140,18 @@ def border_bands(mesh: Mesh, band_uv: float, pid: np.ndarray | None = None) -> t
     e = a1 - a0
     ln = np.linalg.norm(e, axis=1)
     ok = ln > np.sqrt(EDGE_EPS)
-    a0, a1, a2, e, ln = a0[ok], a1[ok], a2[ok], e[ok], ln[ok]
-    nrm = np.stack([e[:, 1], -e[:, 0]], 1) / ln[:, None]
+    a0, a1, a2, e = a0[ok], a1[ok], a2[ok], e[ok] / ln[ok][:, None]
+    nrm = np.stack([e[:, 1], -e[:, 0]], 1)
     nrm = np.where((np.einsum("ij,ij->i", a2 - a0, nrm) > 0)[:, None], -nrm, nrm)  # away from the triangle
+    return a0, a1, e, nrm
+
+
+def border_bands(mesh: Mesh, band_uv: float, pid: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Every chart border edge's own strip of gutter: a quad `band_uv` wide outside the edge, as two
+    triangles (K, 3, 2) with their distance from the edge (K, 3). In the seam map they claim the
+    gutter nearest a chart's border for that chart (dilation, no fill) wherever no extension is nearer:
+    a border without an extension (or a chart too small to have one) keeps its own neighbourhood."""
+    a0, a1, _, nrm = _border_frames(mesh, pid)
     b0, b1 = a0 + band_uv * nrm, a1 + band_uv * nrm
     quads = np.concatenate([np.stack([a0, a1, b1], 1), np.stack([a0, b1, b0], 1)])
     zero, one = np.zeros(len(a0)), np.full(len(a0), band_uv)
@@ -159,17 +166,7 @@ def border_strips(mesh: Mesh, out_uv: float, in_uv: float = 0.0, pid: np.ndarray
     lies in the rectangle of an edge it is outside of). With out_uv >= half a texel's diagonal they hold
     every gutter texel whose square overlaps a chart: the texels a nearest lookup inside the chart can
     read (texture-space diffusion's light-through record, app/render/techniques/tsd/passes.py)."""
-    f = mesh.indices.astype(np.int64)
-    uv = mesh.uvs.astype(np.float64)
-    t, k = border_edges(mesh, pid)
-    a0, a1, a2 = uv[f[t, k]], uv[f[t, (k + 1) % 3]], uv[f[t, (k + 2) % 3]]
-    e = a1 - a0
-    ln = np.linalg.norm(e, axis=1)
-    ok = ln > np.sqrt(EDGE_EPS)
-    a0, a1, a2, e, ln = a0[ok], a1[ok], a2[ok], e[ok], ln[ok]
-    e = e / ln[:, None]
-    nrm = np.stack([e[:, 1], -e[:, 0]], 1)
-    nrm = np.where((np.einsum("ij,ij->i", a2 - a0, nrm) > 0)[:, None], -nrm, nrm)  # away from the triangle
+    a0, a1, e, nrm = _border_frames(mesh, pid)
     p0, p1 = a0 - out_uv * e, a1 + out_uv * e
     c = [p0 - in_uv * nrm, p1 - in_uv * nrm, p1 + out_uv * nrm, p0 + out_uv * nrm]
     return np.concatenate([np.stack([c[0], c[1], c[2]], 1), np.stack([c[0], c[2], c[3]], 1)])

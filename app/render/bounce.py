@@ -257,25 +257,24 @@ class BouncePass:
             )
             self._points(node, prog).render(moderngl.POINTS)
         verts, weights, ring_index, ring_entries = self._records(tr)
-        gathered, gfbo = self._target(p.resolution, "gathered")
-        gfbo.use()
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/bounce_gather.frag")
-        units = TextureUnits(ctx)
-        units.bind(prog, "u_exitance", exitance)
-        units.bind(prog, "u_ray_vertices", verts)
-        units.bind(prog, "u_ray_weights", weights)
-        set_uniforms(prog, {"u_rays": tr.rays, "u_vertices": tr.total_vertices})
-        self.r.fullscreen(prog)
-        _, fbo = self._target(p.resolution, prm.order)
-        fbo.use()
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/bounce_smooth.frag")
-        units = TextureUnits(ctx)
-        units.bind(prog, "u_gathered", gathered)
-        units.bind(prog, "u_ring_index", ring_index)
-        units.bind(prog, "u_ring_entries", ring_entries)
-        set_uniforms(prog, {"u_vertices": tr.total_vertices})
-        self.r.fullscreen(prog)
+        gathered = self._target(p.resolution, "gathered")
+        textures = {"u_exitance": exitance, "u_ray_vertices": verts, "u_ray_weights": weights}
+        self._fullscreen(gathered[1], "bounce_gather", textures, {"u_rays": tr.rays, "u_vertices": tr.total_vertices})
+        textures = {"u_gathered": gathered[0], "u_ring_index": ring_index, "u_ring_entries": ring_entries}
+        self._fullscreen(
+            self._target(p.resolution, prm.order)[1], "bounce_smooth", textures, {"u_vertices": tr.total_vertices}
+        )
         self.publish(frame, p)
+
+    def _fullscreen(self, fbo, shader: str, textures: dict, uniforms: dict) -> None:
+        """One fullscreen draw of shaders/passes/<shader>.frag into `fbo` (vertex-space targets)."""
+        fbo.use()
+        prog = self.r.programs.get("passes/fullscreen.vert", f"passes/{shader}.frag")
+        units = TextureUnits(self.r.ctx)
+        for sampler, tex in textures.items():
+            units.bind(prog, sampler, tex)
+        set_uniforms(prog, uniforms)
+        self.r.fullscreen(prog)
 
 
 # -- the receiving side: every pass that shades ambient light -----------------------------
