@@ -48,6 +48,10 @@ if TYPE_CHECKING:
 VERTEX_TEXTURE_WIDTH = 1024  # vertex-space targets: vertex i at texel (i % width, i / width)
 RECORD_TEXTURE_WIDTH = 4096  # ray records: ray r (= vertex x rays + k) at texel (r % width, r / width)
 DATA_KEY = "bounce"  # frame.data: {"offsets": node uid -> first vertex}
+# rays per frame's geometry: the records take 24 bytes a ray (48 MB here) and Embree casts about a
+# million a second on 2 cores; past it each vertex casts fewer rays, down to MIN_RAYS, then none
+MAX_RAYS = 2_000_000
+MIN_RAYS = 4
 
 
 @dataclass
@@ -84,7 +88,21 @@ def plan_bounce(
     if not lights and not np.any(np.asarray(scene.environment.ambient) > 0):
         plan.skipped.append(("bounce", "no light to bounce (no lights, no ambient)"))
         return []
-    transfer = build_transfer(meshes, settings.bounce_rays)
+    vertices = sum(len(n.mesh.positions) for n in meshes)
+    rays = min(settings.bounce_rays, MAX_RAYS // max(vertices, 1))
+    if rays < MIN_RAYS:
+        plan.warnings.append(
+            f"interreflection skipped: {vertices} vertices need more than {MAX_RAYS:,} rays even at {MIN_RAYS} "
+            "per vertex (decimate the mesh, or render with bounces = 0 to silence this)"
+        )
+        plan.skipped.append(("bounce", f"{vertices} vertices: over the ray budget ({MAX_RAYS:,} rays)"))
+        return []
+    if rays < settings.bounce_rays:
+        plan.warnings.append(
+            f"interreflection: {rays} rays per vertex instead of {settings.bounce_rays} for {vertices} vertices "
+            f"(the ray budget is {MAX_RAYS:,} rays: casting time and the records' memory grow with it)"
+        )
+    transfer = build_transfer(meshes, rays)
     if not transfer.any_hit:
         plan.skipped.append(("bounce", "no surface sees another: every ray from every vertex leaves the scene"))
         return []

@@ -175,3 +175,21 @@ def test_sender_albedo_twin(glsl):
         "lib/bounce.glsl", "bounce_sender_albedo(b, m, s)", {"b": base, "m": metallic, "s": spec}, out_components=3
     )
     assert_close_fp32(gpu, sender_albedo(base, metallic, spec), rtol=1e-4, atol=1e-6, what="bounce_sender_albedo")
+
+
+def test_a_mesh_too_large_for_the_ray_budget_casts_fewer_rays_then_none(monkeypatch):
+    """Casting time and the records' memory grow with vertices x rays: past the budget each vertex
+    casts fewer rays (a warning says how many), and below MIN_RAYS the pass is skipped with a warning."""
+    from app.render import bounce
+    from app.render.plan import plan_frame
+
+    s = open_book_scene()  # 1250 vertices
+    monkeypatch.setattr(bounce, "MAX_RAYS", 20_000)
+    plan = plan_frame(s, settings())
+    first = next(p for p in plan.passes if p.name == "bounce[1]")
+    assert first.params.transfer.rays == 16 and "16 rays" in first.reason
+    assert any("16 rays per vertex instead of 64" in w for w in plan.warnings)
+    monkeypatch.setattr(bounce, "MAX_RAYS", 4_000)
+    plan = plan_frame(s, settings())
+    assert not any(n.startswith("bounce") for n in plan.names())
+    assert any("interreflection skipped: 1250 vertices" in w for w in plan.warnings)
