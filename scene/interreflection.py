@@ -205,7 +205,9 @@ def one_rings(positions, faces, first, inverse) -> tuple[np.ndarray, np.ndarray,
     # every copy of a welded vertex has its ring
     counts = counts_w[inverse]
     offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-    idx = np.concatenate([np.arange(start_w[u], start_w[u + 1]) for u in inverse]) if len(inverse) else np.zeros(0, int)
+    # entry j of vertex i is its welded vertex's entry (j - offsets[i]): no loop over the vertices
+    within = np.arange(offsets[-1]) - np.repeat(offsets[:-1], counts)
+    idx = np.repeat(start_w[inverse], counts) + within
     return offsets, first[pairs[idx, 1]], w[idx].astype(np.float32)
 
 

@@ -2,8 +2,8 @@
 
 The image is the mean of ``passes`` (>= 2) independent renders with different seeds; its noise
 floor is :func:`app.truth.compare.image_error` between the means of the first and second half of
-the passes. Each pass is rendered in chunks of at most ``CHUNK_SPP`` samples per pixel (a progress
-bar counts samples).
+the passes. Each pass is rendered in chunks of at most ``CHUNK_SPP`` samples per pixel
+(app/truth/description.py; a progress bar counts samples).
 
 Results are cached by a hash of everything that affects them: the exported description (world-space
 geometry, media, BSDFs, baked textures, lights, camera, size), samples, passes, seed, variant,
@@ -27,7 +27,7 @@ from app.atomic_write import atomic_path, write_text_atomic
 from scene.graph import Scene
 
 from .compare import image_error, object_mask
-from .description import CHUNK_SPP, chunk_plan, path_trace  # noqa: F401  (chunk_plan: part of this module's API)
+from .description import path_trace
 from .export import ReferenceDescription, describe
 
 EXPORT_VERSION = 2  # bump when the exporter changes what a scene renders as

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from app.truth import export as ex
-from app.truth.reference import ReferenceRequest, chunk_plan
+from app.truth.description import chunk_plan
+from app.truth.reference import ReferenceRequest
 from scene.graph import CameraNode, LightNode, MeshNode, Scene
 from scene.materials import Material
 from scene.optics.media import preset
