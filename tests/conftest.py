@@ -23,7 +23,7 @@ _hyp_settings.load_profile(os.environ.get("SKINLAB_HYPOTHESIS") or ("ci" if os.e
 
 @pytest.fixture(scope="session")
 def ctx():
-    from app.gl.context import create_headless_context
+    from skinlab.gl.context import create_headless_context
 
     c = create_headless_context()
     yield c
@@ -31,7 +31,7 @@ def ctx():
 
 @pytest.fixture(scope="session")
 def glsl(ctx):
-    from app.gl.glsl_eval import GLSLEvaluator
+    from skinlab.gl.glsl_eval import GLSLEvaluator
 
     return GLSLEvaluator(ctx)
 
@@ -39,7 +39,7 @@ def glsl(ctx):
 @pytest.fixture(scope="module")
 def renderer(ctx):
     """One renderer per test module (its GPU caches are reset between modules)."""
-    from app.render.renderer import Renderer
+    from skinlab.render.renderer import Renderer
 
     r = Renderer(ctx)
     yield r
@@ -54,7 +54,7 @@ def multiple_only(monkeypatch):
 
     import numpy as np
 
-    import app.render.boundary as render_boundary
+    import skinlab.render.boundary as render_boundary
 
     whole = render_boundary.material_boundary
 

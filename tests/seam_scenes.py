@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from scene.graph import CameraNode, MeshNode, Scene
-from scene.materials import Material
-from scene.mesh import Mesh
+from skinlab.scene.graph import CameraNode, MeshNode, Scene
+from skinlab.scene.materials import Material
+from skinlab.scene.mesh import Mesh
 from tests.tsd_scenes import light_from, skin
 
 UV_SCALE = 0.25  # UV units per scene unit in every layout (the same mm per texel)

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from scene import transform as tf
-from scene.graph import CameraNode, LightNode, MeshNode, Scene
-from scene.materials import Material
-from scene.mesh import Mesh
+from skinlab.scene import transform as tf
+from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Scene
+from skinlab.scene.materials import Material
+from skinlab.scene.mesh import Mesh
 
 
 def quad_mesh(name, x0, x1, y0, y1, z=0.0, uv=((0, 0), (1, 1))) -> Mesh:
@@ -76,8 +76,8 @@ def pixel_x(width: int, half: float) -> np.ndarray:
 
 def exact_profile(model, medium):
     """The exact radial profile of a material's sss_model (R(r_mm) -> (N, 3))."""
-    from scene.optics.profiles import get_profile
-    from scene.optics.tsd import MODEL_PROFILES
+    from skinlab.scene.optics.profiles import get_profile
+    from skinlab.scene.optics.tsd import MODEL_PROFILES
 
     return lambda r: get_profile(MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
 
@@ -85,13 +85,13 @@ def exact_profile(model, medium):
 def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab") -> float:
     """How far (mm, along +x) slab_scene's shadow edge moves for the light feeding the diffusion:
     the light travels along (1, 0, -1), so the diffusion is centred sin(theta_t) z0 further along +x
-    than where the light entered (oblique entry, scene/optics/oblique.py; the frame looks the shadow
+    than where the light entered (oblique entry, skinlab/scene/optics/oblique.py; the frame looks the shadow
     up at the entry point). Edge responses of the multiply scattered light are centred there. The
     light is sampled at the centres of a grid of grid_mm (irradiance texels, or pixels for the
     screen-space techniques) whose boundaries fall on x = 0: the sampled edge moves by the shift
     rounded to whole cells."""
-    from scene.optics.oblique import entry_offset
-    from scene.optics.tsd import material_medium
+    from skinlab.scene.optics.oblique import entry_offset
+    from skinlab.scene.optics.tsd import material_medium
 
     medium = material_medium(scene.find(node).material.values)
     z0 = np.asarray(medium.mfp_arr)  # 1 / mu_t' (isotropic phase): the shaders' u_sss_mfp

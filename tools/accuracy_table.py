@@ -1,5 +1,5 @@
 """Regenerate the accuracy table of docs/accuracy.md: every profile model against the Monte Carlo
-reference (scene/optics/montecarlo.py) for reduced albedos 0.1 .. 0.99.
+reference (skinlab/scene/optics/montecarlo.py) for reduced albedos 0.1 .. 0.99.
 
     .venv/bin/python tools/accuracy_table.py [--photons 200000] [--eta 1.3] [--seed 1] [--out FILE]
 
@@ -22,9 +22,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from scene.optics.media import Medium  # noqa: E402
-from scene.optics.montecarlo import simulate  # noqa: E402
-from scene.optics.profiles import evaluate_profile, total_reflectance  # noqa: E402
+from skinlab.scene.optics.media import Medium  # noqa: E402
+from skinlab.scene.optics.montecarlo import simulate  # noqa: E402
+from skinlab.scene.optics.profiles import evaluate_profile, total_reflectance  # noqa: E402
 
 ALBEDOS = (0.1, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95, 0.99)
 MODELS = ("dipole", "dipole+ss", "pbd", "burley", "blender-burley", "gaussians")
@@ -95,7 +95,7 @@ def main(argv=None):
     a = p.parse_args(argv)
     text = markdown(measure(a.photons, a.eta, a.seed, not a.no_progress), a.photons, a.eta, a.seed)
     if a.out:
-        from app.atomic_write import write_text_atomic
+        from skinlab.atomic_write import write_text_atomic
 
         write_text_atomic(a.out, text)
     else:

@@ -10,7 +10,7 @@ directional albedo at that cosine, boundary reflection included: 8x8 pixels, 102
 one directional light of irradiance 1 from 0, 45 and 70 degrees seen from above (16x16, 1024 spp);
 `dark` is the same boundary over a medium that returns nothing (what the boundary itself reflects).
 Model (sky rows only): multiple scattering A_ms(mu) + single scattering A_ss(mu) + the boundary's
-reflectance R(mu) (scene/optics/boundary.py, rough_dielectric.py). `--roughness` renders the slab
+reflectance R(mu) (skinlab/scene/optics/boundary.py, rough_dielectric.py). `--roughness` renders the slab
 again at other roughnesses (the truth's boundary: GGX alpha = roughness^2, smooth below 0.032).
 The standard error is from the difference of the reference's two halves. A directional light behind
 a smooth dielectric never reaches the medium in the path tracer (no path connects to a delta light
@@ -24,20 +24,20 @@ import sys
 
 import numpy as np
 
-from app.bench.truth_ledger import REFERENCE_SCENES
-from app.gl.context import create_headless_context
-from app.render.boundary import boundary_ggx_alpha
-from app.render.renderer import Renderer
-from app.render.settings import RenderSettings
-from app.truth.reference import ReferenceRequest, render_reference
-from scene.graph import CameraNode, LightNode, MeshNode, Scene
-from scene.materials import Material
-from scene.optics.boundary import boundary_tables, single_ambient_albedo
-from scene.optics.rough_dielectric import SMOOTH_ALPHA, rough_albedos
-from scene.optics.tsd import material_medium
-from scene.primitives import box_mesh
-from scene.scenefile import load_scene
-from scene.transform import look_at_rotation
+from skinlab.bench.truth_ledger import REFERENCE_SCENES
+from skinlab.gl.context import create_headless_context
+from skinlab.render.boundary import boundary_ggx_alpha
+from skinlab.render.renderer import Renderer
+from skinlab.render.settings import RenderSettings
+from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Scene
+from skinlab.scene.materials import Material
+from skinlab.scene.optics.boundary import boundary_tables, single_ambient_albedo
+from skinlab.scene.optics.rough_dielectric import SMOOTH_ALPHA, rough_albedos
+from skinlab.scene.optics.tsd import material_medium
+from skinlab.scene.primitives import box_mesh
+from skinlab.scene.scenefile import load_scene
+from skinlab.scene.transform import look_at_rotation
+from skinlab.truth.reference import ReferenceRequest, render_reference
 
 
 def slab(material: Material, view_deg: float, light_deg: float | None) -> Scene:

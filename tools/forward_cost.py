@@ -1,6 +1,6 @@
 """Where the plain frame's time goes (the frame `skinlab bench peer` times against pyrender): the head
 with sss_model none and no shadow-casting light, rendered with one part of
-shaders/passes/forward.frag taken out or one texture setting changed, the variants interleaved
+skinlab/shaders/passes/forward.frag taken out or one texture setting changed, the variants interleaved
 round by round so that a change of machine load hits all alike. Whole frames with the colour+depth
 read-back, as the peer bench times them. The variants are measurements only (copies of shaders/
 under a temporary folder); none of them is what the renderer runs.
@@ -49,12 +49,12 @@ def main(argv=None) -> int:
     ap.add_argument("--size", type=int, default=640, help="frame width and height (default 640)")
     ap.add_argument("--rounds", type=int, default=7, help="timed rounds (default 7)")
     args = ap.parse_args(argv)
-    from app.bench.shader_variants import edited_shader_root
-    from app.gl.context import create_headless_context, describe
-    from app.gl.shader_source import ShaderLibrary
-    from app.render.renderer import Renderer
-    from app.render.settings import RenderSettings
-    from scene.scenefile import load_scene
+    from skinlab.bench.shader_variants import edited_shader_root
+    from skinlab.gl.context import create_headless_context, describe
+    from skinlab.gl.shader_source import ShaderLibrary
+    from skinlab.render.renderer import Renderer
+    from skinlab.render.settings import RenderSettings
+    from skinlab.scene.scenefile import load_scene
 
     ctx = create_headless_context()
     scene = load_scene(None)

@@ -37,11 +37,11 @@ SETTINGS = (
 
 
 def main(argv: list[str]) -> int:
-    from app.gl.context import create_headless_context, describe
-    from app.render.renderer import Renderer
-    from app.render.settings import RenderSettings, parse_size
-    from scene.interreflection import build_transfer, clear_cache
-    from scene.scenefile import load_scene
+    from skinlab.gl.context import create_headless_context, describe
+    from skinlab.render.renderer import Renderer
+    from skinlab.render.settings import RenderSettings, parse_size
+    from skinlab.scene.interreflection import build_transfer, clear_cache
+    from skinlab.scene.scenefile import load_scene
 
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--size", default="1920x1080")
@@ -54,7 +54,7 @@ def main(argv: list[str]) -> int:
     r = Renderer(ctx)
     out = {"gl": describe(ctx), "size": [w, h], "loadavg": list(os.getloadavg()), "results": []}
     print(out["gl"], flush=True)
-    for name in ("assets/scenes/head.toml", "assets/scenes/bunny-skimmilk.toml"):
+    for name in ("head", "bunny-skimmilk"):
         s = load_scene(name)
         clear_cache()
         t0 = time.perf_counter()

@@ -6,7 +6,7 @@ the cases a 2-core CPU cannot make quiet enough (the head at its real index, doc
     python tools/gpu_reference.py render DIR/NAME.npz --spp N --out RESULT.npz  # there: numpy + Mitsuba only
     python tools/gpu_reference.py store SCENE.toml RESULT.npz                   # here: into the cache
 
-``render`` imports only app/truth/description.py (no scene graph, no GL), so the GPU machine needs
+``render`` imports only skinlab/truth/description.py (no scene graph, no GL), so the GPU machine needs
 nothing but numpy and Mitsuba. ``store`` files the result under the cache key of the request it was
 rendered with (size, spp, passes, seed, variant), so `load_truth` / tools/truth_table.py find it
 (SKINLAB_TRUTH=96:SPP:cuda_ad_rgb)."""
@@ -30,9 +30,9 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def export(args) -> int:
-    from app.truth.description import save
-    from app.truth.export import describe
-    from scene.scenefile import load_scene
+    from skinlab.scene.scenefile import load_scene
+    from skinlab.truth.description import save
+    from skinlab.truth.export import describe
 
     scene = load_scene(args.scene)
     w, h = _size(args.size)
@@ -47,7 +47,7 @@ def export(args) -> int:
 def render(args) -> int:
     import mitsuba as mi
 
-    from app.truth.description import load, path_trace
+    from skinlab.truth.description import load, path_trace
 
     mi.set_variant(args.variant)
     desc = load(Path(args.description))
@@ -74,10 +74,10 @@ def render(args) -> int:
 
 
 def store(args) -> int:
-    from app.truth.compare import image_error, object_mask
-    from app.truth.export import describe
-    from app.truth.reference import Reference, ReferenceRequest, reference_key, store_reference
-    from scene.scenefile import load_scene
+    from skinlab.scene.scenefile import load_scene
+    from skinlab.truth.compare import image_error, object_mask
+    from skinlab.truth.export import describe
+    from skinlab.truth.reference import Reference, ReferenceRequest, reference_key, store_reference
 
     with np.load(args.result) as z:
         image, a, b = z["image"], z["half_a"], z["half_b"]

@@ -1,5 +1,5 @@
 """Where the texture-space irradiance pass's time goes: the pass on the head at the default settings,
-run again with one part of shaders/passes/tsd_irradiance.frag (or of lib/shadow.glsl) taken out,
+run again with one part of skinlab/shaders/passes/tsd_irradiance.frag (or of lib/shadow.glsl) taken out,
 the variants interleaved round by round so that a change of machine load hits all alike; the
 forward pass of the same frame beside it. The variants are measurements only (copies of shaders/
 under a temporary folder); none of them is what the renderer runs.
@@ -17,7 +17,7 @@ change of the shaders saved.
 rasterises the mesh's triangles in UV space; texels no triangle covers are only cleared).
 
 With translucency, the pass ends with the fill of its light-through record's gutter (across UV seams
-and one ring past the other chart borders, app/render/techniques/tsd/passes.py through_fill); that
+and one ring past the other chart borders, skinlab/render/techniques/tsd/passes.py through_fill); that
 fill is also timed alone, interleaved, and printed as its part of the base pass.
 
 Variants: base (as shipped), pcf_1tap (one shadow
@@ -69,9 +69,9 @@ VARIANTS = {
 
 
 def coverage(rounds: int) -> int:
-    from app.gl.context import create_headless_context, describe
-    from app.render.renderer import Renderer
-    from app.render.settings import RenderSettings
+    from skinlab.gl.context import create_headless_context, describe
+    from skinlab.render.renderer import Renderer
+    from skinlab.render.settings import RenderSettings
     from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
     ctx = create_headless_context()
@@ -111,12 +111,12 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.coverage:
         return coverage(args.rounds)
-    from app.bench.shader_variants import edited_shader_root
-    from app.gl.context import create_headless_context, describe
-    from app.gl.shader_source import SHADER_ROOT, ShaderLibrary
-    from app.render.renderer import Renderer
-    from app.render.settings import RenderSettings
-    from scene.scenefile import load_scene
+    from skinlab.bench.shader_variants import edited_shader_root
+    from skinlab.gl.context import create_headless_context, describe
+    from skinlab.gl.shader_source import SHADER_ROOT, ShaderLibrary
+    from skinlab.render.renderer import Renderer
+    from skinlab.render.settings import RenderSettings
+    from skinlab.scene.scenefile import load_scene
 
     ctx = create_headless_context()
     scene = load_scene(args.scene)
@@ -150,9 +150,9 @@ def main(argv=None) -> int:
             irr = next(p for p in res.plan.passes if p.kind == "tsd_irradiance")
             fwd = next(p for p in res.plan.passes if p.kind == "forward")
             runs[name] = (r, r.last_frame, irr, fwd)
-        from app.render.lights import SHADOW_SLOTS
-        from app.render.techniques.tsd.passes import store, through_fill
-        from app.render.techniques.tsd.seams import node_border_strips
+        from skinlab.render.lights import SHADOW_SLOTS
+        from skinlab.render.techniques.tsd.passes import store, through_fill
+        from skinlab.render.techniques.tsd.seams import node_border_strips
 
         base_irr = runs["base"][2]
         fill_times = []

@@ -1,9 +1,9 @@
-"""Write the slab meshes of the reference scenes (assets/meshes/*.obj): `python tools/make_reference_meshes.py`.
+"""Write the slab meshes of the reference scenes (skinlab/assets/meshes/*.obj): `python tools/make_reference_meshes.py`.
 Sizes in millimetres (the scenes say mm_per_unit = 1)."""
 
 from pathlib import Path
 
-from scene.primitives import box_mesh, write_obj
+from skinlab.scene.primitives import box_mesh, write_obj
 
 OUT = Path(__file__).resolve().parents[1] / "assets" / "meshes"
 MESHES = {

@@ -20,16 +20,16 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from scipy.ndimage import distance_transform_edt  # noqa: E402
 
-from app.bench.sweep import QUICK  # noqa: E402
-from app.bench.truth_ledger import REFERENCE_SCENES, TruthSpec, load_truth  # noqa: E402
-from app.gl.context import create_headless_context  # noqa: E402
-from app.render.renderer import Renderer  # noqa: E402
-from app.render.settings import RenderSettings  # noqa: E402
-from app.render.techniques.tsd.passes import frame_nodes, read_texture  # noqa: E402
-from app.truth.compare import image_error  # noqa: E402
-from scene.mesh import with_atlas  # noqa: E402
-from scene.scenefile import load_scene  # noqa: E402
-from scene.uv_seams import seam_extension  # noqa: E402
+from skinlab.bench.sweep import QUICK  # noqa: E402
+from skinlab.bench.truth_ledger import REFERENCE_SCENES, TruthSpec, load_truth  # noqa: E402
+from skinlab.gl.context import create_headless_context  # noqa: E402
+from skinlab.render.renderer import Renderer  # noqa: E402
+from skinlab.render.settings import RenderSettings  # noqa: E402
+from skinlab.render.techniques.tsd.passes import frame_nodes, read_texture  # noqa: E402
+from skinlab.scene.mesh import with_atlas  # noqa: E402
+from skinlab.scene.scenefile import load_scene  # noqa: E402
+from skinlab.scene.uv_seams import seam_extension  # noqa: E402
+from skinlab.truth.compare import image_error  # noqa: E402
 
 
 def pass_key(name: str) -> str:

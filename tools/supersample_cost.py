@@ -12,10 +12,10 @@ import os
 import statistics
 import sys
 
-from app.gl.context import create_headless_context
-from app.render.renderer import Renderer
-from app.render.settings import RenderSettings
-from scene.scenefile import load_scene
+from skinlab.gl.context import create_headless_context
+from skinlab.render.renderer import Renderer
+from skinlab.render.settings import RenderSettings
+from skinlab.scene.scenefile import load_scene
 
 FACTORS = (1, 2, 4)
 PASSES = ("forward", "tonemap", "shadow[key]")

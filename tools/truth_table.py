@@ -2,13 +2,13 @@
 96x96, 256 spp (the quick ledger's references; nothing is rendered by Mitsuba here): relative L1 on
 4x4 blocks and per pixel, per-channel energy, the worst 8x8 block (luminance), issue 12's block
 target (8x8 blocks more than 15 % off among those the truth's noise allows to judge: over/judged,
-app/truth/compare.py judged_blocks), the truth's noise.
+skinlab/truth/compare.py judged_blocks), the truth's noise.
 
     python tools/truth_table.py [SCENES] [TECHNIQUES]      # comma-separated; default all
 
 SKINLAB_SSS_MODEL=<model> overrides every material's sss_model (burley, dipole, pbd, ...).
 SKINLAB_SUPERSAMPLE=N renders the frames at N x N samples per pixel (default: the ledger's,
-app/bench/truth_ledger.py TRUTH_SUPERSAMPLE; 1 = each pixel's centre only).
+skinlab/bench/truth_ledger.py TRUTH_SUPERSAMPLE; 1 = each pixel's centre only).
 SKINLAB_TRUTH=192 compares with the 192x192, 1024-spp references instead (frames at 192x192; the
 references must be cached: `skinlab reference SCENE --size 192x192 --spp 1024`), and
 SKINLAB_TRUTH=SIZE:SPP:VARIANT:SEED with a reference rendered elsewhere (tools/gpu_reference.py).
@@ -24,19 +24,19 @@ import sys
 
 import numpy as np
 
-from app.bench.sweep import QUICK
-from app.bench.truth_ledger import (
+from skinlab.bench.sweep import QUICK
+from skinlab.bench.truth_ledger import (
     REFERENCE_SCENES,
     TRUTH_SUPERSAMPLE,
     TruthSpec,
     load_truth,
     reference_scene_names,
 )
-from app.gl.context import create_headless_context
-from app.render.renderer import Renderer
-from app.render.settings import RenderSettings
-from app.truth.compare import image_error, judged_blocks, relative_difference
-from scene.scenefile import load_scene
+from skinlab.gl.context import create_headless_context
+from skinlab.render.renderer import Renderer
+from skinlab.render.settings import RenderSettings
+from skinlab.scene.scenefile import load_scene
+from skinlab.truth.compare import image_error, judged_blocks, relative_difference
 
 
 def truth_spec(text: str) -> TruthSpec:

@@ -1,12 +1,12 @@
-"""Interreflection's NumPy reference (scene/interreflection.py): ray directions, records and gather
+"""Interreflection's NumPy reference (skinlab/scene/interreflection.py): ray directions, records and gather
 against analytic form factors and a furnace."""
 
 import numpy as np
 import pytest
 import trimesh
 
-from scene.graph import MeshNode
-from scene.interreflection import (
+from skinlab.scene.graph import MeshNode
+from skinlab.scene.interreflection import (
     bounce_irradiance,
     build_transfer,
     clear_cache,
@@ -16,9 +16,9 @@ from scene.interreflection import (
     smooth,
     weld,
 )
-from scene.materials import Material
-from scene.mesh import Mesh
-from scene.primitives import box_mesh
+from skinlab.scene.materials import Material
+from skinlab.scene.mesh import Mesh
+from skinlab.scene.primitives import box_mesh
 
 # Form factor between two unit squares sharing an edge at a right angle (Howell, "A Catalog of
 # Radiation Heat Transfer Configuration Factors", C-14; Hottel's value 0.20004)

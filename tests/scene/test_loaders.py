@@ -1,13 +1,12 @@
-from pathlib import Path
-
 import numpy as np
 import pytest
 import trimesh
 
-from scene.loaders import load_mesh_file
-from scene.scenefile import load_scene
+from skinlab.resources import assets_root
+from skinlab.scene.loaders import load_mesh_file
+from skinlab.scene.scenefile import load_scene
 
-ASSETS = Path(__file__).resolve().parents[2] / "assets"
+ASSETS = assets_root()
 
 
 def two_level_glb(path):
@@ -91,7 +90,7 @@ def test_bunny_without_uvs_gets_an_atlas_or_a_clear_error():
 
 
 def _grid_mesh(n=6):
-    from scene.mesh import Mesh
+    from skinlab.scene.mesh import Mesh
 
     xs, ys = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n))
     pos = np.stack([xs.ravel(), ys.ravel(), np.sin(3 * xs.ravel()) * 0.2], axis=1)
@@ -105,7 +104,7 @@ def test_atlas_is_cached_by_mesh_content(tmp_path, monkeypatch, capsys):
     nothing, and equals the first; other geometry misses; a damaged cache file is remade."""
     import xatlas
 
-    from scene.mesh import generate_atlas
+    from skinlab.scene.mesh import generate_atlas
 
     monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path))
     first = _grid_mesh()
@@ -139,7 +138,7 @@ def test_atlas_is_cached_by_mesh_content(tmp_path, monkeypatch, capsys):
 def test_generated_atlases_leave_the_loader_cache_alone(tmp_path):
     """generate_uvs (and texture-space diffusion on a mesh without UVs) give the scene an atlased
     copy: loading the file again still gives the mesh as the file has it."""
-    from scene.scenefile import load_scene
+    from skinlab.scene.scenefile import load_scene
 
     scene_file = tmp_path / "s.toml"
     scene_file.write_text(f'[[meshes]]\nfile = "{ASSETS / "stanford-bunny" / "bunny.ply"}"\ngenerate_uvs = true\n')

@@ -1,12 +1,12 @@
 """docs/scenes.md is generated from the declarations: it must be up to date and cover every key."""
 
-from scene.materials import PRINCIPLED_PARAMS
-from scene.scene_docs import DOC_PATH, main, scenes_markdown
-from scene.scenefile import SCENE_FILE_KEYS
+from skinlab.scene.materials import PRINCIPLED_PARAMS
+from skinlab.scene.scene_docs import DOC_PATH, main, scenes_markdown
+from skinlab.scene.scenefile import SCENE_FILE_KEYS
 
 
 def test_docs_scenes_md_is_up_to_date():
-    assert DOC_PATH.read_text(encoding="utf-8") == scenes_markdown(), "run: python -m scene.scene_docs"
+    assert DOC_PATH.read_text(encoding="utf-8") == scenes_markdown(), "run: python -m skinlab.scene.scene_docs"
     assert main(["--check"]) == 0
 
 
@@ -18,7 +18,7 @@ def test_every_key_and_parameter_is_documented_with_its_meaning():
             assert f"| `{k.name}` |" in text and k.doc
     for p in PRINCIPLED_PARAMS:
         assert f"| `{p.name}` |" in text and p.doc, p.name
-    # one meaning for the subsurface pair, the same as the code's (scene/optics/tsd.material_medium)
+    # one meaning for the subsurface pair, the same as the code's (skinlab/scene/optics/tsd.material_medium)
     radius = next(p for p in PRINCIPLED_PARAMS if p.name == "subsurface_radius")
     colour = next(p for p in PRINCIPLED_PARAMS if p.name == "subsurface_color")
     assert "R = 4 pi l" in radius.doc and radius.unit == "mm"
@@ -27,10 +27,10 @@ def test_every_key_and_parameter_is_documented_with_its_meaning():
 
 
 def test_a_declared_key_change_makes_the_docs_stale(monkeypatch):
-    from scene import scenefile
+    from skinlab.scene import scenefile
 
     changed = dict(SCENE_FILE_KEYS)
     changed["[scene]"] = changed["[scene]"][:1]
-    monkeypatch.setattr("scene.scene_docs.SCENE_FILE_KEYS", changed)
+    monkeypatch.setattr("skinlab.scene.scene_docs.SCENE_FILE_KEYS", changed)
     assert scenes_markdown() != DOC_PATH.read_text(encoding="utf-8")
     assert scenefile.SCENE_FILE_KEYS["[scene]"][1].name == "mm_per_unit"

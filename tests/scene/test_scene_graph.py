@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
 
-from scene import transform as tf
-from scene.graph import CameraNode, LightNode, MeshNode, Node, Scene
-from scene.materials import Material
-from scene.mesh import Mesh
+from skinlab.scene import transform as tf
+from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Node, Scene
+from skinlab.scene.materials import Material
+from skinlab.scene.mesh import Mesh
 
 
 def tri_mesh():
@@ -86,7 +86,7 @@ def test_mesh_validation_and_degenerate_normals():
 
 
 def test_tangents_follow_uv_u_direction():
-    from scene.mesh import compute_tangents
+    from skinlab.scene.mesh import compute_tangents
 
     p = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0]], np.float32)
     n = np.tile([0, 0, 1.0], (3, 1))
@@ -96,7 +96,7 @@ def test_tangents_follow_uv_u_direction():
 
 
 def test_param_clamp_keeps_values_in_range_for_widgets():
-    from scene.materials import PRINCIPLED_PARAMS
+    from skinlab.scene.materials import PRINCIPLED_PARAMS
 
     pm = {p.name: p for p in PRINCIPLED_PARAMS}
     assert pm["roughness"].clamp(3.0) == 1.0 and pm["roughness"].clamp(-1) == 0.0

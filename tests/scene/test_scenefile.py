@@ -1,11 +1,10 @@
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-from scene.scenefile import DEFAULT_SCENE, SceneFileError, load_scene
+from skinlab.resources import assets_root
+from skinlab.scene.scenefile import DEFAULT_SCENE, SceneFileError, load_scene
 
-ASSETS = Path(__file__).resolve().parents[2] / "assets"
+ASSETS = assets_root()
 
 
 def write(tmp_path, text):

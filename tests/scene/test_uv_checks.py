@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from scene.mesh import Mesh
-from scene.scenefile import DEFAULT_SCENE, load_scene
-from scene.uv_checks import analyse_uvs
+from skinlab.scene.mesh import Mesh
+from skinlab.scene.scenefile import DEFAULT_SCENE, load_scene
+from skinlab.scene.uv_checks import analyse_uvs
 
 QUAD_UV = [[0, 0], [1, 0], [1, 1], [0, 1]]
 QUAD_IDX = [[0, 1, 2], [0, 2, 3]]

@@ -1,10 +1,10 @@
-"""Seam extensions (scene/uv_seams.py): seam edges found, the surface across a seam unfolded into the
+"""Seam extensions (skinlab/scene/uv_seams.py): seam edges found, the surface across a seam unfolded into the
 owner chart's frame exactly where the layout is rigid, never over the owner's own chart."""
 
 import numpy as np
 import pytest
 
-from scene.uv_seams import charts, clip_triangles, seam_edges, seam_extension, seam_transform
+from skinlab.scene.uv_seams import charts, clip_triangles, seam_edges, seam_extension, seam_transform
 from tests.seam_scenes import TEXELS, UV_SCALE, plane_mesh
 
 
@@ -121,7 +121,7 @@ def test_clip_triangles_keeps_exactly_the_far_side():
 def test_seam_band_from_the_kernel():
     from types import SimpleNamespace
 
-    from app.render.techniques.tsd.seams import SEAM_BAND_MAX_TEXELS, seam_band_texels
+    from skinlab.render.techniques.tsd.seams import SEAM_BAND_MAX_TEXELS, seam_band_texels
 
     k = SimpleNamespace(steps=(SimpleNamespace(variance_mm2=0.25), SimpleNamespace(variance_mm2=4.0)))
     assert seam_band_texels(k, 1.0) == 8  # 3 x 2 mm / 1 mm + 2 = 8 texels
@@ -132,7 +132,7 @@ def test_seam_band_from_the_kernel():
 def test_border_bands_lie_outside_their_charts():
     """Every chart border edge (the plane's outline, and both sides of the cut) gets a strip of gutter
     `band` wide outside it: depth 0 on the edge, `band` at the far side, never over a chart."""
-    from scene.uv_seams import border_bands, border_edges
+    from skinlab.scene.uv_seams import border_bands, border_edges
 
     n, band = 8, 4.0 / TEXELS
     assert len(border_edges(plane_mesh(None, n=n))[0]) == 4 * n
@@ -166,10 +166,10 @@ def _in_triangles(tri: np.ndarray, p: np.ndarray) -> np.ndarray:
 
 
 def test_border_strips_hold_every_point_near_a_chart_outside_it():
-    """border_strips (the light-through record's fill, app/render/techniques/tsd/passes.py) covers
+    """border_strips (the light-through record's fill, skinlab/render/techniques/tsd/passes.py) covers
     every point outside the charts within `out` of one - beside an edge and past a convex corner - and
     nothing farther than out (plus its inner margin: it reaches `inside` into the chart)."""
-    from scene.uv_seams import border_edges, border_strips
+    from skinlab.scene.uv_seams import border_edges, border_strips
 
     m = plane_mesh("rotate", n=4)
     out, inside = 3.0 / TEXELS, 1.0 / TEXELS

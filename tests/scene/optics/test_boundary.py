@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics import boundary as b
-from scene.optics.montecarlo import chandrasekhar_h, exact_albedo_isotropic, simulate
-from scene.optics.single_scattering import single_scatter_brdf
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics import boundary as b
+from skinlab.scene.optics.montecarlo import chandrasekhar_h, exact_albedo_isotropic, simulate
+from skinlab.scene.optics.single_scattering import single_scatter_brdf
 
 ALBEDOS = (0.0, 0.3, 0.687, 0.894, 0.99, 1.0)
 MU = np.array([0.0, 1e-4, 0.02, 0.1, 0.3, 0.5, 0.707, 0.9, 1.0])
@@ -103,7 +103,7 @@ def test_boundary_glsl_twins(glsl):
         t = b.boundary_tables((0.894, 0.687, 0.494), (0.46, 0.23, 0.126), eta)
 
         def setup(prog, t=t, eta=eta):
-            from app.gl.uniforms import set_array, set_uniforms
+            from skinlab.gl.uniforms import set_array, set_uniforms
 
             set_array(prog, "u_sss_entry", t.entry, b.ANGULAR_NODES)
             set_array(prog, "u_sss_exit", t.exit, b.ANGULAR_NODES)

@@ -5,9 +5,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from scene.optics import media
-from scene.optics.dipole import dipole_total
-from scene.optics.media import Medium
+from skinlab.scene.optics import media
+from skinlab.scene.optics.dipole import dipole_total
+from skinlab.scene.optics.media import Medium
 
 
 def test_all_twelve_presets_load_with_table_values():

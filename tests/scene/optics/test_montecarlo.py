@@ -4,10 +4,10 @@ and agreement of the analytic profiles with it."""
 import numpy as np
 import pytest
 
-from scene.optics import montecarlo as mc
-from scene.optics.dipole import dipole_profile, dipole_total
-from scene.optics.pbd import pbd_profile, pbd_total
-from scene.optics.single_scattering import single_scatter_profile
+from skinlab.scene.optics import montecarlo as mc
+from skinlab.scene.optics.dipole import dipole_profile, dipole_total
+from skinlab.scene.optics.pbd import pbd_profile, pbd_total
+from skinlab.scene.optics.single_scattering import single_scatter_profile
 
 
 def test_matches_chandrasekhar_exact_reflectance_eta1():

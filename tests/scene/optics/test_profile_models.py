@@ -8,9 +8,9 @@ from numpy.polynomial import chebyshev as C
 from scipy.integrate import quad
 from scipy.stats import kstest
 
-from scene.optics import burley, constants, dipole, fresnel, gaussians, pbd, profiles
-from scene.optics import single_scattering as ss
-from scene.optics.media import Medium, preset
+from skinlab.scene.optics import burley, constants, dipole, fresnel, gaussians, pbd, profiles
+from skinlab.scene.optics import single_scattering as ss
+from skinlab.scene.optics.media import Medium, preset
 
 
 def plane_integral(fn, upper=np.inf, points=None):

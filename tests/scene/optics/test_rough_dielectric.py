@@ -1,4 +1,4 @@
-"""The rough dielectric boundary's directional albedos (scene/optics/rough_dielectric.py): the smooth
+"""The rough dielectric boundary's directional albedos (skinlab/scene/optics/rough_dielectric.py): the smooth
 limit, energy bounds, and Mitsuba's own roughdielectric (the truth's boundary) sampled directly."""
 
 from __future__ import annotations
@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from scene.optics.fresnel import fresnel_dielectric
-from scene.optics.rough_dielectric import SMOOTH_ALPHA, ggx_g1, rough_albedos, rough_diffuse_albedos
+from skinlab.scene.optics.fresnel import fresnel_dielectric
+from skinlab.scene.optics.rough_dielectric import SMOOTH_ALPHA, ggx_g1, rough_albedos, rough_diffuse_albedos
 
 MU = np.array([1.0, 0.9, 0.7, 0.5, 0.3, 0.1, 0.01, 0.0])
 

@@ -1,4 +1,4 @@
-"""Light through thin parts (scene/optics/slab.py, shaders/lib/sss_boundary.glsl sss_slab_through): the
+"""Light through thin parts (skinlab/scene/optics/slab.py, skinlab/shaders/lib/sss_boundary.glsl sss_slab_through): the
 doubling method against Chandrasekhar's exact semi-infinite albedo, energy conservation, the
 single-scattering limit, the flat-medium Monte Carlo through a slab, the table's interpolation, the
 hard cases, and the GLSL twin."""
@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics import slab as s
-from scene.optics.boundary import albedo_isotropic, boundary_tables, table_lookup
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics import slab as s
+from skinlab.scene.optics.boundary import albedo_isotropic, boundary_tables, table_lookup
 
 
 def _exact(a, tau, mu):
@@ -114,7 +114,7 @@ def test_table_lookup_follows_the_exact_slab():
 
 @pytest.mark.parametrize("eta", [1.0, 1.4])
 def test_slab_through_glsl_twin(glsl, eta):
-    from app.gl.uniforms import set_array, set_uniforms
+    from skinlab.gl.uniforms import set_array, set_uniforms
 
     alpha, colour, mfp = np.array([0.894, 0.687, 0.0]), np.array([0.46, 0.23, 0.0]), np.array([1.3, 0.95, 0.67])
     table = s.slab_table(alpha, colour)
@@ -186,7 +186,7 @@ def test_exit_of_light_through_is_normalised_and_finite(eta):
 
 @pytest.mark.parametrize("eta", [1.0, 1.4])
 def test_slab_exit_glsl_twin(glsl, eta):
-    from app.gl.uniforms import set_array, set_uniforms
+    from skinlab.gl.uniforms import set_array, set_uniforms
 
     alpha, colour, mfp = np.array([0.894, 0.687, 0.0]), np.array([0.46, 0.23, 0.0]), np.array([1.3, 0.95, 0.67])
     table = s.slab_table(alpha, colour)

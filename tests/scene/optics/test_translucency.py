@@ -1,13 +1,13 @@
-"""Light through thin parts (scene/optics/translucency.py) and its GLSL twin (lib/sss_translucency.glsl):
+"""Light through thin parts (skinlab/scene/optics/translucency.py) and its GLSL twin (lib/sss_translucency.glsl):
 the thickness lookup in the shadow pass's distance map and the slab transmission through it."""
 
 import moderngl
 import numpy as np
 
-from app.gl.glsl_eval import assert_close_fp32
-from app.render.boundary import bind_boundary, material_boundary
-from scene.optics import translucency as tr
-from scene.optics.tsd import material_medium
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.render.boundary import bind_boundary, material_boundary
+from skinlab.scene.optics import translucency as tr
+from skinlab.scene.optics.tsd import material_medium
 from tests.tsd_scenes import skin
 
 
@@ -21,7 +21,7 @@ def _distance_texture(ctx, dist: np.ndarray):
 
 def _lookup_setup(maps, matrices, eyes, shrink, mm_per_unit, material=None):
     """A GLSLEvaluator setup binding lib/sss_translucency.glsl's uniforms and distance maps."""
-    from app.gl.uniforms import set_array, set_uniforms
+    from skinlab.gl.uniforms import set_array, set_uniforms
 
     def setup(prog):
         for slot, tex in enumerate(maps):
@@ -103,7 +103,7 @@ def test_thickness_lookup_matches_numpy_twin(ctx, glsl):
 def _slab_map(direction, size, radius, z_lit):
     """(distance map, shadow matrix, eye) of a directional light travelling along `direction` onto
     the plane z = z_lit (the slab's lit face), orthographic over a disc of `radius` around the origin
-    as app/render/passes/shadow.py fits it: each texel holds the distance of the plane along the ray
+    as skinlab/render/passes/shadow.py fits it: each texel holds the distance of the plane along the ray
     through the texel's centre."""
     d = np.asarray(direction, np.float64) / np.linalg.norm(direction)
     e1 = np.cross(d, [0.0, 1.0, 0.0])
@@ -129,7 +129,7 @@ def test_flat_slab_keeps_its_thickness():
     size, radius = 512, 40.0
     dist, m, eye = _slab_map(d, size, radius, -1.5)
     texel = 2 * radius / size
-    shrink = radius / size  # half a texel (app/render/translucency.py thickness_shrink)
+    shrink = radius / size  # half a texel (skinlab/render/translucency.py thickness_shrink)
     rng = np.random.default_rng(3)
     p = np.column_stack([rng.uniform(-25, 25, (4000, 2)), np.full(4000, 1.5)])
     nrm = np.tile([0.0, 0.0, 1.0], (4000, 1))
@@ -150,7 +150,7 @@ def test_flat_slab_keeps_its_thickness():
 
 
 def test_through_matches_slab_transmission_and_glsl(glsl):
-    """sss_through(back, d) against its twin (the exact slab transmittance, scene/optics/slab.py
+    """sss_through(back, d) against its twin (the exact slab transmittance, skinlab/scene/optics/slab.py
     slab_through) within 1e-4, for skin at eta 1 and 1.4, at the hard cases: zero thickness (nothing
     collides: 0), grazing light (finite), very thick (0); past a few mean free paths thicker passes less."""
     backs = np.array([1.0, 0.866, 0.5, 1e-3, 0.0, 1.0, 0.3, 1.0])

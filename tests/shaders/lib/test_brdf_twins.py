@@ -5,8 +5,8 @@ import itertools
 import numpy as np
 import pytest
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics import brdf
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics import brdf
 
 F32 = np.float32
 

@@ -1,8 +1,8 @@
 import numpy as np
 import pytest
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics import color
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics import color
 
 
 @pytest.fixture(scope="module")

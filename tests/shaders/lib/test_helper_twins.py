@@ -8,10 +8,10 @@ import itertools
 import numpy as np
 import pytest
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics import brdf, burley, dipole, fresnel, pbd
-from scene.optics import single_scattering as ss
-from scene.optics._profile_util import optical
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics import brdf, burley, dipole, fresnel, pbd
+from skinlab.scene.optics import single_scattering as ss
+from skinlab.scene.optics._profile_util import optical
 
 
 def f32(a):

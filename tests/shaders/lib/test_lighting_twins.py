@@ -1,7 +1,7 @@
 import numpy as np
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics import lighting
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics import lighting
 
 
 def test_perturb_normal_matches_numpy_including_degenerate_frames(glsl):
@@ -35,7 +35,7 @@ def test_inverse_square_matches_and_stays_finite_at_zero(glsl):
 
 
 def test_light_incidence_matches_numpy_for_directional_and_point_lights(glsl):
-    from app.gl.uniforms import set_array, set_uniforms
+    from skinlab.gl.uniforms import set_array, set_uniforms
 
     rng = np.random.default_rng(7)
     world = rng.normal(size=(300, 3)) * 2.0

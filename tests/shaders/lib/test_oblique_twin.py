@@ -1,13 +1,13 @@
-"""Oblique entry (shaders/lib/sss_oblique.glsl vs scene/optics/oblique.py): the diffusion of light
+"""Oblique entry (skinlab/shaders/lib/sss_oblique.glsl vs skinlab/scene/optics/oblique.py): the diffusion of light
 arriving at an angle is centred sin(theta_t) z0 along the surface from where it entered (Wang &
 Jacques 1995), and the shadow lookup point built from it. Twins within 1e-4, hard cases finite."""
 
 import numpy as np
 import pytest
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics.constants import LUMA_B, LUMA_G, LUMA_R
-from scene.optics.oblique import LUMA, entry_offset, entry_point
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics.constants import LUMA_B, LUMA_G, LUMA_R
+from skinlab.scene.optics.oblique import LUMA, entry_offset, entry_point
 
 
 def _unit(v):

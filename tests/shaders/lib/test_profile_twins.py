@@ -1,4 +1,4 @@
-"""GLSL profile library (shaders/lib/profiles_*.glsl) vs its NumPy twins, hard cases included."""
+"""GLSL profile library (skinlab/shaders/lib/profiles_*.glsl) vs its NumPy twins, hard cases included."""
 
 import itertools
 
@@ -7,10 +7,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics import burley, dipole, fresnel, gaussians, pbd
-from scene.optics import single_scattering as ss
-from scene.optics.constants import MIN_MFP_MM
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics import burley, dipole, fresnel, gaussians, pbd
+from skinlab.scene.optics import single_scattering as ss
+from skinlab.scene.optics.constants import MIN_MFP_MM
 
 F32 = np.float32
 

@@ -1,8 +1,8 @@
 import moderngl
 import numpy as np
 
-from app.gl.glsl_eval import assert_close_fp32
-from scene.optics import shadow
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene.optics import shadow
 
 
 def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl):

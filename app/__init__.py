@@ -1,1 +1,0 @@
-"""Skinlab programs: CLI, viewer, workbench, render passes and the GL context."""

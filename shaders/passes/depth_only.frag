@@ -1,6 +1,0 @@
-#version 330 core
-// Depth pre-pass (app/render/passes/forward.py): forward.vert's positions, depth only, no colour.
-// The forward pass then shades each visible pixel once (depth test <=, no depth writes). Also the
-// strip mask of texture-space diffusion's light-through record fill (with fullscreen.vert's in_pos:
-// app/render/techniques/tsd/passes.py strip_mask).
-void main() {}

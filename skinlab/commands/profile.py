@@ -1,0 +1,222 @@
+"""`skinlab profile MODEL [--preset NAME | --albedo R,G,B --mfp R,G,B] [--r LIST] [--json] [--plot PATH]`:
+evaluate a diffusion profile (skinlab/scene/optics/profiles.py) for a medium; optionally plot every model
+against the Monte Carlo reference."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from skinlab.atomic_write import atomic_path
+
+MAX_LENGTH_MM = 1e6  # a kilometre of mean free path: beyond it the profiles underflow to nothing
+DEFAULT_R = "0,0.01,0.02,0.05,0.1,0.2,0.5,1,2,5,10"
+
+
+def _triple(text: str, name: str):
+    try:
+        vals = [float(v) for v in text.split(",")]
+    except ValueError:
+        raise ValueError(f"{name}: expected a number or R,G,B numbers, got {text!r}") from None
+    if len(vals) == 1:
+        vals *= 3
+    if len(vals) != 3:
+        raise ValueError(f"{name}: expected 1 or 3 comma-separated values, got {len(vals)}")
+    if name in ("mfp", "radius") and any(abs(v) > MAX_LENGTH_MM for v in vals if np.isfinite(v)):
+        raise ValueError(f"{name}: expected lengths of at most {MAX_LENGTH_MM:g} mm, got {text!r}")
+    return vals
+
+
+def _radii(text: str):
+    try:
+        r = np.array([float(v) for v in text.split(",") if v.strip()])
+    except ValueError:
+        raise ValueError(f"r: expected comma-separated radii in mm, got {text!r}") from None
+    if r.size == 0 or np.any(~np.isfinite(r)) or np.any(r < 0):
+        raise ValueError(f"r: radii must be finite and >= 0 mm, got {text!r}")
+    return r
+
+
+def register(sub) -> None:
+    from skinlab.scene.optics.profiles import profile_names
+
+    p = sub.add_parser("profile", help="evaluate a diffusion profile R(r) for a medium")
+    p.add_argument("model", choices=profile_names() + ["all"], help="profile model ('all': every model)")
+    src = p.add_mutually_exclusive_group()
+    src.add_argument("--preset", help="Jensen 2001 Table 1 material (e.g. skin1, marble)")
+    src.add_argument(
+        "--albedo",
+        help="surface albedo (total diffuse reflectance, the colour seen from afar) R,G,B in [0, 1]; "
+        "needs --mfp or --radius",
+    )
+    p.add_argument("--mfp", help="mean free path l = 1/sigma_t' in mm, R,G,B (with --albedo)")
+    p.add_argument(
+        "--radius",
+        help="artist radius R = 4 pi l in mm, R,G,B (with --albedo): the scene files' subsurface_radius "
+        "and Blender's Subsurface Radius x Scale",
+    )
+    p.add_argument(
+        "--eta", type=float, default=None, help="relative index of refraction (default 1.3, or the preset's)"
+    )
+    p.add_argument(
+        "--albedo-method",
+        choices=("pbd", "dipole", "cycles"),
+        default="pbd",
+        help="how --albedo is inverted to the single-scattering albedo (default pbd)",
+    )
+    p.add_argument("--r", default=DEFAULT_R, help=f"radii in mm (default {DEFAULT_R})")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("--plot", help="PNG path: every model vs the Monte Carlo reference (log axes)")
+    p.add_argument(
+        "--mc-photons",
+        type=float,
+        default=2e5,
+        help="Monte Carlo photons per channel for --plot, an integer >= 2 (default 2e5)",
+    )
+    p.add_argument("--seed", type=int, default=0, help="Monte Carlo random seed for --plot (default 0)")
+    p.set_defaults(func=run)
+
+
+def medium_from_args(args):
+    from skinlab.scene.optics.media import Medium, preset
+
+    if args.albedo is not None:
+        if (args.mfp is None) == (args.radius is None):
+            raise ValueError("mfp: --albedo needs exactly one of --mfp or --radius (mm)")
+        eta = 1.3 if args.eta is None else args.eta
+        A = _triple(args.albedo, "albedo")
+        if args.mfp is not None:
+            return Medium.from_surface_albedo(A, _triple(args.mfp, "mfp"), eta, args.albedo_method, "custom")
+        return Medium.from_artist_radius(A, _triple(args.radius, "radius"), eta, args.albedo_method, "custom")
+    if args.mfp is not None or args.radius is not None:
+        raise ValueError("albedo: --mfp/--radius need --albedo R,G,B")
+    m = preset(args.preset or "skin1")
+    if args.eta is not None:
+        from skinlab.scene.optics.media import Medium as M
+
+        m = M(m.alpha, m.mfp_mm, args.eta, m.name)
+    return m
+
+
+def run(args) -> int:
+    from skinlab.scene.optics.profiles import PROFILE_MODELS, evaluate_profile, profile_names, total_reflectance
+
+    if args.seed < 0:
+        raise ValueError(f"--seed: expected an integer >= 0, got {args.seed}")
+    m = medium_from_args(args)
+    r = _radii(args.r)
+    names = profile_names() if args.model == "all" else [args.model]
+    models = {}
+    for n in names:
+        models[n] = {"R": evaluate_profile(n, r, m).tolist(), "total": total_reflectance(n, m).tolist()}
+    medium = {
+        "name": m.name,
+        "alpha": list(m.alpha),
+        "mfp_mm": list(m.mfp_mm),
+        "eta": m.eta,
+        "sigma_s_per_mm": m.sigma_s.tolist(),
+        "sigma_a_per_mm": m.sigma_a.tolist(),
+        "surface_albedo": m.surface_albedo().tolist(),
+    }
+    if args.plot:
+        if not np.isfinite(args.mc_photons) or args.mc_photons != int(args.mc_photons) or args.mc_photons < 2:
+            raise ValueError(f"--mc-photons: expected an integer >= 2, got {args.mc_photons!r}")
+        from skinlab.image_output import check_output_path
+
+        if not args.plot.lower().endswith(".png"):
+            raise ValueError(f"--plot: expected a .png path, got {args.plot!r}")
+        check_output_path(args.plot, "--plot")
+        plot_models(m, args.plot, int(args.mc_photons), args.seed)
+    notes = {n: PROFILE_MODELS[n].note for n in names if PROFILE_MODELS[n].note}
+    if args.json:
+        out = {"medium": medium, "r_mm": r.tolist(), "units": "R in 1/mm^2 per unit entering flux"}
+        if len(names) == 1:
+            out.update(model=names[0], **models[names[0]])
+        else:
+            out["models"] = models
+        if args.plot:
+            out["plot"] = args.plot
+        nulls: list[str] = []
+        out = strict_json(out, "", nulls)
+        if nulls:  # JSON has no Infinity or NaN: such numbers are null, and this says where and why
+            notes["null"] = (
+                f"{', '.join(nulls)}: not finite (a mean free path of 0 mm gives infinite coefficients), "
+                "written as null"
+            )
+        if notes:
+            out["notes"] = notes
+        print(json.dumps(out, allow_nan=False))
+    else:
+        print(
+            f"medium {m.name or '(custom)'}: alpha' = {np.round(m.alpha, 5).tolist()}, "
+            f"mfp = {np.round(m.mfp_mm, 5).tolist()} mm, eta = {m.eta}"
+        )
+        for n in names:
+            print(f"\n{n}: total reflectance R,G,B = {np.round(models[n]['total'], 5).tolist()}")
+            if n in notes:
+                print(f"  note: {notes[n]}")
+            print(f"{'r (mm)':>10} {'R':>12} {'G':>12} {'B':>12}   (1/mm^2)")
+            for ri, row in zip(r, models[n]["R"]):
+                print(f"{ri:10.4g} " + " ".join(f"{v:12.5g}" for v in row))
+        if args.plot:
+            print(f"\nwrote {args.plot}")
+    return 0
+
+
+def strict_json(value, where: str, nulls: list[str]):
+    """``value`` with every non-finite float replaced by None; the dotted paths replaced go to ``nulls``
+    (a list with any bad element is named once)."""
+    if isinstance(value, dict):
+        return {k: strict_json(v, f"{where}.{k}" if where else k, nulls) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        inner: list[str] = []
+        out = [strict_json(v, where, inner) for v in value]
+        if inner:
+            nulls.append(where)
+        return out
+    if isinstance(value, float) and not np.isfinite(value):
+        nulls.append(where)
+        return None
+    return value
+
+
+def plot_models(m, path, photons, seed=0):
+    """All models against the Monte Carlo reference, one panel per channel, log-log axes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from skinlab.scene.optics.montecarlo import simulate
+    from skinlab.scene.optics.profiles import evaluate_profile, profile_names
+
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), sharey=False)
+    for c, (ax, chan) in enumerate(zip(axes, "RGB")):
+        l = m.mfp_mm[c]
+        if l <= 0 or m.alpha[c] <= 0:
+            ax.set_title(f"{chan}: no scattering")
+            continue
+        res = simulate(m.alpha[c], m.eta, 0.0, "normal", photons, seed + c, progress=True, workers=2)
+        edges, R, se = res.scaled(l)
+        rm = res.r_mid * l
+        ok = R > 0
+        ax.errorbar(rm[ok], R[ok], yerr=se[ok], fmt="k.", ms=3, lw=0.6, label=f"Monte Carlo ({photons:.0e})")
+        r = np.geomspace(edges[1], edges[-1], 300)
+        for n in profile_names():
+            if n == "none":
+                continue
+            ax.plot(r, evaluate_profile(n, r, m)[:, c], lw=1.2, label=n)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_ylim(max(R[ok].min() * 0.3, 1e-12), R[ok].max() * 5)
+        ax.set_xlabel("r (mm)")
+        ax.set_ylabel("R(r) (1/mm^2)")
+        ax.set_title(f"{m.name or 'custom'} {chan}: alpha'={m.alpha[c]:.4g}, l={l:.3g} mm, eta={m.eta}")
+        ax.grid(True, which="both", alpha=0.25)
+    axes[0].legend(fontsize=7)
+    fig.tight_layout()
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format=Path(path).suffix.lstrip(".") or "png")
+    plt.close(fig)

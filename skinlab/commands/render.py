@@ -1,0 +1,152 @@
+"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--supersample N] [--technique NAME] [--json] [--explain]
+[--reuse]`: the technique options come from the registered techniques and --supersample from RenderSettings'
+declaration (skinlab/commands/technique_options.py)."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from skinlab.commands.technique_options import (
+    add_render_options,
+    add_technique_options,
+    render_options_from_args,
+    technique_from_args,
+)
+from skinlab.render.settings import RenderSettings, parse_size
+from skinlab.scene.materials import SSS_MODELS
+
+
+def register(sub) -> None:
+    p = sub.add_parser("render", help="render a scene headless to PNG or EXR")
+    p.add_argument(
+        "scene",
+        nargs="?",
+        help="scene file (TOML) or a mesh file (.glb .gltf .obj .ply .stl .off: default camera, two lights "
+        "and a plain grey material); default: the Lee Perry-Smith head",
+    )
+    p.add_argument(
+        "--out",
+        default="out/render.png",
+        help="output image: .png (tone mapped, 8-bit sRGB) or .exr (linear radiance, 32-bit float, with alpha) "
+        "(default out/render.png)",
+    )
+    p.add_argument("--size", default="640x640", help="image size WIDTHxHEIGHT in pixels (default 640x640)")
+    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)")
+    add_render_options(p)  # --supersample N, from RenderSettings' declarations
+    p.add_argument(
+        "--exposure",
+        type=float,
+        default=None,
+        help="linear multiplier on radiance before tone mapping, > 0 (default: the scene's [environment] exposure, "
+        "1.0 if unset); EXR output is radiance, unaffected",
+    )
+    p.add_argument(
+        "--camera-orbit",
+        type=float,
+        default=0.0,
+        metavar="DEG",
+        help="swing the scene's camera DEG degrees about the vertical axis through the meshes' centre "
+        "(positive: the camera moves to its right; default 0)",
+    )
+    p.add_argument(
+        "--sss",
+        choices=SSS_MODELS,
+        default=None,
+        help="subsurface model for every material (default: each material's own sss_model)",
+    )
+    add_technique_options(p)  # an option of another technique than --technique is an error naming it
+    p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
+    p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
+    p.add_argument(
+        "--reuse",
+        action="store_true",
+        help="the timed frame reuses the warm-up frame's results whose inputs did not change (shadow maps, "
+        "texture-space irradiance and blurs: what the viewer does while only the camera moves); --explain "
+        "lists them as 'reused: inputs unchanged since frame 1'. Default: every pass runs",
+    )
+    p.set_defaults(func=run)
+
+
+def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, prepare=None, reuse: bool = False):
+    """Render once and write each output (PNG from the tone-mapped image, EXR linear).
+    ``prepare(scene)`` may adjust the loaded scene (camera, exposure) before rendering. A warm-up
+    frame comes first; with `reuse` the written frame reuses its view-independent results."""
+    from skinlab.gl.context import create_headless_context
+    from skinlab.image_output import check_output_path, image_format, write_image
+    from skinlab.render.renderer import Renderer
+    from skinlab.scene.scenefile import load_scene
+
+    for o in outputs:
+        check_output_path(o, "--out")  # fail before rendering
+    scene = load_scene(scene_path)
+    if prepare is not None:
+        prepare(scene)
+    ctx = create_headless_context()
+    renderer = Renderer(ctx)
+    renderer.render(scene, settings, readback=False)  # warm-up: compiles and uploads are not frame time
+    if not reuse:
+        renderer.forget_reuse()  # the timed frame runs every pass
+    result = renderer.render(scene, settings)
+    written = []
+    for o in outputs:
+        pixels = result.ldr if image_format(o) == "png" else result.hdr
+        written.append(str(write_image(o, pixels)))
+    return scene, result, written, ctx
+
+
+def settings_from_args(args, w: int, h: int) -> RenderSettings:
+    return RenderSettings(
+        w,
+        h,
+        shadow_size=args.shadow_size,
+        sss_model=args.sss,
+        technique=technique_from_args(args),
+        **render_options_from_args(args),
+    )
+
+
+def run(args) -> int:
+    w, h = parse_size(args.size)
+    settings = settings_from_args(args, w, h)
+    if args.exposure is not None and not (args.exposure > 0 and args.exposure < float("inf")):
+        raise ValueError(f"--exposure: expected a finite multiplier > 0, got {args.exposure}")
+    if args.camera_orbit != args.camera_orbit or abs(args.camera_orbit) == float("inf"):
+        raise ValueError(f"--camera-orbit: expected a finite angle in degrees, got {args.camera_orbit}")
+
+    def prepare(scene):
+        if args.exposure is not None:
+            scene.environment.exposure = args.exposure
+        if args.camera_orbit:
+            scene.orbit_camera(args.camera_orbit)
+
+    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare, args.reuse)
+    for warning in result.plan.warnings:
+        print(f"warning: {warning}", file=sys.stderr)
+    if args.explain:  # the warnings were printed above, once
+        print(result.plan.explain(warnings=False), file=sys.stderr if args.json else sys.stdout)
+    if args.json:
+        from skinlab.gl.context import describe
+
+        print(
+            json.dumps(
+                {
+                    "scene": str(scene.source),
+                    "outputs": written,
+                    "size": [w, h],
+                    "gl": describe(ctx),
+                    "timings": result.timings.as_dict(),
+                    "plan": result.plan.as_dict(),
+                    "warnings": result.plan.warnings,
+                },
+                indent=2,
+            )
+        )
+    else:
+        for path in written:
+            print(f"wrote {path}")
+        print(result.timings.table())
+        for name in result.plan.reused():
+            print(f"  {name}: reused, inputs unchanged since the warm-up frame")
+    return 0

@@ -1,0 +1,184 @@
+"""GLSL source files with ``#include``, defines and exact error locations.
+
+A pass file such as ``skinlab/shaders/passes/forward.frag`` starts with ``#version`` and may say
+``#include "lib/brdf.glsl"``. :class:`ShaderLibrary` expands includes (each file once, like
+``#pragma once``), inserts ``#define`` lines for the variant, and emits ``#line LINE FILE``
+directives so that drivers that honour source-string numbers report the right file.
+
+Mesa reports every error as source string 0, so the ``#line`` numbers alone cannot tell which
+file an error is in. Each expansion therefore also keeps a table from the *flat* text (the same
+text without ``#line`` directives) to (file, line); :func:`compile_error` recompiles that flat
+text when a compile fails and maps its global line numbers back through the table. The result is
+an error like ``shaders/lib/brdf.glsl:42: error: ...`` followed by the offending source line on
+every driver (the approach of vispy's error display, with moderngl-window's include handling).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from skinlab.resources import shader_root
+
+SHADER_ROOT = shader_root()
+
+_INCLUDE = re.compile(r'^\s*#\s*include\s+[<"]([^">]+)[">]\s*(//.*)?$')
+_VERSION = re.compile(r"^\s*#\s*version\b")
+# Mesa: "0:12(5): error: ..."; NVIDIA: "0(12) : error C0000: ..."; AMD/Intel Windows: "ERROR: 0:12: ..."
+_ERROR_LOC = [
+    re.compile(r"^(?P<pre>.*?)(?P<src>\d+):(?P<line>\d+)\((?P<col>\d+)\):\s*(?P<msg>.*)$"),
+    re.compile(r"^(?P<pre>.*?)(?P<src>\d+)\((?P<line>\d+)\)\s*:\s*(?P<msg>.*)$"),
+    re.compile(r"^(?P<pre>ERROR:\s*|WARNING:\s*)(?P<src>\d+):(?P<line>\d+):\s*(?P<msg>.*)$"),
+]
+
+
+class ShaderError(Exception):
+    """A shader file could not be read or compiled. ``str()`` names file and line."""
+
+    def __init__(self, message: str, locations: list[tuple[str, int]] | None = None):
+        super().__init__(message)
+        self.locations = locations or []
+
+
+@dataclass
+class ExpandedSource:
+    """One shader stage after include expansion."""
+
+    text: str  # with #line directives: what is compiled
+    flat: str  # same code without #line directives (for error mapping)
+    line_map: list[tuple[int, int]]  # flat line index (0-based) -> (file index, 1-based line)
+    files: list[str]  # file index -> display name
+    paths: list[Path | None]  # file index -> path on disk (None for virtual files)
+
+    def locate(self, flat_line: int) -> tuple[str, int]:
+        """(file name, line) for a 1-based line number of the flat text."""
+        idx = min(max(flat_line - 1, 0), len(self.line_map) - 1)
+        f, ln = self.line_map[idx]
+        return self.files[f], ln
+
+    def source_line(self, file_name: str, line: int) -> str:
+        i = self.files.index(file_name)
+        for (f, ln), text in zip(self.line_map, self.flat.splitlines()):
+            if f == i and ln == line:
+                return text
+        return ""
+
+
+@dataclass
+class ShaderLibrary:
+    """Resolves shader files under ``root`` plus generated virtual files (e.g. constants)."""
+
+    root: Path = SHADER_ROOT
+    virtual: Mapping[str, Callable[[], str]] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        self.root = Path(self.root)
+        if not self.virtual:
+            from skinlab.scene.materials import glsl_material_uniforms
+            from skinlab.scene.optics.constants import glsl_header
+
+            self.virtual = {"skinlab/constants.glsl": glsl_header, "skinlab/material.glsl": glsl_material_uniforms}
+
+    # -- reading -------------------------------------------------------------------------
+    def display_name(self, path: Path) -> str:
+        try:
+            return str(Path(self.root.name) / path.resolve().relative_to(self.root.resolve()))
+        except ValueError:
+            return str(path)
+
+    def _read(self, name: str, including: Path | None) -> tuple[str, Path | None, str]:
+        if name in self.virtual:
+            return self.virtual[name](), None, f"<{name}>"
+        candidates = []
+        if including is not None:
+            candidates.append(including.parent / name)
+        candidates.append(self.root / name)
+        candidates.append(self.root / "lib" / name)
+        for c in candidates:
+            if c.is_file():
+                try:
+                    return c.read_text(encoding="utf-8"), c, self.display_name(c)
+                except (OSError, UnicodeDecodeError) as exc:
+                    raise ShaderError(f"{self.display_name(c)}: cannot read shader file: {exc}") from exc
+        where = f" (included from {self.display_name(including)})" if including else ""
+        raise ShaderError(f"shader file '{name}' not found{where}; looked in: " + ", ".join(str(c) for c in candidates))
+
+    # -- expansion -----------------------------------------------------------------------
+    def expand(
+        self, name: str, defines: Mapping[str, object] | None = None, aliases: Mapping[str, str] | None = None
+    ) -> ExpandedSource:
+        """Expand ``name`` (relative to the shader root) with ``defines`` for its variant. ``aliases``
+        map an include name to a file under the root for this expansion only: the forward pass's
+        ``#include "skinlab/sss_hook.glsl"`` names the technique's hook file this way."""
+        aliases = dict(aliases or {})
+        files: list[str] = []
+        paths: list[Path | None] = []
+        out: list[str] = []
+        flat: list[str] = []
+        line_map: list[tuple[int, int]] = []
+        seen: set[str] = set()
+
+        def emit(code: str, file_idx: int, line: int) -> None:
+            flat.append(code)
+            line_map.append((file_idx, line))
+            out.append(code)
+
+        def visit(fname: str, including: Path | None, include_site: tuple[int, int] | None) -> None:
+            if fname in aliases:
+                fname, including = aliases[fname], None
+            text, path, shown = self._read(fname, including)
+            key = str(path.resolve()) if path else shown
+            if key in seen:
+                return
+            seen.add(key)
+            idx = len(files)
+            files.append(shown)
+            paths.append(path)
+            lines = text.splitlines()
+            first = 0
+            if include_site is None:
+                # top file: #version first, then the variant's defines
+                if lines and _VERSION.match(lines[0]):
+                    emit(lines[0], idx, 1)
+                    first = 1
+                for k, v in (defines or {}).items():
+                    emit(f"#define {k} {'' if v is True else v}".rstrip(), idx, 0)
+            out.append(f"#line {first + 1} {idx}")
+            for i in range(first, len(lines)):
+                m = _INCLUDE.match(lines[i])
+                if m:
+                    visit(m.group(1), path, (idx, i + 1))
+                    out.append(f"#line {i + 2} {idx}")
+                    continue
+                if _VERSION.match(lines[i]):
+                    raise ShaderError(f"{shown}:{i + 1}: #version is only allowed on the first line of a pass file")
+                emit(lines[i], idx, i + 1)
+
+        visit(name, None, None)
+        return ExpandedSource("\n".join(out) + "\n", "\n".join(flat) + "\n", line_map, files, paths)
+
+
+def parse_errors(log: str, src: ExpandedSource, stage: str) -> tuple[str, list[tuple[str, int]]]:
+    """Rewrite a driver log of the *flat* source so each line names file:line and shows the code."""
+    lines_out: list[str] = []
+    locs: list[tuple[str, int]] = []
+    for raw in log.splitlines():
+        raw = raw.rstrip()
+        if not raw or set(raw) <= {"="} or raw in ("GLSL Compiler failed",) or raw.endswith("_shader"):
+            continue
+        for pat in _ERROR_LOC:
+            m = pat.match(raw)
+            if m:
+                fname, ln = src.locate(int(m.group("line")))
+                locs.append((fname, ln))
+                msg = m.group("msg").strip()
+                lines_out.append(f"{fname}:{ln}: {msg}")
+                code = src.source_line(fname, ln).strip()
+                if code:
+                    lines_out.append(f"    {ln:>4} | {code}")
+                break
+        else:
+            lines_out.append(raw)
+    return f"{stage} shader failed to compile:\n" + "\n".join(lines_out), locs

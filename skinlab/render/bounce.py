@@ -1,0 +1,312 @@
+"""Interreflection: the light the scene's surfaces throw onto each other, for every technique.
+
+Planned by the core (skinlab/render/plan.py) when ``RenderSettings.bounces`` > 0 and some ray from some
+vertex meets the front of a surface (a convex mesh alone has nothing to gather: the pass is skipped
+and the plan says so). Each order is one pass, ``bounce[N]``, in three draws on small vertex-space
+targets (vertex i of the frame's meshes at texel (i % 1024, i / 1024)):
+
+1. radiant exitance per vertex (skinlab/shaders/passes/bounce_exitance.{vert,frag}: one point per vertex):
+   sender albedo x (the lights with their shadow maps + the sky + the previous order's bounce);
+2. gather (skinlab/shaders/passes/bounce_gather.frag): each vertex's irradiance from what its rays met, with
+   the ray records of skinlab/scene/interreflection.py (computed once per geometry on the CPU, cached);
+3. the one-ring average of those estimates (skinlab/shaders/passes/bounce_smooth.frag).
+
+The last order's target holds all orders' light (each order's senders carry the previous ones). The
+passes that shade ambient light read it per vertex (lib/bounce_vertex.glsl in forward.vert and
+tsd_uv.vert, lib/ambient.glsl in the fragment shaders: variant ``BOUNCE``) and treat it like the
+sky's light: it enters the medium (texture-space diffusion blurs it) and is reflected. The passes
+only depend on geometry, lights and materials, so an orbiting camera reuses them. How, what it changes
+against the truth and what it costs: docs/interreflection.md; sources: docs/references.md#interreflection.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import moderngl
+import numpy as np
+
+from skinlab.gl.uniforms import set_uniform, set_uniforms
+from skinlab.scene.interreflection import BounceTransfer, build_transfer
+
+from .frame_plan import PlannedPass, shadow_pass_name
+from .gpu_resources import VERTEX_ATTRS, VERTEX_FORMAT, node_uniforms
+from .lights import bind_shadow_maps, light_defines, set_light_uniforms
+from .reuse import light_state, material_state
+from .texture_units import TextureUnits
+
+if TYPE_CHECKING:
+    from skinlab.scene.graph import LightNode, MeshNode, Scene
+    from skinlab.scene.mesh import Mesh
+
+    from .frame import Frame
+    from .frame_plan import FramePlan
+    from .settings import RenderSettings
+
+VERTEX_TEXTURE_WIDTH = 1024  # vertex-space targets: vertex i at texel (i % width, i / width)
+RECORD_TEXTURE_WIDTH = 4096  # ray records: ray r (= vertex x rays + k) at texel (r % width, r / width)
+DATA_KEY = "bounce"  # frame.data: {"offsets": node uid -> first vertex}
+# rays per frame's geometry: the records take 24 bytes a ray (48 MB here) and Embree casts about a
+# million a second on 2 cores; past it each vertex casts fewer rays, down to MIN_RAYS, then none
+MAX_RAYS = 2_000_000
+MIN_RAYS = 4
+
+
+@dataclass
+class BounceParams:
+    transfer: BounceTransfer
+    order: int  # 1: light that bounced once
+    lights: list[LightNode]
+    shadow_lights: list[LightNode]
+    nodes: list[MeshNode]
+
+
+def vertex_target_size(vertices: int) -> tuple[int, int]:
+    return VERTEX_TEXTURE_WIDTH, max(1, math.ceil(vertices / VERTEX_TEXTURE_WIDTH))
+
+
+def bounce_pass_name(order: int) -> str:
+    return f"bounce[{order}]"
+
+
+def plan_bounce(
+    scene: Scene,
+    settings: RenderSettings,
+    meshes: list[MeshNode],
+    lights: list[LightNode],
+    shadow_lights: list[LightNode],
+    plan: FramePlan,
+) -> list[PlannedPass]:
+    """The interreflection passes this frame needs (none when off, or nothing sees anything)."""
+    if settings.bounces == 0:
+        plan.skipped.append(("bounce", "interreflection off (bounces = 0)"))
+        return []
+    if not meshes:
+        return []
+    if not lights and not np.any(np.asarray(scene.environment.ambient) > 0):
+        plan.skipped.append(("bounce", "no light to bounce (no lights, no ambient)"))
+        return []
+    vertices = sum(len(n.mesh.positions) for n in meshes)
+    rays = min(settings.bounce_rays, MAX_RAYS // max(vertices, 1))
+    if rays < MIN_RAYS:
+        plan.warnings.append(
+            f"interreflection skipped: {vertices} vertices need more than {MAX_RAYS:,} rays even at {MIN_RAYS} "
+            "per vertex (decimate the mesh, or render with bounces = 0 to silence this)"
+        )
+        plan.skipped.append(("bounce", f"{vertices} vertices: over the ray budget ({MAX_RAYS:,} rays)"))
+        return []
+    if rays < settings.bounce_rays:
+        plan.warnings.append(
+            f"interreflection: {rays} rays per vertex instead of {settings.bounce_rays} for {vertices} vertices "
+            f"(the ray budget is {MAX_RAYS:,} rays: casting time and the records' memory grow with it)"
+        )
+    transfer = build_transfer(meshes, rays)
+    if not transfer.any_hit:
+        plan.skipped.append(("bounce", "no surface sees another: every ray from every vertex leaves the scene"))
+        return []
+    seen = sum(transfer.hit_fraction[n.uid] * transfer.counts[n.uid] for n in meshes) / transfer.total_vertices
+    inputs = (
+        transfer.key,
+        tuple(light_state(l) for l in lights),
+        tuple(material_state(n.material) for n in meshes),
+        np.asarray(scene.environment.ambient, np.float64).tobytes(),
+        scene.mm_per_unit,
+    )
+    shadows = tuple(shadow_pass_name(l) for l in shadow_lights)
+    out = []
+    for order in range(1, settings.bounces + 1):
+        previous = (bounce_pass_name(order - 1),) if order > 1 else ()
+        out.append(
+            PlannedPass(
+                bounce_pass_name(order),
+                "bounce",
+                "bounce_irradiance",
+                vertex_target_size(transfer.total_vertices),
+                f"interreflection, order {order} of {settings.bounces}: {transfer.total_vertices} vertices x "
+                f"{transfer.rays} rays, {100 * seen:.1f} % of them meet a surface",
+                BounceParams(transfer, order, lights, shadow_lights, list(meshes)),
+                inputs=(*inputs, order),
+                after=(*shadows, *previous),
+            )
+        )
+    return out
+
+
+def uv_footprint(mesh: Mesh) -> float:
+    """The side of one vertex's share of the mesh's UV area (UV units; 0 without UVs)."""
+    if mesh.uvs is None:
+        return 0.0
+    uv = mesh.uvs.astype(np.float64)[mesh.indices.astype(np.int64)]
+    a, b = uv[:, 1] - uv[:, 0], uv[:, 2] - uv[:, 0]
+    area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum()
+    return math.sqrt(area / len(mesh.positions))
+
+
+class BouncePass:
+    """Runs each planned ``bounce[N]`` (module docstring)."""
+
+    def __init__(self, renderer):
+        self.r = renderer
+        self.targets: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer]] = {}  # order -> irradiance
+        self.exitance: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
+        self.gathered: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None  # before the one-ring average
+        # (transfer key, ray vertices, ray weights, ring index, ring entries)
+        self.records: tuple | None = None
+        self._point_vaos: dict[tuple[int, int], moderngl.VertexArray] = {}
+        self._footprints: dict[tuple[int, int], float] = {}  # (mesh uid, version) -> uv_footprint
+
+    # -- GPU objects ---------------------------------------------------------------------
+    def _target(self, size, order: int | str):
+        """The vertex-space target of an order (int), or the scratch "exitance" / "gathered" one."""
+        held = self.targets.get(order) if isinstance(order, int) else getattr(self, order)
+        if held is None or held[0].size != tuple(size):
+            if held is not None:
+                held[1].release()
+                held[0].release()
+            tex = self.r.ctx.texture(size, 4, dtype="f4")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            held = (tex, self.r.ctx.framebuffer([tex]))
+            if isinstance(order, int):
+                self.targets[order] = held
+            else:
+                setattr(self, order, held)
+        return held
+
+    def _upload(self, rows: np.ndarray, width: int) -> moderngl.Texture:
+        """Rows of 2 or 3 floats as a float texture, row r at texel (r % width, r / width)."""
+        n, c = rows.shape
+        height = max(1, math.ceil(n / width))
+        padded = np.zeros((height * width, c), np.float32)
+        padded[:n] = rows
+        tex = self.r.ctx.texture((width, height), c, padded.tobytes(), dtype="f4")
+        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        return tex
+
+    def _records(self, transfer: BounceTransfer):
+        """The transfer's ray records and one-rings on the GPU (uploaded once per transfer)."""
+        if self.records is None or self.records[0] != transfer.key:
+            self._release_records()
+            ring = np.stack([transfer.ring_offsets[:-1], np.diff(transfer.ring_offsets)], 1)
+            self.records = (
+                transfer.key,
+                self._upload(transfer.vertices, RECORD_TEXTURE_WIDTH),
+                self._upload(transfer.weights, RECORD_TEXTURE_WIDTH),
+                self._upload(ring, VERTEX_TEXTURE_WIDTH),
+                self._upload(np.stack([transfer.ring_vertices, transfer.ring_weights], 1), RECORD_TEXTURE_WIDTH),
+            )
+        return self.records[1:]
+
+    def _points(self, node, prog) -> moderngl.VertexArray:
+        """A mesh's vertices as points, without its index buffer (gl_VertexID = the vertex)."""
+        gm = self.r.resources.mesh(node.mesh)
+        key = (id(gm.vbo), id(prog))
+        vao = self._point_vaos.get(key)
+        if vao is None or vao.program is not prog:
+            vao = self._point_vaos[key] = self.r.ctx.vertex_array(
+                prog, [(gm.vbo, VERTEX_FORMAT, *VERTEX_ATTRS)], skip_errors=True
+            )
+        return vao
+
+    def _release_records(self) -> None:
+        if self.records is not None:
+            for tex in self.records[1:]:
+                tex.release()
+            self.records = None
+
+    def release(self) -> None:
+        for tex, fbo in [*self.targets.values(), *(x for x in (self.exitance, self.gathered) if x is not None)]:
+            fbo.release()
+            tex.release()
+        self.targets.clear()
+        self.exitance = self.gathered = None
+        self._release_records()
+        for vao in self._point_vaos.values():
+            vao.release()
+        self._point_vaos.clear()
+
+    # -- the pass ------------------------------------------------------------------------
+    def outputs(self, frame, p) -> tuple:
+        return (self._target(p.resolution, p.params.order)[0],)
+
+    def publish(self, frame: Frame, p) -> None:
+        prm: BounceParams = p.params
+        frame.targets["bounce_irradiance"] = self._target(p.resolution, prm.order)[0]
+        frame.data[DATA_KEY] = {"offsets": dict(prm.transfer.offsets), "order": prm.order}
+
+    def run(self, frame: Frame, p) -> None:
+        ctx = self.r.ctx
+        prm: BounceParams = p.params
+        tr = prm.transfer
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+        exitance, efbo = self._target(p.resolution, "exitance")
+        efbo.use()
+        efbo.clear(0.0, 0.0, 0.0, 0.0)
+        previous = self.targets.get(prm.order - 1) if prm.order > 1 else None
+        nmax = frame.settings.max_lights
+        for node in prm.nodes:
+            mat = node.material
+            defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax)}
+            prog = self.r.programs.get("passes/bounce_exitance.vert", "passes/bounce_exitance.frag", defines)
+            units = TextureUnits(ctx)
+            bind_shadow_maps(self.r, frame, prog, units)
+            set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
+            self.r.resources.bind_material(prog, mat, units)
+            lod = 0.0
+            maps = mat.textures()
+            if "u_base_color_map" in maps:
+                tex = self.r.resources.texture(*maps["u_base_color_map"])
+                key = (node.mesh.uid, node.mesh.version)
+                if key not in self._footprints:
+                    self._footprints[key] = uv_footprint(node.mesh)
+                lod = max(0.0, math.log2(max(max(tex.size) * self._footprints[key], 1e-30)))
+            units.bind(prog, "u_bounce_previous", previous[0] if previous is not None else self.r.dummy_texture())
+            set_uniforms(
+                prog,
+                {
+                    **node_uniforms(node),
+                    "u_vertex_offset": tr.offsets[node.uid],
+                    "u_target_size": np.asarray(p.resolution, np.int32).tobytes(),
+                    "u_ambient": frame.scene.environment.ambient,
+                    "u_albedo_lod": lod,
+                    "u_has_previous": int(previous is not None),
+                },
+            )
+            self._points(node, prog).render(moderngl.POINTS)
+        verts, weights, ring_index, ring_entries = self._records(tr)
+        gathered = self._target(p.resolution, "gathered")
+        textures = {"u_exitance": exitance, "u_ray_vertices": verts, "u_ray_weights": weights}
+        self._fullscreen(gathered[1], "bounce_gather", textures, {"u_rays": tr.rays, "u_vertices": tr.total_vertices})
+        textures = {"u_gathered": gathered[0], "u_ring_index": ring_index, "u_ring_entries": ring_entries}
+        self._fullscreen(
+            self._target(p.resolution, prm.order)[1], "bounce_smooth", textures, {"u_vertices": tr.total_vertices}
+        )
+        self.publish(frame, p)
+
+    def _fullscreen(self, fbo, shader: str, textures: dict, uniforms: dict) -> None:
+        """One fullscreen draw of skinlab/shaders/passes/<shader>.frag into `fbo` (vertex-space targets)."""
+        fbo.use()
+        prog = self.r.programs.get("passes/fullscreen.vert", f"passes/{shader}.frag")
+        units = TextureUnits(self.r.ctx)
+        for sampler, tex in textures.items():
+            units.bind(prog, sampler, tex)
+        set_uniforms(prog, uniforms)
+        self.r.fullscreen(prog)
+
+
+# -- the receiving side: every pass that shades ambient light -----------------------------
+def bounce_defines(frame: Frame, node: MeshNode) -> dict:
+    """``BOUNCE`` when this frame has interreflection light for `node` (lib/bounce_vertex.glsl,
+    lib/ambient.glsl)."""
+    data = frame.data.get(DATA_KEY)
+    return {"BOUNCE": 1} if data is not None and node.uid in data["offsets"] else {}
+
+
+def bind_bounce(frame: Frame, node: MeshNode, prog, units: TextureUnits) -> None:
+    """The per-vertex bounce light for a program compiled with :func:`bounce_defines`."""
+    data = frame.data.get(DATA_KEY)
+    if data is None or node.uid not in data["offsets"]:
+        return
+    units.bind(prog, "u_bounce", frame.targets["bounce_irradiance"])
+    set_uniform(prog, "u_bounce_offset", data["offsets"][node.uid])

@@ -1,0 +1,78 @@
+"""The uniforms of skinlab/shaders/lib/sss_boundary.glsl for one mesh: how light enters and leaves its
+material's medium (skinlab/scene/optics/boundary.py). The forward pass and the passes that gather light
+into a profile (texture-space irradiance) bind them; every technique shares them, so only the
+convolution differs between techniques."""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from skinlab.gl.uniforms import set_array, set_uniforms
+from skinlab.scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables
+from skinlab.scene.optics.fresnel import fdr
+from skinlab.scene.optics.slab import LN_FLOOR, SLAB_MU_NODES, SLAB_TAU_NODES, slab_decay, slab_exit_tables, slab_table
+from skinlab.scene.optics.tsd import material_medium
+
+_ZERO_TABLE = np.zeros((ANGULAR_NODES, 3))
+_SLAB_ROWS = SLAB_MU_NODES * SLAB_TAU_NODES
+_DARK_SLAB = np.full((_SLAB_ROWS, 3), LN_FLOOR)
+_DARK_NORM = np.full((SLAB_TAU_NODES, 3), LN_FLOOR)
+_ZERO_H = np.zeros((_SLAB_ROWS, 3))
+_UNIT_AB = np.concatenate([np.ones((SLAB_TAU_NODES, 3)), np.zeros((SLAB_TAU_NODES, 3))])
+
+
+@lru_cache(maxsize=256)
+def _slab_tables(alpha: tuple, colour: tuple, eta: float):
+    """The slab transmittance table (ln T per unit colour) and the exit factor's tables of the light
+    that comes through (skinlab/scene/optics/slab.py slab_exit_tables: ln T_d, h, A and B)."""
+    table = slab_table(np.array(alpha), np.array(colour))
+    return table, slab_exit_tables(np.array(alpha), table, eta)
+
+
+def material_boundary(material) -> BoundaryTables | None:
+    """The tables of a material that scatters below its surface; None for one that does not."""
+    if material is None or not material.has_subsurface:
+        return None
+    medium = material_medium(material.values)
+    return boundary_tables(medium.alpha_arr, material["subsurface_color"], medium.eta, boundary_ggx_alpha(material))
+
+
+def boundary_ggx_alpha(material) -> float:
+    """GGX alpha of the material's boundary, roughness^2 (as the truth exporter's rough dielectric)."""
+    return float(material["roughness"]) ** 2
+
+
+def bind_boundary(prog, material) -> None:
+    """Write the u_sss_* boundary uniforms for `material` (zeros: no subsurface term)."""
+    t = material_boundary(material)
+    if t is None:
+        set_array(prog, "u_sss_entry", _ZERO_TABLE, ANGULAR_NODES)
+        set_array(prog, "u_sss_exit", _ZERO_TABLE, ANGULAR_NODES)
+        set_array(prog, "u_sss_single_ambient", _ZERO_TABLE, ANGULAR_NODES)
+        zero = (0.0, 0.0, 0.0)
+        set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0})
+        set_array(prog, "u_sss_slab", _DARK_SLAB, _SLAB_ROWS)
+        set_array(prog, "u_sss_slab_norm", _DARK_NORM, SLAB_TAU_NODES)
+        set_array(prog, "u_sss_slab_h", _ZERO_H, _SLAB_ROWS)
+        set_array(prog, "u_sss_slab_ab", _UNIT_AB, 2 * SLAB_TAU_NODES)
+        set_uniforms(prog, {"u_sss_mfp": zero, "u_sss_slab_decay": zero, "u_sss_slab_out": 1.0})
+        return
+    set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
+    set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
+    set_array(prog, "u_sss_single_ambient", t.single_ambient, ANGULAR_NODES)
+    set_uniforms(prog, {"u_sss_entry_diffuse": t.entry_diffuse, "u_sss_single": t.single, "u_sss_eta": t.eta})
+    medium = material_medium(material.values)
+    table, (norm, h, ab) = _slab_tables(
+        tuple(medium.alpha_arr), tuple(np.ravel(material["subsurface_color"])), float(medium.eta)
+    )
+    set_array(prog, "u_sss_slab", table, _SLAB_ROWS)
+    set_array(prog, "u_sss_slab_norm", norm, SLAB_TAU_NODES)
+    set_array(prog, "u_sss_slab_h", h, _SLAB_ROWS)
+    set_array(prog, "u_sss_slab_ab", ab, 2 * SLAB_TAU_NODES)
+    out = 1.0 - float(fdr(medium.eta)) if medium.eta > 1.0 else 1.0
+    set_uniforms(
+        prog,
+        {"u_sss_mfp": medium.mfp_arr, "u_sss_slab_decay": slab_decay(medium.alpha_arr), "u_sss_slab_out": out},
+    )

@@ -1,0 +1,115 @@
+"""GPU copies of scene data: vertex buffers per mesh, textures per file. Owned by the renderer."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import moderngl
+import numpy as np
+
+from skinlab.gl.uniforms import set_uniforms
+from skinlab.scene.mesh import Mesh
+from skinlab.scene.optics.preintegrated import vertex_curvature
+from skinlab.scene.textures import load_texture
+
+VERTEX_FORMAT = "3f 3f 2f 4f 1f"
+# in_curvature: per-vertex mean curvature (1/scene unit; skinlab/scene/optics/preintegrated.py), for the
+# techniques that look it up (pre-integrated skin)
+VERTEX_ATTRS = ("in_position", "in_normal", "in_uv", "in_tangent", "in_curvature")
+
+
+class GpuMesh:
+    def __init__(self, ctx: moderngl.Context, mesh: Mesh):
+        self.ctx = ctx
+        self.version = mesh.version
+        n = len(mesh.positions)
+        uv = mesh.uvs if mesh.uvs is not None else np.zeros((n, 2), np.float32)
+        if mesh.uvs is not None:
+            tan = mesh.ensure_tangents()
+        else:
+            tan = np.tile(np.array([1, 0, 0, 1], np.float32), (n, 1))
+        curv = vertex_curvature(mesh.positions, mesh.normals, mesh.indices)[:, None]
+        data = np.concatenate([mesh.positions, mesh.normals, uv, tan, curv], axis=1).astype(np.float32)
+        self.vbo = ctx.buffer(np.ascontiguousarray(data).tobytes())
+        self.ibo = ctx.buffer(mesh.indices.astype(np.uint32).tobytes())
+        self.count = mesh.indices.size
+        self._vaos: dict[int, moderngl.VertexArray] = {}
+
+    def vao(self, program: moderngl.Program) -> moderngl.VertexArray:
+        key = id(program)
+        vao = self._vaos.get(key)
+        if vao is None or vao.program is not program:
+            vao = self.ctx.vertex_array(
+                program,
+                [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRS)],
+                index_buffer=self.ibo,
+                index_element_size=4,
+                skip_errors=True,
+            )
+            self._vaos[key] = vao
+        return vao
+
+    def release(self) -> None:
+        for v in self._vaos.values():
+            v.release()
+        self.vbo.release()
+        self.ibo.release()
+
+
+def node_uniforms(node) -> dict:
+    """A mesh node's transform uniforms (forward.vert, tsd_uv.vert)."""
+    model = node.world_matrix
+    return {"u_model": model, "u_normal_matrix": np.linalg.inv(model[:3, :3]).T}
+
+
+class GpuResources:
+    """Caches GPU meshes (by Mesh identity and version) and textures (by path and colour space)."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self.meshes: dict[int, GpuMesh] = {}
+        self.textures: dict[tuple[str, str], moderngl.Texture] = {}
+        self.uploads = 0
+
+    def mesh(self, mesh: Mesh) -> GpuMesh:
+        g = self.meshes.get(mesh.uid)
+        if g is None or g.version != mesh.version:
+            if g is not None:
+                g.release()
+            g = self.meshes[mesh.uid] = GpuMesh(self.ctx, mesh)
+            self.uploads += 1
+        return g
+
+    def texture(self, path: Path, colorspace: str) -> moderngl.Texture:
+        key = (str(path), colorspace)
+        tex = self.textures.get(key)
+        if tex is None:
+            img = load_texture(path, colorspace)
+            h, w, c = img.shape
+            if c == 2:
+                img = np.concatenate([img, np.zeros((h, w, 1), np.float32)], 2)
+                c = 3
+            # row 0 of the file is the top; OpenGL's v = 0 is the bottom row
+            data = np.ascontiguousarray(img[::-1].astype(np.float16))
+            tex = self.ctx.texture((w, h), c, data.tobytes(), dtype="f2")
+            tex.build_mipmaps()
+            tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            tex.anisotropy = 8.0
+            tex.repeat_x = tex.repeat_y = True
+            self.textures[key] = tex
+            self.uploads += 1
+        return tex
+
+    def bind_material(self, prog: moderngl.Program, material, units) -> None:
+        """The material's plain values as uniforms and its maps on units from `units` (TextureUnits)."""
+        set_uniforms(prog, material.uniforms())
+        for sampler, (path, cs) in material.textures().items():
+            units.bind(prog, sampler, self.texture(path, cs))
+
+    def release(self) -> None:
+        for g in self.meshes.values():
+            g.release()
+        for t in self.textures.values():
+            t.release()
+        self.meshes.clear()
+        self.textures.clear()

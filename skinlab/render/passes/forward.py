@@ -1,0 +1,123 @@
+"""Forward shading of every visible mesh into an HDR target with depth. The subsurface part of the
+diffuse term is the technique's hook (ForwardParams.hook; skinlab/render/technique.py): per mesh it
+names the material, the hook's GLSL file and variant, and binds the hook's uniforms and textures.
+
+The entry/exit factors and single scattering every technique shares (skinlab/render/boundary.py) are
+bound here for a mesh the hook shades as scattering, zeros for the others.
+
+With ``RenderSettings.depth_prepass`` the meshes are first drawn depth-only (forward.vert with an
+empty fragment shader), then shaded with the depth test ``<=`` and no depth writes: each pixel is
+shaded once, however many surfaces lie behind it (the same image; where two surfaces have exactly
+the same depth, the one drawn last shows instead of the one drawn first)."""
+
+from __future__ import annotations
+
+import moderngl
+
+from skinlab.gl.uniforms import set_uniforms
+from skinlab.render.bounce import bind_bounce, bounce_defines
+from skinlab.render.boundary import bind_boundary
+from skinlab.render.frame_plan import ForwardParams
+from skinlab.render.gpu_resources import node_uniforms
+from skinlab.render.lights import bind_shadow_maps, light_defines, set_light_uniforms
+from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK, NodeShading
+from skinlab.render.texture_units import TextureUnits
+
+
+class ForwardPass:
+    def __init__(self, renderer):
+        self.r = renderer
+        self._targets = None
+        self._depth_fbo = None  # the depth target alone, for the depth pre-pass
+
+    def targets(self, size, outputs: tuple[str, ...] = ()):
+        """(colour, depth, framebuffer, extra colour targets): one more float target per name in
+        `outputs` (a technique's, e.g. screen-space SSS's subsurface diffuse)."""
+        t = self._targets
+        if t is None or t[0].size != tuple(size) or len(t[3]) != len(outputs):
+            if t is not None:
+                for x in (t[2], t[1], t[0], *t[3]):
+                    x.release()
+            ctx = self.r.ctx
+            color = ctx.texture(size, 4, dtype="f4")
+            depth = ctx.depth_texture(size)
+            depth.compare_func = ""  # sampled as plain depth (screen-space SSS)
+            extra = [ctx.texture(size, 4, dtype="f4") for _ in outputs]
+            for x in (color, *extra):
+                x.repeat_x = x.repeat_y = False
+            fbo = ctx.framebuffer([color, *extra], depth)
+            t = self._targets = (color, depth, fbo, extra)
+            if self._depth_fbo is not None:
+                self._depth_fbo.release()
+            self._depth_fbo = ctx.framebuffer(depth_attachment=depth)
+        return t
+
+    def release(self) -> None:
+        if self._targets is not None:
+            color, depth, fbo, extra = self._targets
+            for x in (self._depth_fbo, fbo, color, depth, *extra):
+                x.release()
+            self._targets = self._depth_fbo = None
+
+    def run(self, frame, p) -> None:
+        ctx = self.r.ctx
+        prm: ForwardParams = p.params
+        hook = prm.hook
+        color, depth, fbo, extra = self.targets(p.resolution, hook.outputs)
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
+        per_frame = {
+            "u_view_proj": frame.view_proj,
+            "u_camera_pos": frame.camera_pos,
+            "u_ambient": frame.scene.environment.ambient,
+        }
+        prepass = frame.settings.depth_prepass
+        if prepass:
+            self.depth_prepass(frame, per_frame)
+            fbo.use()
+            ctx.depth_func, fbo.depth_mask = "<=", False
+        try:
+            self.shade(frame, prm, per_frame)
+        finally:
+            if prepass:
+                ctx.depth_func, fbo.depth_mask = "<", True
+        frame.targets["hdr_color"] = color
+        frame.targets["depth"] = depth
+        for name, tex in zip(hook.outputs, extra):
+            frame.targets[name] = tex
+
+    def depth_prepass(self, frame, per_frame) -> None:
+        self._depth_fbo.use()
+        prog = self.r.programs.get("passes/forward.vert", "passes/depth_only.frag")
+        set_uniforms(prog, {"u_view_proj": per_frame["u_view_proj"]})
+        for node in frame.scene.mesh_nodes():
+            set_uniforms(prog, node_uniforms(node))
+            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+
+    def shade(self, frame, prm: ForwardParams, per_frame) -> None:
+        ctx, hook, nmax = self.r.ctx, prm.hook, frame.settings.max_lights
+        for node in frame.scene.mesh_nodes():
+            sh = hook.shading(node, frame) or NodeShading(node.material)
+            defines = {
+                **sh.material.defines(),
+                **light_defines(prm.shadow_lights, nmax),
+                **bounce_defines(frame, node),
+                **sh.defines,
+            }
+            prog = self.r.programs.get(
+                "passes/forward.vert", "passes/forward.frag", defines, includes={HOOK_INCLUDE: sh.hook}
+            )
+            units = TextureUnits(ctx)
+            set_uniforms(prog, per_frame)
+            bind_shadow_maps(self.r, frame, prog, units)
+            set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
+            set_uniforms(prog, node_uniforms(node))
+            bind_bounce(frame, node, prog, units)
+            self.r.resources.bind_material(prog, sh.material, units)
+            scatters = sh.hook != PLAIN_HOOK and sh.subsurface
+            bind_boundary(prog, sh.material if scatters else None)
+            if sh.bind is not None:
+                sh.bind(prog, units)
+            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)

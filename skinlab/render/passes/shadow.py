@@ -1,0 +1,132 @@
+"""Shadow maps: depth from a light. A directional light's orthographic map is fitted to the scene's
+bounding box as the light sees it (the box's corners in light space), so that its texels are as
+small as the box allows; a point light's perspective map is fitted to the bounding sphere."""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from skinlab.gl.uniforms import set_uniforms
+from skinlab.render.frame_plan import ShadowParams
+from skinlab.scene import transform as tf
+from skinlab.scene.graph import LightNode
+
+# maps clip space [-1, 1] to texture space [0, 1]
+CLIP_TO_TEXTURE = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1.0]])
+
+
+FIT_MARGIN = 0.01  # the fitted box grows by this fraction of its size each side (no geometry on the clip planes)
+
+
+def box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """The 8 corners of an axis-aligned box, (8, 3)."""
+    return np.array([[(lo, hi)[i >> k & 1][k] for k in range(3)] for i in range(8)], np.float64)
+
+
+def light_view_proj(light: LightNode, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    centre = (lo + hi) / 2
+    radius = max(float(np.linalg.norm(hi - lo)) / 2, 1e-6)
+    if light.kind == "directional":
+        d = light.direction
+        eye = centre - d * 2 * radius
+        view = np.linalg.inv(tf.compose(eye, tf.look_at_rotation(eye, centre), np.ones(3)))
+        # the box's extent across and along the light: the map covers exactly that (plus a margin),
+        # not the bounding sphere's square (up to 1.7x smaller texels on a flat scene)
+        c = box_corners(lo, hi) @ view[:3, :3].T + view[:3, 3]
+        pad = FIT_MARGIN * (c.max(0) - c.min(0)) + 1e-6 * radius
+        x0, y0, z0 = c.min(0) - pad
+        x1, y1, z1 = c.max(0) + pad
+        shift = np.eye(4)
+        shift[:2, 3] = -(x0 + x1) / 2, -(y0 + y1) / 2
+        return tf.orthographic((x1 - x0) / 2, (y1 - y0) / 2, -z1, -z0) @ shift @ view
+    pos = light.world_position
+    dist = float(np.linalg.norm(centre - pos))
+    if dist <= radius * 1.01:
+        raise ValueError(
+            f"light {light.name!r}: a shadow-casting point light must be outside the scene's "
+            f"bounding sphere (distance {dist:.3g} <= radius {radius:.3g})"
+        )
+    fov = 2 * np.arcsin(radius / dist)
+    view = np.linalg.inv(tf.compose(pos, tf.look_at_rotation(pos, centre), np.ones(3)))
+    return tf.perspective(fov, 1.0, max(dist - radius, 1e-4), dist + radius) @ view
+
+
+def light_eye(light: LightNode) -> np.ndarray:
+    """The light's position (w = 1) or the direction its light travels (w = 0)."""
+    return np.append(light.direction, 0.0) if light.kind == "directional" else np.append(light.world_position, 1.0)
+
+
+class ShadowPass:
+    def __init__(self, renderer):
+        self.r = renderer
+        self.maps: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
+
+    def target(self, slot: int, size: int, distance: bool = False):
+        """(depth texture, framebuffer, distance texture or None) for a slot."""
+        t = self.maps.get(slot)
+        if t is None or t[0].size != (size, size) or (t[2] is not None) != distance:
+            if t is not None:
+                for x in (t[1], t[0], t[2]):
+                    if x is not None:
+                        x.release()
+            ctx = self.r.ctx
+            tex = ctx.depth_texture((size, size))
+            tex.compare_func = "<="
+            tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            tex.repeat_x = tex.repeat_y = False
+            dist = None
+            if distance:
+                dist = ctx.texture((size, size), 1, dtype="f4")
+                dist.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                dist.repeat_x = dist.repeat_y = False
+            fbo = ctx.framebuffer([dist] if dist is not None else [], depth_attachment=tex)
+            t = self.maps[slot] = (tex, fbo, dist)
+        return t
+
+    def release(self) -> None:
+        for tex, fbo, dist in self.maps.values():
+            for x in (fbo, tex, dist):
+                if x is not None:
+                    x.release()
+        self.maps.clear()
+
+    def outputs(self, frame, p) -> tuple:
+        """The textures holding the pass's result (reuse across frames, skinlab/render/reuse.py)."""
+        tex, _, dist = self.target(p.params.slot, p.resolution[0], p.params.distance)
+        return (tex,) if dist is None else (tex, dist)
+
+    def publish(self, frame, p) -> None:
+        """Hand the slot's maps and matrices to the frame (after run, or when reused)."""
+        prm: ShadowParams = p.params
+        light, slot = prm.light, prm.slot
+        tex, _, dist = self.target(slot, p.resolution[0], prm.distance)
+        frame.targets[f"shadow_map{slot}"] = tex
+        frame.shadow_eyes[slot] = light_eye(light)
+        if dist is not None:
+            frame.targets[f"shadow_distance{slot}"] = dist
+        frame.shadow_matrices[slot] = CLIP_TO_TEXTURE @ light_view_proj(light, *frame.scene.world_bounds())
+
+    def run(self, frame, p) -> None:
+        ctx = self.r.ctx
+        prm: ShadowParams = p.params
+        light, slot, distance = prm.light, prm.slot, prm.distance
+        tex, fbo, dist = self.target(slot, p.resolution[0], distance)
+        lo, hi = frame.scene.world_bounds()
+        vp = light_view_proj(light, lo, hi)
+        prog = self.r.programs.get(
+            "passes/shadow.vert", "passes/shadow.frag", {"SHADOW_DISTANCE": 1} if distance else None
+        )
+        set_uniforms(prog, {"u_light_eye": light_eye(light)})
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        if dist is not None:  # "no surface": as far as it gets
+            fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.CULL_FACE)
+        ctx.polygon_offset = (2.0, 2.0)
+        for node in frame.scene.mesh_nodes():
+            set_uniforms(prog, {"u_model": node.world_matrix, "u_light_view_proj": vp})
+            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        ctx.polygon_offset = (0.0, 0.0)
+        self.publish(frame, p)

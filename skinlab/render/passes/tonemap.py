@@ -1,0 +1,55 @@
+"""HDR -> display: exposure, ACES, sRGB (skinlab/shaders/passes/tonemap.frag; twins in skinlab/scene/optics/color.py).
+
+With ``RenderSettings.supersample`` N > 1 the forward HDR holds N x N samples per output pixel: this
+pass box-filters them (the mean of linear radiance and coverage) into ``hdr_filtered`` at the output
+size, what the ``hdr`` read-back returns, and tone-maps the filtered radiance
+(skinlab/shaders/passes/tonemap_supersample.frag; NumPy twin: skinlab/render/supersample.py)."""
+
+from __future__ import annotations
+
+import moderngl
+
+from skinlab.gl.uniforms import set_uniforms
+
+
+class TonemapPass:
+    def __init__(self, renderer):
+        self.r = renderer
+        self._target = None  # (ldr, framebuffer, filtered hdr or None)
+
+    def release(self) -> None:
+        if self._target is not None:
+            for x in self._target:
+                if x is not None:
+                    x.release()
+            self._target = None
+
+    def targets(self, size, filtered: bool):
+        t = self._target
+        if t is None or t[0].size != tuple(size) or (t[2] is not None) != filtered:
+            self.release()
+            ctx = self.r.ctx
+            tex = ctx.texture(size, 4, dtype="f1")
+            hdr = ctx.texture(size, 4, dtype="f4") if filtered else None
+            self._target = (tex, ctx.framebuffer([tex] if hdr is None else [tex, hdr]), hdr)
+        return self._target
+
+    def run(self, frame, p) -> None:
+        ctx = self.r.ctx
+        n = frame.settings.supersample
+        tex, fbo, hdr = self.targets(p.resolution, n > 1)
+        if n > 1:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap_supersample.frag", {"SUPERSAMPLE": n})
+        else:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap.frag")
+        fbo.use()
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+        frame.targets["hdr_color"].use(0)
+        set_uniforms(
+            prog,
+            {"u_hdr": 0, "u_exposure": frame.scene.environment.exposure, "u_background": frame.settings.background},
+        )
+        self.r.fullscreen(prog)
+        frame.targets["ldr_color"] = tex
+        if hdr is not None:
+            frame.targets["hdr_filtered"] = hdr

@@ -1,0 +1,96 @@
+"""The frame is planned from the scene: a pass runs only when something visible needs it."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from .bounce import plan_bounce
+from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams, shadow_pass_name
+from .registry import get_technique
+from .reuse import light_placement, scene_geometry
+from .technique import PlanContext
+
+if TYPE_CHECKING:
+    from skinlab.scene.graph import LightNode, Scene
+
+    from .settings import RenderSettings
+
+__all__ = ["FramePlan", "PlannedPass", "ShadowParams", "ForwardParams", "plan_frame"]
+
+
+def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
+    """Passes for this frame: shadow maps, interreflection (skinlab/render/bounce.py), the technique's
+    passes (registry), the forward pass with
+    the technique's shading hook, tone mapping. ``state``: the technique's renderer-side state (its
+    caches, e.g. texture-space diffusion's stretch maps); None plans as if nothing were cached."""
+    meshes = scene.mesh_nodes()
+    lights = scene.lights()
+    n = settings.supersample
+    plan = FramePlan([])
+    if len(lights) > settings.max_lights:
+        plan.skipped.append(
+            (
+                f"{len(lights) - settings.max_lights} light(s)",
+                f"more than {settings.max_lights} lights; the first {settings.max_lights} are used",
+            )
+        )
+        lights = lights[: settings.max_lights]
+    shadow_lights: list[LightNode] = [l for l in lights if l.cast_shadow]
+    for l in lights:
+        if not l.cast_shadow:
+            plan.skipped.append((f"shadow[{l.name}]", "light does not cast shadows"))
+    if not meshes:
+        plan.skipped.append(("shadows", "no visible mesh"))
+        shadow_lights = []
+    technique = get_technique(settings.technique_name)
+    tp = technique.plan(PlanContext(scene, settings, meshes, lights, shadow_lights[:2], plan, state))
+    distance = tp.shadow_distance and bool(shadow_lights)
+    geometry = scene_geometry(scene) if shadow_lights else ()
+    for slot, l in enumerate(shadow_lights[:2]):
+        plan.passes.append(
+            PlannedPass(
+                shadow_pass_name(l),
+                "shadow",
+                f"shadow_map{slot}" + (f"+shadow_distance{slot}" if distance else ""),
+                (settings.shadow_size, settings.shadow_size),
+                f"{l.kind} light '{l.name}' casts shadows on {len(meshes)} visible mesh(es)"
+                + ("; distance map for translucency" if distance else ""),
+                ShadowParams(l, slot, distance),
+                inputs=(slot, distance, light_placement(l), geometry),
+            )
+        )
+    for l in shadow_lights[2:]:
+        plan.skipped.append((f"shadow[{l.name}]", "at most 2 shadow-casting lights"))
+    bounce = plan_bounce(scene, settings, meshes, lights, shadow_lights[:2], plan)
+    plan.passes += bounce
+    if bounce:  # bounce light is ambient light: every pass of the technique that is kept across frames reads it
+        for p in tp.before_forward:
+            if p.inputs is not None:
+                p.after = (*p.after, bounce[-1].name)
+    plan.passes += tp.before_forward
+    hook = tp.forward
+    plan.passes.append(
+        PlannedPass(
+            "forward",
+            "forward",
+            "+".join(["hdr_color", "depth", *hook.outputs]),
+            settings.render_size,
+            (f"{n} x {n} samples per output pixel (supersample); " if n > 1 else "")
+            + ("depth pre-pass, then " if settings.depth_prepass else "")
+            + f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)"
+            + hook.reason,
+            ForwardParams(lights, shadow_lights[:2], hook),
+        )
+    )
+    plan.passes += tp.after_forward
+    plan.passes.append(
+        PlannedPass(
+            "tonemap",
+            "tonemap",
+            "ldr_color" + ("+hdr_filtered" if n > 1 else ""),
+            settings.size,
+            (f"box filter of each pixel's {n} x {n} samples (linear radiance), then " if n > 1 else "")
+            + "ACES tone mapping and sRGB encoding for display/PNG",
+        )
+    )
+    return plan

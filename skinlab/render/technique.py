@@ -1,0 +1,144 @@
+"""Where the core meets a subsurface technique: the interfaces a technique package implements.
+
+A technique (skinlab/render/techniques/<name>/, registered in skinlab/render/registry.py) declares
+
+- ``name`` and a one-line ``description`` (shown by `skinlab render --help` and the viewer); ``slow``
+  when a frame may take seconds (the viewer's T key skips it);
+- ``settings_type``: its settings dataclass (skinlab/render/options.py), the value of
+  ``RenderSettings.technique``;
+- :meth:`Technique.plan`: its passes for the visible meshes (PlannedPass lists with reasons, skips in
+  the frame plan) and how the forward pass shades each mesh (a :class:`ForwardHook`);
+- ``passes``: its pass classes by kind (each a :class:`RenderPass`), made once per renderer;
+- ``state``: GPU state it keeps across frames (per renderer), if any;
+- for the accuracy ledger (skinlab/bench/): :meth:`Technique.edge_response` and its :class:`LedgerStyle`.
+
+The forward pass (skinlab/render/passes/forward.py) shades every mesh with skinlab/shaders/passes/forward.frag;
+the subsurface part of the diffuse term is one GLSL hook, ``skinlab/sss_hook.glsl``, which each
+mesh's :class:`NodeShading` resolves to a technique's file (skinlab/shaders/techniques/<name>/forward.glsl):
+
+    float sss_plain_weight();                        // weight of the surface's own Burley diffuse
+    void  sss_add_light(vec3 e, float vis, float NoL);  // per light: irradiance e, shadow vis, cosine
+    vec3  sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv);  // after the lights: the
+                                                     // subsurface radiance added toward the viewer
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Protocol
+
+from skinlab.scene.optics.edges import step_edge
+
+from .frame_plan import FramePlan, PlannedPass
+from .options import TechniqueSettings
+
+if TYPE_CHECKING:
+    import moderngl
+
+    from skinlab.scene.graph import LightNode, MeshNode, Scene
+
+    from .frame import Frame
+    from .settings import RenderSettings
+    from .texture_units import TextureUnits
+
+PLAIN_HOOK = "techniques/none/forward.glsl"  # no subsurface term: Burley diffuse only
+HOOK_INCLUDE = "skinlab/sss_hook.glsl"  # the include name forward.frag uses for the hook
+
+
+class RenderPass(Protocol):
+    """A pass kind's implementation: made once per renderer, run for each planned pass of its kind.
+    A pass holding GPU objects of its own also has ``release()``, called by Renderer.release. A pass
+    that can be reused across frames (its PlannedPass has ``inputs``; skinlab/render/reuse.py) also has
+    ``outputs(frame, planned)`` (the textures holding its result) and ``publish(frame, planned)``
+    (hands them to the frame as ``run`` does)."""
+
+    def __init__(self, renderer) -> None: ...
+
+    def run(self, frame: Frame, planned: PlannedPass) -> None: ...
+
+
+@dataclass
+class NodeShading:
+    """How the forward pass shades one mesh: the material to bind, the hook file, the variant's
+    defines and a function binding the hook's uniforms and textures."""
+
+    material: Any
+    hook: str = PLAIN_HOOK
+    defines: dict[str, object] = field(default_factory=dict)
+    bind: Callable[[moderngl.Program, TextureUnits], None] | None = None
+    # the mesh scatters below its surface: the forward pass binds its medium's entry/exit factors
+    # and single scattering (skinlab/render/boundary.py); False for a hook that shades it without
+    subsurface: bool = True
+
+
+class ForwardHook:
+    """A technique's part of the forward pass (planned per frame). The base class shades every mesh
+    with plain Burley diffuse."""
+
+    outputs: tuple[str, ...] = ()  # extra colour targets (frame.targets names) written at locations 1, 2...
+    reason: str = ""  # appended to the forward pass's reason in the frame plan
+
+    def shading(self, node: MeshNode, frame: Frame) -> NodeShading | None:
+        """None: the node's own material with the plain hook."""
+        return None
+
+
+@dataclass
+class PlanContext:
+    """What a technique plans from."""
+
+    scene: Scene
+    settings: RenderSettings
+    meshes: list[MeshNode]  # visible mesh nodes
+    lights: list[LightNode]  # the lights used (at most settings.max_lights)
+    shadow_lights: list[LightNode]  # those with a shadow map (at most 2)
+    plan: FramePlan  # record skips and warnings here
+    state: Any = None  # the technique's renderer-side state; None when planned without a renderer
+
+    @property
+    def options(self) -> TechniqueSettings:
+        return self.settings.technique
+
+
+@dataclass
+class TechniquePlan:
+    """A technique's share of the frame plan."""
+
+    forward: ForwardHook = field(default_factory=ForwardHook)
+    before_forward: list[PlannedPass] = field(default_factory=list)
+    after_forward: list[PlannedPass] = field(default_factory=list)
+    shadow_distance: bool = False  # the shadow passes also write light-space distance maps
+
+
+@dataclass(frozen=True)
+class LedgerStyle:
+    """How the accuracy ledger names, tabulates and plots a technique's settings."""
+
+    marker: str  # matplotlib marker
+    colour: str
+    columns: dict[str, str] = field(default_factory=dict)  # ledger CSV column -> settings field
+    label: str = ""  # setting label, str.format over the columns (None shows as "auto"); "" = the name
+
+
+class Technique:
+    """Base class of a technique package's ``TECHNIQUE``; see the module docstring."""
+
+    name: str = ""
+    description: str = ""
+    settings_type: type[TechniqueSettings] = TechniqueSettings
+    passes: dict[str, type] = {}
+    state: tuple[str, Callable[[Any], Any]] | None = None  # (key shared by techniques, factory(ctx))
+    ledger: LedgerStyle = LedgerStyle("o", "grey")
+    scatters: bool = True  # False: the technique renders no material as scattering (its model is "none")
+    # not empty: why a frame may take long (an image reference); the viewer's T key skips the technique
+    # and its panel marks it with this, so a slow GPU is not stalled by one key press
+    slow: str = ""
+
+    def plan(self, ctx: PlanContext) -> TechniquePlan:
+        return TechniquePlan()
+
+    def edge_response(self, model: str, medium, plan: FramePlan):
+        """The technique's edge response x_mm -> (N, 3) for a material of `model` and `medium`, as
+        the frame `plan` rendered it; None where it has none. Default: no light moves (a step)."""
+        return step_edge

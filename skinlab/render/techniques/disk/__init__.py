@@ -1,0 +1,124 @@
+"""Technique "disk": importance-sampled Burley disk SSS in screen space (Golubev, SIGGRAPH 2018
+"Efficient Screen-Space Subsurface Scattering Using Burley's Normalized Diffusion in Real-Time"; as
+Unity HDRP and Blender EEVEE Next ship it). The forward pass writes the subsurface diffuse radiance
+and each pixel's profile index to a second target; one post-process gathers, per pixel, samples on
+a disc whose radii follow the Burley CDF (millimetres on the surface, from the pixel's depth),
+weighted by the pixel's own profile (a table of up to 16 profiles per frame: many media in one
+frame), with depth-aware rejection and a per-pixel rotation. NumPy model: skinlab/scene/optics/disk.py. With
+`translucency` the forward pass adds the light through thin parts (skinlab/render/translucency.py, as
+texture-space diffusion's irradiance pass does) to the light the disk pass gathers."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from skinlab.gl.uniforms import set_uniform
+from skinlab.render.frame_plan import FramePlan, PlannedPass
+from skinlab.render.options import TechniqueSettings, option
+from skinlab.render.scattering import scattering_material
+from skinlab.render.technique import ForwardHook, LedgerStyle, PlanContext, Technique, TechniquePlan
+from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
+from skinlab.scene.optics.disk import MAX_DISK_PROFILES, MAX_DISK_SAMPLES, disk_edge_response, disk_kernel
+from skinlab.scene.optics.tsd import material_medium
+
+from .passes import DIFFUSE_TARGET, DiskParams, DiskPass
+
+HOOK = "techniques/disk/forward.glsl"
+
+
+@dataclass(frozen=True)
+class DiskSettings(TechniqueSettings):
+    technique = "disk"
+    samples: int = option(
+        32, "disk samples per pixel, radii from the Burley CDF (Golubev 2018)", "int", range=(8, MAX_DISK_SAMPLES)
+    )
+    rotate: bool = option(True, "rotate each pixel's sample spiral (noise instead of banding)", "bool")
+    translucency: bool = option(True, OPTION_DOC, "bool")
+
+
+@dataclass
+class DiskForward(ForwardHook):
+    profiles: dict = field(default_factory=dict)  # node uid -> (effective material, profile index)
+    translucency: bool = False  # add the light through thin parts (shadow distance maps) before the disk pass
+
+    outputs = (DIFFUSE_TARGET,)
+
+    @property
+    def reason(self) -> str:
+        return (
+            "; subsurface diffuse"
+            + (f" and {REASON}" if self.translucency else "")
+            + (" and profile index to a second target for the disk pass")
+        )
+
+    def shading(self, node, frame):
+        hit = self.profiles.get(node.uid)
+        mat, index = hit if hit is not None else (node.material, -1)
+        value = float(index + 1)
+        through = self.translucency and index >= 0
+
+        def bind(prog, units):
+            set_uniform(prog, "u_disk_profile", value)
+
+        return translucent_shading(mat, HOOK, frame, through, bind, subsurface=index >= 0)
+
+
+def plan_profiles(ctx: PlanContext):
+    """Node uid -> (material, profile index) and the distinct (model, medium) profiles, in order."""
+    keys, labels, nodes = [], [], {}
+    for n in ctx.meshes:
+        mat = scattering_material(n, ctx.settings, ctx.plan, f"disk[{n.name}]")
+        if mat is None:
+            continue
+        key = (mat["sss_model"], material_medium(mat.values))
+        if key not in keys:
+            if len(keys) == MAX_DISK_PROFILES:
+                ctx.plan.warnings.append(
+                    f"disk SSS keeps {MAX_DISK_PROFILES} profiles per frame: node '{n.name}' "
+                    f"(material '{mat.name}') uses material '{labels[-1]}''s profile"
+                )
+                nodes[n.uid] = (mat, len(keys) - 1)
+                continue
+            keys.append(key)
+            labels.append(mat.name)
+        nodes[n.uid] = (mat, keys.index(key))
+    return nodes, keys, labels
+
+
+class DiskTechnique(Technique):
+    name = "disk"
+    description = "importance-sampled Burley disk SSS in screen space (Golubev 2018; HDRP, EEVEE Next)"
+    settings_type = DiskSettings
+    passes = {"disk_sss": DiskPass}
+    ledger = LedgerStyle("P", "tab:red", {"disk_samples": "samples"}, "disk {disk_samples}")
+
+    def plan(self, ctx: PlanContext) -> TechniquePlan:
+        o = ctx.options
+        nodes, keys, labels = plan_profiles(ctx)
+        if not keys:
+            ctx.plan.skipped.append(("disk_sss", "no visible material scatters below the surface"))
+            return TechniquePlan()
+        kernels = [disk_kernel(model, medium, o.samples) for model, medium in keys]
+        names = ", ".join(f"'{lab}' ({m})" for lab, (m, _) in zip(labels, keys))
+        p = PlannedPass(
+            "disk_sss",
+            "disk_sss",
+            "hdr_color",
+            ctx.settings.render_size,
+            f"Burley disk SSS (Golubev 2018): {o.samples} samples per pixel"
+            f"{', rotated per pixel' if o.rotate else ''}, depth-aware; {len(keys)} profile(s): {names}",
+            DiskParams(o.samples, o.rotate, kernels, labels),
+        )
+        through = plan_translucency(ctx, True, o.translucency)
+        return TechniquePlan(DiskForward(nodes, through), after_forward=[p], shadow_distance=through)
+
+    def edge_response(self, model, medium, plan: FramePlan):
+        """The disk kernel's edge response averaged over the per-pixel rotation."""
+        for p in plan.passes:
+            if isinstance(p.params, DiskParams):
+                k = disk_kernel(model, medium, p.params.samples)
+                return lambda x: disk_edge_response(x, k)
+        return super().edge_response(model, medium, plan)
+
+
+TECHNIQUE = DiskTechnique()

@@ -1,0 +1,73 @@
+"""The disk pass: importance-sampled Burley disk SSS over the forward pass's subsurface diffuse
+target (skinlab/shaders/passes/disk_sss.frag), then the composite with the rest of the lit image."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from skinlab.gl.uniforms import set_array, set_uniforms
+from skinlab.render.passes.screen_targets import ScreenTargets, composite
+from skinlab.scene.optics.disk import MAX_DISK_PROFILES
+
+DIFFUSE_TARGET = "disk_diffuse"
+
+
+@dataclass
+class DiskParams:
+    samples: int
+    rotate: bool
+    kernels: list  # skinlab.scene.optics.disk.DiskKernel per profile index
+    labels: list  # the material named for each profile (the plan's explanation)
+
+    def table(self) -> np.ndarray:
+        """(profiles, samples, 4) float32: rgb weight, a radius mm (the shader's u_table)."""
+        t = np.zeros((len(self.kernels), self.samples, 4), np.float32)
+        for j, k in enumerate(self.kernels):
+            t[j, :, :3] = k.weights
+            t[j, :, 3] = k.radii_mm
+        return t
+
+
+class DiskPass:
+    def __init__(self, renderer):
+        self.r = renderer
+        self._gpu = ScreenTargets(renderer.ctx, 2)  # filtered, composite
+
+    def release(self) -> None:
+        self._gpu.release()
+
+    def run(self, frame, p) -> None:
+        ctx, prm = self.r.ctx, p.params
+        w, h = p.resolution
+        filtered, out = self._gpu.at((w, h))
+        ffilt, fout = self._gpu.fbos
+        cam = frame.scene.camera
+        table = self._gpu.table(prm.table())
+        prog = self.r.programs.get("passes/fullscreen.vert", "passes/disk_sss.frag")
+        reach = np.array([k.reach_mm for k in prm.kernels], np.float32)
+        set_array(prog, "u_reach_mm", reach, MAX_DISK_PROFILES)
+        set_uniforms(
+            prog,
+            {
+                "u_src": 0,
+                "u_depth": 1,
+                "u_table": 2,
+                "u_samples": prm.samples,
+                "u_mm_per_unit": frame.scene.mm_per_unit,
+                "u_pixels_per_unit": h / (2.0 * math.tan(cam.yfov / 2.0)),
+                "u_size": (float(w), float(h)),
+                "u_near_far": (cam.znear, cam.zfar),
+                "u_rotate": 1.0 if prm.rotate else 0.0,
+            },
+        )
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+        frame.targets[DIFFUSE_TARGET].use(0)
+        frame.targets["depth"].use(1)
+        table.use(2)
+        ffilt.use()
+        self.r.fullscreen(prog)
+        composite(self.r, frame, fout, out, filtered, "disk_filtered")

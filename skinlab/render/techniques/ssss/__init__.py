@@ -1,0 +1,104 @@
+"""Technique "ssss": screen-space separable subsurface scattering (Jimenez et al., "Separable
+Subsurface Scattering", 2015; docs/references.md). The forward pass writes the subsurface diffuse
+radiance and each pixel's profile index to a second target; one post-process blurs it horizontally
+then vertically with the pixel's own profile's 1-D kernel (skinlab/scene/optics/ssss.py; a table of up to 16
+profiles per frame) and adds it back. With `translucency` the forward pass adds the light through
+thin parts (skinlab/render/translucency.py, as texture-space diffusion's irradiance pass does) to the
+light that gets blurred."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from skinlab.gl.uniforms import set_uniform
+from skinlab.render.frame_plan import FramePlan, PlannedPass
+from skinlab.render.options import TechniqueSettings, option
+from skinlab.render.technique import ForwardHook, LedgerStyle, PlanContext, Technique, TechniquePlan
+from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
+from skinlab.scene.optics.edges import separable_edge
+
+from .passes import MAX_SSSS_TAPS, SsssBlurParams, SsssBlurPass
+from .plan import SsssPlan, plan_ssss
+
+HOOK = "techniques/ssss/forward.glsl"
+DIFFUSE_TARGET = "ssss_diffuse"
+
+
+@dataclass(frozen=True)
+class SsssSettings(TechniqueSettings):
+    technique = "ssss"
+    taps: int = option(
+        17, "screen-space kernel samples (Jimenez presets: 11, 17, 25)", "int", range=(3, MAX_SSSS_TAPS), odd=True
+    )
+    gaussians: int = option(6, "Gaussians fitted to the profile the kernel is sampled from", "int", range=(1, 6))
+    translucency: bool = option(True, OPTION_DOC, "bool")
+
+
+@dataclass
+class SsssForward(ForwardHook):
+    ssss: SsssPlan
+    translucency: bool = False  # add the light through thin parts (shadow distance maps) before the blur
+
+    outputs = (DIFFUSE_TARGET,)
+
+    @property
+    def reason(self) -> str:
+        return (
+            "; subsurface diffuse"
+            + (f" and {REASON}" if self.translucency else "")
+            + (" to a second target for the screen-space blur")
+        )
+
+    def shading(self, node, frame):
+        # every mesh writes the second target, its alpha the profile index + 1 (0: not blurred); the
+        # node's own values apply (sss_model overrides change no uniform)
+        index = float(self.ssss.profile.get(node.uid, -1) + 1)
+        through = self.translucency and index > 0
+
+        def bind(prog, units):
+            set_uniform(prog, "u_ssss_profile", index)
+
+        return translucent_shading(node.material, HOOK, frame, through, bind, subsurface=index > 0)
+
+
+class SsssTechnique(Technique):
+    name = "ssss"
+    description = "screen-space separable SSS (Jimenez et al.): a post-process blur of the diffuse light"
+    settings_type = SsssSettings
+    passes = {"ssss_blur": SsssBlurPass}
+    ledger = LedgerStyle("s", "tab:orange", {"ssss_taps": "taps"}, "ssss {ssss_taps}")
+
+    def plan(self, ctx: PlanContext) -> TechniquePlan:
+        o = ctx.options
+        ssss = plan_ssss(ctx.meshes, ctx.settings, ctx.plan, o.gaussians, o.taps)
+        if ssss is None:
+            return TechniquePlan()
+        names = ", ".join(f"'{k.material.name}' ({k.material['sss_model']})" for k in ssss.kernels)
+        blur = PlannedPass(
+            "ssss_blur",
+            "ssss_blur",
+            "hdr_color",
+            ctx.settings.render_size,
+            f"screen-space separable SSS (Jimenez et al.): {o.taps}-tap kernel per pixel's profile "
+            f"({len(ssss.kernels)}: {names}), horizontal then vertical, depth-aware",
+            SsssBlurParams(ssss, o.gaussians),
+        )
+        through = plan_translucency(ctx, True, o.translucency)
+        return TechniquePlan(SsssForward(ssss, through), after_forward=[blur], shadow_distance=through)
+
+    def edge_response(self, model, medium, plan: FramePlan):
+        """The 1-D kernel of the material's profile across an edge along a screen axis (the separable
+        kernel's best case), at the frame's tap count."""
+        for p in plan.passes:
+            if isinstance(p.params, SsssBlurParams):
+                from skinlab.scene.optics.ssss import ssss_kernel
+                from skinlab.scene.optics.tsd import profile_fit
+
+                offsets, weights, _ = ssss_kernel(
+                    profile_fit(model, medium, p.params.gaussians), len(p.params.ssss.offsets_mm)
+                )
+                return separable_edge(offsets, weights)
+        return super().edge_response(model, medium, plan)
+
+
+TECHNIQUE = SsssTechnique()

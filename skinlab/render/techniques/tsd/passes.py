@@ -1,0 +1,463 @@
+"""Texture-space diffusion passes (d'Eon & Luebke 2007, GPU Gems 3 ch. 14), per subsurface mesh:
+
+  tsd_stretch     world mm per texel along u and v (only when the geometry or scene scale changes)
+  tsd_irradiance  light entering the surface, rasterised at the UVs, x albedo^mix; with translucency
+                  also the record of the light through thin parts, its gutter then filled across
+                  seams and one ring past the other chart borders (through_fill)
+  tsd_seams       the seam map: the gutter across UV seams paired with texels of the other chart
+                  (seams.py; only for meshes with seams; when the mesh changes)
+  tsd_dilate      the gutter across seams filled from the seam map, then irradiance pushed past the
+                  remaining chart borders (a few one-texel rings)
+  tsd_blur        one Gaussian level of the chain: separable u then v, taps in mm via the stretch map;
+                  then the level's gutter filled across seams
+
+The kernel (variances, weights, taps) comes from skinlab/scene/optics/tsd.py, which also holds the NumPy
+twin of the blur and gather. The gather is the technique's forward hook
+(skinlab/shaders/techniques/tsd/forward.glsl, variant TSD_LEVELS; bound by forward.py here).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import moderngl
+import numpy as np
+
+from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
+from skinlab.render.bounce import bind_bounce, bounce_defines
+from skinlab.render.boundary import bind_boundary
+from skinlab.render.gpu_resources import node_uniforms
+from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
+from skinlab.render.texture_units import TextureUnits
+from skinlab.render.translucency import bind_translucency
+from skinlab.scene.optics.tsd import DiffusionKernel, blur_taps
+
+from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
+from .seams import SeamMap, node_border_strips
+
+STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
+
+MAX_TAPS = 31  # skinlab/shaders/passes/tsd_blur.frag
+
+
+def _texture(ctx, size: int) -> moderngl.Texture:
+    t = ctx.texture((size, size), 4, dtype="f4")
+    t.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    t.repeat_x = t.repeat_y = False
+    return t
+
+
+def _record_textures(ctx, size: int) -> list:
+    """The light-through record's textures (TsdNodeTargets.through_record): RGBA, RGBA, RG, nearest."""
+    out = []
+    for comps in (4, 4, 2):
+        t = ctx.texture((size, size), comps, dtype="f4")
+        t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        t.repeat_x = t.repeat_y = False
+        out.append(t)
+    return out
+
+
+@dataclass
+class TsdNodeTargets:
+    """The GPU textures of one subsurface mesh node (float32 RGBA, premultiplied by coverage): the
+    irradiance as rasterised (raw) and dilated, a scratch texture for ping-ponging, the stretch map
+    and the blurred levels. Each pass's result stays in its own texture, so a pass whose inputs
+    did not change can be reused on later frames (skinlab/render/reuse.py)."""
+
+    size: int
+    irradiance: moderngl.Texture
+    scratch: moderngl.Texture
+    stretch: moderngl.Texture
+    raw: moderngl.Texture
+    levels: list = field(default_factory=list)
+    fbos: dict = field(default_factory=dict)
+    seam: SeamMap | None = None  # the seam map (meshes with UV seams)
+    through: list = field(default_factory=list)  # the light-through record, filled (through_record)
+    through_raw: list = field(default_factory=list)  # as the irradiance pass wrote it
+    strips: tuple = ()  # (source array, depth renderbuffer): where the record's fill runs (strip_mask)
+
+    def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture, depth=None) -> moderngl.Framebuffer:
+        key = (id(tex), *(id(m) for m in more), id(depth))
+        f = self.fbos.get(key)
+        if f is None:
+            f = self.fbos[key] = ctx.framebuffer([tex, *more], depth)
+        return f
+
+    def strip_mask(self, renderer, strips: np.ndarray):
+        """`strips` (seams.node_border_strips) drawn once into a depth renderbuffer (0.5 on them, 0
+        elsewhere), kept until they change (a new mesh version or size): a fullscreen pass tested
+        against it with "<=" shades only the strips. One draw of the strips per frame cost more on
+        llvmpipe (thousands of sliver triangles: 20 ms on the bunny) than the early depth test of
+        every texel."""
+        if not self.strips or self.strips[0] is not strips:
+            ctx = renderer.ctx
+            mask = self.strips[1] if self.strips else ctx.depth_renderbuffer((self.size, self.size))
+            fbo = ctx.framebuffer(depth_attachment=mask)
+            fbo.use()
+            ctx.viewport = (0, 0, self.size, self.size)
+            fbo.clear(depth=0.0)
+            ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
+            ctx.enable(moderngl.DEPTH_TEST)
+            ctx.depth_func = "1"  # always: every strip texel gets depth 0.5
+            if len(strips):
+                prog = renderer.programs.get("passes/fullscreen.vert", "passes/depth_only.frag")
+                vbo = ctx.buffer(strips.tobytes())
+                vao = ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
+                vao.render(moderngl.TRIANGLES)
+                vao.release()
+                vbo.release()
+            ctx.depth_func = "<"
+            ctx.disable(moderngl.DEPTH_TEST)
+            fbo.release()
+            self.strips = (strips, mask)
+        return self.strips[1]
+
+    def through_record(self, ctx) -> list:
+        """The irradiance pass's record of the light through thin parts, per texel and shadow slot,
+        unblurred (for the gather's exit factor of that light, skinlab/shaders/techniques/tsd/forward.glsl):
+        RGBA per slot (the light entering through, the thickness in mm) and RG (each slot's cosine on
+        the far face), its gutter filled (through_fill). Nearest filtering: a texel's record belongs
+        to it alone."""
+        if not self.through:
+            self.through = _record_textures(ctx, self.size)
+        return self.through
+
+    def through_raw_record(self, ctx) -> list:
+        """The same record as the irradiance pass rasterised it (empty in the gutter)."""
+        if not self.through_raw:
+            self.through_raw = _record_textures(ctx, self.size)
+        return self.through_raw
+
+    def level(self, ctx, k: int) -> moderngl.Texture:
+        while len(self.levels) <= k:
+            self.levels.append(_texture(ctx, self.size))
+        return self.levels[k]
+
+    def seam_map(self, ctx) -> SeamMap:
+        if self.seam is None:
+            self.seam = SeamMap(ctx, self.size)
+        return self.seam
+
+    def release(self) -> None:
+        for f in self.fbos.values():
+            f.release()
+        for t in [
+            self.irradiance,
+            self.scratch,
+            self.stretch,
+            self.raw,
+            *self.levels,
+            *self.through,
+            *self.through_raw,
+        ]:
+            t.release()
+        if self.seam is not None:
+            self.seam.release()
+        if self.strips:
+            self.strips[1].release()
+
+
+@dataclass
+class TsdFrameNode:
+    """What the gather needs for one node this frame."""
+
+    targets: TsdNodeTargets
+    kernel: DiffusionKernel  # the gather's weights (UNIT_KERNEL after the exact convolution)
+    material: object
+    mix: float
+    translucency: bool = False  # the irradiance gathered light through thin parts
+    through_slots: int = 0  # the shadow slots whose light through it recorded (TsdNodeTargets.through_record)
+
+
+class TsdStore:
+    """Per-node TSD textures, kept across frames (the renderer reuses the results of passes whose
+    inputs did not change). The renderer keeps one per renderer (Renderer.state) and calls
+    begin_frame with each frame plan."""
+
+    def __init__(self, ctx):
+        self.ctx = ctx
+        self.nodes: dict[int, TsdNodeTargets] = {}
+        self.stretch_updates = 0
+
+    def targets(self, node, size: int) -> TsdNodeTargets:
+        t = self.nodes.get(node.uid)
+        if t is None or t.size != size:
+            if t is not None:
+                t.release()
+            c = self.ctx
+            t = self.nodes[node.uid] = TsdNodeTargets(size, *(_texture(c, size) for _ in range(4)))
+        return t
+
+    def retain(self, uids) -> int:
+        """Release the textures of nodes not in `uids` (removed nodes, a reloaded scene); returns
+        how many were released."""
+        gone = [u for u in self.nodes if u not in uids]
+        for u in gone:
+            self.nodes.pop(u).release()
+        return len(gone)
+
+    def begin_frame(self, plan) -> None:
+        """Keep the textures of the nodes this frame's passes use; release the rest."""
+        self.retain({p.params.node.uid for p in plan.passes if isinstance(p.params, TsdNodeParams)})
+
+    def release(self) -> None:
+        for t in self.nodes.values():
+            t.release()
+        self.nodes.clear()
+
+
+def store(renderer) -> TsdStore:
+    """The renderer's TSD store."""
+    return renderer.state(STATE_KEY, TsdStore)
+
+
+def frame_nodes(frame) -> dict:
+    """This frame's TsdFrameNode per node uid (written by the irradiance pass, read by the gather)."""
+    return frame.data.setdefault(STATE_KEY, {})
+
+
+def _uv_raster_setup(ctx, fbo, size: int) -> None:
+    fbo.use()
+    ctx.viewport = (0, 0, size, size)
+    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+
+
+def dilate(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, rings: int) -> None:
+    """`rings` one-texel dilation steps from `src` into `dst`, ping-ponging with the scratch
+    texture (in place, src is dst, the count is rounded up to an even one)."""
+    ctx = renderer.ctx
+    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_dilate.frag")
+    steps = rings + (rings % 2) if src is dst else max(rings, 1)
+    for i in range(steps):
+        out = dst if (steps - 1 - i) % 2 == 0 else t.scratch
+        t.fbo(ctx, out).use()
+        ctx.viewport = (0, 0, t.size, t.size)
+        src.use(0)
+        set_uniform(prog, "u_src", 0)
+        renderer.fullscreen(prog)
+        src = out
+
+
+class TsdPass:
+    """A texture-space pass of one mesh node; ``output`` names the node texture holding its result."""
+
+    def __init__(self, renderer):
+        self.r = renderer
+
+    def node_targets(self, p) -> TsdNodeTargets:
+        return store(self.r).targets(p.params.node, p.params.size)
+
+    def outputs(self, frame, p) -> tuple:
+        """The texture holding the pass's result (reuse across frames, skinlab/render/reuse.py)."""
+        return (self.output(self.node_targets(p), p),)
+
+    def publish(self, frame, p) -> None:
+        """Hand the result to the frame (after run, or when reused)."""
+
+
+class TsdStretchPass(TsdPass):
+    def output(self, t, p):
+        return t.stretch
+
+    def run(self, frame, p) -> None:
+        prm: TsdNodeParams = p.params
+        ctx, node, size = self.r.ctx, prm.node, prm.size
+        t = self.node_targets(p)
+        fbo = t.fbo(ctx, t.stretch)
+        _uv_raster_setup(ctx, fbo, size)
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        radius_map = {k: v for k, v in node.material.textures().items() if k == "u_subsurface_radius_map"}
+        defines = {"HAS_SUBSURFACE_RADIUS_MAP": "1"} if radius_map else {}
+        prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_stretch.frag", defines)
+        set_uniforms(prog, {**node_uniforms(node), "u_mm_per_unit": frame.scene.mm_per_unit})
+        units = TextureUnits(ctx)
+        for sampler, (path, cs) in radius_map.items():
+            units.bind(prog, sampler, self.r.resources.texture(path, cs))
+        if prm.seams is not None:  # the surface across seams, in the gutter: drawn first, the charts win
+            self.r.resources.mesh(prm.seams.mesh()).vao(prog).render(moderngl.TRIANGLES)
+        self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        dilate(self.r, t, t.stretch, t.stretch, prm.dilate)
+        store(self.r).stretch_updates += 1
+
+
+class TsdIrradiancePass(TsdPass):
+    def output(self, t, p):
+        return t.raw
+
+    def outputs(self, frame, p) -> tuple:
+        t = self.node_targets(p)
+        return (t.raw, *(t.through_record(self.r.ctx) if p.params.translucency else ()))
+
+    def publish(self, frame, p) -> None:
+        prm: TsdIrradianceParams = p.params
+        t = self.node_targets(p)
+        gather = prm.gather if prm.gather is not None else prm.kernel
+        frame_nodes(frame)[prm.node.uid] = TsdFrameNode(
+            t, gather, prm.material, prm.mix, prm.translucency, min(len(prm.shadow_lights), SHADOW_SLOTS)
+        )
+        frame.targets[f"tsd_irradiance_raw[{prm.node.name}]"] = t.raw
+
+    def run(self, frame, p) -> None:
+        prm: TsdIrradianceParams = p.params
+        ctx, node, size, mat = self.r.ctx, prm.node, prm.size, prm.material
+        t = self.node_targets(p)
+        fbo = t.fbo(ctx, t.raw, *(t.through_raw_record(ctx) if prm.translucency else ()))
+        _uv_raster_setup(ctx, fbo, size)
+        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        nmax = frame.settings.max_lights
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **bounce_defines(frame, node)}
+        if prm.translucency:
+            defines["TSD_TRANSLUCENCY"] = 1
+        prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
+        units = TextureUnits(ctx)
+        bind_shadow_maps(self.r, frame, prog, units)
+        set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
+        set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
+        self.r.resources.bind_material(prog, mat, units)
+        bind_bounce(frame, node, prog, units)
+        bind_boundary(prog, mat)
+        if "u_slot_light" in prog:  # the light each filled shadow slot holds (its lights are shaded per slot)
+            slot_light = np.full(2, -1, np.int32)
+            for s, light in enumerate(prm.shadow_lights[:2]):
+                slot_light[s] = next(i for i, x in enumerate(prm.lights) if x is light)
+            prog["u_slot_light"].write(slot_light[: max(prog["u_slot_light"].array_length, 1)].tobytes())
+        if prm.translucency:
+            bind_translucency(prog, frame, units, self.r.dummy_texture())
+        self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        if prm.translucency:  # the record's gutter by the chart borders: across the seams, else dilated
+            slots = min(len(prm.shadow_lights), SHADOW_SLOTS)
+            through_fill(self.r, t, prm.seams is not None, node_border_strips(node.mesh, size), slots)
+        self.publish(frame, p)
+
+
+def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | None = None, slots: int = 2) -> None:
+    """The irradiance pass's light-through record (t.through_raw_record, read with t.raw's coverage)
+    into t.through_record with its gutter filled (skinlab/shaders/passes/tsd_through_fill.frag): the texels
+    the seam map marks from across the seam (`seams`: the node's seam map is drawn), the others one
+    ring from their covered neighbours. The gather reads the record with nearest filtering, so a
+    fragment by a chart border reads the gutter texels whose square overlaps the chart: without the
+    fill, a ring along every border left the light through with the reflected light's exit.
+    The covered texels' records are copied (blits; slot 1's only for `slots` > 1: the gather reads
+    only the slots the frame filled, variant TSD_THROUGH_SLOTS); the fill shades only `strips`
+    (seams.node_border_strips: every texel a fragment inside a chart can read, and a few more),
+    through an early depth test against their mask (TsdNodeTargets.strip_mask, drawn once per mesh),
+    or every texel (None). On llvmpipe a fill of every texel cost 20 % of the irradiance pass on the
+    head and 2.6x it on the back-lit slab (a sparse layout), drawing the strips every frame 20 ms
+    on the bunny (thousands of sliver triangles); docs/tsd.md has the cost as shipped."""
+    ctx = renderer.ctx
+    for k, (src, dst) in enumerate(zip(t.through_raw_record(ctx), t.through_record(ctx))):
+        if k != 1 or slots > 1:  # the covered texels' records
+            ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, src))
+    defines = {"TSD_THROUGH_SLOTS": 2 if slots > 1 else 1, **({"TSD_SEAMS": 1} if seams else {})}
+    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_through_fill.frag", defines)
+    mask = t.strip_mask(renderer, strips) if strips is not None else None
+    fbo = t.fbo(ctx, *t.through_record(ctx), depth=mask)
+    fbo.depth_mask = False
+    fbo.use()
+    ctx.viewport = (0, 0, t.size, t.size)
+    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+    units = TextureUnits(ctx)
+    for name, tex in zip(("u_raw", "u_through0", "u_through1", "u_through_cos"), (t.raw, *t.through_raw_record(ctx))):
+        units.bind(prog, name, tex)
+    if seams:
+        units.bind(prog, "u_seam", t.seam_map(ctx).texture)
+    if mask is not None:  # only the strips (0.5 <= their depth 0.5; 0 elsewhere): an early depth test
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<="
+    try:
+        renderer.fullscreen(prog)
+    finally:
+        ctx.depth_func = "<"
+        ctx.disable(moderngl.DEPTH_TEST)
+
+
+class TsdDilatePass(TsdPass):
+    def output(self, t, p):
+        return t.irradiance
+
+    def publish(self, frame, p) -> None:
+        name = p.params.node.name
+        t = self.node_targets(p)
+        frame.targets.pop(f"tsd_irradiance_raw[{name}]", None)
+        frame.targets[f"tsd_irradiance[{name}]"] = t.irradiance
+        frame.targets[f"tsd_stretch[{name}]"] = t.stretch
+
+    def run(self, frame, p) -> None:
+        t = self.node_targets(p)
+        if p.params.seams is not None:  # the gutter across seams, then dilation for the rest
+            seam_fill(self.r, t, t.raw, t.irradiance)
+            dilate(self.r, t, t.irradiance, t.irradiance, p.params.dilate)
+        else:
+            dilate(self.r, t, t.raw, t.irradiance, p.params.dilate)
+        self.publish(frame, p)
+
+
+class TsdSeamPass(TsdPass):
+    """The seam map of one node (seams.py)."""
+
+    def output(self, t, p):
+        return t.seam_map(self.r.ctx).texture
+
+    def publish(self, frame, p) -> None:
+        frame.targets[f"tsd_seams[{p.params.node.name}]"] = self.output(self.node_targets(p), p)
+
+    def run(self, frame, p) -> None:
+        t = self.node_targets(p)
+        prog = self.r.programs.get("passes/tsd_seam.vert", "passes/tsd_seam.frag")
+        t.seam_map(self.r.ctx).draw(prog, p.params.seams, p.params.node.mesh)
+        self.publish(frame, p)
+
+
+def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture) -> None:
+    """`src` into `dst` (another texture), the texels the seam map marks read across the seam
+    (skinlab/shaders/passes/tsd_seam_fill.frag)."""
+    ctx = renderer.ctx
+    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_seam_fill.frag")
+    t.fbo(ctx, dst).use()
+    ctx.viewport = (0, 0, t.size, t.size)
+    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+    src.use(0)
+    t.seam_map(ctx).texture.use(1)
+    set_uniforms(prog, {"u_src": 0, "u_seam": 1})
+    renderer.fullscreen(prog)
+
+
+class TsdBlurPass(TsdPass):
+    def output(self, t, p):
+        return t.level(self.r.ctx, p.params.step.level)
+
+    def publish(self, frame, p) -> None:
+        prm: TsdBlurParams = p.params
+        frame.targets[f"tsd_level{prm.step.level}[{prm.node.name}]"] = self.output(self.node_targets(p), p)
+
+    def run(self, frame, p) -> None:
+        prm: TsdBlurParams = p.params
+        ctx, size, step = self.r.ctx, prm.size, prm.step
+        t = self.node_targets(p)
+        src = t.irradiance if step.level == 0 else t.level(ctx, step.level - 1)
+        dst = t.level(ctx, step.level)
+        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
+        taps_t, taps_w = blur_taps(step.taps)
+        set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
+        set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)
+        set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_sigma_mm": step.sigma_mm, "u_taps": step.taps})
+        t.stretch.use(1)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+        for axis, (a, b) in enumerate(((src, t.scratch), (t.scratch, dst))):
+            t.fbo(ctx, b).use()
+            ctx.viewport = (0, 0, size, size)
+            a.use(0)
+            set_uniform(prog, "u_axis", axis)
+            self.r.fullscreen(prog)
+        if prm.seams is not None:  # the level's gutter across the seams, for the next blur and the gather
+            seam_fill(self.r, t, dst, t.scratch)
+            ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, t.scratch))
+        self.publish(frame, p)
+
+
+def read_texture(tex: moderngl.Texture) -> np.ndarray:
+    """A float texture as (H, W, C) float32, row 0 at v = 0 (the UV layout's bottom) - the layout the
+    NumPy twins in skinlab/scene/optics/tsd.py use."""
+    w, h = tex.size
+    return np.frombuffer(tex.read(), np.float32).reshape(h, w, tex.components).copy()

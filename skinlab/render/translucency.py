@@ -1,0 +1,69 @@
+"""Light through thin parts, the renderer's side (skinlab/shaders/lib/sss_translucency.glsl; NumPy twin
+skinlab/scene/optics/translucency.py): whether a frame plans it, and the uniforms and distance maps of a
+program that computes it. Texture-space diffusion's irradiance pass and the forward hooks of the
+techniques without a texture-space pass (screen-space SSS, disk, pre-integrated skin) share it, so
+every technique transmits the same light through the same thickness."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from skinlab.gl.uniforms import set_array, set_uniforms
+from skinlab.render.technique import NodeShading
+
+DEFINE = "SSS_TRANSLUCENCY"  # the forward hooks' variant (skinlab/shaders/techniques/<name>/forward.glsl)
+REASON = "translucency through thin parts"  # in the frame plan's reasons
+OPTION_DOC = "light through thin parts (needs a shadow-casting light)"  # every technique's `translucency`
+
+
+def plan_translucency(ctx, needed: bool, enabled: bool) -> bool:
+    """Whether the frame computes translucency (PlanContext `ctx`): a visible material scatters
+    (`needed`), the technique's setting allows it (`enabled`) and a light casts a shadow (its
+    distance map gives the thickness). Records why not in the plan's skips."""
+    use = needed and enabled and bool(ctx.shadow_lights)
+    if needed and not use:
+        ctx.plan.skipped.append(
+            ("translucency", "disabled in the settings" if not enabled else "no shadow-casting light")
+        )
+    return use
+
+
+def thickness_shrink(frame) -> float:
+    """How far (scene units) the thickness lookup moves the point inward along its normal: half a
+    texel of the distance maps, which span the scene's bounding sphere (skinlab/render/passes/shadow.py:
+    the orthographic map is 2 r wide; a point light's is about as wide at the scene's centre)."""
+    cached = frame.data.setdefault("translucency", {})
+    if "shrink" not in cached:
+        lo, hi = frame.scene.world_bounds()
+        radius = max(float(np.linalg.norm(hi - lo)) / 2.0, 1e-6)
+        cached["shrink"] = radius / max(int(frame.settings.shadow_size), 1)
+    return cached["shrink"]
+
+
+def bind_translucency(prog, frame, units, fallback=None) -> None:
+    """The distance maps (u_distance0/1 on units from `units`), the lights' eyes and the shrink for
+    lib/sss_translucency.glsl. A slot without a distance map gets the other slot's (never sampled:
+    no light points at it) or `fallback` (a texture) when neither has one."""
+    maps = [frame.targets.get(f"shadow_distance{slot}") for slot in (0, 1)]
+    present = [m for m in maps if m is not None] or [fallback]
+    for slot, m in enumerate(maps):
+        tex = m if m is not None else present[0]
+        if tex is None:
+            raise RuntimeError("translucency: no shadow distance map this frame and no fallback texture")
+        units.bind(prog, f"u_distance{slot}", tex)
+    eyes = np.stack([frame.shadow_eyes.get(s, np.zeros(4)) for s in (0, 1)])
+    set_array(prog, "u_light_eye", eyes, 2)
+    set_uniforms(prog, {"u_thickness_shrink": thickness_shrink(frame)})
+
+
+def translucent_shading(material, hook: str, frame, through: bool, bind, subsurface: bool = True) -> NodeShading:
+    """A forward hook's NodeShading that adds the light through thin parts where `through`: the
+    hook's SSS_TRANSLUCENCY variant, and the distance maps bound after the hook's own `bind(prog,
+    units)`. Shared by the hooks of screen-space SSS, the disk technique and pre-integrated skin."""
+
+    def bind_all(prog, units):
+        bind(prog, units)
+        if through:
+            bind_translucency(prog, frame, units)
+
+    return NodeShading(material, hook, {DEFINE: 1} if through else {}, bind_all, subsurface=subsurface)

@@ -1,0 +1,316 @@
+"""Interreflection: the light a scene's surfaces throw onto each other (NumPy reference).
+
+Every vertex of every visible mesh casts ``rays`` cosine-weighted rays into its hemisphere
+(stratified: a Hammersley-like set in the disk, rotated per vertex). A ray that meets the front of
+a surface records the three vertices of the triangle it met and its barycentric weights; a ray that
+leaves the scene or meets a back face (the inside of an open mesh) records nothing. With those
+records the irradiance a vertex receives from the scene's surfaces is
+
+    E_bounce(i) = 1/K sum_k M(hit_k)
+
+where M is the radiant exitance (W/m^2) of the surface hit, interpolated from its vertices. This is
+the rendering equation's one-bounce estimator with cosine-weighted sampling: for a Lambertian
+sender the radiance is M / pi, and E = integral L cos dw = pi E_cos[L] = E_cos[M] (Pharr, Jakob &
+Humphreys, "Physically Based Rendering", 4th ed., sec. 13.6; the gathering of radiosity at mesh
+vertices as in Cohen & Wallace, "Radiosity and Realistic Image Synthesis", 1993, ch. 4). Repeating
+it with M = albedo x (direct + bounce) gives the next order.
+
+Copies of one vertex (the same position and normal, split along UV seams) share one set of rays,
+so the bounce light is continuous across seams. The estimate is then averaged over each vertex's
+one-ring (area-weighted, on the welded mesh): bounce light varies slowly, and the average of 7 or so
+independent estimates has about a third of the variance of one (a bias of about an edge length).
+
+Sources: docs/references.md#interreflection. The GPU twin is skinlab/render/bounce.py with
+skinlab/shaders/passes/bounce_exitance.{vert,frag} (M per vertex), bounce_gather.frag (the sum above) and
+bounce_smooth.frag (the one-ring average); the records are computed here once per geometry and cached
+(ray casting with trimesh through Embree, the ``embreex`` package).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from .graph import MeshNode
+
+GOLDEN = 0.6180339887498949  # the golden ratio's fractional part: the second coordinate's sequence
+RAY_OFFSET = 1e-5  # ray origins leave the surface by this fraction of the scene's bounding diagonal
+
+
+@dataclass
+class BounceTransfer:
+    """The ray records of a set of mesh nodes (all in world space).
+
+    ``vertices[i * rays + k]``: the three global vertex indices of the triangle ray k of vertex i met,
+    ``weights[i * rays + k]``: their barycentric weights divided by ``rays`` (zero for a ray that met
+    nothing or a back face). Global vertex index = ``offsets[node_uid]`` + the mesh's own index."""
+
+    rays: int
+    offsets: dict[int, int]  # node uid -> first global vertex
+    counts: dict[int, int]  # node uid -> its vertices
+    vertices: np.ndarray  # (V * rays, 3) int64
+    weights: np.ndarray  # (V * rays, 3) float32
+    key: str = ""  # what the records were computed from (geometry, rays, seed): a cache key
+    hit_fraction: dict[int, float] = field(default_factory=dict)  # node uid -> front hits / rays
+    # the one-ring average: vertex i's estimate is sum_j ring_weights[j] E[ring_vertices[j]] over
+    # j in ring_offsets[i] .. ring_offsets[i + 1] (itself and its neighbours, weights summing to 1)
+    ring_offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))  # (V + 1,)
+    ring_vertices: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    ring_weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
+
+    @property
+    def total_vertices(self) -> int:
+        return sum(self.counts.values())
+
+    @property
+    def any_hit(self) -> bool:
+        """True when some ray met the front of a surface (else there is nothing to gather); from the
+        hit fractions, not the records (the plan asks every frame)."""
+        return any(f > 0.0 for f in self.hit_fraction.values())
+
+
+def cosine_directions(normals: np.ndarray, rays: int, seed: int = 0) -> np.ndarray:
+    """(V, rays, 3) unit directions about each normal, cosine-weighted (Malley's method: uniform
+    points in the unit disk lifted to the hemisphere). Stratified: point k has radius^2 (k + j)/K and
+    angle 2 pi frac(k GOLDEN + r), with j, r random per vertex (Cranley-Patterson rotation)."""
+    n = np.asarray(normals, np.float64)
+    v = len(n)
+    rng = np.random.default_rng(seed)
+    jitter = rng.random((v, 1))
+    rot = rng.random((v, 1))
+    k = np.arange(rays)[None, :]
+    u1 = (k + jitter) / rays
+    u2 = np.mod(k * GOLDEN + rot, 1.0)
+    r = np.sqrt(u1)
+    phi = 2.0 * np.pi * u2
+    x, y, z = r * np.cos(phi), r * np.sin(phi), np.sqrt(np.maximum(1.0 - u1, 0.0))
+    # an orthonormal frame per normal (Duff et al. 2017, "Building an Orthonormal Basis, Revisited")
+    sign = np.where(n[:, 2] >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sign + n[:, 2])
+    b = n[:, 0] * n[:, 1] * a
+    t = np.stack([1.0 + sign * n[:, 0] ** 2 * a, sign * b, -sign * n[:, 0]], 1)
+    s = np.stack([b, sign + n[:, 1] ** 2 * a, -n[:, 1]], 1)
+    return x[..., None] * t[:, None] + y[..., None] * s[:, None] + z[..., None] * n[:, None]
+
+
+def world_geometry(node: MeshNode) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh node's vertex positions and unit normals in world space (float64)."""
+    m = np.asarray(node.world_matrix, np.float64)
+    p = node.mesh.positions.astype(np.float64) @ m[:3, :3].T + m[:3, 3]
+    nrm = node.mesh.normals.astype(np.float64) @ np.linalg.inv(m[:3, :3])
+    length = np.linalg.norm(nrm, axis=1, keepdims=True)
+    nrm = np.where(length > 0.0, nrm / np.maximum(length, 1e-300), [0.0, 0.0, 1.0])
+    return p, nrm
+
+
+_DIGESTS: dict[tuple[int, int], bytes] = {}  # (mesh uid, version) -> digest of its arrays
+
+
+def _mesh_digest(mesh) -> bytes:
+    """A digest of a mesh's positions, triangles and normals, computed once per mesh version (the
+    frame plan asks every frame; hashing 10k vertices each time cost a millisecond or two)."""
+    key = (mesh.uid, mesh.version)
+    d = _DIGESTS.get(key)
+    if d is None:
+        h = hashlib.sha1()
+        for a in (mesh.positions, mesh.indices, mesh.normals):
+            h.update(np.ascontiguousarray(a).tobytes())
+        d = _DIGESTS[key] = h.digest()
+        if len(_DIGESTS) > 256:
+            _DIGESTS.pop(next(iter(_DIGESTS)))
+    return d
+
+
+def geometry_key(nodes: list[MeshNode], rays: int, seed: int) -> str:
+    """What the records depend on: each mesh's arrays (by content: the same mesh loaded twice shares
+    its records) and world transform, the rays and the seed."""
+    h = hashlib.sha1()
+    h.update(np.array([rays, seed], np.int64).tobytes())
+    for node in nodes:
+        h.update(np.asarray(node.world_matrix, np.float64).tobytes())
+        h.update(_mesh_digest(node.mesh))
+    return h.hexdigest()
+
+
+_CACHE: dict[str, tuple] = {}  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights
+_CACHE_SIZE = 8
+
+
+def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> BounceTransfer:
+    """The ray records of `nodes` against each other (cached per geometry, rays and seed: the same
+    meshes at the same places share them, whichever scene object holds them)."""
+    if not isinstance(rays, int) or isinstance(rays, bool) or rays < 1:
+        raise ValueError(f"interreflection rays: expected a positive integer (rays per vertex), got {rays!r}")
+    key = geometry_key(nodes, rays, seed)
+    offsets, counts, total = {}, {}, 0
+    for node in nodes:
+        offsets[node.uid], counts[node.uid] = total, len(node.mesh.positions)
+        total += len(node.mesh.positions)
+    hit = _CACHE.get(key)
+    if hit is None:
+        hit = _cast(nodes, rays, seed, total)
+        if len(_CACHE) >= _CACHE_SIZE:
+            _CACHE.pop(next(iter(_CACHE)))
+        _CACHE[key] = hit
+    vertices, weights, fractions, r_off, r_vert, r_w = hit
+    return BounceTransfer(
+        rays,
+        offsets,
+        counts,
+        vertices,
+        weights,
+        key,
+        {n.uid: f for n, f in zip(nodes, fractions)},
+        r_off,
+        r_vert,
+        r_w,
+    )
+
+
+def weld(positions: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(first, inverse): copies of a vertex (bit-identical position and normal) map to one welded
+    vertex; ``first[w]`` is its first copy, ``inverse[i]`` vertex i's welded index."""
+    key = np.ascontiguousarray(np.concatenate([positions, normals], 1).astype(np.float64))
+    _, first, inverse = np.unique(key.view(np.dtype((np.void, key.itemsize * 6))).ravel(), True, True)
+    return first.astype(np.int64), inverse.ravel().astype(np.int64)
+
+
+def one_rings(positions, faces, first, inverse) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each vertex's one-ring on the welded mesh, as CSR (offsets, vertices, weights): itself and
+    its edge neighbours (as their first copies), weighted by their area (a third of the incident
+    triangles'), the weights of a ring summing to 1."""
+    nw = len(first)
+    f = inverse[faces]
+    tri_area = 0.5 * np.linalg.norm(
+        np.cross(positions[faces[:, 1]] - positions[faces[:, 0]], positions[faces[:, 2]] - positions[faces[:, 0]]),
+        axis=1,
+    )
+    area = np.bincount(f.ravel(), np.repeat(tri_area / 3.0, 3), minlength=nw)
+    edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]], np.stack([np.arange(nw)] * 2, 1)])
+    edges = np.unique(np.sort(np.concatenate([edges, edges[:, ::-1]]), axis=1), axis=0)
+    pairs = np.concatenate([edges, edges[edges[:, 0] != edges[:, 1]][:, ::-1]])  # both directions, self once
+    pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+    w = area[pairs[:, 1]]
+    total = np.bincount(pairs[:, 0], w, minlength=nw)
+    w = np.where(total[pairs[:, 0]] > 0, w / np.maximum(total[pairs[:, 0]], 1e-300), 0.0)
+    # a welded vertex no triangle uses (area 0): its own estimate alone
+    lonely = total == 0
+    w[lonely[pairs[:, 0]] & (pairs[:, 0] == pairs[:, 1])] = 1.0
+    counts_w = np.bincount(pairs[:, 0], minlength=nw)
+    start_w = np.concatenate([[0], np.cumsum(counts_w)])
+    # every copy of a welded vertex has its ring
+    counts = counts_w[inverse]
+    offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    # entry j of vertex i is its welded vertex's entry (j - offsets[i]): no loop over the vertices
+    within = np.arange(offsets[-1]) - np.repeat(offsets[:-1], counts)
+    idx = np.repeat(start_w[inverse], counts) + within
+    return offsets, first[pairs[idx, 1]], w[idx].astype(np.float32)
+
+
+def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
+    import trimesh
+
+    if total == 0:
+        z = np.zeros(0, np.int64)
+        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), [], np.zeros(1, np.int64), z, z
+
+    pos, nrm, faces = [], [], []
+    start = 0
+    for node in nodes:
+        p, n = world_geometry(node)
+        pos.append(p)
+        nrm.append(n)
+        faces.append(node.mesh.indices.astype(np.int64) + start)
+        start += len(p)
+    p_all, n_all, f_all = np.concatenate(pos), np.concatenate(nrm), np.concatenate(faces)
+    mesh = trimesh.Trimesh(p_all, f_all, process=False)
+    try:  # Embree's BVH: 0.6 M rays in about a second on 2 cores (trimesh's fallback needs rtree and is far slower)
+        from trimesh.ray.ray_pyembree import RayMeshIntersector
+    except ImportError:
+        raise RuntimeError(
+            "interreflection: casting rays needs embreex (pip install embreex; a dependency in pyproject.toml), "
+            "or render without it: bounces = 0 (--bounces 0)"
+        ) from None
+    mesh.ray = RayMeshIntersector(mesh)
+    diag = float(np.linalg.norm(p_all.max(0) - p_all.min(0))) or 1.0
+    first, inverse = weld(p_all, n_all)
+    nw = len(first)
+    dirs = cosine_directions(n_all[first], rays, seed).reshape(-1, 3)
+    origins = np.repeat(p_all[first] + n_all[first] * (RAY_OFFSET * diag), rays, axis=0)
+    tri, ray, loc = mesh.ray.intersects_id(origins, dirs, multiple_hits=False, return_locations=True)
+    vertices = np.zeros((nw * rays, 3), np.int64)
+    weights = np.zeros((nw * rays, 3), np.float32)
+    if len(tri):
+        front = np.einsum("ij,ij->i", mesh.face_normals[tri], dirs[ray]) < 0.0
+        tri, ray, loc = tri[front], ray[front], loc[front]
+        corners = f_all[tri]
+        bary = trimesh.triangles.points_to_barycentric(p_all[corners], loc)
+        bary = np.clip(np.nan_to_num(bary, nan=1.0 / 3.0), 0.0, 1.0)
+        bary /= np.maximum(bary.sum(1, keepdims=True), 1e-12)
+        vertices[ray] = corners
+        weights[ray] = (bary / rays).astype(np.float32)
+    no_normal = np.concatenate([np.linalg.norm(n.mesh.normals, axis=1) == 0 for n in nodes])
+    weights[np.repeat(no_normal[first], rays)] = 0.0  # a vertex without a normal (no triangle uses it) receives nothing
+    # every copy of a welded vertex gets its records
+    rows = (inverse[:, None] * rays + np.arange(rays)[None, :]).ravel()
+    vertices, weights = vertices[rows], weights[rows]
+    hit_rays = (weights.sum(1) > 0).reshape(total, rays).mean(1)
+    fractions, start = [], 0
+    for node in nodes:
+        k = len(node.mesh.positions)
+        fractions.append(float(hit_rays[start : start + k].mean()))
+        start += k
+    return vertices, weights, fractions, *one_rings(p_all, f_all, first, inverse)
+
+
+def gather(transfer: BounceTransfer, exitance: np.ndarray) -> np.ndarray:
+    """(V, C) irradiance each vertex receives from the surfaces its rays met, for the senders'
+    radiant exitance `exitance` (V, C) per global vertex."""
+    m = np.asarray(exitance, np.float64)
+    if m.shape[0] != transfer.total_vertices:
+        raise ValueError(
+            f"interreflection gather: exitance has {m.shape[0]} vertices, the transfer {transfer.total_vertices}"
+        )
+    per_ray = np.einsum("rj,rjc->rc", transfer.weights.astype(np.float64), m[transfer.vertices])
+    return per_ray.reshape(transfer.total_vertices, transfer.rays, -1).sum(1)
+
+
+def smooth(transfer: BounceTransfer, irradiance: np.ndarray) -> np.ndarray:
+    """The one-ring average of per-vertex estimates (module docstring)."""
+    e = np.asarray(irradiance, np.float64)
+    per = transfer.ring_weights.astype(np.float64)[:, None] * e[transfer.ring_vertices]
+    owner = np.repeat(np.arange(transfer.total_vertices), np.diff(transfer.ring_offsets))
+    out = np.zeros_like(e)
+    np.add.at(out, owner, per)
+    return out
+
+
+def bounce_irradiance(transfer: BounceTransfer, direct: np.ndarray, albedo: np.ndarray, bounces: int) -> np.ndarray:
+    """Irradiance from interreflection up to order `bounces` (0: none), per global vertex: each
+    order's senders leave albedo x (direct + the previous orders' bounce light)."""
+    direct = np.asarray(direct, np.float64)
+    e = np.zeros_like(direct)
+    for _ in range(bounces):
+        e = smooth(transfer, gather(transfer, np.asarray(albedo, np.float64) * (direct + e)))
+    return e
+
+
+def sender_albedo(base, metallic, specular) -> np.ndarray:
+    """The fraction of the light arriving at a surface that it sends back out, as the bounce counts
+    it: the diffuse albedo base x (1 - metallic) plus the specular reflectance at normal incidence
+    (principled F0), both as if Lambertian (a first-order estimate: the specular part is a few
+    percent and leaves in a lobe). A subsurface material's total diffuse reflectance is its base
+    colour (skinlab/scene/materials.py), so the same holds for it. GLSL twin: skinlab/shaders/lib/bounce.glsl."""
+    from .optics.brdf import principled_f0
+
+    base = np.asarray(base, np.float64)
+    m = np.asarray(metallic, np.float64)[..., None]
+    return base * (1.0 - m) + principled_f0(base, metallic, specular)
+
+
+def clear_cache() -> None:
+    _CACHE.clear()

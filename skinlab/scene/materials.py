@@ -1,0 +1,254 @@
+"""Materials declare their parameters once; uniforms, shader variants and UI derive from that.
+
+A :class:`Param` has a name, a kind, a default and a valid range. Kinds:
+- ``float`` / ``color`` / ``vec3``: plain values, uploaded as uniforms ``u_<name>``;
+- ``texture``: a file path; when set it selects a shader variant (``HAS_<NAME>``) and binds a sampler;
+- ``choice``: an option the renderer reads on the CPU (the SSS model picks the profile a technique
+  plans with); it is no uniform and no define.
+
+The GLSL declarations of the uniforms and samplers come from the same declaration: the virtual
+include ``skinlab/material.glsl`` (:func:`glsl_material_uniforms`), so a renamed parameter is a
+compile error in the shaders that use it, not a uniform silently left at zero.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+SSS_MODELS = ("none", "dipole", "burley", "blender-burley", "gaussians", "pbd")
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str
+    kind: str  # float | color | vec3 | texture | choice
+    default: Any
+    range: tuple[float, float] | None = None
+    choices: tuple[str, ...] = ()
+    colorspace: str = "linear"  # for textures: "srgb" colour data or "linear" data
+    doc: str = ""
+    unit: str = ""
+
+    @property
+    def uniform(self) -> str:
+        return f"u_{self.name}"
+
+    @property
+    def define(self) -> str:
+        return f"HAS_{self.name.upper()}"
+
+    def _numbers(self, value: Any, label: str) -> np.ndarray:
+        """A float or colour/vec3 value as an array (1 or 3 numbers; a scalar fills R, G, B)."""
+        if self.kind == "float":
+            try:
+                return np.array([float(value)])
+            except (TypeError, ValueError):
+                raise ValueError(
+                    f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}"
+                ) from None
+        try:
+            arr = np.asarray(value, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError):
+            raise ValueError(f"{label}: expected 3 numbers, got {value!r}") from None
+        if arr.size == 1:
+            arr = np.repeat(arr, 3)
+        if arr.size != 3:
+            raise ValueError(f"{label}: expected 3 numbers (R, G, B), got {arr.size}")
+        return arr
+
+    def _canonical(self, arr: np.ndarray):
+        return float(arr[0]) if self.kind == "float" else tuple(float(x) for x in arr)
+
+    def validate(self, value: Any, where: str = "") -> Any:
+        """Return the value in canonical form or raise ValueError naming the parameter."""
+        label = f"{where}{self.name}"
+        if self.kind == "texture":
+            if value is None or value == "":
+                return None
+            if not isinstance(value, str | Path):
+                raise ValueError(f"{label}: expected a file path (string), got {value!r}")
+            return Path(value)
+        if self.kind == "choice":
+            if not isinstance(value, str) or value not in self.choices:
+                raise ValueError(f"{label}: expected one of {', '.join(self.choices)}; got {value!r}")
+            return value
+        arr = self._numbers(value, label)
+        lo, hi = self.range
+        if not np.isfinite(arr).all() or (arr < lo).any() or (arr > hi).any():
+            unit = f" {self.unit}" if self.unit else ""
+            raise ValueError(f"{label}: value {value!r} outside the valid range [{lo}, {hi}]{unit}")
+        return self._canonical(arr)
+
+    def clamp(self, value: Any) -> Any:
+        """Like validate, but numbers out of range are clamped into it and NaN becomes the default
+        (for UI widgets); malformed values and unknown choices still raise, naming the parameter."""
+        if self.kind not in ("float", "color", "vec3"):
+            return self.validate(value)
+        arr = self._numbers(value, self.name)
+        arr = np.where(np.isnan(arr), np.asarray(self._numbers(self.default, self.name)), arr)
+        return self._canonical(np.clip(arr, *self.range))
+
+
+# One meaning per parameter, stated here once: the panel's tooltips, the docs (docs/scenes.md, generated
+# from this table by `python -m skinlab.scene.scene_docs`) and errors all read it.
+PRINCIPLED_PARAMS: tuple[Param, ...] = (
+    Param(
+        "base_color",
+        "color",
+        (0.8, 0.8, 0.8),
+        (0.0, 1.0),
+        unit="linear RGB",
+        doc="diffuse albedo of the surface without subsurface scattering, or the F0 of a metal",
+    ),
+    Param("base_color_map", "texture", None, colorspace="srgb", doc="colour map (sRGB file); multiplies base_color"),
+    Param("roughness", "float", 0.5, (0.0, 1.0), doc="perceptual roughness; GGX alpha = roughness^2"),
+    Param("roughness_map", "texture", None, doc="roughness map (R channel, linear); multiplies roughness"),
+    Param("metallic", "float", 0.0, (0.0, 1.0), doc="0 dielectric, 1 metal (base_color becomes the specular F0)"),
+    Param("specular", "float", 0.5, (0.0, 1.0), doc="dielectric F0 = 0.08 * specular (0.5 -> 4 %, index 1.5)"),
+    Param("normal_map", "texture", None, doc="tangent-space normal map (linear, OpenGL +Y)"),
+    Param("normal_scale", "float", 1.0, (0.0, 4.0), doc="strength of the normal map (0: off)"),
+    Param("occlusion_map", "texture", None, doc="ambient occlusion (R channel, linear); multiplies the ambient light"),
+    Param(
+        "subsurface",
+        "float",
+        0.0,
+        (0.0, 1.0),
+        doc="weight of subsurface scattering against plain diffuse (Blender: Subsurface Weight)",
+    ),
+    Param(
+        "subsurface_radius",
+        "vec3",
+        (1.0, 0.2, 0.1),
+        (0.0, 1000.0),
+        unit="mm",
+        doc="artist radius R = 4 pi l per channel (l: mean free path), millimetres; Blender's Subsurface Radius "
+        "x Subsurface Scale in mm",
+    ),
+    Param(
+        "subsurface_map",
+        "texture",
+        None,
+        doc="subsurface weight map (R channel, linear); multiplies subsurface per texel (every technique)",
+    ),
+    Param(
+        "subsurface_radius_map",
+        "texture",
+        None,
+        doc="subsurface radius scale map (R channel, linear): subsurface_radius x 2 R per texel (mid grey keeps "
+        "it; ears and nostrils scatter further than the forehead); honoured by disk (per-pixel sample radius), "
+        "tsd and exact (through the stretch map); ssss, tint and preintegrated keep one radius per material",
+    ),
+    Param(
+        "subsurface_color",
+        "color",
+        (0.8, 0.4, 0.3),
+        (0.0, 1.0),
+        unit="linear RGB",
+        doc="surface albedo of the scattering medium: its total diffuse reflectance, the colour seen from afar "
+        "(inverted to the single-scattering albedo by photon beam diffusion)",
+    ),
+    Param(
+        "sss_model",
+        "choice",
+        "burley",
+        choices=SSS_MODELS,
+        doc="diffusion profile for subsurface scattering (none: plain diffuse)",
+    ),
+)
+
+
+@dataclass
+class Material:
+    """A principled material: a name and values for the declared parameters."""
+
+    name: str = "default"
+    values: dict[str, Any] = field(default_factory=dict)
+    params: tuple[Param, ...] = PRINCIPLED_PARAMS
+
+    def __post_init__(self) -> None:
+        given = dict(self.values)
+        self.values = {p.name: p.validate(p.default) if p.default is not None else None for p in self.params}
+        self.update(given)
+
+    @property
+    def param_map(self) -> dict[str, Param]:
+        return {p.name: p for p in self.params}
+
+    def update(self, values: Mapping[str, Any]) -> Material:
+        pm = self.param_map
+        for k, v in values.items():
+            if k not in pm:
+                raise ValueError(f"material {self.name!r}: unknown parameter {k!r}; known: {', '.join(pm)}")
+            self.values[k] = pm[k].validate(v, where=f"material {self.name!r}: ")
+        return self
+
+    def __getitem__(self, name: str) -> Any:
+        return self.values[name]
+
+    def with_overrides(self, overrides: Mapping[str, Any], name: str | None = None) -> Material:
+        m = Material(name or self.name, dict(self.values), self.params)
+        return m.update(overrides)
+
+    # -- what the renderer derives from the declaration -------------------------------
+    def uniforms(self) -> dict[str, Any]:
+        return {p.uniform: self.values[p.name] for p in self.params if p.kind in ("float", "color", "vec3")}
+
+    def textures(self) -> dict[str, tuple[Path, str]]:
+        """sampler uniform -> (path, colorspace) for the maps that are set."""
+        return {
+            p.uniform: (self.values[p.name], p.colorspace)
+            for p in self.params
+            if p.kind == "texture" and self.values[p.name] is not None
+        }
+
+    def defines(self) -> dict[str, str]:
+        """Shader-variant defines: ``HAS_<MAP>`` for the maps that are set (plain values are uniforms,
+        so materials that differ only in values share a program)."""
+        return {p.define: "1" for p in self.params if p.kind == "texture" and self.values[p.name] is not None}
+
+    @property
+    def has_subsurface(self) -> bool:
+        return (
+            self.values["subsurface"] > 0
+            and self.values["sss_model"] != "none"
+            and max(self.values["subsurface_radius"]) > 0
+        )
+
+
+_GLSL_TYPES = {"float": "float", "color": "vec3", "vec3": "vec3"}
+
+
+def glsl_material_uniforms(params: tuple[Param, ...] = PRINCIPLED_PARAMS) -> str:
+    """The material uniform and sampler declarations (the virtual include ``skinlab/material.glsl``):
+    ``uniform <type> u_<name>;`` per plain value and ``uniform sampler2D u_<map>;`` inside
+    ``#ifdef HAS_<MAP>`` per texture. Choices are read on the CPU and declare nothing."""
+    lines = ["// generated from skinlab/scene/materials.py (PRINCIPLED_PARAMS): the material's uniforms"]
+    for p in params:
+        if p.kind in _GLSL_TYPES:
+            unit = f" ({p.unit})" if p.unit else ""
+            lines.append(f"uniform {_GLSL_TYPES[p.kind]} {p.uniform};" + (f"  // {p.doc}{unit}" if p.doc else ""))
+        elif p.kind == "texture":
+            lines += [f"#ifdef {p.define}", f"uniform sampler2D {p.uniform};  // {p.doc}", "#endif"]
+    return "\n".join(lines) + "\n"
+
+
+def medium_values(medium) -> dict[str, Any]:
+    """Principled-material values that reproduce a homogeneous medium (a Jensen 2001 preset, say):
+    its diffuse surface albedo as base and subsurface colour, its artist radius (4 pi l, Blender's
+    convention) as subsurface_radius, and the specular whose F0 matches its index of refraction
+    (F0 = ((eta - 1)/(eta + 1))^2 = 0.08 specular). Values are clipped to the declared ranges."""
+    albedo = np.clip(np.asarray(medium.surface_albedo(), np.float64), 0.0, 1.0)
+    radius = np.clip(np.asarray(medium.artist_radius_mm, np.float64), 0.0, 1000.0)
+    f0 = ((medium.eta - 1.0) / (medium.eta + 1.0)) ** 2
+    return {
+        "base_color": tuple(float(x) for x in albedo),
+        "subsurface_color": tuple(float(x) for x in albedo),
+        "subsurface_radius": tuple(float(x) for x in radius),
+        "subsurface": 1.0,
+        "specular": float(min(f0 / 0.08, 1.0)),
+    }

@@ -1,0 +1,213 @@
+"""Triangle meshes: positions, normals, UVs, tangents; tangent generation and UV atlases."""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import os
+import sys
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+_UIDS = itertools.count(1)
+
+
+@dataclass
+class Mesh:
+    name: str
+    positions: np.ndarray  # (N, 3) float32
+    indices: np.ndarray  # (M, 3) uint32
+    normals: np.ndarray | None = None  # (N, 3) float32
+    uvs: np.ndarray | None = None  # (N, 2) float32, OpenGL convention (v up)
+    tangents: np.ndarray | None = None  # (N, 4) float32, w = handedness
+    source: str = ""
+    version: int = 0  # bump when geometry changes (GPU buffers and stretch maps key on it)
+    _bounds: tuple | None = field(default=None, repr=False)
+    # unique for the process (unlike id(), never reused after the mesh is freed): GPU caches key on it
+    uid: int = field(default_factory=lambda: next(_UIDS), repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        self.positions = np.ascontiguousarray(self.positions, np.float32)
+        self.indices = np.ascontiguousarray(self.indices, np.uint32).reshape(-1, 3)
+        where = f"mesh {self.name!r}" + (f" ({self.source})" if self.source else "")
+        if self.positions.ndim != 2 or self.positions.shape[1] != 3:
+            raise ValueError(f"{where}: positions must be (N, 3), got {self.positions.shape}")
+        if len(self.indices) == 0:
+            raise ValueError(f"{where}: has no triangles")
+        if self.indices.max() >= len(self.positions):
+            raise ValueError(
+                f"{where}: triangle index {self.indices.max()} out of range ({len(self.positions)} vertices)"
+            )
+        if not np.isfinite(self.positions).all():
+            raise ValueError(f"{where}: positions contain NaN or Inf")
+        if self.normals is None:
+            self.normals = vertex_normals(self.positions, self.indices)
+        self.normals = np.ascontiguousarray(self.normals, np.float32)
+        if self.uvs is not None:
+            self.uvs = np.ascontiguousarray(self.uvs, np.float32)
+        if self.tangents is not None:
+            self.tangents = np.ascontiguousarray(self.tangents, np.float32)
+
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._bounds is None:
+            self._bounds = (self.positions.min(0).astype(np.float64), self.positions.max(0).astype(np.float64))
+        return self._bounds
+
+    def bound_corners(self) -> np.ndarray:
+        lo, hi = self.bounds
+        return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+
+    def ensure_tangents(self) -> np.ndarray:
+        if self.tangents is None:
+            if self.uvs is None:
+                raise ValueError(f"mesh {self.name!r}: tangents need UVs")
+            self.tangents = compute_tangents(self.positions, self.normals, self.uvs, self.indices)
+        return self.tangents
+
+    def ensure_uvs(self, reason: str = "a technique needs UVs", generate: bool = True) -> None:
+        """Generate a UV atlas with xatlas if the mesh has none (or raise naming the mesh)."""
+        if self.uvs is not None:
+            return
+        if not generate:
+            raise ValueError(f"mesh {self.name!r} ({self.source or 'no file'}) has no UV coordinates, and {reason}")
+        generate_atlas(self)
+
+
+_ATLASED: dict[int, Mesh] = {}
+
+
+def with_atlas(mesh: Mesh) -> Mesh:
+    """``mesh`` if it has UVs, else a copy of it with an xatlas atlas (one per source mesh and
+    process). The source is left alone: meshes from skinlab.scene.loaders are shared through its cache."""
+    if mesh.uvs is not None:
+        return mesh
+    if mesh.uid not in _ATLASED:
+        copy = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, None, None, mesh.source)
+        generate_atlas(copy)
+        _ATLASED[mesh.uid] = copy
+    return _ATLASED[mesh.uid]
+
+
+def vertex_normals(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """Area-weighted vertex normals; degenerate vertices get +Z rather than NaN."""
+    p = positions.astype(np.float64)
+    f = indices.astype(np.int64)
+    fn = np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]])
+    n = np.zeros_like(p)
+    for k in range(3):
+        np.add.at(n, f[:, k], fn)
+    ln = np.linalg.norm(n, axis=1, keepdims=True)
+    out = np.where(ln > 0, n / np.where(ln > 0, ln, 1), [0.0, 0.0, 1.0])
+    return out.astype(np.float32)
+
+
+def compute_tangents(positions, normals, uvs, indices) -> np.ndarray:
+    """Per-vertex tangents (xyz) and handedness (w) from UV derivatives (Lengyel 2001), with
+    Gram-Schmidt against the normal; triangles with degenerate UVs contribute nothing and
+    vertices left without a tangent get any unit vector perpendicular to the normal."""
+    p = positions.astype(np.float64)
+    uv = uvs.astype(np.float64)
+    n = normals.astype(np.float64)
+    f = indices.astype(np.int64)
+    e1, e2 = p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]
+    d1, d2 = uv[f[:, 1]] - uv[f[:, 0]], uv[f[:, 2]] - uv[f[:, 0]]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    ok = np.abs(det) > 1e-20
+    r = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)[:, None]
+    sdir = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * r
+    tdir = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * r
+    t = np.zeros_like(p)
+    b = np.zeros_like(p)
+    for k in range(3):
+        np.add.at(t, f[:, k], sdir)
+        np.add.at(b, f[:, k], tdir)
+    t = t - n * np.sum(n * t, axis=1, keepdims=True)
+    ln = np.linalg.norm(t, axis=1, keepdims=True)
+    # fallback: any perpendicular
+    alt = np.cross(n, np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
+    alt /= np.maximum(np.linalg.norm(alt, axis=1, keepdims=True), 1e-30)
+    t = np.where(ln > 1e-12, t / np.where(ln > 1e-12, ln, 1), alt)
+    w = np.where(np.sum(np.cross(n, t) * b, axis=1) < 0.0, -1.0, 1.0)
+    return np.concatenate([t, w[:, None]], axis=1).astype(np.float32)
+
+
+ATLAS_CACHE_VERSION = 1  # bump when the way atlases are made changes
+
+
+def cache_dir() -> Path:
+    """Where derived data (UV atlases) is cached: $SKINLAB_CACHE_DIR, else $XDG_CACHE_HOME/skinlab,
+    else ~/.cache/skinlab. Deleting it is always safe."""
+    env = os.environ.get("SKINLAB_CACHE_DIR")
+    if env:
+        return Path(env)
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "skinlab"
+
+
+def atlas_key(positions: np.ndarray, indices: np.ndarray) -> str:
+    """Content hash of a mesh's geometry (the atlas depends on nothing else), with the xatlas version."""
+    import xatlas
+
+    h = hashlib.sha256()
+    h.update(f"atlas-v{ATLAS_CACHE_VERSION}-xatlas-{getattr(xatlas, '__version__', '?')}".encode())
+    for a in (np.ascontiguousarray(positions, np.float32), np.ascontiguousarray(indices, np.uint32)):
+        h.update(str(a.shape).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()[:32]
+
+
+def _read_atlas(path: Path, n_vertices: int):
+    try:
+        with np.load(path) as z:
+            vmapping, idx, uvs = z["vmapping"], z["indices"], z["uvs"]
+    except Exception:  # missing, truncated or from elsewhere: make it again
+        return None
+    if vmapping.ndim != 1 or len(vmapping) != len(uvs) or (len(vmapping) and vmapping.max() >= n_vertices):
+        return None
+    if idx.ndim != 2 or idx.shape[1] != 3 or (idx.size and idx.max() >= len(vmapping)):
+        return None
+    return vmapping, idx, uvs
+
+
+def generate_atlas(mesh: Mesh, cache: bool = True) -> None:
+    """Give ``mesh`` a UV atlas with xatlas (vertices are split along chart seams). Atlases are
+    cached by mesh content under :func:`cache_dir` (xatlas takes seconds on a 70k-triangle scan);
+    ``cache=False`` or SKINLAB_CACHE_DIR=off always recomputes."""
+    use_cache = cache and os.environ.get("SKINLAB_CACHE_DIR", "").lower() != "off"
+    key = atlas_key(mesh.positions, mesh.indices)
+    path = cache_dir() / "atlas" / f"{key}.npz"
+    found = _read_atlas(path, len(mesh.positions)) if use_cache else None
+    if found is None:
+        import xatlas
+
+        where = f"mesh {mesh.name!r}" + (f" ({Path(mesh.source).name})" if mesh.source else "")
+        print(
+            f"skinlab: generating a UV atlas for {where}, {len(mesh.indices)} triangles, with xatlas"
+            + (f"; cached in {path.parent} for next time" if use_cache else ""),
+            file=sys.stderr,
+            flush=True,
+        )
+        vmapping, idx, uvs = xatlas.parametrize(mesh.positions, mesh.indices)
+        if use_cache:
+            tmp = None
+            try:
+                path.parent.mkdir(parents=True, exist_ok=True)
+                fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".npz", dir=path.parent)
+                with os.fdopen(fd, "wb") as f:
+                    np.savez(f, vmapping=vmapping, indices=idx, uvs=uvs)
+                os.replace(tmp, path)
+            except OSError as exc:
+                if tmp is not None:
+                    Path(tmp).unlink(missing_ok=True)  # a read-only home is no reason to fail a render
+                print(f"skinlab: could not cache the atlas in {path.parent}: {exc}", file=sys.stderr)
+    else:
+        vmapping, idx, uvs = found
+    mesh.positions = np.ascontiguousarray(mesh.positions[vmapping])
+    mesh.normals = np.ascontiguousarray(mesh.normals[vmapping])
+    mesh.indices = np.ascontiguousarray(idx, np.uint32)
+    mesh.uvs = np.ascontiguousarray(uvs, np.float32)
+    mesh.tangents = None
+    mesh.version += 1

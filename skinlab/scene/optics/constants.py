@@ -1,0 +1,187 @@
+"""The one source of numeric constants shared by the NumPy references and the GLSL shaders.
+
+`GLSL_CONSTANTS` is turned into the virtual include file ``skinlab/constants.glsl`` by
+:func:`glsl_header`; shaders never spell these numbers themselves.
+"""
+
+from __future__ import annotations
+
+import math
+
+PI = math.pi
+INV_PI = 1.0 / math.pi
+
+# Smallest GGX alpha (= roughness^2). Roughness 0 is a mirror; alpha is clamped so that the
+# D term stays finite in fp32 (peak 1/(pi alpha^2) ~ 3.2e5 at alpha=1e-3).
+MIN_GGX_ALPHA = 1.0e-3
+# Cosines are clamped to at least this before they divide anything (grazing angles n.v -> 0).
+MIN_COS = 1.0e-4
+# Dielectric F0 for specular = 0.5 (Burley 2012: specular 0.5 <=> F0 = 0.04); F0 = 0.08 * specular.
+SPECULAR_F0_SCALE = 0.08
+
+# sRGB transfer function (IEC 61966-2-1)
+SRGB_LINEAR_THRESHOLD = 0.0031308
+SRGB_ENCODED_THRESHOLD = 0.04045
+
+# Point lights: distances are clamped to at least this (metres) before the inverse square.
+MIN_LIGHT_DISTANCE_M = 1.0e-3
+
+# Shadow map depth bias in normalised light depth units (slope-scaled part added in shader).
+SHADOW_BIAS = 0.0015
+
+GLSL_CONSTANTS: dict[str, float] = {
+    "PI": PI,
+    "INV_PI": INV_PI,
+    "MIN_GGX_ALPHA": MIN_GGX_ALPHA,
+    "MIN_COS": MIN_COS,
+    "SPECULAR_F0_SCALE": SPECULAR_F0_SCALE,
+    "SRGB_LINEAR_THRESHOLD": SRGB_LINEAR_THRESHOLD,
+    "SRGB_ENCODED_THRESHOLD": SRGB_ENCODED_THRESHOLD,
+    "SHADOW_BIAS": SHADOW_BIAS,
+    "MIN_LIGHT_DISTANCE_M": MIN_LIGHT_DISTANCE_M,
+}
+
+
+def register(name: str, value: float) -> float:
+    """Add a constant to the shared table (for optics modules defined elsewhere) and return it."""
+    if name in GLSL_CONSTANTS and GLSL_CONSTANTS[name] != value:
+        raise ValueError(f"constant {name} registered twice with different values")
+    GLSL_CONSTANTS[name] = float(value)
+    return float(value)
+
+
+def glsl_header() -> str:
+    """GLSL source for the shared constants (included as "skinlab/constants.glsl")."""
+    lines = ["// Generated from skinlab/scene/optics/constants.py - do not edit."]
+    for name, value in GLSL_CONSTANTS.items():
+        lines.append(f"const float {name} = {float(value)!r};")
+    return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------------------------------------
+# Diffusion profiles (issue 3). Appended as a block so the dict order above is unchanged.
+# Sources (docs/references.md): jensen-2001, christensen-burley-2015, blender-burley, habel-2013
+# (pbrt-v4 src/pbrt/bssrdf.cpp + util/scattering.h, Fresnel moments), deon-luebke-2007 (GPU Gems 3, 14).
+# ---------------------------------------------------------------------------------------------
+# Mean free paths (mm) below this are "no scattering": every profile returns 0 (the delta at r = 0
+# is the renderer's plain diffuse term). Keeps 1/l^2 far from fp32 overflow. A power of two so
+# that fp32 and float64 agree on which side of it a value lies.
+MIN_MFP_MM = 2.0**-20
+# Burley-type profiles diverge like 1/r at r = 0. They are evaluated at max(r, BURLEY_R0_EPS d):
+# the analytic value at the rim of a disc of radius 1e-3 d (continuous; finite at r = 0; the energy
+# inside that disc is underestimated by about A * BURLEY_R0_EPS / 4, i.e. 2.5e-4 A).
+BURLEY_R0_EPS = 2.0**-10
+# Blender (Cycles/EEVEE) Burley: truncation radius in units of d and the CDF there.
+BURLEY_TRUNCATE = 16.0
+BURLEY_TRUNCATE_CDF = 1.0 - 0.25 * math.exp(-16.0) - 0.75 * math.exp(-16.0 / 3.0)
+# Profiles are exactly 0 beyond this many mean free paths (far below fp32 range anyway; avoids
+# inf/inf in d = sqrt(r^2 + z^2) for absurd radii).
+PROFILE_MAX_OPTICAL_R = 1.0e6
+# Photon beam diffusion: depth samples per evaluation (pbrt-v4 bssrdf.cpp uses 100).
+PBD_SAMPLES = 100
+# Jensen 2001 / Egan & Hilgeman 1979 diffuse Fresnel reflectance fits (eta >= 1 and eta < 1).
+FDR_GT1 = (-1.440, 0.710, 0.668, 0.0636)  # c0/eta^2 + c1/eta + c2 + c3 eta
+FDR_LT1 = (-0.4399, 0.7099, -0.3319, 0.0636)  # c0 + c1/eta + c2/eta^2 + c3/eta^3
+# The eta fits above and below are only meaningful over a limited range (Egan's eta < 1 fit
+# diverges below ~0.4; the pbrt moment fits make 1 - 2 FM1 negative above ~2.8): diffusion
+# models clamp eta to [DIFFUSION_ETA_MIN, DIFFUSION_ETA_MAX] before using them.
+DIFFUSION_ETA_MIN = 0.5
+DIFFUSION_ETA_MAX = 2.5
+# pbrt-v4 FresnelMoment1/2 polynomial fits (util/scattering.cpp).
+FM1_LT1 = (0.45966, -1.73965, 3.37668, -3.904945, 2.49277, -0.68441)  # powers eta^0..5
+FM1_GE1 = (-4.61686, 11.1136, -10.4646, 5.11455, -1.27198, 0.12746)  # powers eta^0..5
+FM2_LT1 = (0.27614, -0.87350, 1.12077, -0.65095, 0.07883, 0.04860)  # powers eta^0..5
+FM2_GE1 = (
+    -547.033,
+    458.843,
+    -218.725,
+    45.3087,  # eta^0, eta^-1..-3
+    404.557,
+    -189.519,
+    54.9327,
+    -9.00603,
+    0.63942,
+)  # eta^1..5
+
+
+def _fm_reference(eta: float, which: int) -> float:
+    """pbrt-v4 FresnelMoment1 (which = 1) / FresnelMoment2 (which = 2) in float64."""
+    if which == 1:
+        c = FM1_LT1 if eta < 1.0 else FM1_GE1
+        return sum(ck * eta**k for k, ck in enumerate(c))
+    if eta < 1.0:
+        return sum(ck * eta**k for k, ck in enumerate(FM2_LT1))
+    c = FM2_GE1
+    return c[0] + c[1] / eta + c[2] / eta**2 + c[3] / eta**3 + sum(c[4 + k] * eta ** (k + 1) for k in range(5))
+
+
+def _chebyshev_fit(fn, lo: float, hi: float, n: int = 14) -> tuple[float, ...]:
+    """Chebyshev coefficients of fn on [lo, hi] (interpolation at n Chebyshev nodes)."""
+    nodes = [math.cos(math.pi * (j + 0.5) / n) for j in range(n)]
+    vals = [fn(lo + (hi - lo) * 0.5 * (t + 1.0)) for t in nodes]
+    return tuple(
+        (2.0 if k else 1.0) / n * sum(v * math.cos(math.pi * k * (j + 0.5) / n) for j, v in enumerate(vals))
+        for k in range(n)
+    )
+
+
+# The pbrt moment polynomials cancel badly in fp32 (FM2 for eta >= 1 sums terms of +-500 to
+# get ~0.1). GLSL evaluates the same functions re-expanded as Chebyshev series on the two eta
+# intervals (Clenshaw: well conditioned); truncation error < 1e-10 (tests/scene/optics/test_profile_models.py).
+FM_CHEB_N = 22
+FM1_CHEB_LT1 = _chebyshev_fit(lambda e: _fm_reference(e, 1), DIFFUSION_ETA_MIN, 1.0, FM_CHEB_N)
+FM1_CHEB_GE1 = _chebyshev_fit(lambda e: _fm_reference(e, 1), 1.0, DIFFUSION_ETA_MAX, FM_CHEB_N)
+FM2_CHEB_LT1 = _chebyshev_fit(lambda e: _fm_reference(e, 2), DIFFUSION_ETA_MIN, 1.0, FM_CHEB_N)
+FM2_CHEB_GE1 = _chebyshev_fit(lambda e: _fm_reference(e, 2), 1.0, DIFFUSION_ETA_MAX, FM_CHEB_N)
+
+# d'Eon & Luebke 2007 six-Gaussian skin profile: variances (mm^2) and RGB weights.
+SKIN6_VARIANCES = (0.0064, 0.0484, 0.187, 0.567, 1.99, 7.41)
+SKIN6_WEIGHTS = (
+    (0.233, 0.455, 0.649),
+    (0.100, 0.336, 0.344),
+    (0.118, 0.198, 0.0),
+    (0.113, 0.007, 0.007),
+    (0.358, 0.004, 0.0),
+    (0.078, 0.0, 0.0),
+)
+
+GLSL_CONSTANTS.update(
+    {
+        "MIN_MFP_MM": MIN_MFP_MM,
+        "BURLEY_R0_EPS": BURLEY_R0_EPS,
+        "BURLEY_TRUNCATE": BURLEY_TRUNCATE,
+        "BURLEY_TRUNCATE_CDF": BURLEY_TRUNCATE_CDF,
+        "PBD_SAMPLES": float(PBD_SAMPLES),
+        "PROFILE_MAX_OPTICAL_R": PROFILE_MAX_OPTICAL_R,
+        "DIFFUSION_ETA_MIN": DIFFUSION_ETA_MIN,
+        "DIFFUSION_ETA_MAX": DIFFUSION_ETA_MAX,
+        **{f"FDR_GT1_{i}": v for i, v in enumerate(FDR_GT1)},
+        **{f"FDR_LT1_{i}": v for i, v in enumerate(FDR_LT1)},
+        **{f"FM1_CHEB_LT1_{i}": v for i, v in enumerate(FM1_CHEB_LT1)},
+        **{f"FM1_CHEB_GE1_{i}": v for i, v in enumerate(FM1_CHEB_GE1)},
+        **{f"FM2_CHEB_LT1_{i}": v for i, v in enumerate(FM2_CHEB_LT1)},
+        **{f"FM2_CHEB_GE1_{i}": v for i, v in enumerate(FM2_CHEB_GE1)},
+        **{f"SKIN6_VAR_{i}": v for i, v in enumerate(SKIN6_VARIANCES)},
+        **{f"SKIN6_W{c}_{i}": w[j] for j, c in enumerate("RGB") for i, w in enumerate(SKIN6_WEIGHTS)},
+    }
+)
+
+# ---------------------------------------------------------------------------------------------
+# Texture-space diffusion (d'Eon & Luebke 2007; skinlab/scene/optics/tsd.py, skinlab/shaders/passes/tsd_*.frag)
+TSD_TAP_RANGE = 3.0  # blur taps span +-3 sigma
+TSD_MIN_MM_PER_TEXEL = 1e-6  # zero-area triangles (infinite stretch) clamp to this
+TSD_MAX_STEP_TEXELS = 4096.0  # one sigma never spans more texels than this (finite for any stretch)
+COVERAGE_EPS = 1e-6  # premultiplied coverage below this is "no surface"
+GLSL_CONSTANTS.update(
+    {
+        "TSD_MIN_MM_PER_TEXEL": TSD_MIN_MM_PER_TEXEL,
+        "TSD_MAX_STEP_TEXELS": TSD_MAX_STEP_TEXELS,
+        "COVERAGE_EPS": COVERAGE_EPS,
+    }
+)
+
+# Luminance weights of linear Rec. 709 / sRGB primaries (ITU-R BT.709-6, item 3.2): one figure
+# from three channels where a single value must stand for all (the oblique entry offset,
+# skinlab/scene/optics/oblique.py).
+LUMA_R, LUMA_G, LUMA_B = 0.2126, 0.7152, 0.0722
+GLSL_CONSTANTS.update({"LUMA_R": LUMA_R, "LUMA_G": LUMA_G, "LUMA_B": LUMA_B})

@@ -1,0 +1,114 @@
+"""Light through thin parts: NumPy twin of skinlab/shaders/lib/sss_translucency.glsl.
+
+The thickness of matter between a light and a surface point comes from the shadow pass's distance
+map (per texel, the distance from the light of the first surface it meets: scene units, 1e30 where
+none), as in Jimenez, Whelan, Sundstedt & Gutierrez 2010, "Real-Time Realistic Skin Translucency"
+(docs/references.md#jimenez-2010): the point's distance from the light minus the first surface's,
+looked up at the point moved `shrink` inward along its normal, times the cosine between the normal
+and the light (a flat slab's own thickness), plus the shrink (which a flat part's lookup lost); 0
+where the moved point is still in front of the first surface (a point that is itself the first
+surface reads 0, not the map's quantisation noise; so does a part thinner than the shrink). What
+crosses that thickness is the exact slab transmittance of skinlab/scene/optics/slab.py (`slab_through`: all
+orders of scattering, Fresnel in and out). Texture-space diffusion gathers it in its irradiance pass,
+the screen-space techniques in the forward pass; both call the same GLSL functions.
+
+Distance maps are (H, W) with row 0 at texture v = 0 (GL order), read texel by texel (texelFetch:
+the bilinear weights are computed, not the sampler's, so the twin is exact to fp32)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .boundary import BoundaryTables
+from .slab import slab_exit, slab_exit_tables, slab_table, slab_through
+
+NO_SURFACE = 1e29  # a distance-map texel at or above this holds no surface (cleared to 1e30)
+
+
+def _points(world) -> np.ndarray:
+    return np.atleast_2d(np.asarray(world, np.float64))
+
+
+def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
+    """(first, hit) per point of world (N, 3): the map's distance at the point's light-space
+    position, bilinear between the four nearest texel centres (clamped to the map) where all four
+    hold a surface, else the texel containing the point; hit False outside the map or where that
+    texel holds no surface (first 0 outside). GLSL first_hit_distance."""
+    world = _points(world)
+    dist = np.asarray(distance_map, np.float64)
+    h, w = dist.shape
+    p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        uv = p[:, :2] / p[:, 3:4]
+    inside = np.all((uv >= 0.0) & (uv <= 1.0), axis=1)
+    uv = np.where(inside[:, None], uv, 0.0)
+    x, y = uv[:, 0] * w - 0.5, uv[:, 1] * h - 0.5
+    i0, j0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+    fx, fy = x - i0, y - j0
+    ia, ib = np.clip(i0, 0, w - 1), np.clip(i0 + 1, 0, w - 1)
+    ja, jb = np.clip(j0, 0, h - 1), np.clip(j0 + 1, 0, h - 1)
+    d00, d10, d01, d11 = dist[ja, ia], dist[ja, ib], dist[jb, ia], dist[jb, ib]
+    bilinear = (d00 * (1 - fx) + d10 * fx) * (1 - fy) + (d01 * (1 - fx) + d11 * fx) * fy
+    all4 = np.maximum(np.maximum(d00, d10), np.maximum(d01, d11)) < NO_SURFACE
+    i = np.clip(np.floor(uv[:, 0] * w).astype(np.int64), 0, w - 1)
+    j = np.clip(np.floor(uv[:, 1] * h).astype(np.int64), 0, h - 1)
+    nearest = dist[j, i]
+    first = np.where(inside, np.where(all4, bilinear, nearest), 0.0)
+    return first, inside & (all4 | (nearest < NO_SURFACE))
+
+
+def distance_from_light(eye, world) -> np.ndarray:
+    """Distance from the light along its travel (directional: eye = (direction it travels, 0)) or to
+    its position (point: eye = (position, 1)); scene units. GLSL distance_from_light."""
+    eye = np.asarray(eye, np.float64).reshape(4)
+    world = _points(world)
+    return world @ eye[:3] if eye[3] == 0.0 else np.linalg.norm(world - eye[:3], axis=1)
+
+
+def thickness_mm(distance_map, shadow_matrix, eye, world, normal, back, shrink, mm_per_unit):
+    """(d_mm, hit): the thickness (mm, along the normal) of matter between the light and each point;
+    normal (N, 3) the outward geometric normal, back (N,) its cosine with the direction the light
+    travels, shrink in scene units. GLSL sss_thickness_mm."""
+    p = _points(world) - float(shrink) * _points(normal)
+    first, hit = first_hit_distance(distance_map, shadow_matrix, p)
+    inside = distance_from_light(eye, p) - first
+    d = np.where(inside > 0.0, (inside * np.asarray(back, np.float64) + float(shrink)) * float(mm_per_unit), 0.0)
+    return np.where(hit, d, 0.0), hit
+
+
+def through(back, d_mm, tables: BoundaryTables, medium, colour) -> np.ndarray:
+    """(N, 3): of the irradiance on a surface facing the light, per unit base colour, what crosses a
+    slab d_mm thick lit at cosine `back` on its far side and leaves through this side: the exact slab
+    transmittance (skinlab/scene/optics/slab.py slab_through, at the boundary's index `tables.eta`). `medium`:
+    the material's medium (alpha_arr, mfp_arr), `colour` its subsurface_color (the table is per unit
+    of it): what skinlab/render/boundary.py binds. GLSL sss_through."""
+    back = np.atleast_1d(np.asarray(back, np.float64))
+    d = np.broadcast_to(np.atleast_1d(np.asarray(d_mm, np.float64)), back.shape)
+    table = slab_table(medium.alpha_arr, colour)
+    out = [slab_through(c, x, table, medium.mfp_arr, medium.alpha_arr, tables.eta) for c, x in zip(back, d)]
+    return np.array(out, np.float64).reshape(-1, 3)
+
+
+def translucent_irradiance(e, back, d_mm, hit, tables: BoundaryTables, medium, colour) -> np.ndarray:
+    """(N, 3) irradiance entering through thin parts from one light of irradiance e (3,) on a surface
+    facing it: e back through(back, d) where the light is behind the surface (back > 0) and the map
+    has a surface in front (hit); 0 elsewhere. GLSL sss_translucent_light."""
+    back = np.atleast_1d(np.asarray(back, np.float64))
+    ok = (back > 0) & np.asarray(hit, bool)
+    t = through(np.where(ok, back, 1.0), np.where(ok, d_mm, 0.0), tables, medium, colour)
+    return np.where(ok[:, None], np.asarray(e, np.float64).reshape(1, 3) * back[:, None] * t, 0.0)
+
+
+def translucent_exit(mu, back, d_mm, tables: BoundaryTables, medium, colour) -> np.ndarray:
+    """(N, 3) the exit factor of the light through thin parts toward a viewer at cosine mu (light that
+    arrived at cosine `back` on the far face of a part d_mm thick): skinlab/scene/optics/slab.py slab_exit with
+    the material's tables (what skinlab/render/boundary.py binds). Radiance: base colour / pi x
+    translucent_irradiance x this (the reflected light's exit(mu) is boundary.py's). GLSL: the factor
+    sss_translucent_light_toward applies (sss_slab_exit(mu, back, d_mm))."""
+    mu = np.atleast_1d(np.asarray(mu, np.float64))
+    back = np.broadcast_to(np.atleast_1d(np.asarray(back, np.float64)), mu.shape)
+    d = np.broadcast_to(np.atleast_1d(np.asarray(d_mm, np.float64)), mu.shape)
+    table = slab_table(medium.alpha_arr, colour)
+    ex = slab_exit_tables(medium.alpha_arr, table, tables.eta)
+    out = [slab_exit(m, b, x, table, ex, medium.mfp_arr, tables.eta) for m, b, x in zip(mu, back, d)]
+    return np.array(out, np.float64).reshape(-1, 3)

@@ -1,0 +1,559 @@
+"""Scene files (TOML, read with tomllib). Every key with its type, default and meaning is in
+docs/scenes.md, generated from SCENE_FILE_KEYS below and the material declarations.
+
+```toml
+[scene]
+name = "head"
+mm_per_unit = 45.0            # physical scale: scattering distances are in millimetres
+
+[environment]
+ambient = [0.03, 0.03, 0.035]
+exposure = 1.0
+
+[camera]
+position = [0, 1, 30]
+target = [0, 1, 0]
+yfov_deg = 28
+
+[materials.skin]               # any declared material parameter; paths relative to this file
+base_color_map = "../lee-perry-smith/Map-COL.jpg"
+roughness = 0.45
+# preset = "marble"            # first take a Jensen 2001 medium (albedo, radius, index), then the rest
+
+[[meshes]]
+name = "head"
+file = "../lee-perry-smith/LeePerrySmith.glb"
+material = "skin"
+translation = [0, 0, 0]
+rotation_deg = [0, 0, 0]        # or rotation = [x, y, z, w]
+scale = 1.0
+flip_v = false                             # true for assets whose UV origin is the image's top-left
+generate_uvs = false                       # true: an xatlas atlas where the file has no UVs
+overrides = { roughness = 0.4 }            # per-node material overrides
+[meshes.nodes.EyeLeft]                     # nodes inside the file, by name
+material = "eye"
+overrides = { roughness = 0.05 }
+
+[[lights]]
+name = "key"
+type = "directional"           # or "point" (use position)
+direction = [-0.5, -0.3, -1]   # the way the light travels
+color = [1, 0.97, 0.92]
+intensity = 3.0
+cast_shadow = true
+```
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from skinlab.resources import assets_root, bundled_scenes, scene_by_name
+
+from . import transform as tf
+from .graph import CameraNode, LightNode, MeshNode, Node, Scene
+from .loaders import SUPPORTED, LoadedNode, load_mesh_file
+from .materials import Material
+from .mesh import Mesh, with_atlas
+
+ASSETS = assets_root()
+DEFAULT_SCENE = ASSETS / "scenes" / "head.toml"
+
+
+class SceneFileError(ValueError):
+    pass
+
+
+@dataclass(frozen=True)
+class Key:
+    """One scene-file key: its TOML type, default, range or unit, and meaning (docs/scenes.md)."""
+
+    name: str
+    type: str
+    default: str
+    doc: str
+
+
+# Every key of every table, declared once: validation rejects anything else and docs/scenes.md is
+# generated from this (skinlab/scene/scene_docs.py). Material parameters come from skinlab.scene.materials.
+SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
+    "[scene]": (
+        Key("name", "string", "the file's stem", "shown in the viewer's title and output names"),
+        Key(
+            "mm_per_unit",
+            "number > 0",
+            "1.0",
+            "millimetres per scene unit: the physical scale that subsurface_radius (mm) is measured against",
+        ),
+    ),
+    "[environment]": (
+        Key("ambient", "3 numbers >= 0", "[0.03, 0.03, 0.035]", "uniform ambient radiance, linear RGB"),
+        Key("exposure", "number > 0", "1.0", "linear multiplier on radiance before tone mapping (PNG only)"),
+    ),
+    "[camera]": (
+        Key("position", "3 numbers", "[0, 0, 10]", "eye position, scene units"),
+        Key("target", "3 numbers", "[0, 0, 0]", "point looked at; must differ from position"),
+        Key("up", "3 numbers", "[0, 1, 0]", "up direction (non-zero)"),
+        Key("yfov_deg", "number in (0, 179]", "30", "vertical field of view, degrees"),
+        Key("znear", "number > 0", "0.1", "near clipping distance, scene units"),
+        Key("zfar", "number > znear", "1000", "far clipping distance, scene units"),
+    ),
+    "[materials.NAME]": (
+        Key(
+            "preset",
+            "string",
+            "none",
+            "a Jensen et al. 2001 medium (assets/presets/): sets base_color, subsurface_color, subsurface_radius, "
+            "subsurface = 1 and specular first; the table's other keys then override",
+        ),
+    ),
+    "[[meshes]]": (
+        Key("file", "string (required)", "-", "mesh file (.glb .gltf .obj .ply .stl .off), relative to the scene file"),
+        Key("name", "string", "the file's stem", "name of the node that holds the file's nodes"),
+        Key("material", "string", "a default material", "name of a [materials.NAME] table"),
+        Key("overrides", "table", "{}", "material parameters for this mesh only, e.g. { roughness = 0.4 }"),
+        Key("nodes", "table of tables", "{}", "per node of the file, by name: material, overrides, visible"),
+        Key("translation", "3 numbers", "[0, 0, 0]", "scene units"),
+        Key("rotation", "4 numbers", "[0, 0, 0, 1]", "quaternion x, y, z, w (not with rotation_deg)"),
+        Key("rotation_deg", "3 numbers", "[0, 0, 0]", "Euler angles about X, Y, Z in degrees (not with rotation)"),
+        Key("scale", "1 or 3 numbers, non-zero", "1", "scale factor(s)"),
+        Key("visible", "boolean", "true", "false hides the mesh and all its nodes"),
+        Key("flip_v", "boolean", "false", "v -> 1 - v: for files whose UV origin is the image's top-left"),
+        Key(
+            "generate_uvs",
+            "boolean",
+            "false",
+            "make an xatlas UV atlas where the file has none (cached by mesh content in ~/.cache/skinlab)",
+        ),
+    ),
+    "[meshes.nodes.NAME]": (
+        Key("material", "string", "the mesh's material", "name of a [materials.NAME] table"),
+        Key("overrides", "table", "{}", "material parameters for this node (on top of the mesh's overrides)"),
+        Key("visible", "boolean", "true", "false hides this node"),
+    ),
+    "[[lights]]": (
+        Key("name", "string", "lightN", "the viewer's key light is the one named 'key'"),
+        Key("type", "string", '"directional"', '"directional" (uses direction) or "point" (uses position)'),
+        Key("direction", "3 numbers, non-zero", "[0, 0, -1]", "the way a directional light travels"),
+        Key("position", "3 numbers", "(required for point)", "a point light's position, scene units"),
+        Key("color", "1 or 3 numbers >= 0", "[1, 1, 1]", "linear RGB"),
+        Key("intensity", "number >= 0", "1.0", "irradiance (directional) or intensity (point) multiplier on color"),
+        Key("cast_shadow", "boolean", "false", "render a shadow map (at most 2 lights; needed for translucency)"),
+    ),
+}
+
+
+def _keys(section: str) -> set[str]:
+    return {k.name for k in SCENE_FILE_KEYS[section]}
+
+
+# -- typed reads: every wrong type or value names its key ------------------------------------------
+
+_TOML_TYPE = {
+    bool: "a boolean",
+    int: "an integer",
+    float: "a number",
+    str: "a string",
+    list: "an array",
+    dict: "a table",
+}
+
+
+def _kind(value: Any) -> str:
+    return next((name for t, name in _TOML_TYPE.items() if isinstance(value, t)), type(value).__name__)
+
+
+def _show(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _table(where: str, value: Any) -> dict:
+    if not isinstance(value, dict):
+        raise SceneFileError(f"{where}: expected a table, got {_kind(value)} {_show(value)}")
+    return value
+
+
+def _tables(where: str, value: Any) -> list[dict]:
+    """An array of tables (``[[meshes]]``)."""
+    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+        raise SceneFileError(
+            f"{where}: expected an array of tables ([[{where.strip('[]')}]] entries), got {_kind(value)} {_show(value)}"
+        )
+    return value
+
+
+def _str(where: str, value: Any) -> str:
+    if not isinstance(value, str):
+        raise SceneFileError(f"{where}: expected a string, got {_kind(value)} {_show(value)}")
+    return value
+
+
+def _bool(where: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise SceneFileError(f"{where}: expected true or false, got {_kind(value)} {_show(value)}")
+    return value
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def _num(where: str, value: Any, lo: float | None = None, hi: float | None = None, lo_open: bool = False) -> float:
+    """A finite number in [lo, hi] (or (lo, hi] with lo_open)."""
+    rng = f"{'(' if lo_open else '['}{'-inf' if lo is None else lo}, {'inf' if hi is None else hi}]"
+    if not _is_number(value) or not np.isfinite(value):
+        raise SceneFileError(f"{where}: expected a finite number in {rng}, got {_kind(value)} {_show(value)}")
+    v = float(value)
+    if (lo is not None and (v <= lo if lo_open else v < lo)) or (hi is not None and v > hi):
+        raise SceneFileError(f"{where}: expected a number in {rng}, got {_show(value)}")
+    if abs(v) > MAX_MAGNITUDE:
+        raise SceneFileError(f"{where}: expected a number of magnitude at most {MAX_MAGNITUDE:g}, got {_show(value)}")
+    return v
+
+
+MAX_MAGNITUDE = 1e12  # coordinates, scales, colours: larger ones overflow float32 products (NaN pixels)
+
+
+def _vec(where: str, value: Any, n: int = 3, lo: float | None = None) -> np.ndarray:
+    """n finite numbers (a single number fills all n) of magnitude <= MAX_MAGNITUDE, each >= lo if given."""
+    items = value if isinstance(value, list) else [value]
+    if not all(_is_number(v) for v in items):
+        raise SceneFileError(f"{where}: expected {n} numbers, got {_kind(value)} {_show(value)}")
+    a = np.asarray(items, np.float64).reshape(-1)
+    if a.size == 1 and n > 1:
+        a = np.repeat(a, n)
+    if a.size != n or not np.isfinite(a).all():
+        raise SceneFileError(f"{where}: expected {n} finite numbers, got {_show(value)}")
+    if lo is not None and (a < lo).any():
+        raise SceneFileError(f"{where}: expected numbers >= {lo}, got {_show(value)}")
+    if (np.abs(a) > MAX_MAGNITUDE).any():
+        raise SceneFileError(f"{where}: expected numbers of magnitude at most {MAX_MAGNITUDE:g}, got {_show(value)}")
+    return a
+
+
+def _known(where: str, table: dict, keys: set[str]) -> None:
+    extra = set(table) - keys
+    if extra:
+        raise SceneFileError(
+            f"{where}: unknown key(s) {', '.join(sorted(extra))}; expected some of {', '.join(sorted(keys))}"
+        )
+
+
+def _trs(where: str, t: dict) -> dict:
+    out = {}
+    if "translation" in t:
+        out["translation"] = _vec(f"{where}.translation", t["translation"])
+    if "rotation" in t and "rotation_deg" in t:
+        raise SceneFileError(f"{where}: give rotation or rotation_deg, not both")
+    if "rotation" in t:
+        q = _vec(f"{where}.rotation", t["rotation"], 4)
+        if np.linalg.norm(q) == 0:
+            raise SceneFileError(f"{where}.rotation: quaternion must be non-zero")
+        out["rotation"] = q / np.linalg.norm(q)
+    if "rotation_deg" in t:
+        out["rotation"] = tf.euler_deg_to_quat(_vec(f"{where}.rotation_deg", t["rotation_deg"]))
+    if "scale" in t:
+        s = _vec(f"{where}.scale", t["scale"])
+        if (s == 0).any():
+            raise SceneFileError(f"{where}.scale: must be non-zero, got {t['scale']!r}")
+        out["scale"] = s
+    return out
+
+
+def _resolve_paths(where: str, values: dict, base: Path, material: Material) -> dict:
+    out = dict(values)
+    for p in material.params:
+        if p.kind == "texture" and p.name in out and out[p.name] not in (None, ""):
+            path = Path(_str(f"{where}.{p.name}", out[p.name]))
+            out[p.name] = path if path.is_absolute() else (base / path).resolve()
+    return out
+
+
+def _material_values(where: str, material: Material, values: dict) -> Material:
+    """material.update(values) with errors naming the table: unknown parameters, types and ranges."""
+    pm = material.param_map
+    for k, v in values.items():
+        if k not in pm:
+            raise SceneFileError(f"{where}: unknown material parameter {k!r}; known: {', '.join(pm)}")
+        if pm[k].kind in ("float", "color", "vec3") and not (
+            _is_number(v) or (isinstance(v, list) and all(_is_number(x) for x in v))
+        ):
+            n = "a number" if pm[k].kind == "float" else "3 numbers"
+            raise SceneFileError(f"{where}.{k}: expected {n}, got {_kind(v)} {_show(v)}")
+        if pm[k].kind == "choice" and not isinstance(v, str):
+            raise SceneFileError(f"{where}.{k}: expected one of {', '.join(pm[k].choices)}; got {_show(v)}")
+        try:
+            material.values[k] = pm[k].validate(v)
+        except ValueError as exc:
+            raise SceneFileError(f"{where}.{exc}") from None
+    return material
+
+
+def _check_textures(where: str, material: Material) -> None:
+    """Every map set on the material exists and decodes (cached: the renderer reuses the pixels)."""
+    from .textures import load_texture
+
+    for p in material.params:
+        tex = material.values.get(p.name) if p.kind == "texture" else None
+        if tex is None:
+            continue
+        if not Path(tex).is_file():
+            raise SceneFileError(f"{where}.{p.name}: texture file not found: {tex}")
+        try:
+            load_texture(tex, p.colorspace)
+        except (ValueError, OSError) as exc:
+            raise SceneFileError(f"{where}.{p.name}: {exc}") from None
+
+
+def resolve_scene_path(path: str | Path | None) -> Path:
+    """A file that exists, else a bundled scene of that name; FileNotFoundError naming both tries."""
+    if not path:
+        return DEFAULT_SCENE
+    p = Path(path)
+    if p.exists():
+        return p
+    bundled = scene_by_name(p.with_suffix("").as_posix() if p.suffix.lower() == ".toml" else p.as_posix())
+    if bundled is not None:
+        return bundled
+    names = ", ".join(s.name for s in bundled_scenes() if "/" not in s.name)
+    raise FileNotFoundError(
+        f"scene file not found: {path} (and no bundled scene of that name: {names}, ...; `skinlab scenes` lists all)"
+    )
+
+
+def load_scene(path: str | Path | None = None) -> Scene:
+    """Read a TOML scene file (or a mesh file: see :func:`scene_from_mesh`), or a bundled scene by
+    name (``"head"``, ``"bunny-marble"``: ``skinlab scenes`` lists them); errors name the file and
+    the offending key."""
+    path = resolve_scene_path(path)
+    if path.is_dir():
+        raise SceneFileError(f"{path}: is a folder, expected a scene file (.toml) or a mesh file")
+    if path.suffix.lower() in SUPPORTED:
+        return scene_from_mesh(path)
+    try:
+        text = path.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise SceneFileError(f"{path}: not UTF-8 text (byte {exc.start}): is this a scene file?") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneFileError(f"{path}: not valid TOML: {exc}") from None
+    try:
+        return _build(path, data)
+    except SceneFileError as exc:
+        raise SceneFileError(f"{path}: {exc}") from None
+    except (ValueError, FileNotFoundError) as exc:
+        raise SceneFileError(f"{path}: {exc}") from None
+
+
+def _build(path: Path, data: dict) -> Scene:
+    base = path.parent
+    _known("top level", data, {"scene", "environment", "camera", "materials", "meshes", "lights"})
+    sc = _table("[scene]", data.get("scene", {}))
+    _known("[scene]", sc, _keys("[scene]"))
+    name = _str("[scene].name", sc["name"]) if "name" in sc else path.stem
+    mm = _num("[scene].mm_per_unit", sc["mm_per_unit"], 0.0, lo_open=True) if "mm_per_unit" in sc else 1.0
+    scene = Scene(name, mm)
+    scene.source = path
+
+    env = _table("[environment]", data.get("environment", {}))
+    _known("[environment]", env, _keys("[environment]"))
+    if "ambient" in env:
+        scene.environment.ambient = _vec("[environment].ambient", env["ambient"], lo=0.0)
+    if "exposure" in env:
+        scene.environment.exposure = _num("[environment].exposure", env["exposure"], 0.0, lo_open=True)
+
+    materials: dict[str, Material] = {}
+    for name, values in _table("[materials]", data.get("materials", {})).items():
+        where = f"[materials.{name}]"
+        values = dict(_table(where, values))
+        m = Material(name)
+        preset_name = values.pop("preset", None)
+        if preset_name is not None:  # a measured medium (skinlab/assets/presets/jensen2001_table1.csv) first
+            from skinlab.scene.materials import medium_values
+            from skinlab.scene.optics.media import preset
+
+            try:
+                m.update(medium_values(preset(_str(f"{where}.preset", preset_name))))
+            except ValueError as e:
+                raise SceneFileError(f"{where}.preset: {e}") from None
+        _material_values(where, m, _resolve_paths(where, values, base, m))
+        _check_textures(where, m)
+        materials[name] = m
+
+    def material_for(where: str, name: Any, overrides: Any) -> Material:
+        if name is None:
+            mat = Material("default")
+        elif _str(f"{where}.material", name) not in materials:
+            raise SceneFileError(
+                f"{where}.material: no material named {name!r} (defined: {', '.join(materials) or 'none'})"
+            )
+        else:
+            mat = materials[name]
+        if overrides:
+            ow = f"{where}.overrides"
+            mat = Material(f"{mat.name}+overrides", dict(mat.values), mat.params)
+            _material_values(ow, mat, _resolve_paths(ow, overrides, base, mat))
+            _check_textures(ow, mat)
+        return mat
+
+    for i, entry in enumerate(_tables("[meshes]", data.get("meshes", []))):
+        where = f"[[meshes]] #{i + 1}"
+        _known(where, entry, _keys("[[meshes]]"))
+        if "file" not in entry:
+            raise SceneFileError(f"{where}: missing 'file'")
+        mpath = Path(_str(f"{where}.file", entry["file"]))
+        mpath = mpath if mpath.is_absolute() else base / mpath
+        top = Node(_str(f"{where}.name", entry.get("name", mpath.stem)), **_trs(where, entry))
+        top.visible = _bool(f"{where}.visible", entry.get("visible", True))
+        scene.add(top)
+        mesh_overrides = _table(f"{where}.overrides", entry.get("overrides", {}))
+        default_mat = material_for(where, entry.get("material"), mesh_overrides)
+        node_cfg = _table(f"{where}.nodes", entry.get("nodes", {}))
+        try:
+            loaded = load_mesh_file(mpath)
+        except (ValueError, FileNotFoundError) as exc:
+            raise SceneFileError(f"{where}.file: {exc}") from None
+        names = {n.name for n in loaded}
+        for nname, cfg in node_cfg.items():
+            _table(f"{where}.nodes.{nname}", cfg)
+            if nname not in names:
+                raise SceneFileError(
+                    f"{where}.nodes.{nname}: {mpath.name} has no node named {nname!r} "
+                    f"(it has: {', '.join(sorted(names))})"
+                )
+        if _bool(f"{where}.flip_v", entry.get("flip_v", False)):
+            loaded = [LoadedNode(ln.name, ln.parent, ln.matrix, flip_v(ln.mesh)) for ln in loaded]
+        if _bool(f"{where}.generate_uvs", entry.get("generate_uvs", False)):  # an xatlas atlas where none
+            loaded = [LoadedNode(ln.name, ln.parent, ln.matrix, ln.mesh and with_atlas(ln.mesh)) for ln in loaded]
+        created: dict[str, Node] = {}
+        for ln in loaded:
+            nwhere = f"{where}.nodes.{ln.name}"
+            cfg = node_cfg.get(ln.name, {})
+            _known(nwhere, cfg, _keys("[meshes.nodes.NAME]"))
+            if ln.mesh is not None:
+                mat = default_mat
+                if "material" in cfg or "overrides" in cfg:
+                    mat = material_for(
+                        nwhere,
+                        cfg.get("material", entry.get("material")),
+                        {**mesh_overrides, **_table(f"{nwhere}.overrides", cfg.get("overrides", {}))},
+                    )
+                node = MeshNode(ln.name, ln.mesh, mat)
+            else:
+                node = Node(ln.name)
+            node.set_matrix(ln.matrix)
+            node.visible = _bool(f"{nwhere}.visible", cfg.get("visible", True))
+            (created[ln.parent] if ln.parent else top).add(node)
+            created[ln.name] = node
+
+    for i, entry in enumerate(_tables("[lights]", data.get("lights", []))):
+        where = f"[[lights]] #{i + 1}"
+        _known(where, entry, _keys("[[lights]]"))
+        kind = _str(f"{where}.type", entry.get("type", "directional"))
+        if kind not in LightNode.KINDS:
+            raise SceneFileError(f"{where}.type: expected one of {', '.join(LightNode.KINDS)}, got {kind!r}")
+        light = LightNode(
+            _str(f"{where}.name", entry.get("name", f"light{i + 1}")),
+            kind,
+            _vec(f"{where}.color", entry.get("color", 1.0), lo=0.0),
+            _num(f"{where}.intensity", entry.get("intensity", 1.0), 0.0),
+            _bool(f"{where}.cast_shadow", entry.get("cast_shadow", False)),
+        )
+        if kind == "directional":
+            if "position" in entry:
+                raise SceneFileError(f"{where}.position: a directional light has no position (use direction)")
+            d = _vec(f"{where}.direction", entry.get("direction", [0, 0, -1]))
+            if np.linalg.norm(d) == 0:
+                raise SceneFileError(f"{where}.direction: must be non-zero")
+            light.rotation = tf.look_at_rotation(np.zeros(3), d)
+        else:
+            if "position" not in entry:
+                raise SceneFileError(f"{where}: a point light needs 'position'")
+            if "direction" in entry:
+                raise SceneFileError(f"{where}.direction: a point light shines every way (remove direction)")
+            light.translation = _vec(f"{where}.position", entry["position"])
+        scene.add(light)
+
+    if "camera" in data:
+        cam = _table("[camera]", data["camera"])
+        _known("[camera]", cam, _keys("[camera]"))
+        znear = _num("[camera].znear", cam.get("znear", 0.1), 0.0, lo_open=True)
+        zfar = _num("[camera].zfar", cam.get("zfar", 1000.0), 0.0, lo_open=True)
+        if zfar <= znear:
+            raise SceneFileError(f"[camera].zfar: must be greater than znear ({znear}), got {zfar}")
+        yfov = _num("[camera].yfov_deg", cam.get("yfov_deg", 30.0), 0.0, 179.0, lo_open=True)
+        c = CameraNode("camera", np.radians(yfov), znear, zfar)
+        eye = _vec("[camera].position", cam.get("position", [0, 0, 10]))
+        target = _vec("[camera].target", cam.get("target", [0, 0, 0]))
+        up = _vec("[camera].up", cam.get("up", [0, 1, 0]))
+        if np.allclose(eye, target):
+            raise SceneFileError(f"[camera].target: the camera looks at its own position {eye.tolist()}")
+        if np.linalg.norm(up) == 0:
+            raise SceneFileError("[camera].up: must be non-zero")
+        c.look_at(eye, target, up)
+        scene.add(c)
+    if not scene.mesh_nodes(visible_only=False):
+        raise SceneFileError("the scene has no meshes (add a [[meshes]] entry with a file)")
+    if scene.camera is None:
+        scene.add(default_camera(scene))
+    return scene
+
+
+def scene_from_mesh(path: str | Path, mm_per_unit: float = 1.0) -> Scene:
+    """A mesh file opened directly (``skinlab render model.obj``): its own nodes with the default
+    material (plain principled, no subsurface), a camera on +Z framing it, a shadow-casting key
+    light from the upper left and a cool fill, as a scene file with only ``[[meshes]] file``
+    would get plus lights."""
+    path = Path(path)
+    scene = Scene(path.stem, mm_per_unit)
+    scene.source = path
+    top = scene.add(Node(path.stem))
+    loaded = load_mesh_file(path)
+    created: dict[str, Node] = {}
+    material = Material("default")
+    for ln in loaded:
+        node = MeshNode(ln.name, ln.mesh, material) if ln.mesh is not None else Node(ln.name)
+        node.set_matrix(ln.matrix)
+        (created[ln.parent] if ln.parent else top).add(node)
+        created[ln.name] = node
+    for name, direction, color, intensity, shadow in (
+        ("key", (-0.55, -0.35, -0.75), (1.0, 0.96, 0.9), 3.0, True),
+        ("fill", (0.7, -0.1, -0.5), (0.55, 0.65, 0.85), 0.6, False),
+    ):
+        light = LightNode(name, "directional", color, intensity, shadow)
+        light.rotation = tf.look_at_rotation(np.zeros(3), np.asarray(direction))
+        scene.add(light)
+    scene.add(default_camera(scene))
+    return scene
+
+
+_FLIPPED: dict[int, Mesh] = {}
+
+
+def flip_v(mesh: Mesh | None) -> Mesh | None:
+    """The mesh with v -> 1 - v (for assets whose UV origin is the image's top-left corner)."""
+    if mesh is None or mesh.uvs is None:
+        return mesh
+    if mesh.uid not in _FLIPPED:
+        uv = mesh.uvs.copy()
+        uv[:, 1] = 1.0 - uv[:, 1]
+        _FLIPPED[mesh.uid] = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, uv, None, mesh.source)
+    return _FLIPPED[mesh.uid]
+
+
+def default_camera(scene: Scene, yfov_deg: float = 30.0) -> CameraNode:
+    """A camera on +Z framing the scene's bounds."""
+    lo, hi = scene.world_bounds()
+    centre = (lo + hi) / 2
+    radius = max(np.linalg.norm(hi - lo) / 2, 1e-6)
+    dist = radius / np.sin(np.radians(yfov_deg) / 2)
+    cam = CameraNode("camera", np.radians(yfov_deg), znear=dist * 0.05, zfar=dist * 4)
+    cam.look_at(centre + [0, 0, dist], centre)
+    return cam

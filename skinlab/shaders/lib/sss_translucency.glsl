@@ -1,0 +1,130 @@
+// Light through thin parts, shared by every technique that has it: texture-space diffusion's
+// irradiance pass (passes/tsd_irradiance.frag, d'Eon & Luebke 2007) and the forward hooks of the
+// techniques without a texture-space pass (screen-space SSS, disk, pre-integrated skin), in the
+// manner of Jimenez, Whelan, Sundstedt & Gutierrez 2010 ("Real-Time Realistic Skin Translucency"):
+// the distance the light travelled inside the object is its distance from the light minus the
+// distance of the first surface it met there (the shadow pass's distance map, passes/shadow.frag),
+// looked up at the position shrunk a little along the normal; what comes through is the exact slab
+// transmittance of lib/sss_boundary.glsl (sss_slab_through).
+// NumPy twin: skinlab/scene/optics/translucency.py. Bound by skinlab/render/translucency.py.
+#include "lib/lights.glsl"
+#include "lib/sss_boundary.glsl"
+
+uniform sampler2D u_distance0;   // light-space distance of the first surface (scene units), slot 0
+uniform sampler2D u_distance1;   // slot 1
+uniform vec4 u_light_eye[2];     // slot light position (w = 1) or the direction light travels (w = 0)
+uniform float u_thickness_shrink;  // scene units: about half a distance-map texel
+
+float distance_texel(int slot, ivec2 t) {
+    return slot == 0 ? texelFetch(u_distance0, t, 0).r : texelFetch(u_distance1, t, 0).r;
+}
+
+// Distance from the light of the first surface it meets on the way to world; false outside the map
+// or where the map holds no surface. Bilinear between the four nearest texel centres (a plane's
+// distance exactly; the nearest texel alone is off by up to half a texel times the surface's slope,
+// which through 3 mm of skin is +-3 % of the blue light), or the texel containing the point where
+// one of the four holds no surface (a silhouette in the light's view).
+bool first_hit_distance(int slot, vec3 world, out float first) {
+    vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
+    vec2 uv = p.xy / p.w;
+    first = 0.0;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
+    ivec2 size = slot == 0 ? textureSize(u_distance0, 0) : textureSize(u_distance1, 0);
+    vec2 x = uv * vec2(size) - 0.5;
+    ivec2 i0 = ivec2(floor(x));
+    vec2 f = x - vec2(i0);
+    ivec2 hi = size - 1;
+    ivec2 a = clamp(i0, ivec2(0), hi), b = clamp(i0 + 1, ivec2(0), hi);
+    float d00 = distance_texel(slot, a), d10 = distance_texel(slot, ivec2(b.x, a.y));
+    float d01 = distance_texel(slot, ivec2(a.x, b.y)), d11 = distance_texel(slot, b);
+    if (max(max(d00, d10), max(d01, d11)) < 1e29) {
+        first = mix(mix(d00, d10, f.x), mix(d01, d11, f.x), f.y);
+        return true;
+    }
+    first = distance_texel(slot, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), hi));
+    return first < 1e29;  // cleared texels: no surface
+}
+
+float distance_from_light(int slot, vec3 world) {
+    vec4 e = u_light_eye[slot];
+    return e.w == 0.0 ? dot(world, e.xyz) : length(world - e.xyz);
+}
+
+// Thickness (mm, along the normal ng) of the matter between the light of `slot` and world, for a
+// surface whose normal makes cosine `back` with the direction the light travels: the distance
+// inside along the light times that cosine (a flat slab's own thickness). The lookup point is
+// world - shrink ng (Jimenez et al. 2010): a fragment that is itself the first surface (within the
+// map's texel) or lies less than the shrink behind it reads 0, not the map's quantisation noise;
+// behind that, the shrink is added back, so a flat part keeps its exact thickness. False where the
+// map has no surface in front.
+bool sss_thickness_mm(int slot, vec3 world, vec3 ng, float back, out float d_mm) {
+    vec3 p = world - u_thickness_shrink * ng;
+    float first;
+    d_mm = 0.0;
+    if (!first_hit_distance(slot, p, first)) return false;
+    float inside = distance_from_light(slot, p) - first;
+    d_mm = inside > 0.0 ? (inside * back + u_thickness_shrink) * u_mm_per_unit : 0.0;
+    return true;
+}
+
+// What crosses a slab d_mm thick from its far side, lit there at cosine `back`, and leaves through
+// this side, per unit irradiance on a surface facing the light and per unit base colour: the exact
+// slab transmittance (lib/sss_boundary.glsl sss_slab_through: all orders of scattering, Fresnel in
+// and out; NumPy skinlab/scene/optics/slab.py slab_through).
+vec3 sss_through(float back, float d_mm) {
+    return sss_slab_through(back, d_mm);
+}
+
+// Irradiance entering the medium at world through thin parts from light i (direction to it l, its
+// irradiance e on a surface facing it); ng: the surface's outward geometric normal. Zero for a light
+// without a distance map (no shadow slot) or in front of the surface.
+vec3 sss_translucent_light(int i, vec3 world, vec3 ng, vec3 l, vec3 e) {
+    int slot = u_light_shadow[i];
+    float back = -dot(ng, l);
+    float d_mm;
+    if (slot < 0 || back <= 0.0 || !sss_thickness_mm(slot, world, ng, back, d_mm)) return vec3(0.0);
+    return e * back * sss_through(back, d_mm);
+}
+
+// The same light leaving toward a viewer at cosine mu, times the exit factor of light that came
+// through (lib/sss_boundary.glsl sss_slab_exit, at the light's cosine `back` on the far face;
+// reflected light leaves with sss_exit instead): times base colour / pi it is radiance, as the
+// reflected light's entering x sss_exit. `through_exit` returns it; the value is the light entering
+// (as sss_translucent_light). NumPy twin: skinlab/scene/optics/translucency.py translucent_exit.
+vec3 sss_translucent_light_toward(int i, vec3 world, vec3 ng, vec3 l, vec3 e, float mu, out vec3 through_exit) {
+    int slot = u_light_shadow[i];
+    float back = -dot(ng, l);
+    float d_mm;
+    through_exit = vec3(0.0);
+    if (slot < 0 || back <= 0.0 || !sss_thickness_mm(slot, world, ng, back, d_mm)) return vec3(0.0);
+    vec3 entering = e * back * sss_through(back, d_mm);
+    through_exit = entering * sss_slab_exit(mu, back, d_mm);
+    return entering;
+}
+
+// The sum over the lights (for a hook that does not run its own light loop).
+vec3 sss_translucent_irradiance(vec3 world, vec3 ng) {
+    vec3 acc = vec3(0.0);
+    for (int i = 0; i < MAX_LIGHTS; ++i) {
+        if (i >= u_num_lights) break;
+        vec3 l, e;
+        light_incidence(i, world, ng, l, e);
+        acc += sss_translucent_light(i, world, ng, l, e);
+    }
+    return acc;
+}
+
+// The sum over the lights of the light through thin parts leaving toward a viewer at cosine mu
+// (sss_translucent_light_toward's through_exit); `entering` gets the light entering.
+vec3 sss_translucent_toward(vec3 world, vec3 ng, float mu, out vec3 entering) {
+    vec3 acc = vec3(0.0);
+    entering = vec3(0.0);
+    for (int i = 0; i < MAX_LIGHTS; ++i) {
+        if (i >= u_num_lights) break;
+        vec3 l, e, te;
+        light_incidence(i, world, ng, l, e);
+        entering += sss_translucent_light_toward(i, world, ng, l, e, mu, te);
+        acc += te;
+    }
+    return acc;
+}

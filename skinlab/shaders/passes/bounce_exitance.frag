@@ -1,0 +1,44 @@
+#version 330 core
+// Interreflection, one order (skinlab/render/bounce.py; NumPy twin skinlab/scene/interreflection.py): the
+// radiant exitance of a mesh vertex, M = sender albedo x (the lights with their shadows + the sky
+// + the previous order's bounce light). The colour map is read at the mip level whose texel spans
+// about one vertex's share of the UV area (a vertex stands for the surface around it).
+#include "lib/brdf.glsl"
+#include "lib/lights.glsl"
+#include "lib/bounce.glsl"
+#include "skinlab/material.glsl"
+
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_uv;
+
+uniform vec3 u_ambient;
+uniform float u_albedo_lod;           // mip level of the colour map for one vertex's area
+uniform sampler2D u_bounce_previous;  // the previous order's irradiance per vertex
+uniform int u_has_previous;           // 0 for the first order
+
+out vec4 f_exitance;
+
+void main() {
+    if (dot(v_normal, v_normal) == 0.0) {  // a vertex without a normal (no triangle uses it) sends nothing
+        f_exitance = vec4(0.0, 0.0, 0.0, 1.0);
+        return;
+    }
+    vec3 n = normalize(v_normal);
+    vec3 base = u_base_color;
+#ifdef HAS_BASE_COLOR_MAP
+    base *= textureLod(u_base_color_map, v_uv, u_albedo_lod).rgb;
+#endif
+    vec3 e = PI * u_ambient;
+    for (int i = 0; i < MAX_LIGHTS; ++i) {
+        if (i >= u_num_lights) break;
+        vec3 l, li;
+        light_incidence(i, v_world, n, l, li);
+        float NoL = dot(n, l);
+        if (NoL <= 0.0) continue;
+        float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, NoL) : 1.0;
+        e += li * (vis * NoL);
+    }
+    if (u_has_previous != 0) e += texelFetch(u_bounce_previous, ivec2(gl_FragCoord.xy), 0).rgb;
+    f_exitance = vec4(bounce_sender_albedo(base, u_metallic, u_specular) * e, 1.0);
+}

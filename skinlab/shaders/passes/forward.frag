@@ -1,0 +1,83 @@
+#version 330 core
+// Principled shading (Burley diffuse + GGX specular) with up to MAX_LIGHTS lights and two
+// shadow maps. Variants: HAS_BASE_COLOR_MAP, HAS_ROUGHNESS_MAP, HAS_NORMAL_MAP, HAS_OCCLUSION_MAP
+// (skinlab/material.glsl, generated from the material's parameter declarations). The subsurface part
+// of the diffuse term is the technique's hook (skinlab/sss_hook.glsl, resolved per program to
+// skinlab/shaders/techniques/<name>/forward.glsl; the contract is in skinlab/render/technique.py): plain
+// Burley diffuse weighted by sss_plain_weight(), the hook told about each light, and its radiance
+// added after the lights. Specular and ambient specular as usual. Single scattering (Jensen 2001,
+// lib/sss_boundary.glsl) is added per light, and for ambient light, for a mesh whose technique
+// scatters (u_sss_single > 0): it leaves within about a mean free path of where it entered, so no
+// technique blurs it. Ambient light is the sky and, with variant BOUNCE, the light the scene's
+// surfaces throw onto this one (interreflection, lib/ambient.glsl).
+#include "lib/brdf.glsl"
+#include "lib/sss_boundary.glsl"
+#include "lib/sss_oblique.glsl"
+#include "lib/lights.glsl"
+#include "lib/ambient.glsl"
+#include "skinlab/material.glsl"
+
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_uv;
+in vec4 v_tangent;
+
+uniform vec3 u_camera_pos;
+
+layout(location = 0) out vec4 f_color;
+
+#include "skinlab/sss_hook.glsl"
+#include "lib/sss_maps.glsl"
+
+void main() {
+    vec3 ng = normalize(v_normal);
+    vec3 v = normalize(u_camera_pos - v_world);
+    if (!gl_FrontFacing) ng = -ng;
+    vec3 n = ng;
+#ifdef HAS_NORMAL_MAP
+    n = perturb_normal(ng, vec4(gl_FrontFacing ? v_tangent.xyz : -v_tangent.xyz, v_tangent.w),
+                       texture(u_normal_map, v_uv).rgb, u_normal_scale);
+#endif
+    vec3 base = u_base_color;
+#ifdef HAS_BASE_COLOR_MAP
+    base *= texture(u_base_color_map, v_uv).rgb;
+#endif
+    float rough = u_roughness;
+#ifdef HAS_ROUGHNESS_MAP
+    rough *= texture(u_roughness_map, v_uv).r;
+#endif
+    float occlusion = 1.0;
+#ifdef HAS_OCCLUSION_MAP
+    occlusion = texture(u_occlusion_map, v_uv).r;
+#endif
+    float plain = sss_plain_weight();    // weight of the surface's own Burley diffuse
+    vec3 f0 = principled_f0(base, u_metallic, u_specular);
+    float a = ggx_alpha(rough);
+    float NoV = dot(n, v);
+    vec3 color = vec3(0.0);
+    bool single = any(greaterThan(u_sss_single, vec3(0.0)));
+    vec3 single_w = base * ((1.0 - u_metallic) * sss_weight_at(v_uv));  // x the weight map
+    for (int i = 0; i < MAX_LIGHTS; ++i) {
+        if (i >= u_num_lights) break;
+        vec3 l, e;
+        light_incidence(i, v_world, n, l, e);
+        float NoL = dot(n, l);
+        if (NoL <= 0.0) continue;
+        float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
+        vec3 h = half_vector(n, v, l);
+        float LoH = dot(l, h);
+        vec3 diffuse = base * ((1.0 - u_metallic) * plain * burley_diffuse(NoL, NoV, LoH, rough));
+        vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
+        color += e * vis * (diffuse + spec) * NoL;
+        if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
+        // the technique's diffusion: shadowed where it entered (oblique entry, lib/sss_oblique.glsl)
+        vec3 z0 = u_sss_mfp * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
+        vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
+        sss_add_light(e, u_light_shadow[i] >= 0 ? light_visibility(i, entry, dot(ng, l)) : 1.0, NoL);
+    }
+    vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
+    color += ambient * (base * ((1.0 - u_metallic) * plain) + f0);
+    if (single) color += ambient * single_w * sss_single_ambient(NoV);  // its single scattering
+    color += sss_radiance(base, NoV, occlusion, v_uv);
+    f_color = vec4(color, 1.0);
+}

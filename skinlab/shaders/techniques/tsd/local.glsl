@@ -1,0 +1,14 @@
+// Subsurface hook of techniques "tsd" and "exact" for a mesh whose profile is narrower than a texel
+// (the planner's fallback, skinlab/render/techniques/tsd/plan.py): no blur, but the same boundary as the
+// blurred case - each light enters with the multiple-scattering albedo at its incidence and leaves
+// with the exit distribution (lib/sss_local.glsl), single scattering is added by the forward pass -
+// mixed with plain Burley diffuse by the subsurface weight (x its map). Contract:
+// skinlab/render/technique.py.
+#include "lib/sss_local.glsl"
+#include "lib/sss_maps.glsl"
+
+float sss_plain_weight() { return 1.0 - sss_weight_at(v_uv); }
+
+vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
+    return sss_local_radiance(base, NoV, occlusion, sss_weight_at(v_uv));
+}

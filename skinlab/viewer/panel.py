@@ -1,0 +1,352 @@
+"""The parameter panel's logic, independent of any GUI toolkit (unit-tested without a window).
+
+Widgets are derived from the material parameter declarations (``skinlab.scene.materials.Param``), so a
+new parameter appears in the panel without GUI code: ``float`` -> slider over its range,
+``color`` -> colour editor, ``vec3`` -> three draggable numbers within the range, ``texture`` ->
+file path, ``choice`` -> combo box. Edits are clamped into the declared range and then applied
+through ``Material.update`` (which validates again and names the parameter on error).
+
+Presets map a Jensen et al. 2001 medium onto the principled parameters the way Blender's
+Principled BSDF takes them: ``subsurface_color`` is the medium's diffuse surface albedo
+(``Medium.surface_albedo()``, photon-beam-diffusion total reflectance) and ``subsurface_radius``
+its artist radius ``R = 4 pi l`` in mm (``Medium.artist_radius_mm``; Cycles' convention, see
+``skinlab/scene/optics/media.py``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from skinlab.scene import transform as tf
+from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Node, Scene
+from skinlab.scene.materials import Material, Param
+
+# Param.kind -> widget kind
+WIDGETS = {
+    "float": "slider_float",
+    "color": "color_edit3",
+    "vec3": "drag_float3",
+    "texture": "file_path",
+    "choice": "combo",
+}
+
+
+@dataclass(frozen=True)
+class Widget:
+    """What to draw for one parameter: the widget kind plus everything it needs."""
+
+    param: str
+    widget: str
+    value: Any
+    range: tuple[float, float] | None = None
+    choices: tuple[str, ...] = ()
+    unit: str = ""
+    doc: str = ""
+    logarithmic: bool = False  # sliders over ranges spanning decades (e.g. radius 0-1000 mm)
+
+
+def widget_for(param: Param, value: Any = None) -> Widget:
+    kind = WIDGETS.get(param.kind)
+    if kind is None:
+        raise ValueError(
+            f"parameter {param.name!r}: no panel widget for kind {param.kind!r} (known kinds: {', '.join(WIDGETS)})"
+        )
+    value = param.default if value is None and param.kind != "texture" else value
+    rng = tuple(float(x) for x in param.range) if param.range is not None else None
+    log = bool(rng and rng[0] >= 0 and rng[1] >= 1000 * max(rng[0], 1e-3))
+    return Widget(param.name, kind, value, rng, tuple(param.choices), param.unit, param.doc, log)
+
+
+def widget_label(w: Widget) -> str:
+    """What the panel prints beside a widget: the parameter and its unit (colours: linear RGB)."""
+    return f"{w.param} ({w.unit})" if w.unit else w.param
+
+
+def texture_text(value: Any) -> str:
+    """A texture field shows the file's name (the full path is the tooltip); empty: no map."""
+    return "" if value is None else Path(str(value)).name
+
+
+def resolve_texture_input(text: str, current: Any, scene_dir: Path | None) -> str:
+    """A texture typed into the panel: an absolute path as is; a relative one (a bare file name
+    included) next to the current map, else relative to the scene file's folder."""
+    text = text.strip()
+    if not text:
+        return ""
+    p = Path(text).expanduser()
+    if p.is_absolute():
+        return str(p)
+    base = Path(str(current)).parent if current is not None else scene_dir
+    return str((base / p) if base is not None else p)
+
+
+def sss_override_note(material: Material, override: str | None) -> str | None:
+    """The line that says the M key (RenderSettings.sss_model) overrides the material's own model."""
+    if override is None:
+        return None
+    own = material.values.get("sss_model")
+    if own == override:
+        return f"sss_model: M forces '{override}' on every material (this one's own is the same)"
+    return f"sss_model: M forces '{override}' on every material; this one's own '{own}' is not used"
+
+
+def clamp_value(param: Param, value: Any) -> Any:
+    """The value a widget hands back, made valid for ``param``: numbers are clamped into the
+    range (NaN -> the default), colours/vec3 element-wise; choices must be one of the options;
+    textures must name an existing file (or be empty: no map). Errors name the parameter."""
+    if param.kind in ("float", "color", "vec3", "choice"):
+        return param.clamp(value)
+    if param.kind == "texture":
+        if value is None or str(value).strip() == "":
+            return None
+        p = Path(str(value).strip()).expanduser()
+        if not p.is_file():
+            raise ValueError(f"{param.name}: texture file not found: {p}")
+        return p.resolve()
+    raise ValueError(f"parameter {param.name!r}: unknown kind {param.kind!r}")
+
+
+def material_widgets(material: Material) -> list[Widget]:
+    return [widget_for(p, material.values.get(p.name)) for p in material.params]
+
+
+def medium_to_params(medium) -> dict[str, tuple[float, float, float]]:
+    """subsurface_color = diffuse surface albedo, subsurface_radius = artist radius (mm): the
+    scattering part of skinlab.scene.materials.medium_values (the material's own colour map stays)."""
+    from skinlab.scene.materials import medium_values
+
+    v = medium_values(medium)
+    return {"subsurface_color": v["subsurface_color"], "subsurface_radius": v["subsurface_radius"]}
+
+
+def direction_from_angles(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
+    """Direction a light travels for a light placed at (azimuth, elevation): azimuth about +Y
+    from +Z, elevation above the XZ plane; the light shines from there towards the origin."""
+    az, el = math.radians(azimuth_deg), math.radians(elevation_deg)
+    towards_light = np.array([math.cos(el) * math.sin(az), math.sin(el), math.cos(el) * math.cos(az)])
+    return -towards_light
+
+
+def angles_from_direction(direction) -> tuple[float, float]:
+    d = -np.asarray(direction, np.float64)
+    d = d / np.linalg.norm(d)
+    return math.degrees(math.atan2(d[0], d[2])), math.degrees(math.asin(float(np.clip(d[1], -1, 1))))
+
+
+@dataclass
+class TreeRow:
+    node: Node
+    depth: int
+    label: str
+
+
+@dataclass
+class PanelModel:
+    """State behind the panel: the scene tree, the selected node, material edits, presets and
+    the key light. ``version`` increases whenever something that affects the image changed."""
+
+    scene: Scene
+    presets: Callable[[], dict] | None = None  # name -> Medium (the viewer's last good set)
+    selected: Node | None = None
+    version: int = 0
+    error: str | None = None  # last rejected edit, shown in the panel
+    applied_presets: dict[int, str] = field(default_factory=dict)  # id(material) -> preset name
+
+    def __post_init__(self) -> None:
+        self.set_scene(self.scene)
+
+    # -- scene tree ---------------------------------------------------------------------------
+    def set_scene(self, scene: Scene) -> None:
+        """Switch to a (re)loaded scene, keeping the selection by name where it still exists."""
+        old = self.selected.name if self.selected is not None else None
+        self.scene = scene
+        self.applied_presets = {}
+        self.selected = None
+        meshes = scene.mesh_nodes(visible_only=False)
+        if old is not None:
+            self.selected = next((n for n in scene.nodes() if n.name == old), None)
+        if self.selected is None and meshes:
+            self.selected = meshes[0]
+        self.version += 1
+
+    def tree(self) -> list[TreeRow]:
+        rows = []
+
+        def visit(node: Node, depth: int) -> None:
+            kind = (
+                "mesh"
+                if isinstance(node, MeshNode)
+                else "light"
+                if isinstance(node, LightNode)
+                else "camera"
+                if isinstance(node, CameraNode)
+                else "group"
+            )
+            rows.append(TreeRow(node, depth, f"{node.name} ({kind})"))
+            for c in node.children:
+                visit(c, depth + 1)
+
+        for c in self.scene.root.children:
+            visit(c, 0)
+        return rows
+
+    def select(self, name: str) -> Node:
+        node = self.scene.find(name)  # KeyError names the scene and node
+        self.selected = node
+        return node
+
+    @property
+    def material(self) -> Material | None:
+        return self.selected.material if isinstance(self.selected, MeshNode) else None
+
+    def material_users(self) -> list[MeshNode]:
+        m = self.material
+        return [n for n in self.scene.mesh_nodes(visible_only=False) if n.material is m] if m else []
+
+    def widgets(self) -> list[Widget]:
+        return material_widgets(self.material) if self.material is not None else []
+
+    # -- edits --------------------------------------------------------------------------------
+    def edit(self, name: str, value: Any) -> Any:
+        """Clamp and apply one parameter of the selected node's material (shared by every node
+        that uses the same material). Returns the applied value; errors are kept in ``error``
+        and re-raised as ValueError naming the parameter."""
+        m = self.material
+        if m is None:
+            raise ValueError(f"edit {name}: the selected node {getattr(self.selected, 'name', None)!r} has no material")
+        param = m.param_map.get(name)
+        if param is None:
+            raise ValueError(f"material {m.name!r}: unknown parameter {name!r}; known: {', '.join(m.param_map)}")
+        try:
+            if param.kind == "texture" and isinstance(value, str):
+                source = getattr(self.scene, "source", None)
+                value = resolve_texture_input(value, m.values.get(name), Path(source).parent if source else None)
+            v = clamp_value(param, value)
+            m.update({name: v})
+        except ValueError as exc:
+            self.error = f"material {m.name!r}: {exc}" if m.name not in str(exc) else str(exc)
+            raise ValueError(self.error) from None
+        self.error = None
+        if name in ("subsurface_color", "subsurface_radius"):
+            self.applied_presets.pop(id(m), None)  # hand edits detach the preset
+        self.version += 1
+        return m.values[name]
+
+    def preset_names(self) -> list[str]:
+        return sorted(self.presets()) if self.presets else []
+
+    def apply_preset(self, name: str) -> dict:
+        m = self.material
+        if m is None:
+            raise ValueError(f"preset {name}: the selected node has no material")
+        media = self.presets() if self.presets else {}
+        if name not in media:
+            raise ValueError(f"preset: unknown material {name!r}; choose one of {', '.join(sorted(media))}")
+        values = medium_to_params(media[name])
+        for k, v in values.items():
+            self.edit(k, v)
+        self.applied_presets[id(m)] = name
+        return values
+
+    def reapply_presets(self) -> list[str]:
+        """After the preset file changed: apply the new numbers to materials that use a preset."""
+        done = []
+        media = self.presets() if self.presets else {}
+        mats = {id(n.material): n.material for n in self.scene.mesh_nodes(visible_only=False)}
+        for mid, name in list(self.applied_presets.items()):
+            m = mats.get(mid)
+            if m is None or name not in media:
+                continue
+            m.update(medium_to_params(media[name]))
+            done.append(f"{m.name}: {name}")
+        if done:
+            self.version += 1
+        return done
+
+    # -- key light ----------------------------------------------------------------------------
+    def key_light(self) -> LightNode | None:
+        """The light named 'key', else the first shadow-casting light, else the first light."""
+        lights = [n for n in self.scene.nodes() if isinstance(n, LightNode)]
+        for pick in (lambda l: l.name == "key", lambda l: l.cast_shadow, lambda l: True):
+            for l in lights:
+                if pick(l):
+                    return l
+        return None
+
+    def set_light_direction(self, direction) -> np.ndarray:
+        light = self.key_light()
+        if light is None:
+            raise ValueError("light direction: the scene has no light")
+        d = np.asarray(direction, np.float64).reshape(-1)
+        if d.size != 3 or not np.isfinite(d).all() or np.linalg.norm(d) == 0:
+            raise ValueError(f"light direction: expected 3 finite numbers, not all zero; got {direction!r}")
+        d = d / np.linalg.norm(d)
+        if light.kind == "directional":
+            light.rotation = tf.look_at_rotation(np.zeros(3), d)
+        else:  # a point light: move it to the same distance from the origin, opposite the direction
+            r = float(np.linalg.norm(light.translation)) or 1.0
+            light.translation = -d * r
+        self.version += 1
+        return d
+
+    def light_direction(self) -> np.ndarray | None:
+        light = self.key_light()
+        if light is None:
+            return None
+        if light.kind == "directional":
+            return light.direction
+        p = light.world_position
+        n = np.linalg.norm(p)
+        return -p / n if n else np.array([0.0, 0.0, -1.0])
+
+
+# -- the current technique's settings (skinlab/render/options.py declarations) --------------------------------
+
+# Option.kind -> widget kind; an option that may be None (automatic) gets "<kind>_or_auto"
+TECHNIQUE_WIDGETS = {"bool": "checkbox", "int": "slider_int", "float": "slider_float"}
+
+
+def technique_widgets(settings) -> list[Widget]:
+    """One widget per field of a technique's settings, from its declaration (range, meaning, default)."""
+    return option_widgets(settings, settings.defaults())
+
+
+def render_widgets(settings) -> list[Widget]:
+    """One widget per declared render setting (RenderSettings.options(): supersampling,
+    interreflection), from its declaration like a technique's."""
+    import dataclasses
+
+    fields = {f.name: f.default for f in dataclasses.fields(settings)}
+    return option_widgets(settings, {name: fields[name] for name in settings.options()})
+
+
+def option_widgets(settings, defaults: dict) -> list[Widget]:
+    out = []
+    for name, o in settings.options().items():
+        kind = TECHNIQUE_WIDGETS[o.kind] + ("_or_auto" if o.none else "")
+        rng = tuple(float(x) for x in o.range) if o.range is not None else None
+        out.append(Widget(name, kind, getattr(settings, name), rng, unit=o.unit, doc=o.help(defaults[name])))
+    return out
+
+
+def technique_value(settings, name: str, value: Any) -> Any:
+    """A widget's value made valid for the field: numbers clamped into the declared range, integers
+    rounded (odd counts to the nearest odd one inside the range); None (automatic) and booleans as given."""
+    o = settings.options()[name]
+    if value is None or o.kind == "bool":
+        return value
+    v = float(value)
+    if o.range is not None:
+        v = min(max(v, o.range[0]), o.range[1])
+    if o.kind == "float":
+        return v
+    n = int(round(v))
+    if o.odd and n % 2 == 0:
+        n = n + 1 if o.range is None or n + 1 <= o.range[1] else n - 1
+    return n

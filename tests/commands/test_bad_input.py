@@ -1,0 +1,243 @@
+"""Bad input, table-driven: malformed scene files, meshes, textures and options. Every case must end
+in exit status 2 with exactly one line on stderr that names the file (or option) and the key, no
+traceback, and no output file (nor a temporary one) left behind.
+
+The cases run the real command line in-process (``skinlab.cli.main``); none gets as far as rendering."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from skinlab.cli import main
+
+ROOT = Path(__file__).resolve().parents[2]
+JPEG = ROOT / "skinlab" / "assets" / "lee-perry-smith" / "Map-COL.jpg"
+
+TRIANGLE_OBJ = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n"
+BAD_PLY = (
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+    "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 7\n"
+)
+MESH = '[[meshes]]\nfile = "tri.obj"\n'
+MAT = '[materials.m]\n{}\n[[meshes]]\nfile = "tri.obj"\nmaterial = "m"\n'
+LIGHT = MESH + "[[lights]]\n{}\n"
+
+
+def scene(text: str) -> dict:
+    return {"s.toml": text, "tri.obj": TRIANGLE_OBJ}
+
+
+# (id, files to write, argv ({tmp} = the case's folder), what stderr must contain)
+RENDER = ["render", "{tmp}/s.toml", "--out", "{tmp}/out/x.png", "--size", "8x8"]
+CASES = [
+    # -- scene files: wrong types where a table, list, string or number belongs -----------------
+    ("yfov-list", scene(MESH + "[camera]\nyfov_deg = [1, 2]\n"), RENDER, ["s.toml", "[camera].yfov_deg"]),
+    ("mesh-file-number", scene("[[meshes]]\nfile = 123\n"), RENDER, ["s.toml", "[[meshes]] #1.file"]),
+    ("map-number", scene(MAT.format("base_color_map = 5")), RENDER, ["s.toml", "[materials.m].base_color_map"]),
+    ("nodes-number", scene(MESH + "nodes = 5\n"), RENDER, ["s.toml", "[[meshes]] #1.nodes"]),
+    ("scene-number", scene("scene = 5\n" + MESH), RENDER, ["s.toml", "[scene]", "expected a table"]),
+    ("camera-number", scene("camera = 5\n" + MESH), RENDER, ["s.toml", "[camera]", "expected a table"]),
+    ("environment-number", scene("environment = 5\n" + MESH), RENDER, ["s.toml", "[environment]"]),
+    ("materials-number", scene("materials = 5\n" + MESH), RENDER, ["s.toml", "[materials]"]),
+    ("lights-number", scene("lights = 5\n" + MESH), RENDER, ["s.toml", "[lights]", "array of tables"]),
+    ("meshes-string", scene('meshes = "head.glb"\n'), RENDER, ["s.toml", "[meshes]", "array of tables"]),
+    ("material-table-number", scene("[materials]\nm = 5\n" + MESH), RENDER, ["s.toml", "[materials.m]"]),
+    ("mesh-material-number", scene(MESH + "material = 5\n"), RENDER, ["s.toml", "[[meshes]] #1.material"]),
+    ("node-overrides-string", scene(MESH + "overrides = 'x'\n"), RENDER, ["s.toml", "[[meshes]] #1.overrides"]),
+    # -- scene files: values that were accepted without a word ----------------------------------
+    ("mm-string", scene('[scene]\nmm_per_unit = "abc"\n' + MESH), RENDER, ["s.toml", "[scene].mm_per_unit"]),
+    ("mm-bool", scene("[scene]\nmm_per_unit = true\n" + MESH), RENDER, ["s.toml", "[scene].mm_per_unit"]),
+    ("mm-zero", scene("[scene]\nmm_per_unit = 0\n" + MESH), RENDER, ["s.toml", "[scene].mm_per_unit"]),
+    ("name-number", scene("[scene]\nname = 5\n" + MESH), RENDER, ["s.toml", "[scene].name", "string"]),
+    ("visible-string", scene(MESH + 'visible = "no"\n'), RENDER, ["s.toml", "[[meshes]] #1.visible"]),
+    ("flip-v-number", scene(MESH + "flip_v = 1\n"), RENDER, ["s.toml", "[[meshes]] #1.flip_v"]),
+    ("ambient-negative", scene("[environment]\nambient = -0.1\n" + MESH), RENDER, ["[environment].ambient"]),
+    ("exposure-negative", scene("[environment]\nexposure = -1\n" + MESH), RENDER, ["[environment].exposure"]),
+    ("light-colour-negative", scene(LIGHT.format("color = [1, -1, 1]")), RENDER, ["s.toml", "[[lights]] #1.color"]),
+    ("light-intensity-string", scene(LIGHT.format("intensity = 'x'")), RENDER, ["[[lights]] #1.intensity"]),
+    ("light-type", scene(LIGHT.format("type = 'spot'")), RENDER, ["s.toml", "[[lights]] #1.type", "point"]),
+    ("light-shadow-string", scene(LIGHT.format("cast_shadow = 'yes'")), RENDER, ["[[lights]] #1.cast_shadow"]),
+    ("light-name-number", scene(LIGHT.format("name = 5")), RENDER, ["[[lights]] #1.name"]),
+    ("light-intensity-huge", scene(LIGHT.format("intensity = 1e300")), RENDER, ["[[lights]] #1.intensity", "1e+12"]),
+    ("light-direction-huge", scene(LIGHT.format("direction = [1e300, 0, 0]")), RENDER, ["[[lights]] #1.direction"]),
+    ("translation-huge", scene(MESH + "translation = [0, 1e300, 0]\n"), RENDER, ["[[meshes]] #1.translation"]),
+    ("translation-nan", scene(MESH + "translation = [0, nan, 0]\n"), RENDER, ["[[meshes]] #1.translation"]),
+    ("camera-at-target", scene(MESH + "[camera]\nposition = [1, 2, 3]\ntarget = [1, 2, 3]\n"), RENDER, ["[camera]"]),
+    ("camera-znear-zfar", scene(MESH + "[camera]\nznear = 10\nzfar = 1\n"), RENDER, ["s.toml", "[camera].zfar"]),
+    ("roughness-string", scene(MAT.format("roughness = 'abc'")), RENDER, ["s.toml", "[materials.m].roughness"]),
+    ("colour-strings", scene(MAT.format("base_color = ['a', 'b', 'c']")), RENDER, ["[materials.m].base_color"]),
+    ("roughness-range", scene(MAT.format("roughness = 2")), RENDER, ["s.toml", "[materials.m].roughness", "[0.0"]),
+    ("sss-model-number", scene(MAT.format("sss_model = 3")), RENDER, ["s.toml", "[materials.m].sss_model"]),
+    ("unknown-param", scene(MAT.format("roughnes = 0.3")), RENDER, ["s.toml", "[materials.m]", "roughnes"]),
+    ("override-range", scene(MESH + "overrides = { metallic = 3 }\n"), RENDER, ["[[meshes]] #1.overrides.metallic"]),
+    ("preset-unknown", scene(MAT.format("preset = 'cheese'")), RENDER, ["s.toml", "[materials.m].preset"]),
+    ("not-utf8", {"s.toml": b"[scene]\nname = '\xff\xfe'\n"}, RENDER, ["s.toml", "UTF-8"]),
+    ("not-toml", {"s.toml": "[scene\n"}, RENDER, ["s.toml", "not valid TOML"]),
+    ("scene-folder", {"d/x": ""}, ["render", "{tmp}/d", "--out", "{tmp}/x.png"], ["d", "folder"]),
+    # -- meshes --------------------------------------------------------------------------------
+    (
+        "ply-face-past-end",
+        {"s.toml": '[[meshes]]\nfile = "bad.ply"\n', "bad.ply": BAD_PLY},
+        RENDER,
+        ["s.toml", "[[meshes]] #1.file", "bad.ply", "vertex 7"],
+    ),
+    (
+        "ply-direct",
+        {"bad.ply": BAD_PLY},
+        ["render", "{tmp}/bad.ply", "--out", "{tmp}/x.png"],
+        ["bad.ply", "vertex 7"],
+    ),
+    (
+        "obj-face-past-end",
+        {"s.toml": '[[meshes]]\nfile = "bad.obj"\n', "bad.obj": "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"},
+        RENDER,
+        ["s.toml", "[[meshes]] #1.file", "bad.obj"],
+    ),
+    ("mesh-missing", {"s.toml": '[[meshes]]\nfile = "nope.obj"\n'}, RENDER, ["s.toml", "[[meshes]] #1.file", "nope"]),
+    ("mesh-format", scene('[[meshes]]\nfile = "tri.fbx"\n'), RENDER, ["[[meshes]] #1.file", "tri.fbx", ".fbx"]),
+    ("mesh-garbage", {"s.toml": '[[meshes]]\nfile = "g.glb"\n', "g.glb": b"\x00garbage"}, RENDER, ["g.glb"]),
+    # -- textures ------------------------------------------------------------------------------
+    (
+        "jpeg-truncated",
+        {**scene(MAT.format("base_color_map = 'cut.jpg'")), "cut.jpg": JPEG.read_bytes()[:20000]},
+        RENDER,
+        ["s.toml", "[materials.m].base_color_map", "cut.jpg"],
+    ),
+    (
+        "texture-not-an-image",
+        {**scene(MAT.format("normal_map = 'n.png'")), "n.png": "not a png"},
+        RENDER,
+        ["s.toml", "[materials.m].normal_map", "n.png"],
+    ),
+    ("texture-missing", scene(MAT.format("roughness_map = 'r.png'")), RENDER, ["[materials.m].roughness_map", "r.png"]),
+    # -- options -------------------------------------------------------------------------------
+    ("out-below-file", {"f.ply": "x"}, ["render", "--out", "{tmp}/f.ply/x.exr"], ["--out", "f.ply", "not a folder"]),
+    ("out-is-folder", {"d/keep": ""}, ["render", "--out", "{tmp}/d"], ["--out", "d", "folder"]),
+    ("out-extension", {}, ["render", "--out", "{tmp}/x.jpg"], ["x.jpg", ".png or .exr"]),
+    ("size", {}, ["render", "--out", "{tmp}/x.png", "--size", "0x5"], ["--size"]),
+    ("technique-bogus", {}, ["render", "--out", "{tmp}/x.png", "--technique", "bogus"], ["--technique", "bogus"]),
+    ("sss-bogus", {}, ["render", "--out", "{tmp}/x.png", "--sss", "fog"], ["--sss", "fog"]),
+    (
+        "ssss-taps-even",
+        {},
+        ["render", "--out", "{tmp}/x.png", "--technique", "ssss", "--ssss-taps", "12"],
+        ["--ssss-taps", "odd"],
+    ),
+    (
+        "option-of-another-technique",
+        {},
+        ["render", "--out", "{tmp}/x.png", "--technique", "tint", "--ssss-taps", "11"],
+        ["--ssss-taps", "ssss", "tint"],
+    ),
+    ("exposure", {}, ["render", "--out", "{tmp}/x.png", "--exposure", "-1"], ["--exposure"]),
+    ("camera-orbit", {}, ["render", "--out", "{tmp}/x.png", "--camera-orbit", "nan"], ["orbit"]),
+    ("mc-photons-huge", {}, ["mc", "--albedo", "0.5", "--photons", "1e30"], ["photons"]),
+    ("mc-photons-inf", {}, ["mc", "--albedo", "0.5", "--photons", "inf"], ["--photons"]),
+    ("mc-max-steps", {}, ["mc", "--albedo", "0.5", "--max-steps", "0"], ["--max-steps"]),
+    ("mc-max-steps-negative", {}, ["mc", "--albedo", "0.5", "--max-steps", "-3"], ["--max-steps"]),
+    ("mc-workers", {}, ["mc", "--albedo", "0.5", "--workers", "-1"], ["--workers"]),
+    ("mc-albedo", {}, ["mc", "--albedo", "1.5"], ["albedo"]),
+    ("mc-seed", {}, ["mc", "--albedo", "0.5", "--seed", "-1"], ["--seed"]),
+    ("profile-seed", {}, ["profile", "burley", "--seed", "-1"], ["--seed"]),
+    ("profile-mfp-huge", {}, ["profile", "all", "--albedo", "0.5", "--mfp", "1e300"], ["mfp", "mm"]),
+    ("profile-needs-mfp", {}, ["profile", "burley", "--albedo", "0.5"], ["--mfp", "--radius"]),
+    ("profile-radii", {}, ["profile", "burley", "--r", "-1"], ["r:", "mm"]),
+    ("profile-preset", {}, ["profile", "burley", "--preset", "cheese"], ["cheese"]),
+    ("profile-plot-ext", {}, ["profile", "burley", "--plot", "{tmp}/p.jpg"], ["--plot", "p.jpg"]),
+    ("demo-size", {}, ["demo", "--out", "{tmp}/o", "--size", "big"], ["--size", "big"]),
+    ("demo-out-file", {"o": "x"}, ["demo", "--out", "{tmp}/o"], ["--out", "not a folder"]),
+    ("view-frames", {}, ["view", "--frames", "0"], ["--frames"]),
+    ("reference-out-below-file", {"f": "x"}, ["reference", "--out", "{tmp}/f/r.exr"], ["--out", "not a folder"]),
+    ("reference-out-png", {}, ["reference", "--out", "{tmp}/r.png"], ["--out", ".exr"]),
+    ("reference-passes", {}, ["reference", "--out", "{tmp}/r.exr", "--passes", "1"], ["passes"]),
+    ("reference-spp", {}, ["reference", "--out", "{tmp}/r.exr", "--spp", "0"], ["spp"]),
+    (
+        "reference-scene",
+        scene("camera = 5\n" + MESH),
+        ["reference", "{tmp}/s.toml", "--out", "{tmp}/r.exr"],
+        ["[camera]"],
+    ),
+    ("command-unknown", {}, ["rendr"], ["rendr"]),
+    ("supersample-zero", scene(MESH), [*RENDER, "--supersample", "0"], ["--supersample", "[1, 8]"]),
+    ("supersample-fraction", scene(MESH), [*RENDER, "--supersample", "1.5"], ["--supersample", "1.5"]),
+    (
+        "supersample-too-many",
+        scene(MESH),
+        [*RENDER, "--size", "4096x8", "--supersample", "8"],
+        ["supersample", "16384"],
+    ),
+    ("peer-frames", {}, ["bench", "peer", "--frames", "0", "--no-progress"], ["--frames"]),
+    ("peer-rounds", {}, ["bench", "peer", "--rounds", "0", "--no-progress"], ["--rounds"]),
+]
+
+
+def _write(folder: Path, files: dict) -> None:
+    for name, content in files.items():
+        p = folder / name
+        p.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(content, bytes):
+            p.write_bytes(content)
+        else:
+            p.write_text(content)
+
+
+def _tree(folder: Path) -> set[str]:
+    return {str(p.relative_to(folder)) for p in folder.rglob("*")}
+
+
+@pytest.mark.parametrize("files, argv, expected", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
+def test_bad_input_is_one_line_exit_2_naming_file_and_key(tmp_path, capsys, monkeypatch, files, argv, expected):
+    monkeypatch.delenv("SKINLAB_DEBUG", raising=False)
+    _write(tmp_path, files)
+    before = _tree(tmp_path)
+    try:
+        code = main([a.format(tmp=tmp_path) for a in argv])
+    except SystemExit as exc:  # argparse: usage errors
+        code = exc.code
+    err = capsys.readouterr().err
+    assert code == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    for piece in expected:
+        assert piece in lines[0], f"{piece!r} not in {lines[0]!r}"
+    assert _tree(tmp_path) == before, "an output (or temporary) file was left behind"
+
+
+def test_every_case_is_distinct():
+    ids = [c[0] for c in CASES]
+    assert len(ids) == len(set(ids)) and len(ids) >= 60
+
+
+def test_closed_pipe_ends_quietly():
+    """`skinlab profile all --json | head -c 100`: the reader stops early; no traceback."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    p = subprocess.run(
+        f"{sys.executable} -m skinlab.cli profile all --json | head -c 100",
+        shell=True,
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+        executable="/bin/bash",
+    )
+    assert p.stdout.startswith('{"medium"') and len(p.stdout) == 100
+    assert "Traceback" not in p.stderr and "BrokenPipe" not in p.stderr, p.stderr
+
+
+def test_ctrl_c_is_one_line_not_a_traceback(monkeypatch, capsys):
+    import skinlab.commands.mc as mc
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(mc, "run", interrupted)
+    assert main(["mc", "--albedo", "0.5"]) == 130
+    assert capsys.readouterr().err == "skinlab mc: interrupted\n"

@@ -1,0 +1,50 @@
+"""Every option says what it is; every option with a default states it (help texts are the manual)."""
+
+import argparse
+
+from skinlab.cli import build_parser
+
+
+def _subparsers(parser, prefix=()):
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                yield (*prefix, name), sub
+                yield from _subparsers(sub, (*prefix, name))
+
+
+def _forms(value) -> set[str]:
+    """How a default may be written: 2048, 0.05, 1e5 for 100000.0, out/render.png."""
+    if isinstance(value, float):
+        mantissa, exp = f"{value:e}".split("e")
+        return {f"{value:g}", f"{float(mantissa):g}e{int(exp)}", repr(value)}
+    return {str(value)}
+
+
+def test_every_option_has_help_and_states_its_default():
+    missing = []
+    for path, sub in _subparsers(build_parser()):
+        for a in sub._actions:
+            if isinstance(a, argparse._HelpAction | argparse._SubParsersAction) or a.help == argparse.SUPPRESS:
+                continue
+            name = " ".join(path) + " " + (a.option_strings[-1] if a.option_strings else a.dest)
+            if not a.help:
+                missing.append(f"{name}: no help")
+                continue
+            if (
+                a.option_strings
+                and a.default not in (None, False)
+                and not isinstance(a, argparse._StoreTrueAction | argparse._StoreFalseAction)
+            ):
+                if "default" not in a.help or not any(form in a.help for form in _forms(a.default)):
+                    missing.append(f"{name}: default {a.default!r} not stated in {a.help!r}")
+    assert not missing, "\n".join(missing)
+
+
+def test_accuracy_help_defaults_come_from_the_sweeps():
+    from skinlab.bench.accuracy import SWEEPS
+
+    bench = dict(_subparsers(build_parser()))[("bench", "accuracy")]
+    helps = {a.dest: a.help for a in bench._actions}
+    assert f"default {SWEEPS['full'].exact_size}; --quick {SWEEPS['quick'].exact_size}" in helps["exact_size"]
+    assert f"default {SWEEPS['full'].photons}; --quick {SWEEPS['quick'].photons}" in helps["photons"]

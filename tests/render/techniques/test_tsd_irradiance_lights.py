@@ -1,0 +1,62 @@
+"""The texture-space irradiance pass shades the lights without a shadow map in its light loop and
+each filled shadow slot's light once, with its translucency (skinlab/shaders/passes/tsd_irradiance.frag,
+u_slot_light): the frame must not depend on the lights' order or on which slot holds a light. With
+no ambient light the frame is linear in the lights, so two shadow-casting lights together (one in
+slot 0, one in slot 1) render the sum of each alone (in slot 0)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from skinlab.render.settings import RenderSettings
+from skinlab.resources import assets_root
+from skinlab.scene import transform as tf
+from skinlab.scene.graph import LightNode
+from skinlab.scene.scenefile import load_scene
+
+SCENE = assets_root() / "scenes" / "reference" / "slab-thin-backlit-skin1.toml"
+LIGHTS = {  # direction the light travels, intensity, shadow
+    "back": ((0.5, 0.0, 0.866), 3.0, True),  # from behind the 3 mm slab: reaches the camera only through it
+    "key": ((0.3, 0.2, -1.0), 1.0, True),
+    "fill": ((-0.4, -0.1, -1.0), 0.5, False),
+}
+
+
+def _render(renderer, names, translucency=True):
+    s = load_scene(SCENE)
+    for node in s.lights():
+        node.visible = False  # the scene's own light
+    for n in names:
+        d, intensity, shadow = LIGHTS[n]
+        d = np.asarray(d, np.float64) / np.linalg.norm(d)
+        light = LightNode(n, "directional", color=(1.0, 0.9, 0.8), intensity=intensity, cast_shadow=shadow)
+        light.rotation = tf.look_at_rotation(np.zeros(3), d)
+        s.add(light)
+    st = RenderSettings.for_technique("tsd", 48, 48, shadow_size=512, size=128, translucency=translucency)
+    res = renderer.render(s, st, readback=("hdr",))
+    assert [p for p in res.plan.passes if p.kind == "tsd_irradiance"], "no texture-space irradiance pass"
+    return res.hdr[..., :3].astype(np.float64)
+
+
+def test_light_order_and_slot_do_not_change_the_frame(renderer):
+    a = _render(renderer, ["fill", "back", "key"])  # back in slot 0, key in slot 1
+    b = _render(renderer, ["key", "fill", "back"])  # key in slot 0, back in slot 1
+    assert a.max() > 0.01
+    np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6 * a.max())
+
+
+def test_two_shadow_slots_add_up(renderer):
+    back = _render(renderer, ["back"])
+    both = _render(renderer, ["key", "back"])  # back in slot 1 here
+    alone = back + _render(renderer, ["key"])
+    assert back.max() > 1e-3  # the light from behind shows through the slab
+    np.testing.assert_allclose(both, alone, rtol=1e-5, atol=1e-6 * both.max())
+
+
+@pytest.mark.parametrize("names", [["fill", "back"], ["key", "back"]])  # back in slot 0, in slot 1
+def test_translucency_runs_for_the_slot_of_the_back_light(renderer, names):
+    on = _render(renderer, names)
+    off = _render(renderer, names, translucency=False)
+    assert (on - off).max() > 0.01 * on.max()  # light through the slab (none of it reaches the front otherwise)
+    assert (on - off).min() > -1e-6
