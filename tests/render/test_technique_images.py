@@ -4,7 +4,7 @@ tests/data/technique_images.npz holds small HDR frames rendered by the code befo
 moved into packages (skinlab/render/techniques/); each technique must reproduce them to fp32 rounding.
 After a deliberate change of a technique's images, regenerate them with
 
-    python -m tests.app.render.test_technique_images
+    python -m tests.render.test_technique_images
 
 and say why in the commit message.
 """
