@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 import moderngl
 import numpy as np
 
+from skinlab.cache import in_background
 from skinlab.gl.uniforms import set_uniform, set_uniforms
 from skinlab.scene.interreflection import BounceTransfer, build_transfer
 
@@ -71,6 +72,29 @@ def bounce_pass_name(order: int) -> str:
     return f"bounce[{order}]"
 
 
+def bounce_rays(
+    scene: Scene, settings: RenderSettings, meshes: list[MeshNode], lights: list[LightNode]
+) -> tuple[int | None, str]:
+    """(rays per vertex the frame's interreflection casts, or None when it casts none; why not)."""
+    if settings.bounces == 0:
+        return None, "interreflection off (bounces = 0)"
+    if not meshes:
+        return None, ""
+    if not lights and not np.any(np.asarray(scene.environment.ambient) > 0):
+        return None, "no light to bounce (no lights, no ambient)"
+    vertices = sum(len(n.mesh.positions) for n in meshes)
+    return min(settings.bounce_rays, MAX_RAYS // max(vertices, 1)), ""
+
+
+def prefetch_bounce(scene: Scene, settings: RenderSettings, meshes: list[MeshNode], lights: list[LightNode]) -> None:
+    """Start casting the frame's interreflection rays on a worker thread (skinlab/cache.py
+    in_background), so that they are cast while the technique plans; plan_bounce then waits for
+    them. Nothing when the records are cached or the frame casts none."""
+    rays, _ = bounce_rays(scene, settings, meshes, lights)
+    if rays is not None and rays >= MIN_RAYS:
+        in_background(build_transfer, list(meshes), rays)
+
+
 def plan_bounce(
     scene: Scene,
     settings: RenderSettings,
@@ -80,16 +104,12 @@ def plan_bounce(
     plan: FramePlan,
 ) -> list[PlannedPass]:
     """The interreflection passes this frame needs (none when off, or nothing sees anything)."""
-    if settings.bounces == 0:
-        plan.skipped.append(("bounce", "interreflection off (bounces = 0)"))
-        return []
-    if not meshes:
-        return []
-    if not lights and not np.any(np.asarray(scene.environment.ambient) > 0):
-        plan.skipped.append(("bounce", "no light to bounce (no lights, no ambient)"))
+    rays, why = bounce_rays(scene, settings, meshes, lights)
+    if why:
+        plan.skipped.append(("bounce", why))
+    if rays is None:
         return []
     vertices = sum(len(n.mesh.positions) for n in meshes)
-    rays = min(settings.bounce_rays, MAX_RAYS // max(vertices, 1))
     if rays < MIN_RAYS:
         plan.warnings.append(
             f"interreflection skipped: {vertices} vertices need more than {MAX_RAYS:,} rays even at {MIN_RAYS} "

@@ -5,10 +5,9 @@ convolution differs between techniques."""
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
+from skinlab.cache import table
 from skinlab.gl.uniforms import set_array, set_uniforms
 from skinlab.scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables
 from skinlab.scene.optics.fresnel import fdr
@@ -23,7 +22,7 @@ _ZERO_H = np.zeros((_SLAB_ROWS, 3))
 _UNIT_AB = np.concatenate([np.ones((SLAB_TAU_NODES, 3)), np.zeros((SLAB_TAU_NODES, 3))])
 
 
-@lru_cache(maxsize=256)
+@table(disk=True, maxsize=256)
 def _slab_tables(alpha: tuple, colour: tuple, eta: float):
     """The slab transmittance table (ln T per unit colour) and the exit factor's tables of the light
     that comes through (skinlab/scene/optics/slab.py slab_exit_tables: ln T_d, h, A and B)."""

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from .bounce import plan_bounce
+from .bounce import plan_bounce, prefetch_bounce
 from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams, shadow_pass_name
 from .registry import get_technique
 from .reuse import light_placement, scene_geometry
@@ -43,6 +43,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
         plan.skipped.append(("shadows", "no visible mesh"))
         shadow_lights = []
     technique = get_technique(settings.technique_name)
+    prefetch_bounce(scene, settings, meshes, lights)  # rays are cast while the technique plans
     tp = technique.plan(PlanContext(scene, settings, meshes, lights, shadow_lights[:2], plan, state))
     distance = tp.shadow_distance and bool(shadow_lights)
     geometry = scene_geometry(scene) if shadow_lights else ()

@@ -34,6 +34,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from skinlab.cache import Memo, stored
+
+from .mesh import mesh_key
+
 if TYPE_CHECKING:
     from .graph import MeshNode
 
@@ -107,24 +111,6 @@ def world_geometry(node: MeshNode) -> tuple[np.ndarray, np.ndarray]:
     return p, nrm
 
 
-_DIGESTS: dict[tuple[int, int], bytes] = {}  # (mesh uid, version) -> digest of its arrays
-
-
-def _mesh_digest(mesh) -> bytes:
-    """A digest of a mesh's positions, triangles and normals, computed once per mesh version (the
-    frame plan asks every frame; hashing 10k vertices each time cost a millisecond or two)."""
-    key = (mesh.uid, mesh.version)
-    d = _DIGESTS.get(key)
-    if d is None:
-        h = hashlib.sha1()
-        for a in (mesh.positions, mesh.indices, mesh.normals):
-            h.update(np.ascontiguousarray(a).tobytes())
-        d = _DIGESTS[key] = h.digest()
-        if len(_DIGESTS) > 256:
-            _DIGESTS.pop(next(iter(_DIGESTS)))
-    return d
-
-
 def geometry_key(nodes: list[MeshNode], rays: int, seed: int) -> str:
     """What the records depend on: each mesh's arrays (by content: the same mesh loaded twice shares
     its records) and world transform, the rays and the seed."""
@@ -132,17 +118,18 @@ def geometry_key(nodes: list[MeshNode], rays: int, seed: int) -> str:
     h.update(np.array([rays, seed], np.int64).tobytes())
     for node in nodes:
         h.update(np.asarray(node.world_matrix, np.float64).tobytes())
-        h.update(_mesh_digest(node.mesh))
+        h.update(mesh_key(node.mesh).encode())
     return h.hexdigest()
 
 
-_CACHE: dict[str, tuple] = {}  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights
-_CACHE_SIZE = 8
+_CACHE = Memo(8)  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights
 
 
 def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> BounceTransfer:
     """The ray records of `nodes` against each other (cached per geometry, rays and seed: the same
-    meshes at the same places share them, whichever scene object holds them)."""
+    meshes at the same places share them, whichever scene object holds them; on disk too: casting
+    is the slow part of loading a scene, 0.6 s for the head). Thread-safe: a frame plan may start
+    it early on a worker thread (:func:`prefetch_transfer`) and ask for it later."""
     if not isinstance(rays, int) or isinstance(rays, bool) or rays < 1:
         raise ValueError(f"interreflection rays: expected a positive integer (rays per vertex), got {rays!r}")
     key = geometry_key(nodes, rays, seed)
@@ -150,12 +137,12 @@ def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> Boun
     for node in nodes:
         offsets[node.uid], counts[node.uid] = total, len(node.mesh.positions)
         total += len(node.mesh.positions)
-    hit = _CACHE.get(key)
-    if hit is None:
-        hit = _cast(nodes, rays, seed, total)
-        if len(_CACHE) >= _CACHE_SIZE:
-            _CACHE.pop(next(iter(_CACHE)))
-        _CACHE[key] = hit
+    hit = _CACHE.get(
+        key,
+        lambda: stored(
+            "interreflection", key, lambda: _cast(nodes, rays, seed, total), "interreflection rays", code=__name__
+        ),
+    )
     vertices, weights, fractions, r_off, r_vert, r_w = hit
     return BounceTransfer(
         rays,

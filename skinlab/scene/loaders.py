@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
+from skinlab.cache import content_key, stored
+
 from .mesh import Mesh
 
 SUPPORTED = (".glb", ".gltf", ".obj", ".ply", ".stl", ".off")
@@ -31,8 +33,10 @@ def load_mesh_file(path: str | Path) -> list[LoadedNode]:
     if path.suffix.lower() not in SUPPORTED:
         raise ValueError(f"{path}: unsupported mesh format {path.suffix!r}; expected one of {', '.join(SUPPORTED)}")
     key = (str(path.resolve()), path.stat().st_mtime)
-    if key not in _CACHE:
-        _CACHE[key] = _load(path)
+    if key not in _CACHE:  # on disk too, by the file's content: no trimesh import on the next start
+        _CACHE[key] = stored(
+            "meshes", content_key(path.suffix.lower(), path.read_bytes()), lambda: _load(path), str(path), code=__name__
+        )
     # fresh Mesh objects per call would re-upload; share them (meshes are data, not mutated by the renderer)
     return _CACHE[key]
 

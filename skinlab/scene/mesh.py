@@ -2,15 +2,14 @@
 
 from __future__ import annotations
 
-import hashlib
 import itertools
-import os
 import sys
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from skinlab.cache import cache_dir, content_key, disk_enabled, stored
 
 _UIDS = itertools.count(1)
 
@@ -25,9 +24,9 @@ class Mesh:
     tangents: np.ndarray | None = None  # (N, 4) float32, w = handedness
     source: str = ""
     version: int = 0  # bump when geometry changes (GPU buffers and stretch maps key on it)
-    _bounds: tuple | None = field(default=None, repr=False)
+    _bounds: tuple | None = field(default=None, repr=False, metadata={"transient": True})
     # unique for the process (unlike id(), never reused after the mesh is freed): GPU caches key on it
-    uid: int = field(default_factory=lambda: next(_UIDS), repr=False, compare=False)
+    uid: int = field(default_factory=lambda: next(_UIDS), repr=False, compare=False, metadata={"transient": True})
 
     def __post_init__(self) -> None:
         self.positions = np.ascontiguousarray(self.positions, np.float32)
@@ -135,76 +134,60 @@ def compute_tangents(positions, normals, uvs, indices) -> np.ndarray:
     return np.concatenate([t, w[:, None]], axis=1).astype(np.float32)
 
 
-ATLAS_CACHE_VERSION = 1  # bump when the way atlases are made changes
+ATLAS_CACHE_VERSION = 2  # bump when the way atlases are made changes
 
 
-def cache_dir() -> Path:
-    """Where derived data (UV atlases) is cached: $SKINLAB_CACHE_DIR, else $XDG_CACHE_HOME/skinlab,
-    else ~/.cache/skinlab. Deleting it is always safe."""
-    env = os.environ.get("SKINLAB_CACHE_DIR")
-    if env:
-        return Path(env)
-    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "skinlab"
+_KEYS: dict[tuple[int, int], str] = {}  # (mesh uid, version) -> mesh_key
+
+
+def mesh_key(mesh: Mesh) -> str:
+    """Content hash of a mesh's arrays (positions, triangles, normals, UVs), computed once per mesh
+    version: what per-mesh data cached on disk (skinlab/cache.py: rays, seams, thickness) is keyed by."""
+    key = (mesh.uid, mesh.version)
+    k = _KEYS.get(key)
+    if k is None:
+        k = _KEYS[key] = content_key(
+            *(np.zeros(0) if a is None else a for a in (mesh.positions, mesh.indices, mesh.normals, mesh.uvs))
+        )
+        if len(_KEYS) > 512:
+            _KEYS.pop(next(iter(_KEYS)))
+    return k
 
 
 def atlas_key(positions: np.ndarray, indices: np.ndarray) -> str:
     """Content hash of a mesh's geometry (the atlas depends on nothing else), with the xatlas version."""
     import xatlas
 
-    h = hashlib.sha256()
-    h.update(f"atlas-v{ATLAS_CACHE_VERSION}-xatlas-{getattr(xatlas, '__version__', '?')}".encode())
-    for a in (np.ascontiguousarray(positions, np.float32), np.ascontiguousarray(indices, np.uint32)):
-        h.update(str(a.shape).encode())
-        h.update(a.tobytes())
-    return h.hexdigest()[:32]
-
-
-def _read_atlas(path: Path, n_vertices: int):
-    try:
-        with np.load(path) as z:
-            vmapping, idx, uvs = z["vmapping"], z["indices"], z["uvs"]
-    except Exception:  # missing, truncated or from elsewhere: make it again
-        return None
-    if vmapping.ndim != 1 or len(vmapping) != len(uvs) or (len(vmapping) and vmapping.max() >= n_vertices):
-        return None
-    if idx.ndim != 2 or idx.shape[1] != 3 or (idx.size and idx.max() >= len(vmapping)):
-        return None
-    return vmapping, idx, uvs
+    return content_key(
+        f"atlas-v{ATLAS_CACHE_VERSION}-xatlas-{getattr(xatlas, '__version__', '?')}",
+        np.ascontiguousarray(positions, np.float32),
+        np.ascontiguousarray(indices, np.uint32),
+    )
 
 
 def generate_atlas(mesh: Mesh, cache: bool = True) -> None:
     """Give ``mesh`` a UV atlas with xatlas (vertices are split along chart seams). Atlases are
-    cached by mesh content under :func:`cache_dir` (xatlas takes seconds on a 70k-triangle scan);
-    ``cache=False`` or SKINLAB_CACHE_DIR=off always recomputes."""
-    use_cache = cache and os.environ.get("SKINLAB_CACHE_DIR", "").lower() != "off"
-    key = atlas_key(mesh.positions, mesh.indices)
-    path = cache_dir() / "atlas" / f"{key}.npz"
-    found = _read_atlas(path, len(mesh.positions)) if use_cache else None
-    if found is None:
+    cached by mesh content under the cache directory (skinlab/cache.py; xatlas takes seconds on a
+    70k-triangle scan); ``cache=False`` or SKINLAB_CACHE_DIR=off always recomputes."""
+    where = f"mesh {mesh.name!r}" + (f" ({Path(mesh.source).name})" if mesh.source else "")
+
+    def parametrize():
         import xatlas
 
-        where = f"mesh {mesh.name!r}" + (f" ({Path(mesh.source).name})" if mesh.source else "")
         print(
             f"skinlab: generating a UV atlas for {where}, {len(mesh.indices)} triangles, with xatlas"
-            + (f"; cached in {path.parent} for next time" if use_cache else ""),
+            + (f"; cached in {cache_dir() / 'atlas'} for next time" if cache and disk_enabled() else ""),
             file=sys.stderr,
             flush=True,
         )
-        vmapping, idx, uvs = xatlas.parametrize(mesh.positions, mesh.indices)
-        if use_cache:
-            tmp = None
-            try:
-                path.parent.mkdir(parents=True, exist_ok=True)
-                fd, tmp = tempfile.mkstemp(prefix=f".{key}.", suffix=".npz", dir=path.parent)
-                with os.fdopen(fd, "wb") as f:
-                    np.savez(f, vmapping=vmapping, indices=idx, uvs=uvs)
-                os.replace(tmp, path)
-            except OSError as exc:
-                if tmp is not None:
-                    Path(tmp).unlink(missing_ok=True)  # a read-only home is no reason to fail a render
-                print(f"skinlab: could not cache the atlas in {path.parent}: {exc}", file=sys.stderr)
+        return tuple(xatlas.parametrize(mesh.positions, mesh.indices))
+
+    if cache:
+        vmapping, idx, uvs = stored(
+            "atlas", atlas_key(mesh.positions, mesh.indices), parametrize, f"the atlas of {where}"
+        )
     else:
-        vmapping, idx, uvs = found
+        vmapping, idx, uvs = parametrize()
     mesh.positions = np.ascontiguousarray(mesh.positions[vmapping])
     mesh.normals = np.ascontiguousarray(mesh.normals[vmapping])
     mesh.indices = np.ascontiguousarray(idx, np.uint32)

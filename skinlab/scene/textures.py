@@ -15,6 +15,17 @@ from .optics.color import srgb_decode
 _CACHE: dict[tuple[str, float, str], np.ndarray] = {}
 
 
+def _srgb_to_linear(x: np.ndarray, eight_bit: bool) -> np.ndarray:
+    """srgb_decode(x) as float32; an 8-bit image has 256 values, decoded once each through a table
+    (the same numbers: the table holds srgb_decode of the very floats the file decoded to)."""
+    if eight_bit:
+        codes = np.rint(x * 255.0).astype(np.uint8)
+        values = np.arange(256, dtype=np.float32) / np.float32(255.0)
+        if np.array_equal(values[codes], x):
+            return srgb_decode(values).astype(np.float32)[codes]
+    return srgb_decode(x).astype(np.float32)
+
+
 def load_texture(path: str | Path, colorspace: str = "linear") -> np.ndarray:
     if colorspace not in ("srgb", "linear"):
         raise ValueError(f"texture {path}: colorspace must be 'srgb' or 'linear', got {colorspace!r}")
@@ -43,7 +54,7 @@ def load_texture(path: str | Path, colorspace: str = "linear") -> np.ndarray:
     if colorspace == "srgb":
         rgb = min(3, img.shape[2])
         img = img.copy()
-        img[..., :rgb] = srgb_decode(img[..., :rgb]).astype(np.float32)
+        img[..., :rgb] = _srgb_to_linear(img[..., :rgb], str(spec.format) == "uint8")
     if not np.isfinite(img).all():
         raise ValueError(f"{path}: texture contains NaN or Inf")
     _CACHE[key] = img

@@ -63,7 +63,7 @@ class SeamExtension:
     chart: np.ndarray  # (F,) chart id of every triangle of the mesh (charts())
     border_uv: np.ndarray  # (K, 3, 2) every chart border's own strip of gutter (border_bands)
     border_depth: np.ndarray  # (K, 3) distance from the border edge (UV units)
-    _mesh: list = field(default_factory=list, repr=False, compare=False)
+    _mesh: list = field(default_factory=list, repr=False, compare=False, metadata={"transient": True})
 
     @property
     def triangles(self) -> int:

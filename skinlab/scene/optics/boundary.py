@@ -57,9 +57,10 @@ exit(mu) = A_ms(mu)/A_ms_d, sampled at ANGULAR_NODES cosines mu_i = i/(N-1), lin
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
+
+from skinlab.cache import table
 
 from .fresnel import clamp_eta, fresnel_dielectric
 from .rough_dielectric import SMOOTH_ALPHA, rough_albedos
@@ -69,12 +70,13 @@ _GL_N = 96  # Gauss-Legendre nodes of the hemispherical integrals
 _H_N = 800  # nodes of the H-function integral
 
 
+@table(maxsize=8)
 def _gl(n: int = _GL_N):
     x, w = np.polynomial.legendre.leggauss(n)
     return 0.5 * (x + 1.0), 0.5 * w
 
 
-@lru_cache(maxsize=1)
+@table(disk=True, maxsize=1)
 def _h_quadrature(n: int = _H_N):
     """Nodes theta in (0, pi/2) and weights for Chandrasekhar's integral form of H; theta = (pi/2) t^2
     takes the logarithmic singularity at theta = 0 (conservative scattering) out of the integrand."""
@@ -116,7 +118,7 @@ def ms_albedo_matched(a: float, mu0) -> np.ndarray:
     return np.maximum(albedo_isotropic(a, mu0) - single_albedo_isotropic(a, mu0), 0.0)
 
 
-@lru_cache(maxsize=256)
+@table(maxsize=256)
 def _diffuse_albedo_matched(a: float) -> float:
     """All-order albedo of the index-matched medium for diffuse light, 2 int A(mu) mu dmu."""
     return hemispherical(lambda m: albedo_isotropic(a, m))
@@ -135,7 +137,7 @@ def boundary_transmittance(mu, eta: float, ggx_alpha: float = 0.0) -> np.ndarray
     return np.interp(mu, nodes, t)
 
 
-@lru_cache(maxsize=64)
+@table(disk=True, maxsize=64)
 def _rough_transmittance_table(ggx_alpha: float, eta: float) -> tuple[np.ndarray, np.ndarray]:
     """The rough boundary's transmittance from outside at 257 cosines, linear in between (within
     1e-4 of the direct evaluation from GGX alpha 0.05 on; 7e-3 at grazing incidence for a nearly
@@ -144,7 +146,7 @@ def _rough_transmittance_table(ggx_alpha: float, eta: float) -> tuple[np.ndarray
     return nodes, rough_albedos(nodes, ggx_alpha, eta)[1]
 
 
-@lru_cache(maxsize=512)
+@table(maxsize=512)
 def internal_reflect_transmit(a: float, eta: float, ggx_alpha: float = 0.0) -> tuple[float, float]:
     """(R_i, T_i): what the boundary reflects back into the medium and lets out of the light that
     reaches it from inside after scattering. That light arrives with the angular shape of the
@@ -162,7 +164,7 @@ def internal_reflect_transmit(a: float, eta: float, ggx_alpha: float = 0.0) -> t
     return float(np.sum(ww * r)), float(np.sum(ww * t))
 
 
-@lru_cache(maxsize=64)
+@table(disk=True, maxsize=64)
 def _inside_albedos(ggx_alpha: float, eta: float) -> tuple[np.ndarray, np.ndarray]:
     """The boundary's reflectance and transmittance for light from inside, at the quadrature nodes."""
     m, _ = _gl()
@@ -248,7 +250,7 @@ def angular_nodes() -> np.ndarray:
     return np.linspace(0.0, 1.0, ANGULAR_NODES)
 
 
-@lru_cache(maxsize=256)
+@table(disk=True, maxsize=256)
 def _tables(alpha: tuple, colour: tuple, eta: float, ggx_alpha: float) -> BoundaryTables:
     mu = angular_nodes()
     entry = np.zeros((ANGULAR_NODES, 3))

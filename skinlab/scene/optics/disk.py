@@ -23,9 +23,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
+
+from skinlab.cache import table
 
 from .burley import burley_sample_golubev
 from .constants import MIN_MFP_MM, PI
@@ -59,7 +60,7 @@ def _scatter(medium: Medium) -> np.ndarray:
     return (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
 
 
-@lru_cache(maxsize=256)
+@table(disk=True, maxsize=256)
 def disk_kernel(model: str, medium: Medium, samples: int) -> DiskKernel:
     """The disk samples for a material's sss_model and medium (cached per medium and count)."""
     from .gaussians import _energy_radius

@@ -14,7 +14,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize, nnls
 
 from ._profile_util import f64
 from .constants import PI, SKIN6_VARIANCES, SKIN6_WEIGHTS
@@ -75,6 +74,8 @@ def _energy_radius(profile_fn, fraction):
 
 def _solve(basis, target):
     """NNLS per channel; basis (N, K), target (N, C) -> weights (K, C), residual norms (C,)."""
+    from scipy.optimize import nnls  # scipy.optimize takes 0.4 s to import: only where a fit runs
+
     w = np.zeros((basis.shape[1], target.shape[1]))
     res = np.zeros(target.shape[1])
     for c in range(target.shape[1]):
@@ -124,6 +125,8 @@ def fit_gaussians(
 
     def cost(logv):
         return float(np.sum(solve(logv)[2] ** 2))
+
+    from scipy.optimize import minimize
 
     if variances is not None:
         v0 = np.log(f64(variances).ravel())

@@ -23,10 +23,10 @@ from __future__ import annotations
 
 import csv
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
 
+from skinlab.cache import parallel_map, table
 from skinlab.resources import asset_path
 
 from .constants import PI
@@ -134,14 +134,14 @@ def surface_albedo(alpha, eta, method: str = "pbd"):
     raise ValueError(f"method: unknown albedo method {method!r}; choose one of {ALBEDO_METHODS}")
 
 
-@lru_cache(maxsize=32)
+@table(disk=True, maxsize=32)
 def _pbd_table(eta: float):
     """alpha grid (dense near 1, as pbrt's rhoSamples) and PBD effective albedo, made monotonic."""
     n = 256
     i = np.arange(n)
     a = (1.0 - np.exp(-8.0 * i / (n - 1))) / (1.0 - np.exp(-8.0))
     a[-1] = 1.0
-    r = np.concatenate([pbd_total(a[k : k + 64], eta) for k in range(0, n, 64)])
+    r = np.concatenate(parallel_map(lambda k: pbd_total(a[k : k + 64], eta), list(range(0, n, 64))))
     return a, np.maximum.accumulate(r)
 
 
@@ -263,7 +263,7 @@ class Medium:
         return Medium(self.alpha, tuple(self.mfp_arr * float(k)), self.eta, self.name)
 
 
-@lru_cache(maxsize=1)
+@table(maxsize=1)
 def _load_presets() -> dict[str, Medium]:
     out = {}
     with open(PRESET_FILE, newline="") as fh:

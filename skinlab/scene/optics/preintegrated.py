@@ -18,9 +18,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
+
+from skinlab.cache import table
 
 from .media import Medium
 from .tsd import profile_fit
@@ -67,7 +68,7 @@ def ring_diffusion(nol, radius_mm, variances, weights, identity) -> np.ndarray:
     return ident[None, :] * flat + (1.0 - ident[None, :]) * scat
 
 
-@lru_cache(maxsize=64)
+@table(disk=True, maxsize=64)
 def preintegrated_lut(model: str, medium: Medium, gaussians: int = 6) -> PreintegratedLut:
     """The table for a material's sss_model and medium (cached per medium)."""
     fit = profile_fit(model, medium, gaussians)

@@ -24,9 +24,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from functools import lru_cache
 
 import numpy as np
+
+from skinlab.cache import table
 
 from .burley import blender_burley_profile, burley_profile
 from .constants import MIN_MFP_MM
@@ -64,7 +65,7 @@ def _numeric_total(fn, m: Medium):
     return out
 
 
-@lru_cache(maxsize=64)
+@table(disk=True, maxsize=64)
 def gaussian_fit_for(m: Medium, K: int = 6) -> GaussianFit:
     """Shared-variance Gaussian fit of the medium's PBD profile (cached per medium)."""
     return fit_gaussians(lambda r: pbd_profile(r, m.alpha_arr, m.mfp_arr, m.eta), K)

@@ -23,9 +23,9 @@ at index 1.3").
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
+
+from skinlab.cache import table
 
 from .fresnel import fresnel_dielectric
 
@@ -95,7 +95,7 @@ def rough_albedos(mu, alpha: float, eta: float) -> tuple[np.ndarray, np.ndarray]
     return r.mean(-1).reshape(shape), t.mean(-1).reshape(shape)
 
 
-@lru_cache(maxsize=64)
+@table(maxsize=64)
 def rough_diffuse_albedos(alpha: float, eta: float) -> tuple[float, float]:
     """(R_d, T_d): reflected and transmitted fractions of diffuse (cosine-weighted) light arriving at
     the boundary, 2 int R(mu) mu dmu and 2 int T(mu) mu dmu (pass eta < 1 for light from inside)."""

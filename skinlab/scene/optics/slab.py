@@ -31,9 +31,9 @@ a = 1 (tests/scene/optics/test_slab.py).
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
+
+from skinlab.cache import table
 
 from .fresnel import clamp_eta, fdr, fresnel_dielectric
 
@@ -103,7 +103,7 @@ def doubling_exit(a: float, tau: float, mu0: float) -> tuple[np.ndarray, np.ndar
     return mu[:QUAD_NODES], col / (2.0 * wt[:QUAD_NODES] * mu[:QUAD_NODES] * col.sum())
 
 
-@lru_cache(maxsize=512)
+@table(maxsize=512)
 def _transmittance_table(a: float) -> np.ndarray:
     """(SLAB_MU_NODES, SLAB_TAU_NODES) diffuse transmittance at the table's cosines and thicknesses."""
     mu = slab_mu_nodes()
@@ -235,7 +235,7 @@ _NORM_QUAD = 128  # Gauss-Legendre cosines of the exit normalisations
 EXIT_Q_MAX = 2.0
 
 
-@lru_cache(maxsize=512)
+@table(maxsize=512)
 def _eigen_table(a: float) -> np.ndarray:
     """(SLAB_MU_NODES, SLAB_TAU_NODES): h = sqrt(-lambda pi / T_d) psi at the table's cosines and
     thicknesses (psi the remainder's leading eigenfunction, unit cosine-weighted norm, psi(1) > 0;

@@ -17,10 +17,9 @@ slow, e.g. no absorption). The planner skips a mesh's translucency when no part 
 
 from __future__ import annotations
 
-from functools import lru_cache
-
 import numpy as np
 
+from skinlab.cache import table
 from skinlab.scene.optics.boundary import boundary_tables
 from skinlab.scene.optics.slab import SLAB_MU_NODES, slab_table, slab_through
 
@@ -53,7 +52,7 @@ def translucency_reach_mm(alpha, mfp_mm, eta, colour, eps: float = REACH_EPS) ->
     )
 
 
-@lru_cache(maxsize=256)
+@table(disk=True, maxsize=256)
 def _reach(alpha, mfp, eta, colour, eps) -> float:
     scale = max(max(mfp), 1e-9)
     d = _GRID * scale

@@ -28,9 +28,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import lru_cache
 
 import numpy as np
+
+from skinlab.cache import table
 
 from .constants import (
     COVERAGE_EPS,
@@ -91,7 +92,7 @@ class ProfileFit:
     rel_error: np.ndarray  # (3,) the fit's relative L2 error on r R(r)
 
 
-@lru_cache(maxsize=128)
+@table(disk=True, maxsize=128)
 def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
     """K shared-variance Gaussians for `model` (a material sss_model) and `medium`, normalised."""
     if model not in MODEL_PROFILES:
@@ -159,7 +160,7 @@ def tap_count(sigma_texels: float) -> int:
     return int(min(max(n, TSD_MIN_TAPS), TSD_MAX_TAPS))
 
 
-@lru_cache(maxsize=64)
+@table(maxsize=64)
 def blur_taps(n: int) -> tuple[np.ndarray, np.ndarray]:
     """Offsets t_i (in sigmas, uniform over [-3, 3]) and weights: the Gaussian's mass over each
     tap's cell, normalised to sum to 1."""

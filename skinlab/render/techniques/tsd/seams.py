@@ -27,7 +27,9 @@ import math
 import moderngl
 import numpy as np
 
+from skinlab.cache import content_key, stored
 from skinlab.gl.uniforms import set_uniforms
+from skinlab.scene.mesh import mesh_key
 from skinlab.scene.optics.constants import TSD_TAP_RANGE
 from skinlab.scene.uv_seams import SeamExtension, border_strips, seam_extension
 
@@ -58,7 +60,13 @@ def node_seams(mesh, band_texels: int, size: int) -> SeamExtension | None:
     if hit is False:
         if len(_CACHE) > 32:
             _CACHE.clear()
-        ext = seam_extension(mesh, band_uv)
+        ext = stored(  # on disk too: unfolding the head's seams takes 0.4 s
+            "seams",
+            content_key(mesh_key(mesh), round(band_uv, 9)),
+            lambda: seam_extension(mesh, band_uv),
+            f"the UV seams of mesh {mesh.name!r}",
+            code="skinlab.scene.uv_seams",
+        )
         hit = _CACHE[key] = ext if ext.triangles else None
     return hit
 
