@@ -29,8 +29,27 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+def version() -> str:
+    """The installed package's version (its metadata), e.g. ``skinlab 0.2.0``."""
+    import skinlab
+
+    return f"skinlab {skinlab.__version__}"
+
+
+class _VersionAction(argparse.Action):
+    """--version without building the rest of the parser first (it imports every command)."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(version())
+        parser.exit()
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(prog="skinlab", description="Realtime subsurface-scattering workbench")
+    parser.add_argument("--version", action=_VersionAction, help="print the version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
     sub.required = True
     for name in COMMAND_MODULES:
@@ -64,6 +83,9 @@ def _quiet_broken_pipe() -> int:
 
 def main(argv: list[str] | None = None) -> int:
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+    if (sys.argv[1:] if argv is None else argv) == ["--version"]:  # answers before any command module loads
+        print(version())
+        return 0
     args = build_parser().parse_args(argv)
     from skinlab.gl.context import ContextError
     from skinlab.gl.shader_source import ShaderError

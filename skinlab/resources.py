@@ -51,7 +51,7 @@ def scenes_root() -> Path:
 class BundledScene:
     name: str  # path under skinlab/assets/scenes without .toml, '/' separated
     path: Path
-    summary: str  # the first line of the file's opening comment
+    summary: str  # the first line of the file's opening comment (each bundled scene makes it one line)
 
 
 def _summary(path: Path) -> str:
@@ -65,7 +65,7 @@ def _summary(path: Path) -> str:
         for prefix in ("Reference scene:", "The default scene:"):
             if text.startswith(prefix):
                 text = text[len(prefix) :].strip()
-        return text
+        return text[:1].upper() + text[1:]
     return ""
 
 

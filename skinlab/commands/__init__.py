@@ -10,4 +10,5 @@ COMMAND_MODULES = [
     "skinlab.commands.mc",
     "skinlab.commands.view",
     "skinlab.commands.reference",
+    "skinlab.commands.scenes",
 ]
