@@ -1,0 +1,148 @@
+"""`skinlab bench startup`: how long a command takes to answer, and where the time goes.
+
+Each run is a fresh process doing what ``skinlab render SCENE --size WxH --out x.png`` does, timed
+phase by phase from inside (:func:`child`) and as a whole from outside (wall time, interpreter start
+included):
+
+- ``imports``: the command line's modules and its parser (every command module, the registry);
+- ``scene``: reading the scene file, its meshes and textures;
+- ``gl``: the headless EGL context and the renderer;
+- ``plan``: planning the first frame (profile fits, tables, interreflection rays, UV seams: the work
+  skinlab/cache.py keeps on disk);
+- ``first frame``: the first frame's passes (shader compiles, uploads);
+- ``frame``: a second frame with every pass run (what `render` times and reports);
+- ``write``: the PNG.
+
+Three starts per round, in a temporary folder: ``fresh`` as on a new machine (Skinlab's cache and
+Mesa's shader cache both empty), ``cold`` with Skinlab's cache emptied again but Mesa's compiled
+shaders kept (a first run on a machine that has run Skinlab before, or after Skinlab's code changed),
+``warm`` with both kept (every later run). The caches each run
+built or found are counted (``skinlab.cache.BUILT`` / ``LOADED``). Figures depend on the machine and
+its load: the load average is reported with them.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+KINDS = ("fresh", "cold", "warm")
+PHASES = ("imports", "scene", "gl", "plan", "first frame", "frame", "write")
+
+
+# what the timed process runs: the command line's imports and parser first (as `skinlab render`
+# does; the library itself never imports the command line), then child() for the rest
+CHILD = """import time
+t0 = time.perf_counter()
+import json, skinlab.cli
+skinlab.cli.build_parser()
+t1 = time.perf_counter()
+from skinlab.bench.startup import child
+print(json.dumps(child({scene!r}, {size!r}, {out!r}, t0, t1)))
+"""
+
+
+def child(scene: str | None, size: tuple[int, int], out: str, t_start: float, t_imports: float) -> dict:
+    """One start, timed phase by phase (in a fresh interpreter, after CHILD's imports)."""
+    t = {"start": t_start, "imports": t_imports}
+    from skinlab.scene.scenefile import load_scene
+
+    sc = load_scene(scene)
+    t["scene"] = time.perf_counter()
+    from skinlab.gl.context import create_headless_context
+    from skinlab.render.renderer import Renderer
+    from skinlab.render.settings import RenderSettings
+
+    renderer = Renderer(create_headless_context())
+    settings = RenderSettings(*size)
+    t["gl"] = time.perf_counter()
+    renderer.plan(sc, settings)
+    t["plan"] = time.perf_counter()
+    renderer.render(sc, settings, readback=False)
+    t["first frame"] = time.perf_counter()
+    renderer.forget_reuse()
+    result = renderer.render(sc, settings)
+    t["frame"] = time.perf_counter()
+    from skinlab.image_output import write_image
+
+    write_image(Path(out), result.ldr)
+    t["write"] = time.perf_counter()
+    from skinlab.cache import BUILT, LOADED
+
+    keys = ["start", *PHASES]
+    phases = {p: (t[p] - t[keys[i]]) * 1e3 for i, p in enumerate(keys[1:])}
+    return {"phases_ms": phases, "built": dict(BUILT), "loaded": dict(LOADED)}
+
+
+def _run_child(scene: str | None, size: tuple[int, int], env: dict, out: str) -> dict:
+    code = CHILD.format(scene=scene, size=size, out=out)
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=False)
+    wall = (time.perf_counter() - t0) * 1e3
+    if r.returncode != 0:
+        last = (r.stderr.strip().splitlines() or ["(no output)"])[-1]
+        raise RuntimeError(f"bench startup: the timed process failed: {last}")
+    res = json.loads(r.stdout.strip().splitlines()[-1])
+    res["wall_ms"] = wall
+    return res
+
+
+def startup_bench(scene: str | None = None, size: tuple[int, int] = (64, 64), rounds: int = 3, progress=None) -> dict:
+    """``rounds`` rounds of (fresh, cold, warm) starts (see the module docstring)."""
+    if not isinstance(rounds, int) or rounds < 1:
+        raise ValueError(f"--rounds: expected a positive count, got {rounds}")
+    runs: dict[str, list[dict]] = {k: [] for k in KINDS}
+    load_start = _loadavg()
+    with tempfile.TemporaryDirectory(prefix="skinlab-startup-") as tmp:
+        for i in range(rounds):
+            cache, mesa = Path(tmp) / f"cache{i}", Path(tmp) / f"mesa{i}"
+            env = dict(os.environ, SKINLAB_CACHE_DIR=str(cache), MESA_SHADER_CACHE_DIR=str(mesa))
+            for kind in KINDS:
+                if progress:
+                    progress(f"round {i + 1}/{rounds}: {kind} start")
+                if kind == "cold":
+                    shutil.rmtree(cache, ignore_errors=True)
+                runs[kind].append(_run_child(scene, size, env, str(Path(tmp) / "x.png")))
+    out = {"scene": scene or "head", "size": list(size), "rounds": rounds, "cpu_count": os.cpu_count()}
+    out["loadavg_start"], out["loadavg_end"] = load_start, _loadavg()
+    for kind, rs in runs.items():
+        out[kind] = {
+            "wall_ms": statistics.median(r["wall_ms"] for r in rs),
+            "phases_ms": {p: statistics.median(r["phases_ms"][p] for r in rs) for p in PHASES},
+            "built": rs[-1]["built"],
+            "loaded": rs[-1]["loaded"],
+        }
+    return out
+
+
+def _loadavg() -> list[float] | None:
+    try:
+        return [round(x, 2) for x in os.getloadavg()]
+    except OSError:
+        return None
+
+
+def report(res: dict) -> str:
+    w, h = res["size"]
+    lines = [
+        f"skinlab render {res['scene']} --size {w}x{h}: median of {res['rounds']} fresh processes each; "
+        f"load average {res['loadavg_start']} -> {res['loadavg_end']} on {res['cpu_count']} cores"
+    ]
+    for kind in KINDS:
+        r = res[kind]
+        parts = ", ".join(f"{p} {r['phases_ms'][p]:.0f}" for p in PHASES)
+        lines.append(
+            f"  {kind:4s} {r['wall_ms'] / 1e3:6.2f} s wall   ({parts} ms; the rest is the interpreter's start)"
+        )
+        built = ", ".join(f"{k} {v}" for k, v in sorted(r["built"].items())) or "nothing"
+        loaded = ", ".join(f"{k} {v}" for k, v in sorted(r["loaded"].items())) or "nothing"
+        lines.append(f"        computed: {built}")
+        lines.append(f"        read from the cache: {loaded}")
+    return "\n".join(lines)
