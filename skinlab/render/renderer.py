@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Generator, Iterator
 from dataclasses import dataclass
 
 import moderngl
@@ -109,6 +110,21 @@ class Renderer:
     ) -> FrameResult:
         """Plan and run a frame. ``readback``: True for all of hdr/ldr/depth, False for none, or a
         tuple naming the ones wanted (the others come back as None)."""
+        steps = self.frame_steps(scene, settings, readback)
+        while True:
+            try:
+                next(steps)
+            except StopIteration as done:
+                return done.value
+
+    def frame_steps(
+        self, scene: Scene, settings: RenderSettings | None = None, readback: bool | tuple[str, ...] = True
+    ) -> Generator[str, None, FrameResult]:
+        """:meth:`render` in steps: a generator that yields the name of each pass it has just run and
+        returns the FrameResult (StopIteration.value). The viewer runs a few steps per turn of its
+        event loop, so that a slow frame never keeps the window from answering; between steps the
+        caller may draw with GL (each pass sets the state it needs). ``cpu_ms`` counts the steps' own
+        time, not the caller's in between."""
         settings = settings or RenderSettings()
         t0 = time.perf_counter()
         cam = scene.camera
@@ -128,15 +144,23 @@ class Renderer:
         )
         self.frame_number += 1
         self.timer.start_frame()
-        self.run_passes(frame, plan)
+        busy, t0 = time.perf_counter() - t0, time.perf_counter()
+        for name in self._pass_steps(frame, plan):
+            busy += time.perf_counter() - t0
+            yield name
+            t0 = time.perf_counter()
         self.last_frame = frame
         wanted = ("hdr", "ldr", "depth") if readback is True else (readback or ())
         hdr, ldr, depth = self.read_targets(frame, wanted)
-        return FrameResult(hdr, ldr, depth, self.timer.frame, plan, (time.perf_counter() - t0) * 1e3)
+        return FrameResult(hdr, ldr, depth, self.timer.frame, plan, (busy + time.perf_counter() - t0) * 1e3)
 
     def run_passes(self, frame: Frame, plan: FramePlan) -> None:
         """Run the plan's passes in order; with ``self.reuse`` a pass whose outputs still hold the
         result for its current inputs is published from them instead (PlannedPass.reused_since)."""
+        for _ in self._pass_steps(frame, plan):
+            pass
+
+    def _pass_steps(self, frame: Frame, plan: FramePlan) -> Iterator[str]:
         keys: dict[str, object] = {}
         record = self.reuse_record
         for p in plan.passes:
@@ -154,6 +178,7 @@ class Renderer:
                 impl.run(frame, p)
             if outputs:
                 record.record(outputs, key, self.frame_number)
+            yield p.name
 
     def forget_reuse(self) -> None:
         """Run every pass on the next frame (after a change the input keys cannot see)."""

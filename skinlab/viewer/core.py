@@ -16,8 +16,10 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
+from skinlab.cache import computing
 from skinlab.gl.hot_reload import ShaderWatcher
 from skinlab.gl.shader_source import ShaderLibrary
+from skinlab.render.prepare import FramePreparer
 from skinlab.render.registry import get_technique, techniques
 from skinlab.render.renderer import FrameResult, Renderer
 from skinlab.render.settings import RenderSettings
@@ -68,6 +70,7 @@ class ViewerCore:
         shader_root: Path | None = None,
         settle_s: float = 0.05,
         use_watchdog: bool = True,
+        background: bool = False,
     ):
         self.ctx = ctx
         self.settings = settings or RenderSettings()
@@ -76,7 +79,8 @@ class ViewerCore:
         if not library.root.is_dir():
             raise FileNotFoundError(f"--shader-dir: no such folder: {library.root}")
         self.renderer = Renderer(ctx, library)
-        self.scene_src = scene_reloader(scene_path, settle_s, watch, use_watchdog)  # raises on a bad file
+        # background: scene reloads load on a worker thread (the window's loop keeps answering)
+        self.scene_src = scene_reloader(scene_path, settle_s, watch, use_watchdog, background)  # raises on a bad file
         self.presets = preset_reloader(settle_s, watch, use_watchdog)
         self.shaders = (
             ShaderWatcher(self.renderer.programs, library.root, settle_s=settle_s, use_watchdog=use_watchdog)
@@ -94,6 +98,10 @@ class ViewerCore:
         self.log: deque[tuple[float, str, str]] = deque(maxlen=8)  # (time, level, text) for the overlay
         self._seen_panel_version = -1
         self._dirty = True
+        self.preparer = FramePreparer()
+        self._steps = None  # the frame in progress (Renderer.frame_steps), None between frames
+        self._steps_done = 0
+        self._reloads = 0
 
     # -- state -----------------------------------------------------------------------------------
     @property
@@ -114,7 +122,8 @@ class ViewerCore:
 
     @property
     def dirty(self) -> bool:
-        return self._dirty or self.panel.version != self._seen_panel_version
+        """Whether render() has work: a change since the last frame, or a frame in progress."""
+        return self._steps is not None or self._dirty or self.panel.version != self._seen_panel_version
 
     def errors(self) -> list[str]:
         """Everything currently wrong, each naming its file (shown in the overlay)."""
@@ -218,6 +227,7 @@ class ViewerCore:
         elif state == "failed":
             self.note("error", f"preset reload failed, keeping the last good presets: {self.presets.error}")
         if changed:
+            self._reloads += 1
             self.invalidate()
         return changed
 
@@ -237,25 +247,67 @@ class ViewerCore:
         self.note("info", f"scene reloaded: {scene.source}")
 
     # -- frames ------------------------------------------------------------------------------------
-    def render(self) -> bool:
-        """Render one frame into the renderer's targets; errors are reported, never raised."""
-        self._seen_panel_version = self.panel.version
-        self._dirty = False
-        self.orbit.apply(self.scene.camera)
+    def render(self, budget_s: float | None = None) -> bool:
+        """Render one frame into the renderer's targets; errors are reported, never raised. True
+        when a frame was completed.
+
+        ``budget_s`` None: the whole frame now (headless use, tests). A number (the window's event
+        loop): never work much longer than that per call, so that the window keeps answering - the
+        frame's slow CPU work (profile fits, tables, rays, seams) runs on a worker thread first
+        (skinlab/render/prepare.py) and its passes run a few per call; the caller calls again on
+        its next turn (the core stays dirty) and shows the last complete frame meanwhile
+        (:attr:`waiting` says on what)."""
+        if self._steps is None:
+            self._seen_panel_version = self.panel.version
+            self._dirty = False
+            if budget_s is not None and not self.preparer.ready(self.scene, self.settings, self._content_version()):
+                self._dirty = True  # come back: the frame waits on its preparation
+                return False
+            self.orbit.apply(self.scene.camera)
+            self._steps = self.renderer.frame_steps(self.scene, self.settings, readback=False)
+            self._steps_done = 0
+        deadline = None if budget_s is None else time.monotonic() + budget_s
         try:
-            self.result = self.renderer.render(self.scene, self.settings, readback=False)
+            while True:
+                next(self._steps)
+                self._steps_done += 1
+                if deadline is not None and time.monotonic() > deadline:
+                    return False  # the rest on the next call
+        except StopIteration as done:
+            self.result = done.value
         except Exception as exc:  # a failing new shader variant, a bad value...: keep running
+            self._steps = None
             msg = str(exc).strip() or exc.__class__.__name__
             if msg != self.render_error:
                 self.note("error", f"frame failed: {msg}")
             self.render_error = msg
             self.failed_frames += 1
             return False
+        self._steps = None
         if self.render_error:
             self.note("info", "frames render again")
         self.render_error = None
         self.frames += 1
         return True
+
+    @property
+    def waiting(self) -> str | None:
+        """What the next frame waits on (shown in the overlay), None when it waits on nothing."""
+        if self.scene_src.loading:
+            return f"reloading the scene: {', '.join(computing()) or 'reading files'}"
+        if self._steps is not None:
+            return f"frame in progress: {self._steps_done} passes run"
+        s = self.preparer.waiting_s
+        if s is None:
+            return None
+        work = ", ".join(computing()) or "planning"
+        return f"preparing the frame for {s:.1f} s: {work}"
+
+    def _content_version(self) -> tuple:
+        """Changes with every edit of what a frame shows apart from the camera: the panel's edits
+        and the reloads (a reloaded scene is a new object; presets and shaders bump the panel or
+        the program cache)."""
+        return (self.panel.version, self.renderer.programs.generation, self._reloads)
 
     def targets(self) -> dict:
         frame = self.renderer.last_frame

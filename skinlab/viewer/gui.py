@@ -72,6 +72,8 @@ class Gui:
             for p in res.plan.passes:  # kept from an earlier frame (skinlab/render/reuse.py)
                 if p.reused_since is not None:
                     imgui.text_colored(GREY, f"  {p.name:<16} reused: inputs unchanged since frame {p.reused_since}")
+        if core.waiting:  # the last complete frame is shown meanwhile
+            imgui.text_colored(YELLOW, core.waiting)
         name, _ = core.current_target()
         s = core.settings
         imgui.text_colored(
@@ -104,6 +106,8 @@ class Gui:
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self.panel_rect = (pos.x, pos.y, size.x, size.y)
         if expanded:
+            if self.core.waiting:  # slow work runs off this thread: say what the next frame waits on
+                imgui.text_colored(YELLOW, self.core.waiting)
             self._render_section()
             self._inspector_section()
             self._scene_section()

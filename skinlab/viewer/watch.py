@@ -15,6 +15,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable
+from concurrent.futures import Future
 from pathlib import Path
 from typing import Generic, TypeVar
 
@@ -129,6 +130,7 @@ class Reloadable(Generic[T]):
         settle_s: float = 0.1,
         watch: bool = True,
         use_watchdog: bool = True,
+        background: bool = False,
     ):
         self.name = name
         self._load = load
@@ -139,29 +141,57 @@ class Reloadable(Generic[T]):
         self.failures = 0
         self.last_changed: set[Path] = set()
         self.watcher = FileWatcher(files(self.value), settle_s, use_watchdog) if watch else None
+        # background: a reload runs on a worker thread (a new mesh may need seconds of UV atlas);
+        # poll() applies it on the call after it has finished, the last good value stays meanwhile
+        self.background = background
+        self._loading: Future | None = None
+
+    @property
+    def loading(self) -> bool:
+        """A reload is running on a worker thread."""
+        return self._loading is not None
 
     def poll(self) -> str | None:
-        """'reloaded', 'failed' or None (nothing changed)."""
+        """'reloaded', 'failed' or None (nothing changed, or a reload still running)."""
         if self.watcher is None:
             return None
+        if self._loading is not None:
+            if not self._loading.done():
+                return None
+            job, self._loading = self._loading, None
+            exc = job.exception()
+            return self._failed(exc) if exc is not None else self._adopt(job.result())
         changed = self.watcher.poll()
         if not changed:
             return None
         self.last_changed = changed
+        if self.background:
+            from skinlab.cache import in_background
+
+            self._loading = in_background(self._load)
+            return None
         try:
             value = self._load()
         except Exception as exc:  # any failure keeps the last good value; never crash the viewer
-            msg = str(exc).strip() or exc.__class__.__name__
-            names = ", ".join(sorted(str(p) for p in changed))
-            self.error = msg if any(p.name in msg for p in changed) else f"{names}: {msg}"
-            self.failures += 1
-            log.error("%s reload failed, keeping the last good version: %s", self.name, self.error)
-            return "failed"
+            return self._failed(exc)
+        return self._adopt(value)
+
+    def _failed(self, exc: BaseException) -> str:
+        msg = str(exc).strip() or exc.__class__.__name__
+        changed = self.last_changed
+        names = ", ".join(sorted(str(p) for p in changed))
+        self.error = msg if any(p.name in msg for p in changed) else f"{names}: {msg}"
+        self.failures += 1
+        log.error("%s reload failed, keeping the last good version: %s", self.name, self.error)
+        return "failed"
+
+    def _adopt(self, value: T) -> str:
         self.value = value
         self.error = None
         self.reloads += 1
+        assert self.watcher is not None
         self.watcher.set_paths(self._files(value))
-        log.info("%s reloaded (%s)", self.name, ", ".join(sorted(p.name for p in changed)))
+        log.info("%s reloaded (%s)", self.name, ", ".join(sorted(p.name for p in self.last_changed)))
         return "reloaded"
 
     def stop(self) -> None:
@@ -184,11 +214,13 @@ def scene_files(scene) -> set[Path]:
     return files
 
 
-def scene_reloader(path, settle_s: float = 0.1, watch: bool = True, use_watchdog: bool = True) -> Reloadable:
-    from skinlab.scene.scenefile import DEFAULT_SCENE, load_scene
+def scene_reloader(
+    path, settle_s: float = 0.1, watch: bool = True, use_watchdog: bool = True, background: bool = False
+) -> Reloadable:
+    from skinlab.scene.scenefile import load_scene, resolve_scene_path
 
-    path = Path(path) if path else DEFAULT_SCENE
-    return Reloadable(f"scene {path}", lambda: load_scene(path), scene_files, settle_s, watch, use_watchdog)
+    path = resolve_scene_path(path)
+    return Reloadable(f"scene {path}", lambda: load_scene(path), scene_files, settle_s, watch, use_watchdog, background)
 
 
 def load_presets() -> dict:

@@ -24,6 +24,9 @@ from pathlib import Path
 from skinlab.render.settings import RenderSettings
 
 log = logging.getLogger("skinlab.view")
+# the most a turn of the event loop spends on a frame's passes before it answers events again (a
+# slow frame is finished over several turns; its CPU preparation runs on a worker thread)
+FRAME_SLICE_S = 0.05
 
 
 class ViewerError(ValueError):
@@ -92,7 +95,7 @@ class ViewerWindow:
         settings = RenderSettings(max(fw, 1), max(fh, 1), shadow_size=shadow_size, technique=technique)
         try:
             self.core = ViewerCore(
-                self.ctx, scene_path, settings, watch=watch, shader_root=shader_root, settle_s=settle_s
+                self.ctx, scene_path, settings, watch=watch, shader_root=shader_root, settle_s=settle_s, background=True
             )
         except BaseException:
             self.window.close()
@@ -202,8 +205,8 @@ class ViewerWindow:
 
     # -- the loop -----------------------------------------------------------------------------
     def step(self, force_render: bool = False) -> bool:
-        """One iteration: events, reloads, maybe a frame, the display and the UI. True if a
-        frame was rendered."""
+        """One iteration: events, reloads, maybe (part of) a frame, the display and the UI. True if a
+        frame was completed (or failed) in this iteration."""
         import pyglet
 
         imgui = self.imgui
@@ -220,8 +223,9 @@ class ViewerWindow:
         if fw > 0 and fh > 0:
             core.set_size(fw, fh)
             if force_render or self.continuous or core.dirty:
-                core.render()
-                rendered = True
+                ended = core.frames + core.failed_frames
+                core.render(budget_s=FRAME_SLICE_S)
+                rendered = core.frames + core.failed_frames > ended  # a frame completed (or failed)
             core.draw(self.ctx.screen, (fw, fh))
             self.imgui_impl.process_inputs()
             imgui.new_frame()

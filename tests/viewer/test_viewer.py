@@ -697,3 +697,53 @@ def test_viewer_opens_a_mesh_file_directly(ctx, tmp_path):
         assert c.panel.material is not None and c.panel.key_light().name == "key"
     finally:
         c.close()
+
+
+RESPONSIVE_SCRIPT = r"""
+import sys, time
+from skinlab.scene.optics import media
+from skinlab.viewer.window import ViewerWindow
+
+real = media.pbd_total
+def slow_pbd_total(*a, **k):  # the long work a new medium's albedo table is, made certain to be long
+    time.sleep(0.4)
+    return real(*a, **k)
+media.pbd_total = slow_pbd_total
+
+w = ViewerWindow(sys.argv[1], size=(160, 120), watch=False, shadow_size=256, technique="tsd")
+core = w.core
+while core.frames < 1:  # the first frame (it waits on its own preparation too)
+    w.step()
+core.panel.apply_preset("marble")  # a new medium: its profile and albedo tables are made on a worker
+shown, handled, steps_waiting = w.show_ui, False, 0
+while core.frames < 2:
+    w.step()
+    if core.waiting and core.waiting.startswith("preparing"):
+        steps_waiting += 1
+        if not handled:  # an event arrives while the work runs: the window answers it at once
+            w.window.dispatch_event("on_key_press", __import__("pyglet").window.key.H, 0)
+            handled = w.show_ui != shown
+    time.sleep(0.01)
+print(steps_waiting, handled, core.render_error, core.result.plan.explain().count("tsd"))
+w.close()
+"""
+
+
+def test_window_keeps_answering_while_a_preset_is_prepared(xdisplay, tmp_path):
+    """A preset's slow work (here made slow on purpose) runs off the window's thread: the loop turns
+    many times meanwhile and a key pressed during it takes effect before the new frame exists."""
+    script = tmp_path / "responsive.py"
+    script.write_text(RESPONSIVE_SCRIPT)
+    env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
+    env.update(DISPLAY=xdisplay, SKINLAB_CACHE_DIR="off")
+    r = subprocess.run(
+        [sys.executable, str(script), str(DEFAULT_SCENE)],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stderr[-3000:]
+    steps, handled, error, tsd_lines = r.stdout.split()[-4:]
+    assert int(steps) >= 5 and handled == "True" and error == "None" and int(tsd_lines) > 0, r.stdout
