@@ -103,23 +103,11 @@ def load_truth(scene, spec: TruthSpec, render: bool = False, progress: bool = Tr
                 hit = load_truth(scene, q, quiet=False)
                 if hit is not None:
                     return hit
-    from skinlab.truth.export import describe
-    from skinlab.truth.reference import (
-        ReferenceUnavailable,
-        load_cached,
-        mitsuba_module,
-        reference_key,
-        render_reference,
-    )
+    from skinlab.truth.reference import ReferenceUnavailable, render_reference
 
-    req = spec.request()
     try:
-        if render:
-            return render_reference(scene, req, progress=progress)
-        mi = mitsuba_module()  # its version is part of the key; the variant need not run here (a GPU's reference)
-        desc = describe(scene, req.width, req.height, sun_deg=req.sun_deg, max_depth=req.max_depth,
-                        rr_depth=req.rr_depth)  # fmt: skip
-        return load_cached(reference_key(desc, req, mi.__version__))
+        # not rendering: Mitsuba's version is part of the key, the variant need not run here (a GPU's reference)
+        return render_reference(scene, spec.request(), progress=progress, render=render)
     except ReferenceUnavailable:
         return None
 

@@ -1,5 +1,6 @@
-"""`skinlab reference [SCENE] --out PATH.exr --size WxH --spp N [--passes P] [--seed S] [--variant V]`:
-the scene path-traced volumetrically by Mitsuba 3 (the image ground truth; docs/ground-truth.md)."""
+"""`skinlab reference [SCENE] --out PATH.exr --size WxH --spp N [--passes P] [--seed S] [--variant V]
+[--until-noise X] [--time S]`: the scene path-traced volumetrically by Mitsuba 3 (the image ground truth;
+docs/ground-truth.md), in passes saved as they finish (a killed run resumes; skinlab/truth/passes.py)."""
 
 from __future__ import annotations
 
@@ -38,6 +39,21 @@ def register(sub) -> None:
         "dielectric boundary reachable by BSDF sampling)"
     )  # fmt: skip
     p.add_argument("--max-depth", type=int, default=-1, help="path length limit (default -1: none)")
+    p.add_argument(
+        "--until-noise", type=noise_level, default=None, metavar="X",
+        help="add passes (of SPP/PASSES samples each) until the noise floor is at most X (a fraction, 0.01, "
+        "or a percentage, 1%%), measured as --noise-on says; passes already cached count",
+    )  # fmt: skip
+    p.add_argument(
+        "--time", type=float, default=None, metavar="S",
+        help="add passes for S seconds (with --until-noise: whichever comes first); every pass is saved as it "
+        "finishes, so the reference only gets quieter from run to run",
+    )  # fmt: skip
+    p.add_argument(
+        "--noise-on", choices=("block", "pixel"), default="block",
+        help="the noise --until-noise reads: block (relative L1 between the halves on 4x4 blocks, the ledger's) or "
+        "pixel (per pixel) (default block)",
+    )  # fmt: skip
     p.add_argument("--no-cache", action="store_true", help="render even when an identical reference is cached")
     p.add_argument("--json", action="store_true", help="print the result (path, noise floor, time, notes) as JSON")
     p.set_defaults(func=run)
@@ -60,23 +76,31 @@ def run(args) -> int:
     )  # fmt: skip
     scene = load_scene(args.scene)
     try:
-        ref = render_reference(scene, req, progress=not args.json, use_cache=not args.no_cache)
+        ref = render_reference(
+            scene, req, progress=not args.json, use_cache=not args.no_cache, until_noise=args.until_noise,
+            time_s=args.time, noise_measure=args.noise_on,
+        )  # fmt: skip
     except ReferenceUnavailable as exc:
         raise UserError(str(exc)) from None
     written = [str(write_image(out, ref.image).resolve())]
     png = out.with_suffix(".png")
     written.append(str(write_image(png, tone_mapped(ref.image, scene.environment.exposure)).resolve()))
+    noise_png = out.with_name(out.stem + "-noise.png")
+    written.append(str(write_image(noise_png, noise_map_rgb(ref)).resolve()))
     nf = ref.noise
     result = {
         "scene": scene.name,
         "outputs": written,
         "size": [w, h],
-        "spp": req.spp,
-        "passes": req.passes,
+        "spp": ref.meta.get("spp", req.spp),
+        "passes": ref.meta.get("passes", req.passes),
         "variant": req.variant,
         "cached": ref.cached,
         "render_seconds": ref.meta["seconds"],
+        "seconds_this_run": ref.meta.get("seconds_this_run", 0.0),
+        "passes_rendered": ref.meta.get("passes_rendered", 0),
         "noise_floor": nf,
+        "pixel_standard_error": ref.meta.get("pixel_standard_error"),
         "notes": ref.meta["notes"],
         "key": ref.key,
     }
@@ -85,15 +109,59 @@ def run(args) -> int:
         return 0
     for n in ref.meta["notes"]:
         print(f"note: {n}")
-    how = "from the cache" if ref.cached else f"in {ref.meta['seconds']:.1f} s"
-    print(f"{scene.name}: {w}x{h}, {req.spp} spp in {req.passes} passes ({req.variant}), {how}")
+    how = (
+        "all from the cache"
+        if ref.cached
+        else f"{result['passes_rendered']} passes rendered now in {result['seconds_this_run']:.1f} s"
+    )
+    print(
+        f"{scene.name}: {w}x{h}, {result['spp']} spp in {result['passes']} passes ({req.variant}; "
+        f"{ref.meta['seconds']:.1f} s of path tracing in all), {how}"
+    )
     print(
         f"noise floor (between halves of the passes): {100 * nf['rel_l1']:.2f} % per pixel, "
         f"{100 * nf['rel_l1_block']:.2f} % on 4x4 blocks ({nf['pixels']} object pixels)"
     )
+    se = result["pixel_standard_error"] or {}
+    if se:
+        print(
+            f"the full reference's own noise per pixel (standard error over the passes / luminance): median "
+            f"{100 * se['median']:.2f} %, 90th percentile {100 * se['p90']:.2f} % (map: {noise_png.name})"
+        )
     for path in written:
         print(f"wrote {path}")
     return 0
+
+
+def noise_level(text: str) -> float:
+    """'0.01' or '1%' -> 0.01 (argparse type of --until-noise)."""
+    import argparse
+    import math
+
+    t = text.strip()
+    try:
+        v = float(t[:-1]) / 100 if t.endswith("%") else float(t)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a fraction such as 0.01 or a percentage such as 1%, got {text!r}")
+    if not (v > 0 and math.isfinite(v)):
+        raise argparse.ArgumentTypeError(f"expected a noise level > 0, got {text!r}")
+    return v
+
+
+def noise_map_rgb(ref):
+    """uint8 RGB: the full reference's relative standard error per pixel (magma, 0 to 10 %), grey outside."""
+    import matplotlib
+    import numpy as np
+
+    from skinlab.truth.compare import REC709, object_mask
+
+    se = ref.pass_set.standard_error()
+    lum = ref.image[..., :3].astype(np.float64) @ REC709
+    m = object_mask(ref.image) & (lum > 0)
+    rel = np.where(m, se / np.where(m, lum, 1.0), np.nan)
+    rgb = (matplotlib.colormaps["magma"](np.clip(np.nan_to_num(rel) / 0.1, 0, 1))[..., :3] * 255).astype(np.uint8)
+    rgb[~m] = (40, 40, 40)
+    return rgb
 
 
 def tone_mapped(hdr, exposure: float = 1.0):

@@ -226,6 +226,32 @@ def chunk_plan(spp: int, passes: int, chunk: int = CHUNK_SPP) -> list[tuple[int,
     return out
 
 
+def pass_seed(seed: int, index: int, chunk: int) -> int:
+    """Mitsuba's sampler seed for render call `chunk` of pass `index` of a series seeded `seed`: a pass
+    is the same whatever else the series holds (so passes saved by different runs add up)."""
+    return (seed * 1_000_003 + index * 65_537 + chunk) % (1 << 32)
+
+
+def render_pass(desc: ReferenceDescription, spp: int, seed: int, index: int, progress=None, chunk: int = CHUNK_SPP,
+                mscene=None):  # fmt: skip
+    """(image, seconds): pass `index` of the series seeded `seed`, `spp` samples per pixel in render calls
+    of at most `chunk` (Mitsuba's variant already set; `mscene` a scene loaded from `desc` to reuse).
+    The image is the pass's mean, float32 (H, W, 4)."""
+    import mitsuba as mi
+
+    t0 = time.perf_counter()
+    if mscene is None:
+        mscene = mi.load_dict(desc.to_mitsuba(CHUNK_SPP, seed))
+    k = max(1, math.ceil(spp / chunk))
+    acc = np.zeros((desc.height, desc.width, 4), np.float64)
+    for c in range(k):
+        n = spp // k + (1 if c < spp % k else 0)
+        acc += np.asarray(mi.render(mscene, spp=n, seed=pass_seed(seed, index, c)), np.float64) * n
+        if progress is not None:
+            progress(n)
+    return (acc / spp).astype(np.float32), time.perf_counter() - t0
+
+
 def path_trace(desc: ReferenceDescription, spp: int, passes: int, seed: int, progress=None, chunk: int = CHUNK_SPP):
     """(mean, half_a, half_b, seconds): `desc` rendered by Mitsuba (its variant already set) in
     `passes` passes of different seeds, each in render calls of at most `chunk` samples per pixel;

@@ -1,21 +1,28 @@
-"""Render the path-traced reference of a Skinlab scene with Mitsuba 3, in independent passes, cached.
+"""Render the path-traced reference of a Skinlab scene with Mitsuba 3: progressive, resumable, cached.
 
-The image is the mean of ``passes`` (>= 2) independent renders with different seeds; its noise
-floor is :func:`skinlab.truth.compare.image_error` between the means of the first and second half of
-the passes. Each pass is rendered in chunks of at most ``CHUNK_SPP`` samples per pixel
-(skinlab/truth/description.py; a progress bar counts samples).
+The image is the mean of independent passes (skinlab/truth/passes.py), each saved as it finishes, so
+a killed run resumes from its saved passes and a later run adds to them. A request asks for at least
+``spp`` samples in at least ``passes`` passes (each pass ``spp // passes`` samples); with
+``until_noise`` and/or ``time_s`` passes are added until the noise floor (below) is under that value
+or the time is spent. Every pass already saved for the same series is used: the reference only gets
+quieter. The noise floor is :func:`skinlab.truth.compare.image_error` between the means of the first
+and the second half of the samples (per pixel and on 4x4 blocks); ``Reference.passes`` keeps the
+passes for the uncertainty of errors measured against it (skinlab/truth/metrics.py).
 
-Results are cached by a hash of everything that affects them: the exported description (world-space
-geometry, media, BSDFs, baked textures, lights, camera, size), samples, passes, seed, variant,
-integrator settings and the Mitsuba version. The cache lives in ``$SKINLAB_CACHE_DIR/reference`` (default
-``~/.cache/skinlab/reference``): ``<key>.npz`` (mean and the two half means, float32) beside
-``<key>.json`` (how it was made), each written to a temporary name and renamed.
+A series is keyed by a hash of everything that affects a pass: the exported description (world-space
+geometry, media, BSDFs, baked textures, lights, camera, size), seed, variant, integrator settings and
+the Mitsuba version (not the samples: they only decide how many passes there are). The cache lives in
+``$SKINLAB_CACHE_DIR/reference`` (default ``~/.cache/skinlab/reference``): ``passes/<key>/pass-NNNNN.npz``
+and ``series.json``. A whole reference filed from elsewhere (tools/gpu_reference.py ``store``) is
+``<key>.npz`` (mean and the two half means) beside ``<key>.json``, keyed by its request including
+samples and passes; it is found first.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -27,8 +34,8 @@ from skinlab.atomic_write import atomic_path, write_text_atomic
 from skinlab.scene.graph import Scene
 
 from .compare import image_error, object_mask
-from .description import path_trace
 from .export import ReferenceDescription, describe
+from .passes import Pass, PassSet, PassStore
 
 EXPORT_VERSION = 2  # bump when the exporter changes what a scene renders as
 VARIANTS = ("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb")
@@ -51,6 +58,10 @@ class ReferenceRequest:
     max_depth: int = -1  # volpath path length limit (-1: none; Russian roulette ends paths)
     rr_depth: int = 64
 
+    @property
+    def pass_spp(self) -> int:
+        return max(1, self.spp // self.passes)
+
     def __post_init__(self) -> None:
         for name, lo, hi in (("width", 1, 16384), ("height", 1, 16384), ("spp", 2, 1 << 24), ("passes", 2, 1024)):
             v = getattr(self, name)
@@ -71,7 +82,16 @@ class Reference:
     half_b: np.ndarray  # mean of the second half
     key: str
     meta: dict = field(default_factory=dict)
-    cached: bool = False
+    cached: bool = False  # nothing was rendered: every pass came from the cache
+    passes: PassSet | None = None  # the passes (None: a whole reference from elsewhere: its halves stand in)
+
+    @property
+    def pass_set(self) -> PassSet:
+        """The passes, or the two halves as two passes of half the samples each."""
+        if self.passes is not None:
+            return self.passes
+        spp = int(self.meta.get("spp") or self.meta.get("request", {}).get("spp") or 2)
+        return PassSet(np.stack([self.half_a, self.half_b]), np.array([max(spp // 2, 1)] * 2))
 
     @property
     def noise(self) -> dict:
@@ -140,12 +160,68 @@ def load_cached(key: str) -> Reference | None:
     return Reference(img, a, b, key, meta, cached=True)
 
 
+def series_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_version: str) -> str:
+    """The key of the pass series `req` belongs to: everything but the samples and the passes."""
+    what = {k: v for k, v in asdict(req).items() if k not in ("spp", "passes")}
+    h = hashlib.sha256()
+    h.update(json.dumps({"series": 1, "export": EXPORT_VERSION, "mitsuba": mitsuba_version, "request": what}).encode())
+    h.update(json.dumps(desc.content(), sort_keys=True, default=float).encode())
+    for a in desc.arrays():
+        h.update(str(a.shape).encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()[:24]
+
+
+def pass_store(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_version: str, use_cache: bool = True):
+    key = series_key(desc, req, mitsuba_version)
+    folder = cache_dir() / "passes" / key if use_cache else None
+    return key, PassStore(folder, (req.height, req.width, 4))
+
+
 def store_reference(ref: Reference) -> None:
     """File a reference in the cache under its key (atomically: a temporary name, then renamed)."""
     d = cache_dir()
     with atomic_path(d / f"{ref.key}.npz") as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, image=ref.image, half_a=ref.half_a, half_b=ref.half_b)
     write_text_atomic(d / f"{ref.key}.json", json.dumps(ref.meta, indent=1))
+
+
+NOISE_MEASURES = {"block": "rel_l1_block", "pixel": "rel_l1"}
+
+
+def _noise_of(ps: PassSet) -> dict:
+    if ps.count < 2:
+        return {"rel_l1": float("inf"), "rel_l1_block": float("inf"), "energy": [float("nan")] * 3, "pixels": 0}
+    a, b = ps.halves()
+    return image_error(a, b, object_mask(ps.mean()))
+
+
+def assemble(scene_name: str, key: str, passes: list[Pass], req: ReferenceRequest, extra: dict) -> Reference:
+    """A Reference from its passes (mean, halves, noise floor, what it took)."""
+    ps = PassSet.of(passes)
+    mean = ps.mean()
+    a, b = ps.halves()
+    se = ps.standard_error()
+    m = object_mask(mean)
+    lum = mean[..., :3].astype(np.float64) @ np.array([0.2126, 0.7152, 0.0722])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rel = np.where(m & (lum > 0), se / lum, np.nan)
+    meta = {
+        "scene": scene_name,
+        "request": asdict(req),
+        "spp": int(ps.spp.sum()),
+        "passes": ps.count,
+        "pass_spp": sorted({int(x) for x in ps.spp}),
+        "seconds": round(float(sum(p.seconds for p in passes)), 3),
+        "noise_floor": image_error(a, b, m),
+        # the full mean's own noise per pixel: the standard error of its luminance over the passes
+        "pixel_standard_error": {
+            "median": float(np.nanmedian(rel)) if np.isfinite(rel).any() else float("nan"),
+            "p90": float(np.nanpercentile(rel, 90)) if np.isfinite(rel).any() else float("nan"),
+        },
+        **extra,
+    }
+    return Reference(mean, a, b, key, meta, cached=False, passes=ps)
 
 
 def render_reference(
@@ -155,34 +231,86 @@ def render_reference(
     progress: bool = True,
     use_cache: bool = True,
     desc: ReferenceDescription | None = None,
-) -> Reference:
-    """The path-traced reference of `scene` (from the cache when an identical one was made)."""
+    until_noise: float | None = None,
+    time_s: float | None = None,
+    noise_measure: str = "block",
+    max_passes: int = 1024,
+    render: bool = True,
+) -> Reference | None:
+    """The path-traced reference of `scene`: every pass of its series already in the cache, and new
+    passes of ``req.pass_spp`` samples (each saved as it finishes) until there are at least
+    ``req.spp`` samples in ``req.passes`` passes and, where given, the noise floor (``noise_measure``
+    "block": 4x4 blocks, "pixel") is at most ``until_noise`` or this call has spent ``time_s``
+    seconds. ``render=False``: only what the cache holds (None if it holds too few passes)."""
+    if until_noise is not None and not (until_noise > 0 and math.isfinite(until_noise)):
+        raise ValueError(f"--until-noise: expected a noise level > 0 (e.g. 0.01 or 1%), got {until_noise!r}")
+    if time_s is not None and not (time_s > 0 and math.isfinite(time_s)):
+        raise ValueError(f"--time: expected seconds > 0, got {time_s!r}")
+    if noise_measure not in NOISE_MEASURES:
+        raise ValueError(f"noise measure: expected one of {', '.join(NOISE_MEASURES)}, got {noise_measure!r}")
     desc = desc or describe(
         scene, req.width, req.height, sun_deg=req.sun_deg, max_depth=req.max_depth, rr_depth=req.rr_depth
     )
-    mi = set_variant(req.variant)
-    key = reference_key(desc, req, mi.__version__)
-    if use_cache and (hit := load_cached(key)) is not None:
+    mi = set_variant(req.variant) if render else mitsuba_module()
+    if use_cache and (hit := load_cached(reference_key(desc, req, mi.__version__))) is not None:
         return hit
-    from tqdm import tqdm
+    key, store = pass_store(desc, req, mi.__version__, use_cache)
+    have = store.load() if use_cache else []
+    measure = NOISE_MEASURES[noise_measure]
+    t0 = time.perf_counter()
 
-    bar = tqdm(total=req.spp, unit="spp", desc=f"path tracing {scene.name}", disable=not progress, leave=False)
-    mean, a, b, seconds = path_trace(desc, req.spp, req.passes, req.seed, bar.update)
-    bar.close()
-    if not np.isfinite(mean).all():
-        raise RuntimeError(f"scene {scene.name!r}: the path tracer returned NaN or Inf")
-    noise = image_error(a, b, object_mask(mean))
-    meta = {
-        "scene": scene.name,
-        "source": str(scene.source) if scene.source else None,
-        "request": asdict(req),
-        "mitsuba": mi.__version__,
-        "seconds": round(seconds, 3),
-        "noise_floor": noise,
-        "notes": desc.notes,
-        "made": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
-    }
-    ref = Reference(mean, a, b, key, meta, cached=False)
-    if use_cache:
-        store_reference(ref)
+    def enough() -> bool:
+        n, spp = len(have), sum(p.spp for p in have)
+        if n < req.passes or spp < req.spp:
+            return False
+        if n >= max_passes:
+            return True
+        if time_s is not None and time.perf_counter() - t0 >= time_s:
+            return True
+        if until_noise is not None:
+            return n % 2 == 0 and _noise_of(PassSet.of(have))[measure] <= until_noise
+        return time_s is None
+
+    rendered = 0
+    if not render:
+        if len(have) < max(req.passes, 2) or sum(p.spp for p in have) < req.spp:
+            return None
+    elif not enough():
+        from tqdm import tqdm
+
+        from .description import CHUNK_SPP, render_pass
+
+        mscene = mi.load_dict(desc.to_mitsuba(CHUNK_SPP, req.seed))
+        goal = max(req.spp - sum(p.spp for p in have), 0) or None
+        bar = tqdm(total=goal, unit="spp", desc=f"path tracing {scene.name}", disable=not progress, leave=False)
+        index = max((p.index for p in have), default=-1) + 1
+        while not enough():
+            img, sec = render_pass(desc, req.pass_spp, req.seed, index, bar.update, mscene=mscene)
+            if not np.isfinite(img).all():
+                raise RuntimeError(f"scene {scene.name!r}: the path tracer returned NaN or Inf")
+            p = Pass(index, img, req.pass_spp, sec)
+            store.save(p)  # saved as it finishes: a killed run resumes from here
+            have.append(p)
+            index += 1
+            rendered += 1
+            if len(have) >= 2 and progress:
+                bar.set_postfix_str(f"noise {100 * _noise_of(PassSet.of(have))[measure]:.2f} % ({noise_measure})")
+        bar.close()
+    ref = assemble(
+        scene.name,
+        key,
+        have,
+        req,
+        {
+            "source": str(scene.source) if scene.source else None,
+            "variant": req.variant,
+            "mitsuba": mi.__version__,
+            "seconds_this_run": round(time.perf_counter() - t0, 3) if rendered else 0.0,
+            "passes_rendered": rendered,
+            "notes": desc.notes,
+            "made": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+        },
+    )
+    ref.cached = rendered == 0
+    store.write_info({k: ref.meta[k] for k in ("scene", "source", "spp", "passes", "seconds", "variant", "made")})
     return ref
