@@ -142,7 +142,8 @@ def noise_level(text: str) -> float:
     try:
         v = float(t[:-1]) / 100 if t.endswith("%") else float(t)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a fraction such as 0.01 or a percentage such as 1%, got {text!r}")
+        want = "expected a fraction such as 0.01 or a percentage such as 1%"
+        raise argparse.ArgumentTypeError(f"{want}, got {text!r}") from None
     if not (v > 0 and math.isfinite(v)):
         raise argparse.ArgumentTypeError(f"expected a noise level > 0, got {text!r}")
     return v
