@@ -11,4 +11,5 @@ COMMAND_MODULES = [
     "skinlab.commands.view",
     "skinlab.commands.reference",
     "skinlab.commands.scenes",
+    "skinlab.commands.compare",
 ]
