@@ -205,6 +205,7 @@ class Scene:
         self.camera: CameraNode | None = None
         self.environment = Environment()
         self.source = None  # path of the scene file, if any
+        self.measure = None  # what the scene tests (skinlab/scene/measure.py MeasureSpec; a file's [measure])
 
     def add(self, node: Node, parent: Node | None = None) -> Node:
         (parent or self.root).add(node)

@@ -145,6 +145,35 @@ SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
         Key("intensity", "number >= 0", "1.0", "irradiance (directional) or intensity (point) multiplier on color"),
         Key("cast_shadow", "boolean", "false", "render a shadow map (at most 2 lights; needed for translucency)"),
     ),
+    # what the scene tests, for the accuracy ledger (skinlab/scene/measure.py, docs/ledger.md "Edges and profiles")
+    "[measure]": (
+        Key("tests", "string", '""', "what the scene tests, in a sentence (shown in the ledger)"),
+        Key(
+            "profile",
+            "string",
+            '"none"',
+            '"line": a slit or stripe of light (the ledger plots the line spread function), "edge": a shadow or '
+            'light edge (edge spread function), "none"',
+        ),
+        Key("profile_origin", "3 numbers", "(required for a profile)", "a point on the line's centre or the edge"),
+        Key(
+            "profile_axis",
+            "3 numbers, non-zero",
+            "(required for a profile)",
+            "the direction across the line or edge: the profile's coordinate; pixels are averaged along the line",
+        ),
+        Key("profile_range_mm", "number > 0", "30", "the profile spans +-this many mm across the line or edge"),
+        Key("profile_band_mm", "number > 0", "all", "only pixels within this many mm of the origin along the line"),
+        Key("line_width_mm", "number >= 0", "0", "the line's (slit's) width, for its edge region"),
+        Key(
+            "edge_mm",
+            "number >= 0",
+            "3 diffusion lengths",
+            "the edge region (errors within it are reported apart): within this many mm of the declared edge or "
+            "the line's sides, else of the plain frame's light edges; default 3 x 1/sigma_tr of the scene's most "
+            "diffuse channel",
+        ),
+    ),
 }
 
 
@@ -354,7 +383,7 @@ def load_scene(path: str | Path | None = None) -> Scene:
 
 def _build(path: Path, data: dict) -> Scene:
     base = path.parent
-    _known("top level", data, {"scene", "environment", "camera", "materials", "meshes", "lights"})
+    _known("top level", data, {"scene", "environment", "camera", "materials", "meshes", "lights", "measure"})
     sc = _table("[scene]", data.get("scene", {}))
     _known("[scene]", sc, _keys("[scene]"))
     name = _str("[scene].name", sc["name"]) if "name" in sc else path.stem
@@ -499,6 +528,15 @@ def _build(path: Path, data: dict) -> Scene:
             raise SceneFileError("[camera].up: must be non-zero")
         c.look_at(eye, target, up)
         scene.add(c)
+    if "measure" in data:
+        from .measure import parse_measure
+
+        table = _table("[measure]", data["measure"])
+        _known("[measure]", table, _keys("[measure]"))
+        try:
+            scene.measure = parse_measure(table, _num, _vec, _str)
+        except ValueError as exc:
+            raise SceneFileError(str(exc)) from None
     if not scene.mesh_nodes(visible_only=False):
         raise SceneFileError("the scene has no meshes (add a [[meshes]] entry with a file)")
     if scene.camera is None:
