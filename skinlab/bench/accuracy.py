@@ -56,7 +56,7 @@ import numpy as np
 
 from .image_error import image_error, lit_mask
 from .ledger_analysis import error_key, log_slope, pareto_front, recommendations, usable
-from .ledger_csv import CSV_COLUMNS, NUMERIC_COLUMNS, csv_text
+from .ledger_csv import NUMERIC_COLUMNS, csv_columns, csv_text
 from .ledger_files import write_ledger
 from .measure import measure_setting
 from .profile_error import edge_error, edge_response, fit_kernel, model_reference, profile_reference
@@ -71,10 +71,17 @@ from .sweep import (
     sheet_settings,
     sweep_settings,
 )
-from .truth_ledger import error_map_sheet, load_truth, truth_errors, write_error_map
+from .truth_ledger import (
+    error_map_sheet,
+    load_truth,
+    truth_context,
+    truth_errors,
+    write_error_map,
+    write_flip_map,
+)
 
 __all__ = [  # the ledger's public names, importable from here as before the split
-    "CSV_COLUMNS",
+    "csv_columns",
     "NUMERIC_COLUMNS",
     "SWEEPS",
     "TINY",
@@ -110,6 +117,45 @@ def _first_line(exc: BaseException) -> str:
     return text.splitlines()[0][:300] if text else type(exc).__name__
 
 
+def _same_images(scene_rows: dict, digests: dict) -> None:
+    """A row whose compared frame is bit-identical to an earlier row's says so (``same_image_as``)."""
+    first: dict = {}
+    for st, row in scene_rows.items():
+        d = digests.get(st)
+        if d is None:
+            continue
+        if d in first:
+            row["same_image_as"] = first[d]
+        else:
+            first[d] = st.label
+
+
+def _digest(a: np.ndarray) -> str:
+    import hashlib
+
+    return hashlib.sha1(np.ascontiguousarray(a).tobytes()).hexdigest()
+
+
+def _same_size_partner(st: Setting, scene_rows: dict, hdrs: dict, ref_tech: str | None):
+    """The image reference's frame whose settings share this setting's shared parameter columns
+    (e.g. an irradiance size), for a setting of another technique that has such columns."""
+    if ref_tech is None or st.technique == ref_tech:
+        return None
+    from .sweep import _style
+
+    mine, theirs = st.style.columns, _style(ref_tech).columns
+    shared = [c for c in mine if c in theirs]
+    if not shared:
+        return None
+    cells = st.cells()
+    for other, r in scene_rows.items():
+        if other.technique == ref_tech and r["status"] == "ok" and other in hdrs:
+            oc = other.cells()
+            if all(oc[c] == cells[c] for c in shared):
+                return hdrs[other]
+    return None
+
+
 def run_sweep(
     sweep: Sweep,
     out: Path,
@@ -120,24 +166,29 @@ def run_sweep(
     command: str | None = None,
     references: bool = False,
 ) -> dict:
-    """Run the whole ledger and write DIR/ledger.csv, ledger.md, ledger.json, pareto.png and cost.png;
-    with the sweep's truth, error_maps/ and error_maps.png. references: path-trace the references
-    that are not cached yet (else a scene without a cached reference has no truth columns)."""
+    """Run the whole ledger and write DIR/ledger.csv, ledger.md, ledger.html, ledger.json, pareto.png and
+    cost.png; with the sweep's truth, error_maps/, flip_maps/, error_maps.png and profiles.png.
+    references: path-trace the references that are not cached yet (else a scene without a cached
+    reference has no truth columns)."""
     from tqdm import tqdm
 
     from skinlab.gl.context import create_headless_context, describe
     from skinlab.render.registry import get_technique
     from skinlab.render.renderer import Renderer
     from skinlab.render.scattering import effective_material
+    from skinlab.render.settings import RenderSettings
     from skinlab.scene.optics.tsd import material_medium
     from skinlab.scene.scenefile import load_scene
-    from skinlab.truth.compare import relative_difference
+    from skinlab.truth.metrics import relative_map
+
+    from .sweep import reference_technique
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     scenes = tuple(scenes or sweep.scenes)
     paths = {s: resolve_scene(s) for s in scenes}
     settings = sweep_settings(sweep)
+    ref_tech = reference_technique()
     t_start = time.perf_counter()
     load_start = _loadavg()
     ctx = create_headless_context()
@@ -147,6 +198,8 @@ def run_sweep(
     rows: list[dict] = []
     truth_notes: dict[str, str] = {}
     truth_quiet: dict[str, str] = {}  # scenes compared with a quieter reference than the sweep's
+    truth_scenes: dict[str, dict] = {}  # per scene: what its truth took, its edge region, what it tests
+    profiles: dict[str, dict] = {}  # per scene: {"truth": Profile, setting label: Profile}
     sheet: dict[str, dict[str, np.ndarray]] = {}
     on_sheet = set(sheet_settings(settings))
     bar = tqdm(
@@ -175,7 +228,7 @@ def run_sweep(
                 except Exception as exc:
                     print(f"profile references for {label} failed: {_first_line(exc)}", file=sys.stderr)
                     base_mat = None
-            truth = None
+            truth = tctx = None
             if sweep.truth is not None:
                 bar.set_postfix_str(f"{label}: path-traced reference")
                 try:
@@ -192,7 +245,32 @@ def run_sweep(
                         "no cached path-traced reference at "
                         f"{sweep.truth.size[0]}x{sweep.truth.size[1]}, {sweep.truth.spp} spp: run with --references"
                     )
+            if truth is not None:
+                # the plain frame (no scattering) finds the light edges where the scene declares none
+                tw, th = truth.image.shape[1::-1]
+                plain_rs = RenderSettings(
+                    tw, th, shadow_size=sweep.shadow_size, supersample=sweep.truth.supersample, sss_model="none"
+                )
+                plain = renderer.render(scene, plain_rs, readback=("hdr",)).hdr
+                tctx = truth_context(scene, truth, plain)
+                spec = tctx.spec
+                truth_scenes[label] = {
+                    "spp": truth.meta.get("spp"),
+                    "passes": truth.pass_set.count,
+                    "seconds": truth.meta.get("seconds"),
+                    "variant": truth.meta.get("variant", "scalar_rgb"),
+                    "noise": truth.noise.get("rel_l1"),
+                    "noise_block": truth.noise.get("rel_l1_block"),
+                    "edge_mm": tctx.edge_mm,
+                    "edge_from": tctx.edge_from,
+                    "edge_pixels": int(tctx.edge.sum()),
+                    "tests": spec.tests if spec is not None else "",
+                    "profile": spec.profile if spec is not None else "none",
+                }
+                if tctx.profile is not None:
+                    profiles[label] = {"truth": tctx.profile, "kind": spec.profile}
             hdrs: dict[Setting, np.ndarray] = {}
+            digests: dict[Setting, str] = {}
             scene_rows: dict[Setting, dict] = {}
             for st in settings:
                 bar.set_postfix_str(f"{label}: {st.label}")
@@ -225,7 +303,7 @@ def run_sweep(
                                 "frame_ms_p10",
                                 "frame_ms_p90",
                                 "wall_ms_median",
-                                "tsd_ms_median",
+                                "technique_ms_median",
                                 "clock",
                                 "blur_levels",
                             )
@@ -233,16 +311,23 @@ def run_sweep(
                     )
                     row["passes"] = m["passes"]
                     hdrs[st] = m["hdr"]
-                    if truth is not None:
+                    digests[st] = _digest(m["hdr"])
+                    if tctx is not None:
                         # an untimed frame at the reference's size, supersampled like the truth's
                         # box-filtered pixels, compared with the truth
                         small_rs = st.render_settings(sweep, truth.image.shape[1::-1], sweep.truth.supersample)
                         small = renderer.render(scene, small_rs, readback=("hdr",)).hdr
-                        row.update(truth_errors(small, truth))
+                        got = truth_errors(small, tctx)
+                        prof = got.pop("profile", None)
+                        row.update(got)
+                        if prof is not None:
+                            profiles[label][st.label] = prof
+                        digests[st] = _digest(small)
                         safe = st.label.replace(" ", "-")
                         write_error_map(out / "error_maps" / f"{label}-{safe}.png", small, truth)
+                        write_flip_map(out / "flip_maps" / f"{label}-{safe}.png", small, tctx)
                         if st in on_sheet:
-                            sheet.setdefault(label, {})[st.label] = relative_difference(small, truth.image)
+                            sheet.setdefault(label, {})[st.label] = relative_map(small, truth.image)
                     if images:
                         from skinlab.image_output import write_image
 
@@ -261,25 +346,21 @@ def run_sweep(
                 scene_rows[st] = row
                 rows.append(row)
                 bar.update(1)
+            _same_images(scene_rows, digests)
             # image errors against the reference (the exact one, else the proxy)
             ref_st = settings[0] if scene_rows[settings[0]]["status"] == "ok" else proxy_reference(settings)
             if ref_st is not None and scene_rows[ref_st]["status"] != "ok":
                 ref_st = None
             ref = hdrs.get(ref_st) if ref_st is not None else None
             mask = lit_mask(ref) if ref is not None else None
-            # and against the exact convolution at the same irradiance size, where there is one: the
-            # technique's own error without the texture-resolution error of the reference
-            exact_at = {
-                st.tsd_size: hdrs[st]
-                for st, r in scene_rows.items()
-                if st.technique == "exact" and r["status"] == "ok" and st in hdrs
-            }
             for st, row in scene_rows.items():
                 row["reference"] = ref_st.label if ref_st is not None else ""
                 if ref is not None and st in hdrs:
                     row.update(image_error(hdrs[st], ref, mask))
-                same = exact_at.get(st.tsd_size) if st.technique == "tsd" else None
-                if same is not None and st in hdrs:
+                # against the image reference at the same shared settings (an irradiance size): the
+                # technique's own error without the reference's texture-resolution error
+                same = _same_size_partner(st, scene_rows, hdrs, ref_tech) if st in hdrs else None
+                if same is not None:
                     row["image_rel_l1_same_size"] = image_error(hdrs[st], same)["image_rel_l1"]
             del hdrs
     finally:
@@ -290,7 +371,7 @@ def run_sweep(
         error_map_sheet(
             sheet,
             out / "error_maps.png",
-            "signed relative difference against the path-traced truth (red: brighter, blue: darker)",
+            "signed relative difference against the path-traced truth per pixel (red: brighter, blue: darker)",
         )
     peer_res = None
     if peer:
@@ -320,6 +401,7 @@ def run_sweep(
             "supersample": sweep.truth.supersample,
             "missing": truth_notes,
             "quiet": truth_quiet,
+            "scenes": truth_scenes,
         },
         "sweep_s": sweep_s,
         "total_s": time.perf_counter() - t_start,
@@ -329,4 +411,4 @@ def run_sweep(
         "command": command,
         "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
     }
-    return write_ledger(rows, meta, out)
+    return write_ledger(rows, meta, out, sweep, profiles)

@@ -32,16 +32,67 @@ def error_key(rows: list[dict]) -> str:
     return TRUTH_KEY if scenes and with_truth == scenes else "image_rel_l1"
 
 
+TIE_SIGMAS = 2.0  # two errors differ when their difference is more than this many standard errors
+
+
+def sigma(r: dict, key: str) -> float:
+    """The uncertainty of r[key] from the truth's noise (0 for a measure without one)."""
+    v = r.get(f"{key}_sigma")
+    return float(v) if _finite(v) else 0.0
+
+
+def difference_sigma(a: dict, b: dict, key: str) -> float:
+    """The standard error of a[key] - b[key]: paired over the truth's jackknife groups where both rows
+    have them (the noise they share cancels), else from the two uncertainties."""
+    from skinlab.truth.metrics import paired_sigma
+
+    ja, jb = (a.get("jackknife") or {}).get(key), (b.get("jackknife") or {}).get(key)
+    if ja and jb and len(ja) == len(jb):
+        s = paired_sigma(ja, jb)
+        if math.isfinite(s):
+            return s
+    return math.hypot(sigma(a, key), sigma(b, key))
+
+
+def told_apart(a: dict, b: dict, key: str) -> bool:
+    """Whether the errors of two rows differ by more than TIE_SIGMAS times the noise of their difference
+    (identical images never do)."""
+    return abs(a[key] - b[key]) > TIE_SIGMAS * difference_sigma(a, b, key)
+
+
+def distinct(rows: list[dict]) -> list[dict]:
+    """The rows that are not the same image as an earlier row (``same_image_as``)."""
+    return [r for r in rows if not r.get("same_image_as")]
+
+
 def pareto_front(rows: list[dict], key: str = "image_rel_l1") -> list[dict]:
-    """Rows not dominated in (frame_ms_median, key): sorted by time, each strictly more accurate
-    than every cheaper one."""
-    pts = sorted((r for r in rows if usable(r, key)), key=lambda r: (r["frame_ms_median"], r[key]))
-    front, best = [], math.inf
+    """Rows not dominated in (frame_ms_median, key), sorted by time: each is more accurate than every
+    cheaper one by more than the noise (told_apart); a row that is the same image as another is not a
+    point of its own."""
+    pts = sorted((r for r in distinct(rows) if usable(r, key)), key=lambda r: (r["frame_ms_median"], r[key]))
+    front: list[dict] = []
     for r in pts:
-        if r[key] < best:
+        if not front or (r[key] < front[-1][key] and told_apart(r, front[-1], key)):
             front.append(r)
-            best = r[key]
     return front
+
+
+def best_and_ties(rows: list[dict], key: str) -> tuple[dict | None, list[dict]]:
+    """Of one scene's rows: the smallest error, and the other rows the noise cannot tell from it."""
+    ok = [r for r in distinct(rows) if usable(r, key)]
+    if not ok:
+        return None, []
+    best = min(ok, key=lambda r: r[key])
+    return best, [r for r in ok if r is not best and not told_apart(r, best, key)]
+
+
+def mark_ties(rows: list[dict], key: str) -> None:
+    """Set each row's ``ties_best``: "best", "tie" (within the noise of the best) or ""."""
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        srows = [r for r in rows if r["scene"] == scene]
+        best, ties = best_and_ties(srows, key)
+        for r in srows:
+            r["ties_best"] = "best" if r is best else "tie" if any(r is t for t in ties) else ""
 
 
 def log_slope(x, y) -> tuple[float, float, int]:
@@ -54,84 +105,109 @@ def log_slope(x, y) -> tuple[float, float, int]:
     return float(b), float(a), int(ok.sum())
 
 
-def cost_series(rows: list[dict], sweep_like: dict) -> dict:
-    """Per scene: the size series (K = kmax, auto taps) and the K series (at k_size, auto taps)."""
-    out = {}
+def cost_series(rows: list[dict], sweep) -> list[dict]:
+    """Per scene and per axis a technique declares a cost for (LedgerStyle.cost_axes) and sweeps:
+    the rows along that axis (the others at the base), ok, and where the technique declares levels,
+    those whose frame blurs at all (a frame that blurs nothing costs a step, not a power law)."""
+    from skinlab.render.registry import techniques
+
+    from .sweep import Setting, declared_settings
+
+    out = []
     for scene in dict.fromkeys(r["scene"] for r in rows):
-        tsd = [
-            r
-            for r in rows
-            if r["scene"] == scene and r["technique"] == "tsd" and r["status"] == "ok" and r["taps"] == "auto"
-        ]
-        if not tsd:
-            continue
-        kmax = max(r["K"] for r in tsd)
-        by_size = sorted((r for r in tsd if r["K"] == kmax), key=lambda r: r["tsd_size"])
-        k_size = sweep_like.get("k_size")
-        # the cost of K where texture-space diffusion runs at all (K whose Gaussians all fold into the
-        # unblurred term render plain diffuse: a step, not a power law)
-        by_k = sorted(
-            (r for r in tsd if r["tsd_size"] == k_size and (r.get("blur_levels") or 0) > 0), key=lambda r: r["K"]
-        )
-        out[scene] = {"size": by_size, "K": by_k, "kmax": kmax, "k_size": k_size}
+        by_label = {r["setting"]: r for r in rows if r["scene"] == scene and r["status"] == "ok"}
+        for t in techniques():
+            decl = t.ledger.sweep.get(sweep.name)
+            if decl is None or not t.ledger.cost_axes:
+                continue
+            base = declared_settings(t.name, sweep)[0]
+            for field, (what, power) in t.ledger.cost_axes.items():
+                if field not in decl.axes:
+                    continue
+                pts = []
+                for v in decl.axes[field]:
+                    st = Setting.of(t.name, **{**dict(base.values), field: v})
+                    r = by_label.get(st.label)
+                    if r is None or (t.ledger.levels and not (r.get("blur_levels") or 0) > 0) or v is None:
+                        continue
+                    pts.append((float(v), r))
+                pts.sort(key=lambda p: p[0])
+                out.append({"scene": scene, "technique": t.name, "field": field, "what": what, "power": power,
+                            "points": pts})  # fmt: skip
     return out
 
 
-def slopes(series: dict) -> dict:
-    res = {}
-    for scene, s in series.items():
-        tex = [r["tsd_size"] ** 2 for r in s["size"]]
-        ks = [r["K"] for r in s["K"]]
-        lv = [r.get("blur_levels") for r in s["K"]]
-        res[scene] = {
-            "frame_vs_texels": log_slope(tex, [r["frame_ms_median"] for r in s["size"]]),
-            "tsd_vs_texels": log_slope(tex, [r["tsd_ms_median"] for r in s["size"]]),
-            "frame_vs_K": log_slope(ks, [r["frame_ms_median"] for r in s["K"]]),
-            "tsd_vs_K": log_slope(ks, [r["tsd_ms_median"] for r in s["K"]]),
-            "tsd_vs_levels": log_slope(lv, [r["tsd_ms_median"] for r in s["K"]]),
-            "sizes": [r["tsd_size"] for r in s["size"]],
-            "Ks": ks,
-            "levels": lv,
-            "kmax": s["kmax"],
-            "k_size": s["k_size"],
-        }
+def slopes(series: list[dict]) -> list[dict]:
+    res = []
+    for s in series:
+        x = [v ** s["power"] for v, _ in s["points"]]
+        res.append(
+            {
+                **{k: s[k] for k in ("scene", "technique", "field", "what", "power")},
+                "values": [v for v, _ in s["points"]],
+                "frame": log_slope(x, [r["frame_ms_median"] for _, r in s["points"]]),
+                "own": log_slope(x, [r.get("technique_ms_median", math.nan) for _, r in s["points"]]),
+                "levels": [r.get("blur_levels") for _, r in s["points"]],
+            }
+        )
     return res
+
+
+def default_technique() -> str:
+    from skinlab.render.settings import RenderSettings
+
+    return RenderSettings(8, 8).technique_name
 
 
 def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS, key: str = "image_rel_l1") -> list[dict]:
     """For each error budget tau: the cheapest setting (cost: mean over scenes of the median frame
-    time) within it in every scene, overall and among tsd settings that blur in every scene. Against
-    the exact convolution the budget is absolute (error <= tau); against the truth, where every
-    setting keeps the error the techniques share, it counts from each scene's best setting (error <=
-    the scene's smallest error + tau)."""
+    time) within it in every scene, overall and among the default technique's settings that blur in
+    every scene (where it declares levels). Against the exact convolution the budget is absolute
+    (error <= tau); against the truth, where every setting keeps the error the techniques share, it
+    counts from each scene's best setting, and only differences larger than the noise count: a setting
+    qualifies unless its error is above the best's + tau by more than TIE_SIGMAS standard errors of
+    the difference."""
+    from skinlab.render.registry import get_technique
+
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     by_label: dict[str, dict] = {}
     for r in rows:
         by_label.setdefault(r["setting"], {})[r["scene"]] = r
-    floor = {s: 0.0 for s in scenes}
+    best = {s: None for s in scenes}
     if key == TRUTH_KEY:
         for s in scenes:
-            errs = [r[key] for r in rows if r["scene"] == s and usable(r, key)]
-            floor[s] = min(errs) if errs else math.inf
+            best[s], _ = best_and_ties([r for r in rows if r["scene"] == s], key)
+    floor = {s: (best[s][key] if best[s] is not None else (math.inf if key == TRUTH_KEY else 0.0)) for s in scenes}
+
+    def within(r, s, tau) -> bool:
+        if not usable(r, key):
+            return False
+        if best[s] is None:
+            return r[key] <= floor[s] + tau
+        return r[key] - floor[s] - tau <= TIE_SIGMAS * difference_sigma(r, best[s], key)
+
+    dflt = default_technique()
+    levels = get_technique(dflt).ledger.levels
     out = []
     for tau in thresholds:
         ok = []
         for labl, per in by_label.items():
-            if len(per) != len(scenes) or not all(usable(r, key) and r[key] <= floor[s] + tau for s, r in per.items()):
+            if len(per) != len(scenes) or not all(within(r, s, tau) for s, r in per.items()):
                 continue
             cost = float(np.mean([r["frame_ms_median"] for r in per.values()]))
             ok.append((cost, labl, per))
         ok.sort(key=lambda t: t[0])
-        best = ok[0] if ok else None
-        # a tsd setting that blurs nothing in some scene (every Gaussian sub-texel) is the plain frame there
-        best_tsd = next(
+        top = ok[0] if ok else None
+        best_default = next(
             (
                 t
                 for t in ok
-                if next(iter(t[2].values()))["technique"] == "tsd"
-                and all((r.get("blur_levels") or 0) > 0 for r in t[2].values())
+                if next(iter(t[2].values()))["technique"] == dflt
+                and (not levels or all((r.get("blur_levels") or 0) > 0 for r in t[2].values()))
             ),
             None,
         )
-        out.append({"threshold": tau, "best": best, "best_tsd": best_tsd, "key": key, "floor": floor})
+        out.append(
+            {"threshold": tau, "best": top, "best_default": best_default, "default": dflt, "key": key, "floor": floor}
+        )
     return out

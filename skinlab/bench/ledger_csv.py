@@ -8,46 +8,52 @@ import math
 
 from .truth_ledger import TRUTH_COLUMNS
 
-CSV_COLUMNS = [
-    "scene",
-    "setting",
-    "technique",
-    "model",
-    "K",
-    "tsd_size",
-    "taps",
-    "ssss_taps",
-    "disk_samples",
-    "width",
-    "height",
-    "blur_levels",
-    "frames",
-    "frame_ms_median",
-    "frame_ms_p10",
-    "frame_ms_p90",
-    "wall_ms_median",
-    "tsd_ms_median",
-    "clock",
-    "image_rel_l1",
-    "image_max_rel",
-    "image_p95_rel",
-    "pixels",
-    "image_rel_l1_same_size",
-    "profile_err_mc",
-    "profile_err_model",
-    "reference",
-    *TRUTH_COLUMNS,
-    "status",
-    "error",
-    "passes_ms",
-]
+
+def csv_columns() -> list[str]:
+    """The CSV's columns: the setting's, one per parameter column a registered technique declares
+    (LedgerStyle.columns), the timings and the errors."""
+    from .sweep import setting_columns
+
+    return [
+        "scene",
+        "setting",
+        "technique",
+        "model",
+        *setting_columns(),
+        "width",
+        "height",
+        "blur_levels",
+        "frames",
+        "frame_ms_median",
+        "frame_ms_p10",
+        "frame_ms_p90",
+        "wall_ms_median",
+        "technique_ms_median",
+        "clock",
+        "image_rel_l1",
+        "image_max_rel",
+        "image_p95_rel",
+        "pixels",
+        "image_rel_l1_same_size",
+        "profile_err_mc",
+        "profile_err_model",
+        "reference",
+        *TRUTH_COLUMNS,
+        "same_image_as",
+        "ties_best",
+        "status",
+        "error",
+        "passes_ms",
+    ]
+
+
 NUMERIC_COLUMNS = [
     "frames",
     "frame_ms_median",
     "frame_ms_p10",
     "frame_ms_p90",
     "wall_ms_median",
-    "tsd_ms_median",
+    "technique_ms_median",
     "image_rel_l1",
     "image_max_rel",
     "image_p95_rel",
@@ -71,11 +77,12 @@ def fmt_cell(v, digits=4) -> str:
 
 def csv_text(rows: list[dict]) -> str:
     buf = io.StringIO()
-    w = csv.DictWriter(buf, CSV_COLUMNS, lineterminator="\n")
+    columns = csv_columns()
+    w = csv.DictWriter(buf, columns, lineterminator="\n")
     w.writeheader()
     for r in rows:
         cells = {}
-        for c in CSV_COLUMNS:
+        for c in columns:
             if c == "passes_ms":
                 cells[c] = ";".join(f"{k}={v:.3f}" for k, v in (r.get("passes") or {}).items())
             elif c in NUMERIC_COLUMNS:

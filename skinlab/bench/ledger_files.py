@@ -1,5 +1,5 @@
-"""Writing a ledger run's files (each atomically): ledger.csv, ledger.md, ledger.json, pareto.png and
-cost.png."""
+"""Writing a ledger run's files (each atomically): ledger.csv, ledger.md, ledger.html, ledger.json,
+pareto.png, cost.png and (where a scene declares a profile) profiles.png."""
 
 from __future__ import annotations
 
@@ -11,40 +11,50 @@ import numpy as np
 
 from skinlab.atomic_write import write_text_atomic
 
-from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, cost_series, error_key, pareto_front, recommendations, slopes
+from .ledger_analysis import (
+    ERROR_LABELS,
+    TRUTH_KEY,
+    cost_series,
+    error_key,
+    mark_ties,
+    pareto_front,
+    recommendations,
+    slopes,
+)
 from .ledger_csv import csv_text
 from .ledger_markdown import markdown
 
 
-def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
-    from skinlab.bench.ledger_plots import cost_plot, pareto_plot
+def write_ledger(rows: list[dict], meta: dict, out: Path, sweep=None, profiles: dict | None = None) -> dict:
+    from skinlab.bench.ledger_html import html_report
+    from skinlab.bench.ledger_plots import cost_plot, pareto_plot, profile_plot
 
+    from .sweep import SWEEPS
+
+    sweep = sweep or SWEEPS.get(meta.get("sweep"), SWEEPS["full"])
     out = Path(out)
     key = error_key(rows)
+    mark_ties(rows, key)
     fronts = {}
     for scene in dict.fromkeys(r["scene"] for r in rows):
         fronts[scene] = pareto_front([r for r in rows if r["scene"] == scene], key)
-    k_sizes = [r["tsd_size"] for r in rows if r["technique"] == "tsd"]
-    # the K sweep's size: the size with the most distinct K
-    k_size = None
-    if k_sizes:
-        counts = {}
-        for r in rows:
-            if r["technique"] == "tsd" and r["taps"] == "auto":
-                counts.setdefault(r["tsd_size"], set()).add(r["K"])
-        k_size = max(counts, key=lambda s: (len(counts[s]), s)) if counts else None
-    series = cost_series(rows, {"k_size": k_size})
+    series = cost_series(rows, sweep)
     sl = slopes(series)
     recs = recommendations(rows, key=key)
     write_text_atomic(out / "ledger.csv", csv_text(rows))
     pareto_plot(rows, fronts, out / "pareto.png", key=key, label=ERROR_LABELS[key])
     cost_plot(series, sl, out / "cost.png")
+    names = ["ledger.csv", "ledger.md", "ledger.html", "ledger.json", "pareto.png", "cost.png"]
+    if profiles:
+        profile_plot(profiles, rows, out / "profiles.png")
+        names.append("profiles.png")
     md = markdown(rows, meta, sl, recs, fronts)
     write_text_atomic(out / "ledger.md", md)
+    write_text_atomic(out / "ledger.html", html_report(rows, meta, sl, recs, fronts, out))
 
     def clean(v):
         if isinstance(v, (np.floating, float)):
-            return None if math.isnan(float(v)) else float(v)
+            return None if not math.isfinite(float(v)) else float(v)
         if isinstance(v, (np.integer,)):
             return int(v)
         if isinstance(v, dict):
@@ -57,20 +67,20 @@ def write_ledger(rows: list[dict], meta: dict, out: Path) -> dict:
         {
             "threshold": r["threshold"],
             "best": r["best"][1] if r["best"] else None,
-            "best_tsd": r["best_tsd"][1] if r["best_tsd"] else None,
+            "best_default": r["best_default"][1] if r["best_default"] else None,
+            "default": r["default"],
         }
         for r in recs
     ]
     doc = {
         "meta": meta,
         "rows": rows,
-        "slopes": {s: {k: (list(v) if isinstance(v, tuple) else v) for k, v in d.items()} for s, d in sl.items()},
+        "slopes": sl,
         "pareto": {s: [r["setting"] for r in f] for s, f in fronts.items()},
         "recommendations": rec_json,
         "error_axis": key,
     }
-    write_text_atomic(out / "ledger.json", json.dumps(clean(doc), indent=1))
-    names = ["ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png"]
+    write_text_atomic(out / "ledger.json", json.dumps(clean(doc), indent=1, allow_nan=False))
     if key == TRUTH_KEY and (out / "error_maps.png").is_file():
         names.append("error_maps.png")
     return {

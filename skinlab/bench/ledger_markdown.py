@@ -8,7 +8,30 @@ import math
 from .image_error import LUM_FRACTION
 from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, error_key
 from .ledger_csv import fmt_cell
+from .sweep import setting_columns
 from .truth_ledger import truth_markdown
+
+
+def pm(r: dict, key: str, percent: bool = True) -> str:
+    """'value +- sigma' (percent or as is), '' where not measured."""
+    v, s = r.get(key), r.get(f"{key}_sigma")
+    if not isinstance(v, (int, float)) or not math.isfinite(v):
+        return ""
+    k = 100 if percent else 1
+    unit = " %" if percent else ""
+    if isinstance(s, (int, float)) and math.isfinite(s):
+        return f"{k * v:.2f} +- {k * s:.2f}{unit}" if percent else f"{v:.4f} +- {s:.4f}"
+    return f"{k * v:.2f}{unit}" if percent else f"{v:.4f}"
+
+
+def profile_cell(r: dict, key: str) -> str:
+    """A profile error; n/a where the technique moves no light (a step: exactly 100 %, says nothing)."""
+    v = r.get(key)
+    if not isinstance(v, (int, float)) or not math.isfinite(v):
+        return ""
+    if r.get("technique") and r.get("model") == "none" or abs(v - 1.0) < 1e-12:
+        return "n/a (no profile)"
+    return f"{100 * v:.2f} %"
 
 
 def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: dict) -> str:
@@ -44,7 +67,10 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1); `vs model`: the same against the "
         "material's own model profile (the technique's approximation alone).",
         "`truth 4x4` / `truth px`: relative L1 against the path-traced truth on 4x4 blocks / per pixel, "
-        "beside the truth's noise floor (4x4) and the largest per-channel energy difference.",
+        "`truth FLIP`: the mean FLIP of the tone-mapped frames, `truth edge px`: relative L1 per pixel within "
+        "the edge region, each +- its standard error from the truth's passes (jackknife); the truth's noise "
+        "floor (4x4) and the largest per-channel energy difference beside them. `n/a (no profile)`: the "
+        "technique moves no light, its profile is a step.",
         "",
         *truth_markdown(rows, meta),
     ]
@@ -78,13 +104,15 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
                 "reference's own texture-resolution error (compare the exact rows at smaller sizes)."
             )
         L.append("")
-        L.append(
-            "| setting | technique | model | K | tsd size | taps | ssss taps | disk samples | blur levels | frames | "
-            "frame ms median | p10 | p90 | tsd ms | image rel-L1 | image max | image p95 | rel-L1 vs exact same size | "
-            "profile err vs MC | profile err vs model | truth 4x4 | truth px | truth noise 4x4 | truth energy | "
-            "status |"
-        )
-        L.append("|---" * 25 + "|")
+        cols = setting_columns()
+        head = [
+            "setting", "technique", "model", *cols, "blur levels", "frames", "frame ms median", "p10", "p90",
+            "technique ms", "image rel-L1", "image max", "image p95", "rel-L1 vs exact same size", "profile err vs MC",
+            "profile err vs model", "truth 4x4", "truth px", "truth FLIP", "truth edge px", "truth noise 4x4",
+            "truth energy", "same image as", "status",
+        ]  # fmt: skip
+        L.append("| " + " | ".join(head) + " |")
+        L.append("|---" * len(head) + "|")
         for r in srows:
             status = r["status"] + (f": {r['error']}" if r.get("error") else "")
             pct = lambda v: "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100 * v:.2f} %"
@@ -95,27 +123,26 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
                         r["setting"],
                         r["technique"],
                         r.get("model", ""),
-                        fmt_cell(r.get("K")),
-                        fmt_cell(r.get("tsd_size")),
-                        fmt_cell(r.get("taps")),
-                        fmt_cell(r.get("ssss_taps")),
-                        fmt_cell(r.get("disk_samples")),
+                        *(fmt_cell(r.get(c)) for c in cols),
                         fmt_cell(r.get("blur_levels", "")),
                         fmt_cell(r.get("frames", "")),
                         fmt_cell(r.get("frame_ms_median"), 4),
                         fmt_cell(r.get("frame_ms_p10"), 4),
                         fmt_cell(r.get("frame_ms_p90"), 4),
-                        fmt_cell(r.get("tsd_ms_median"), 4),
+                        fmt_cell(r.get("technique_ms_median"), 4),
                         pct(r.get("image_rel_l1")),
                         pct(r.get("image_max_rel")),
                         pct(r.get("image_p95_rel")),
                         pct(r.get("image_rel_l1_same_size")),
-                        pct(r.get("profile_err_mc")),
-                        pct(r.get("profile_err_model")),
-                        pct(r.get("truth_rel_l1_block")),
-                        pct(r.get("truth_rel_l1")),
+                        profile_cell(r, "profile_err_mc"),
+                        profile_cell(r, "profile_err_model"),
+                        pm(r, "truth_rel_l1_block"),
+                        pm(r, "truth_rel_l1"),
+                        pm(r, "truth_flip", percent=False),
+                        pm(r, "truth_edge_rel_l1"),
                         pct(r.get("truth_noise_block")),
                         pct(r.get("truth_energy")),
+                        r.get("same_image_as", ""),
                         status.replace("|", "/"),
                     ]
                 )
@@ -128,30 +155,50 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
             L.append(
                 f"Pareto front (time, {ERROR_LABELS[key]}): "
                 + " -> ".join(f"`{r['setting']}` ({r['frame_ms_median']:.1f} ms, {100 * r[key]:.2f} %)" for r in fr)
+                + " (each point more accurate than the cheaper ones by more than twice the noise of the difference)"
+            )
+            L.append("")
+        same = [r for r in srows if r.get("same_image_as")]
+        if same:
+            L.append(
+                "Same image (bit-identical frames, one point in the Pareto front and the ranks): "
+                + "; ".join(f"`{r['setting']}` = `{r['same_image_as']}`" for r in same)
+            )
+            L.append("")
+        key = error_key(rows)
+        best = next((r for r in srows if r.get("ties_best") == "best"), None)
+        if best is not None and key == TRUTH_KEY:
+            ties = [r["setting"] for r in srows if r.get("ties_best") == "tie"]
+            L.append(
+                f"Best against the truth: `{best['setting']}`; "
+                + (
+                    f"the truth's noise cannot tell it from {', '.join(f'`{t}`' for t in ties)}."
+                    if ties
+                    else "every other setting is worse by more than the noise."
+                )
             )
             L.append("")
     L += [
         "## Cost slopes",
         "",
-        "Least-squares slopes of log(time) against log(irradiance texels = tsd_size^2) over the size sweep "
-        "(K = max, auto taps) and against log(K) over the K sweep (auto taps; only the K for which at least "
-        "one blur pass runs: where every Gaussian folds into the unblurred term the frame is plain diffuse); "
-        "`tsd` is the sum of the "
-        "texture-space passes (stretch when it runs, irradiance, dilation, blurs). Slope 1 = linear.",
+        "Least-squares slopes of log(time) against log(the cost variable) along each axis a technique declares a "
+        "cost for (LedgerStyle.cost_axes; the other settings at the sweep's base, e.g. texture-space diffusion's "
+        "texels = size^2 and K), for the whole frame and for the technique's own passes; where the technique "
+        "declares blur levels, only the points whose frame blurs at all (a frame that blurs nothing is plain "
+        "diffuse: a step, not a power law). Slope 1 = linear.",
         "",
-        "| scene | frame vs texels | tsd passes vs texels | frame vs K | tsd passes vs K "
-        "| tsd passes vs blur levels | sizes | K | blur levels per K |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| scene | series | frame vs it | technique passes vs it | values | blur levels |",
+        "|---|---|---|---|---|---|",
     ]
-    for scene, s in sl.items():
+    for s in sl:
         f = lambda t: "n/a" if math.isnan(t[0]) else f"{t[0]:.3f}"
+        power = "" if s["power"] == 1 else f" = {s['field']}^{s['power']:g}"
         L.append(
-            f"| {scene} | {f(s['frame_vs_texels'])} | {f(s['tsd_vs_texels'])} | {f(s['frame_vs_K'])} | "
-            f"{f(s['tsd_vs_K'])} | {f(s['tsd_vs_levels'])} | {', '.join(map(str, s['sizes']))} | "
-            f"{', '.join(map(str, s['Ks']))} (at {s['k_size']}) | {', '.join(map(str, s['levels']))} |"
+            f"| {s['scene']} | {s['technique']} vs {s['what']}{power} | {f(s['frame'])} | {f(s['own'])} | "
+            f"{', '.join(f'{v:g}' for v in s['values'])} | {', '.join(map(str, s['levels']))} |"
         )
     if not sl:
-        L.append("| (no tsd series measured) | | | | | | | | |")
+        L.append("| (no cost series measured) | | | | | |")
     L.append("")
     L += ["## Peer: pyrender", ""]
     p = meta.get("peer")
@@ -179,9 +226,12 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         L.append(f"| pyrender | {p['pyrender_ms']:.2f} | 1 |")
     L.append("")
     key = recs[0]["key"] if recs else "image_rel_l1"
+    dflt = recs[0]["default"] if recs else "the default technique"
     rule = (
         "whose error against the path-traced truth (4x4 blocks) is within tau of the scene's best setting in "
-        "*every* scene (every technique keeps the error they share, so the budget counts from the best)"
+        "*every* scene (every technique keeps the error they share, so the budget counts from the best), "
+        "unless it is above that by more than twice the standard error of its difference from the best (the "
+        "truth's noise): only differences larger than the noise count"
         if key == TRUTH_KEY
         else "whose image rel-L1 against the reference is <= tau in *every* scene; the reference itself "
         "qualifies trivially"
@@ -190,12 +240,12 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         "## Recommended defaults",
         "",
         f"Rule: for each error budget tau, the cheapest setting (mean over the scenes of its median frame time) "
-        f"{rule}. `tsd only` restricts this to texture-space diffusion settings that blur in every scene (what "
-        "the tsd technique's size / gaussians / taps defaults choose among; one whose Gaussians are all narrower "
-        "than a texel renders the plain frame). A setting must have been measured in every scene.",
+        f"{rule}. `{dflt} only` restricts this to the default technique's settings that blur in every scene (what "
+        "its defaults choose among; one that blurs nothing renders the plain frame). A setting must have been "
+        "measured in every scene.",
         "",
         "| budget tau | cheapest setting | mean ms | errors per scene "
-        "| cheapest tsd setting | mean ms | errors per scene |",
+        f"| cheapest {dflt} setting | mean ms | errors per scene |",
         "|---|---|---|---|---|---|---|",
     ]
     for rec in recs:
@@ -210,7 +260,9 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
                 ", ".join(f"{s} {100 * r[key]:.2f} %" for s, r in per.items()),
             ]
 
-        L.append(f"| {100 * rec['threshold']:g} % | " + " | ".join(cell(rec["best"]) + cell(rec["best_tsd"])) + " |")
+        L.append(
+            f"| {100 * rec['threshold']:g} % | " + " | ".join(cell(rec["best"]) + cell(rec["best_default"])) + " |"
+        )
     if any(r.get("reference") and not r["reference"].startswith("exact") for r in rows):
         L += [
             "",

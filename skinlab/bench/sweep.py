@@ -17,76 +17,55 @@ REFERENCE_SCENE_NAMES = tuple(reference_scene_names())
 
 @dataclass(frozen=True)
 class Sweep:
+    """A sweep preset. Which settings of which technique it measures is declared by each technique
+    (``LedgerStyle.sweep[name]``, skinlab/render/technique.py); the preset holds the conditions."""
+
     name: str
     size: tuple[int, int]
     shadow_size: int
-    k_size: int  # irradiance size of the K and tap sweeps
-    ks: tuple[int, ...]  # K at k_size
-    sizes: tuple[int, ...]  # irradiance sizes at K = max(ks)
-    taps: tuple  # tap counts (None = auto) at k_size, K = max(ks)
-    ssss: tuple[int, ...]
-    exact_size: int  # irradiance size of the exact reference
     frames: int  # timed frames per setting (fewer if over budget_s)
     warmup: int
     budget_s: float  # rough time budget of the timed frames of one setting
     photons: int  # Monte Carlo photons per channel
     peer_frames: int
     scenes: tuple[str, ...] = ("head", "bunny")
-    extra: tuple = ()  # extra settings (tiny sweep)
-    disk: tuple[int, ...] = ()  # Burley disk SSS sample counts
-    every_technique: bool = True  # also a default-settings row for each registered technique not swept above
+    extra: tuple = ()  # extra settings
+    # a technique that declares no sweep for this preset is measured once with its default settings
+    every_technique: bool = True
     # the path-traced truth: reference size and samples (skinlab/bench/truth_ledger.py); None: not measured
     truth: TruthSpec | None = None
+    # settings fields of the image reference's base setting changed from its declaration (--exact-size)
+    reference_values: tuple[tuple[str, object], ...] = ()
 
 
 FULL = Sweep(
     "full",
     (640, 640),
     2048,
-    1024,
-    (1, 2, 3, 4, 5, 6),
-    (256, 512, 1024, 2048),
-    (None, 7, 15, 31),
-    (11, 17, 25),
-    1024,
     frames=10,
     warmup=2,
     budget_s=25.0,
     photons=200_000,
     peer_frames=30,
     scenes=REFERENCE_SCENE_NAMES,
-    disk=(8, 16, 32, 64),
     truth=TruthSpec((192, 192), 1024),
 )
 QUICK = Sweep(
     "quick",
     (160, 160),
     1024,
-    256,
-    (1, 3, 6),
-    (256, 512),
-    (None, 7),
-    (11, 25),
-    256,  # the exact convolution at 512 texels took half of the quick run; the truth is the first axis now
     frames=5,
     warmup=2,
     budget_s=2.0,
     photons=20_000,
     peer_frames=5,
     scenes=("head-skin1-matched", "bunny-skimmilk", "slab-edge-skin1"),
-    disk=(8, 32),
     truth=TruthSpec((96, 96), 256),
 )
-# for the tests: five settings on the index-matched head at 64x64, a 32x32 truth
+# for the tests: the techniques that declare a tiny sweep on the index-matched head at 64x64, a 32x32 truth
 TINY = Sweep(
     "tiny",
     (64, 64),
-    256,
-    256,
-    (1, 6),
-    (256,),
-    (None,),
-    (),
     256,
     frames=2,
     warmup=2,
@@ -100,32 +79,53 @@ TINY = Sweep(
 SWEEPS = {"full": FULL, "quick": QUICK, "tiny": TINY}
 
 
+def _style(technique: str):
+    from skinlab.render.registry import get_technique
+
+    return get_technique(technique).ledger
+
+
+def _fields(technique: str) -> list[str]:
+    """The settings fields the technique's ledger columns show (in column order, once each)."""
+    return list(dict.fromkeys(_style(technique).columns.values()))
+
+
 @dataclass(frozen=True)
 class Setting:
-    """One ledger row's setting: a registered technique and the ledger columns its settings fill
-    (the technique's LedgerStyle.columns maps them to its settings fields)."""
+    """One ledger row's setting: a registered technique and the values of the settings fields its
+    ledger columns show (LedgerStyle.columns), every one filled in (defaults where not given), so
+    that two ways of spelling one setting are one setting."""
 
-    technique: str  # a registered technique: none | tint | tsd | ssss | exact | ...
-    K: int | None = None
-    tsd_size: int | None = None
-    taps: int | None = None  # tsd taps; None = auto (only meaningful for tsd)
-    ssss_taps: int | None = None
-    disk_samples: int | None = None
+    technique: str  # a registered technique
+    values: tuple[tuple[str, object], ...] = ()
 
-    def _style(self):
+    @classmethod
+    def of(cls, technique: str, **values) -> Setting:
         from skinlab.render.registry import get_technique
 
-        return get_technique(self.technique).ledger
+        t = get_technique(technique)
+        fields = _fields(technique)
+        unknown = set(values) - set(fields)
+        if unknown:
+            raise ValueError(
+                f"ledger setting {technique}: {', '.join(sorted(unknown))} is not among its ledger columns' "
+                f"fields ({', '.join(fields) or 'none'})"
+            )
+        defaults = t.settings_type.defaults()
+        return cls(technique, tuple((f, values.get(f, defaults[f])) for f in fields))
+
+    def value(self, field: str):
+        return dict(self.values)[field]
+
+    @property
+    def style(self):
+        return _style(self.technique)
 
     @property
     def label(self) -> str:
-        style = self._style()
-        if not style.label:
+        if not self.style.label:
             return self.technique
-        return style.label.format(**{c: ("auto" if v is None else v) for c, v in self._columns().items()})
-
-    def _columns(self) -> dict:
-        return {c: getattr(self, c) for c in self._style().columns}
+        return self.style.label.format(**{f: ("auto" if v is None else v) for f, v in self.values})
 
     def render_settings(self, sweep: Sweep, size=None, supersample: int = 1):
         """The setting's render settings at the sweep's size (the timed frames) or at `size` with
@@ -133,37 +133,66 @@ class Setting:
         from skinlab.render.settings import RenderSettings
 
         w, h = size or sweep.size
-        cols = self._style().columns
-        opts = {f: getattr(self, c) for c, f in cols.items() if getattr(self, c) is not None}
         return RenderSettings.for_technique(
-            self.technique, w, h, shadow_size=sweep.shadow_size, supersample=supersample, **opts
+            self.technique, w, h, shadow_size=sweep.shadow_size, supersample=supersample, **dict(self.values)
         )
 
     def cells(self) -> dict:
         """The parameter columns; empty where the parameter does not apply to the technique."""
-        own = self._columns()
-        return {c: ("auto" if own[c] is None else own[c]) if c in own else "" for c in SETTING_COLUMNS}
+        own = {c: dict(self.values)[f] for c, f in self.style.columns.items()}
+        return {c: ("auto" if own[c] is None else own[c]) if c in own else "" for c in setting_columns()}
+
+    def varied(self, base: Setting) -> list[str]:
+        """The fields in which this setting differs from `base` (same technique)."""
+        b = dict(base.values)
+        return [f for f, v in self.values if b.get(f) != v]
 
 
-SETTING_COLUMNS = ("K", "tsd_size", "taps", "ssss_taps", "disk_samples")
+def setting_columns() -> list[str]:
+    """The ledger's parameter columns: every registered technique's LedgerStyle.columns, in registry order."""
+    from skinlab.render.registry import techniques
+
+    return list(dict.fromkeys(c for t in techniques() for c in t.ledger.columns))
+
+
+def declared_settings(technique: str, sweep: Sweep) -> list[Setting]:
+    """The technique's settings in `sweep`: its declared base, then each axis varied alone from it;
+    [] where it declares none for this preset (unless the preset measures every technique: then the
+    defaults)."""
+    style = _style(technique)
+    decl = style.sweep.get(sweep.name)
+    if decl is None:
+        return [Setting.of(technique)] if sweep.every_technique else []
+    base = dict(decl.base)
+    if style.reference:
+        base.update(dict(sweep.reference_values))
+    out = [Setting.of(technique, **base)]
+    for field, values in decl.axes.items():
+        out += [Setting.of(technique, **{**base, field: v}) for v in values]
+    return out
+
+
+def base_setting(technique: str, sweep: Sweep) -> Setting | None:
+    got = declared_settings(technique, sweep)
+    return got[0] if got else None
+
+
+def reference_technique() -> str | None:
+    from skinlab.render.registry import techniques
+
+    return next((t.name for t in techniques() if t.ledger.reference), None)
 
 
 def sweep_settings(sweep: Sweep) -> list[Setting]:
-    """The reference first, then the rest, without duplicates (in order)."""
-    kmax = max(sweep.ks)
-    out = [Setting("exact", tsd_size=sweep.exact_size), Setting("none"), Setting("tint")]
-    out += [Setting("tsd", K=k, tsd_size=sweep.k_size) for k in sweep.ks]
-    out += [Setting("tsd", K=kmax, tsd_size=s) for s in sweep.sizes]
-    out += [Setting("tsd", K=kmax, tsd_size=sweep.k_size, taps=t) for t in sweep.taps]
-    out += [Setting("ssss", ssss_taps=n) for n in sweep.ssss]
-    out += [Setting("disk", disk_samples=n) for n in sweep.disk]
-    # the exact convolution at the smaller swept sizes: the irradiance texture's own resolution error
-    out += [Setting("exact", tsd_size=s) for s in sweep.sizes if s < sweep.exact_size]
-    out += list(sweep.extra)
-    if sweep.every_technique:  # a newly registered technique is measured without editing the sweep
-        from skinlab.render.registry import technique_names
+    """The image reference's base setting first, then every registered technique's declared settings
+    (registry order) and the preset's extras, without duplicates (in order)."""
+    from skinlab.render.registry import technique_names
 
-        out += [Setting(name) for name in technique_names() if name not in {s.technique for s in out}]
+    ref = reference_technique()
+    out = declared_settings(ref, sweep)[:1] if ref else []
+    for name in technique_names():
+        out += declared_settings(name, sweep)
+    out += list(sweep.extra)
     seen, uniq = set(), []
     for s in out:
         if s not in seen:
@@ -174,26 +203,41 @@ def sweep_settings(sweep: Sweep) -> list[Setting]:
 
 def sheet_settings(settings: list[Setting]) -> list[Setting]:
     """One setting per technique for the error-map contact sheet: the one with the technique's default
-    settings where it was swept, else the technique's first (for exact: the reference size)."""
-    from skinlab.render.registry import get_technique
-
+    settings where it was swept, else its first (for the image reference: its base)."""
     out = []
     for tech in dict.fromkeys(s.technique for s in settings):
-        t = get_technique(tech)
-        defaults = t.settings_type()
-        cols = t.ledger.columns
-        default = Setting(tech, **{c: getattr(defaults, f) for c, f in cols.items()})
+        default = Setting.of(tech)
         cands = [s for s in settings if s.technique == tech]
-        out.append(default if default in cands and tech != "exact" else cands[0])
+        out.append(default if default in cands and not _style(tech).reference else cands[0])
+    return out
+
+
+def sheet_settings_of_rows(rows: list[dict]) -> dict[str, list[str]]:
+    """Per scene, the labels of one ok row per technique (as sheet_settings picks them)."""
+    out: dict[str, list[str]] = {}
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        srows = [r for r in rows if r["scene"] == scene and r.get("status") == "ok"]
+        labels = []
+        for tech in dict.fromkeys(r["technique"] for r in srows):
+            cands = [r["setting"] for r in srows if r["technique"] == tech]
+            default = Setting.of(tech).label
+            labels.append(default if default in cands and not _style(tech).reference else cands[0])
+        out[scene] = labels
     return out
 
 
 def proxy_reference(settings: list[Setting]) -> Setting | None:
-    """The most accurate tsd setting: largest irradiance texture, then largest K, auto taps first."""
-    tsd = [s for s in settings if s.technique == "tsd"]
-    if not tsd:
+    """The most accurate setting of a technique that declares a proxy order: the largest values of
+    its LedgerStyle.proxy fields, in order (None, e.g. automatic taps, counts as largest)."""
+    cands = [s for s in settings if s.style.proxy]
+    if not cands:
         return None
-    return max(tsd, key=lambda s: (s.tsd_size, s.K, s.taps is None, s.taps or 0))
+
+    def rank(s):
+        v = dict(s.values)
+        return tuple((1, 0) if v.get(f) is None else (0, v.get(f)) for f in s.style.proxy)
+
+    return max(cands, key=rank)
 
 
 def resolve_scene(name: str):

@@ -39,20 +39,35 @@ from skinlab.truth.compare import (
     error_map_rgb,
     image_error,
     judged_blocks,
-    relative_difference,
 )
 
 REFERENCE_SCENES = scenes_root() / "reference"
 TRUTH_COLUMNS = [
     "truth_rel_l1",
+    "truth_rel_l1_sigma",
     "truth_rel_l1_block",
+    "truth_rel_l1_block_sigma",
+    "truth_flip",
+    "truth_flip_sigma",
+    "truth_edge_rel_l1",
+    "truth_edge_rel_l1_sigma",
+    "truth_edge_pixels",
+    "truth_profile_err",
+    "truth_profile_err_sigma",
     "truth_energy",
+    "truth_energy_r",
+    "truth_energy_g",
+    "truth_energy_b",
     "truth_noise",
     "truth_noise_block",
+    "truth_spp",
+    "truth_passes",
     "truth_blocks8_over",
     "truth_blocks8_judged",
     "truth_blocks8_over_frac",
 ]
+# the errors measured with their uncertainty (the jackknife over the truth's passes, skinlab/truth/metrics.py)
+JACKKNIFED = ("truth_rel_l1", "truth_rel_l1_block", "truth_flip", "truth_edge_rel_l1", "truth_profile_err")
 
 
 # samples per pixel side of the frames compared with the truth (box-filtered like the truth's pixels;
@@ -112,26 +127,121 @@ def load_truth(scene, spec: TruthSpec, render: bool = False, progress: bool = Tr
         return None
 
 
-def truth_errors(img: np.ndarray, truth) -> dict:
+@dataclass
+class TruthContext:
+    """What every setting of one scene is measured against: the truth, the leave-one-group-out truths
+    of its passes, the object and edge regions, the declared profile (and the truth's)."""
+
+    truth: object  # skinlab.truth.reference.Reference
+    groups: list  # the truth with each group of passes left out (jackknife)
+    mask: np.ndarray
+    edge: np.ndarray  # the edge region (bool (H, W))
+    edge_mm: float
+    edge_from: str  # "declared" | "plain frame" | ""
+    exposure: float = 1.0
+    spec: object = None  # the scene's MeasureSpec, if any
+    points: object = None  # skinlab.truth.regions.PixelPoints
+    profile: object = None  # the truth's Profile
+    group_profiles: list = None
+
+
+def truth_context(scene, truth, plain: np.ndarray | None) -> TruthContext:
+    """The scene's measuring context; `plain` the plain frame at the truth's size (the edge region
+    where the scene declares no edge)."""
+    from skinlab.truth import regions
+    from skinlab.truth.compare import object_mask
+    from skinlab.truth.export import describe
+
+    h, w = truth.image.shape[:2]
+    mask = object_mask(truth.image)
+    spec = getattr(scene, "measure", None)
+    try:
+        px = regions.pixel_points(describe(scene, w, h))
+    except Exception:  # no ray caster: no profile, the edge region in pixels of 1 mm
+        px = None
+    width = regions.edge_width_mm(scene, spec)
+    edge = regions.edge_region(mask, width, px, spec, plain)
+    declared = spec is not None and spec.has_profile and px is not None
+    ctx = TruthContext(
+        truth, truth.pass_set.jackknife_groups(), mask, edge, width,
+        "declared" if declared else ("plain frame" if plain is not None else ""),
+        scene.environment.exposure, spec, px,
+    )  # fmt: skip
+    if declared:
+        ctx.profile = regions.profile(truth.image, px, spec, mask)
+        ctx.group_profiles = [regions.profile(g, px, spec, mask) for g in ctx.groups]
+    return ctx
+
+
+def truth_errors(img: np.ndarray, tc) -> dict:
+    """The row's truth columns; with a TruthContext also each error's uncertainty (``_sigma``) and,
+    under ``"jackknife"``, the per-group values (for paired comparisons) and ``"profile"`` (the
+    frame's profile across the declared line or edge)."""
+    from skinlab.truth import metrics, regions
+
+    if not isinstance(tc, TruthContext):  # a bare reference: no edges, no profile
+        tc = TruthContext(tc, tc.pass_set.jackknife_groups(), tc.mask, np.zeros(tc.mask.shape, bool), math.nan, "")
+    truth = tc.truth
     e = image_error(img, truth.image)
     finite = [abs(x) for x in e["energy"] if math.isfinite(x)]
     j = judged_blocks(img, truth.image, truth.half_a, truth.half_b)
-    return {
-        "truth_rel_l1": e["rel_l1"],
-        "truth_rel_l1_block": e["rel_l1_block"],
+    out = {
         "truth_energy": max(finite) if finite else math.nan,
+        **{f"truth_energy_{c}": v for c, v in zip("rgb", e["energy"])},
         "truth_noise": truth.noise["rel_l1"],
         "truth_noise_block": truth.noise["rel_l1_block"],
+        "truth_spp": int(truth.meta.get("spp") or 0),
+        "truth_passes": int(truth.pass_set.count),
+        "truth_edge_pixels": int(tc.edge.sum()),
         "truth_blocks8_over": j["over"],
         "truth_blocks8_judged": j["judged"],
         "truth_blocks8_over_frac": j["over_fraction"],
     }
+    measures = {
+        "truth_rel_l1": lambda t: metrics.rel_l1(img, t, tc.mask),
+        "truth_rel_l1_block": lambda t: image_error(img, t, tc.mask)["rel_l1_block"],
+        "truth_flip": lambda t: _flip(img, t, tc),
+    }
+    if tc.edge.any():
+        measures["truth_edge_rel_l1"] = lambda t: metrics.rel_l1(img, t, tc.edge)
+    jk = {}
+    for key, fn in measures.items():
+        v, sigma, loo = metrics.jackknife(fn, truth.image, tc.groups)
+        out[key], out[f"{key}_sigma"], jk[key] = v, sigma, loo
+    for key in JACKKNIFED:
+        out.setdefault(key, math.nan)
+        out.setdefault(f"{key}_sigma", math.nan)
+    if tc.profile is not None:
+        p = regions.profile(img, tc.points, tc.spec, tc.mask)
+        loo = [regions.profile_error(p, g) for g in tc.group_profiles]
+        out["truth_profile_err"] = regions.profile_error(p, tc.profile)
+        out["truth_profile_err_sigma"] = metrics.jackknife_sigma(loo)
+        jk["truth_profile_err"] = loo
+        out["profile"] = p
+    out["jackknife"] = jk
+    return out
+
+
+def _flip(img, t, tc) -> float:
+    from skinlab.truth import metrics
+
+    return metrics.flip_mean(img, t, tc.mask, tc.exposure)
 
 
 def write_error_map(path: Path, img: np.ndarray, truth) -> Path:
+    """The full-resolution signed relative difference per pixel (skinlab/truth/metrics.py relative_map)."""
     from skinlab.image_output import write_image
+    from skinlab.truth.metrics import relative_map
 
-    return write_image(path, error_map_rgb(relative_difference(img, truth.image)))
+    return write_image(path, error_map_rgb(relative_map(img, truth.image)))
+
+
+def write_flip_map(path: Path, img: np.ndarray, tc: TruthContext) -> Path:
+    from skinlab.image_output import write_image
+    from skinlab.truth.compare import magma_rgb
+    from skinlab.truth.metrics import flip_map
+
+    return write_image(path, magma_rgb(flip_map(img, tc.truth.image, tc.exposure)))
 
 
 def error_map_sheet(maps: dict[str, dict[str, np.ndarray]], path: Path, title: str = "") -> Path:
@@ -161,7 +271,7 @@ def error_map_sheet(maps: dict[str, dict[str, np.ndarray]], path: Path, title: s
             if j == 0:
                 ax.set_ylabel(s, fontsize=7)
     sm = plt.cm.ScalarMappable(cmap="RdBu_r", norm=plt.Normalize(-100 * MAP_SCALE, 100 * MAP_SCALE))
-    fig.colorbar(sm, ax=axes, fraction=0.02, pad=0.01, label="(frame - truth) / truth, % (4x4 blocks)")
+    fig.colorbar(sm, ax=axes, fraction=0.02, pad=0.01, label="(frame - truth) / truth, % (per pixel)")
     if title:
         fig.suptitle(title, fontsize=9)
     try:
@@ -174,6 +284,23 @@ def error_map_sheet(maps: dict[str, dict[str, np.ndarray]], path: Path, title: s
 
 def _pct(v) -> str:
     return "" if v is None or not isinstance(v, (int, float)) or not math.isfinite(v) else f"{100 * v:.1f} %"
+
+
+TRUTH_BLOCK_KEY = "truth_rel_l1_block"
+
+
+def _finite(v) -> bool:
+    return isinstance(v, (int, float)) and math.isfinite(v)
+
+
+def _pm(r: dict, key: str, pct: bool) -> str:
+    v, s = r.get(key), r.get(f"{key}_sigma")
+    if not _finite(v):
+        return ""
+    mark = "= " if r.get("ties_best") in ("best", "tie") and key == r.get("_rank_key", TRUTH_BLOCK_KEY) else ""
+    if pct:
+        return mark + f"{100 * v:.1f}" + (f" +- {100 * s:.1f}" if _finite(s) else "") + " %"
+    return mark + f"{v:.3f}" + (f" +- {s:.3f}" if _finite(s) else "")
 
 
 def _blocks(r: dict) -> str:
@@ -199,10 +326,14 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
             else "one sample at each pixel's centre"
         )
         + ") and compared with the scene "
-        f"path-traced by Mitsuba 3 (volpathmis, {t['spp']} spp in {t['passes']} passes; `skinlab reference`, "
+        f"path-traced by Mitsuba 3 (volpathmis, at least {t['spp']} spp in {t['passes']} passes: every pass cached "
+        "for it counts, the table below has each truth's own; `skinlab reference`, "
         "docs/ground-truth.md): relative L1 of linear radiance over the object on 4x4-pixel blocks (per pixel in "
         "the per-scene tables). `noise` is the reference's own noise floor: the same measure between the halves "
-        "of its passes (the full reference is about half as noisy); differences below it are not resolved.",
+        "of its passes (the full reference is about half as noisy); differences below it are not resolved. Every "
+        "error is given with its standard error from the truth's passes (the delete-a-group jackknife over up to "
+        "8 groups of passes, skinlab/truth/metrics.py); two settings are told apart when their errors differ by "
+        "more than twice the standard error of the difference.",
         "",
     ]
     for scene, why in (t.get("missing") or {}).items():
@@ -214,26 +345,60 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
     scenes = [s for s in dict.fromkeys(r["scene"] for r in rows) if s not in (t.get("missing") or {})]
     if not scenes:
         return [*L, ""]
-    noise = {
-        s: next((r.get("truth_noise_block") for r in rows if r["scene"] == s and r.get("truth_noise_block")), None)
-        for s in scenes
-    }
-    # the time is the timed frames' (at the ledger's size, as users render them: no supersampling)
-    L.append(
-        "| setting | " + " | ".join(f"{s} (noise {_pct(noise[s])})" for s in scenes) + " | mean ms (timed, 1 spp) |"
-    )
-    L.append("|---|" + "---|" * (len(scenes) + 1))
+    per_scene = t.get("scenes") or {}
+    if per_scene:
+        L += [
+            "The truths (each the mean of its passes; spp and path-tracing time are what the cached reference took, "
+            "summed over the runs that rendered its passes; the edge region is where the edge errors are measured):",
+            "",
+            "| scene | tests | spp | passes | path tracing s | noise px | noise 4x4 | edge region |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
+        for sc, d in per_scene.items():
+            edge = (
+                f"{d['edge_pixels']} px within {d['edge_mm']:.1f} mm of the {d['edge_from']} edges"
+                if d.get("edge_pixels")
+                else "none found"
+            )
+            sec = d.get("seconds")
+            L.append(
+                f"| {sc} | {d.get('tests') or ''} | {d.get('spp')} | {d.get('passes')} | "
+                f"{'' if sec is None else f'{sec:.0f}'} | {_pct(d.get('noise'))} | {_pct(d.get('noise_block'))} | "
+                f"{edge} |"
+            )
+        L.append("")
     by_label: dict[str, dict] = {}
     for r in rows:
         by_label.setdefault(r["setting"], {})[r["scene"]] = r
-    for labl, per in by_label.items():
-        cells = [_pct(per[s].get("truth_rel_l1_block")) if s in per else "" for s in scenes]
-        ms = [per[s].get("frame_ms_median") for s in scenes if s in per]
-        ms = [m for m in ms if isinstance(m, (int, float)) and math.isfinite(m)]
-        mean_ms = f"{sum(ms) / len(ms):.1f}" if ms else ""
-        L.append(f"| {labl} | " + " | ".join(cells) + f" | {mean_ms} |")
+    for key, what, pct in (
+        ("truth_rel_l1_block", "relative L1 on 4x4 blocks", True),
+        ("truth_rel_l1", "relative L1 per pixel", True),
+        ("truth_flip", "FLIP mean (tone-mapped)", False),
+        ("truth_edge_rel_l1", "relative L1 per pixel within the edge region", True),
+        ("truth_profile_err", "relative L1 of the profile across the declared line or edge", True),
+    ):
+        have = [s for s in scenes if any(_finite(r.get(key)) for r in rows if r["scene"] == s)]
+        if not have:
+            continue
+        noise = {
+            s: next((r.get("truth_noise_block") for r in rows if r["scene"] == s and r.get("truth_noise_block")), None)
+            for s in have
+        }
+        L.append(f"**{what}** (+- its standard error from the truth's passes; `=` marks the best and the settings "
+                 "the noise cannot tell from it):")  # fmt: skip
+        L.append("")
+        head = " | ".join(f"{s} (noise {_pct(noise[s])})" if key == TRUTH_BLOCK_KEY else s for s in have)
+        # the time is the timed frames' (at the ledger's size, as users render them: no supersampling)
+        L.append("| setting | " + head + " | mean ms (timed, 1 spp) |")
+        L.append("|---|" + "---|" * (len(have) + 1))
+        for labl, per in by_label.items():
+            cells = [_pm(per[s], key, pct) if s in per else "" for s in have]
+            ms = [per[s].get("frame_ms_median") for s in have if s in per]
+            ms = [m for m in ms if isinstance(m, (int, float)) and math.isfinite(m)]
+            mean_ms = f"{sum(ms) / len(ms):.1f}" if ms else ""
+            L.append(f"| {labl} | " + " | ".join(cells) + f" | {mean_ms} |")
+        L.append("")
     L += [
-        "",
         f"{JUDGE_BLOCK}x{JUDGE_BLOCK}-pixel blocks more than {100 * JUDGE_TOL:.0f} % off the truth (luminance) of "
         f"those its noise allows to judge (half-to-half block noise below {100 * JUDGE_NOISE:.0f} %, not dark): "
         "over / judged.",

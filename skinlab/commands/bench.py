@@ -101,11 +101,16 @@ def register(sub) -> None:
     acc.add_argument(
         "--out",
         required=True,
-        help="output folder (ledger.csv, ledger.md, ledger.json, pareto.png, cost.png, images/, mc_cache/)",
+        help="output folder (ledger.csv, ledger.md, ledger.html, ledger.json, pareto.png, cost.png, profiles.png, "
+        "error_maps/, flip_maps/, images/, mc_cache/)",
     )
     acc.add_argument("--quick", action="store_true", help="a subset at 160x160 (a few minutes at most on 2 cores)")
     acc.add_argument("--tiny", action="store_true", help=argparse.SUPPRESS)  # tests: 4 settings, head, 64x64
     full, quick = SWEEPS["full"], SWEEPS["quick"]
+    from skinlab.bench.sweep import base_setting, reference_technique
+
+    ref = reference_technique()
+    ref_size = {n: base_setting(ref, SWEEPS[n]).value("size") if ref else None for n in ("full", "quick")}
     acc.add_argument(
         "--size",
         default=None,
@@ -141,8 +146,8 @@ def register(sub) -> None:
         "--exact-size",
         type=int,
         default=None,
-        help=f"irradiance texels per side of the exact reference (default {full.exact_size}; "
-        f"--quick {quick.exact_size})",
+        help=f"irradiance texels per side of the exact reference (default {ref_size['full']}; "
+        f"--quick {ref_size['quick']})",
     )
     acc.add_argument("--no-peer", action="store_true", help="skip the pyrender comparison")
     acc.add_argument("--no-images", action="store_true", help="do not write images/SCENE-SETTING.png")
@@ -277,7 +282,7 @@ def accuracy_sweep_from_args(args):
     if args.exact_size is not None:
         if not 16 <= args.exact_size <= 8192:
             raise ValueError(f"--exact-size: expected texels per side in [16, 8192], got {args.exact_size}")
-        over["exact_size"] = args.exact_size
+        over["reference_values"] = (("size", args.exact_size),)  # the image reference's base setting
     if args.scenes is not None:
         names = tuple(s.strip() for s in args.scenes.split(",") if s.strip())
         if not names:
@@ -323,6 +328,11 @@ def run_accuracy_bench(args) -> int:
         references=args.references,
     )
     rows = res["rows"]
+    truth = res["meta"].get("truth") or {}
+    for scene, why in (truth.get("missing") or {}).items():
+        print(f"  {scene}: not measured against the path-traced truth: {why}")
+    if truth and res["error_axis"] != "truth_rel_l1_block":
+        print("  the ranks and recommendations are against the exact convolution, not the truth (see ledger.md)")
     n_ok = sum(r["status"] == "ok" for r in rows)
     print(f"{res['meta']['gl']}: {len(rows)} settings ({n_ok} ok) in {res['meta']['total_s']:.1f} s")
     for r in rows:

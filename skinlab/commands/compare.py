@@ -120,19 +120,11 @@ def finite_json(v):
     return v
 
 
-def flip_rgb(fmap):
-    """uint8 RGB of a FLIP map (magma, 0 to 1)."""
-    import matplotlib
-    import numpy as np
-
-    return (matplotlib.colormaps["magma"](np.clip(fmap, 0, 1))[..., :3] * 255).astype(np.uint8)
-
-
 def run(args) -> int:
     import math
 
     from skinlab.image_output import check_output_path, write_image
-    from skinlab.truth.compare import error_map_rgb
+    from skinlab.truth.compare import error_map_rgb, magma_rgb
 
     if not (args.exposure > 0 and math.isfinite(args.exposure)):
         raise ValueError(f"--exposure: expected a number > 0, got {args.exposure}")
@@ -148,7 +140,7 @@ def run(args) -> int:
     if out is not None:
         written.append(str(write_image(out, error_map_rgb(res["relative_map"])).resolve()))
         flip_out = out.with_name(out.stem + "-flip.png")
-        written.append(str(write_image(flip_out, flip_rgb(res["flip_map"])).resolve()))
+        written.append(str(write_image(flip_out, magma_rgb(res["flip_map"])).resolve()))
     doc = {
         "a": str(args.a),
         "b": str(args.b),

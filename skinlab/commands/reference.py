@@ -151,16 +151,15 @@ def noise_level(text: str) -> float:
 
 def noise_map_rgb(ref):
     """uint8 RGB: the full reference's relative standard error per pixel (magma, 0 to 10 %), grey outside."""
-    import matplotlib
     import numpy as np
 
-    from skinlab.truth.compare import REC709, object_mask
+    from skinlab.truth.compare import REC709, magma_rgb, object_mask
 
     se = ref.pass_set.standard_error()
     lum = ref.image[..., :3].astype(np.float64) @ REC709
     m = object_mask(ref.image) & (lum > 0)
     rel = np.where(m, se / np.where(m, lum, 1.0), np.nan)
-    rgb = (matplotlib.colormaps["magma"](np.clip(np.nan_to_num(rel) / 0.1, 0, 1))[..., :3] * 255).astype(np.uint8)
+    rgb = magma_rgb(np.nan_to_num(rel) / 0.1)
     rgb[~m] = (40, 40, 40)
     return rgb
 

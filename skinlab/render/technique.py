@@ -112,13 +112,35 @@ class TechniquePlan:
 
 
 @dataclass(frozen=True)
+class LedgerSweep:
+    """The settings the accuracy ledger measures for a technique in one sweep preset ("full",
+    "quick", "tiny"): ``base`` fixes settings fields (the others keep their defaults); each of
+    ``axes`` (field -> values) is varied alone from the base. The base itself is always measured."""
+
+    base: dict[str, Any] = field(default_factory=dict)
+    axes: dict[str, tuple] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
 class LedgerStyle:
-    """How the accuracy ledger names, tabulates and plots a technique's settings."""
+    """How the accuracy ledger measures, names, tabulates and plots a technique's settings
+    (skinlab/bench/sweep.py reads it; nothing there names a technique)."""
 
     marker: str  # matplotlib marker
     colour: str
     columns: dict[str, str] = field(default_factory=dict)  # ledger CSV column -> settings field
-    label: str = ""  # setting label, str.format over the columns (None shows as "auto"); "" = the name
+    label: str = ""  # setting label, str.format over the settings fields (None shows as "auto"); "" = the name
+    # per sweep preset, the settings measured; a preset not named: the default settings once (where the
+    # preset measures every technique)
+    sweep: dict[str, LedgerSweep] = field(default_factory=dict)
+    reference: bool = False  # its base setting is the ledger's image reference (measured first)
+    # a stand-in reference where none renders: its setting with the largest values of these fields
+    # (in this order; None counts as largest)
+    proxy: tuple[str, ...] = ()
+    # cost slopes: field -> (what the cost scales with, power), e.g. size -> ("texels", 2): log time
+    # against log(size^2) over that axis
+    cost_axes: dict[str, tuple[str, float]] = field(default_factory=dict)
+    levels: str = ""  # a pass kind whose count the ledger reports as `blur_levels` (0: the frame blurs nothing)
 
 
 class Technique:

@@ -153,3 +153,10 @@ def error_map_rgb(diff: np.ndarray, scale: float = MAP_SCALE) -> np.ndarray:
     rgb = (cmap(t)[..., :3] * 255).astype(np.uint8)
     rgb[np.isnan(diff)] = (40, 40, 40)
     return rgb
+
+
+def magma_rgb(fmap: np.ndarray) -> np.ndarray:
+    """uint8 RGB of values in [0, 1] (magma): FLIP maps (skinlab/truth/metrics.py), noise maps."""
+    import matplotlib
+
+    return (matplotlib.colormaps["magma"](np.clip(np.nan_to_num(fmap), 0, 1))[..., :3] * 255).astype(np.uint8)

@@ -16,7 +16,7 @@ from skinlab.gl.uniforms import set_uniform
 from skinlab.render.frame_plan import FramePlan, PlannedPass
 from skinlab.render.options import TechniqueSettings, option
 from skinlab.render.scattering import scattering_material
-from skinlab.render.technique import ForwardHook, LedgerStyle, PlanContext, Technique, TechniquePlan
+from skinlab.render.technique import ForwardHook, LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from skinlab.scene.optics.disk import MAX_DISK_PROFILES, MAX_DISK_SAMPLES, disk_edge_response, disk_kernel
 from skinlab.scene.optics.tsd import material_medium
@@ -90,7 +90,13 @@ class DiskTechnique(Technique):
     description = "importance-sampled Burley disk SSS in screen space (Golubev 2018; HDRP, EEVEE Next)"
     settings_type = DiskSettings
     passes = {"disk_sss": DiskPass}
-    ledger = LedgerStyle("P", "tab:red", {"disk_samples": "samples"}, "disk {disk_samples}")
+    ledger = LedgerStyle(
+        "P",
+        "tab:cyan",
+        {"disk_samples": "samples"},
+        "disk {samples}",
+        sweep={"full": LedgerSweep(axes={"samples": (8, 16, 32, 64)}), "quick": LedgerSweep(axes={"samples": (8, 32)})},
+    )
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options

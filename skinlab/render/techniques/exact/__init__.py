@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 from skinlab.render.frame_plan import FramePlan
 from skinlab.render.options import TechniqueSettings, option
-from skinlab.render.technique import LedgerStyle, PlanContext, Technique, TechniquePlan
+from skinlab.render.technique import LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.render.techniques.tsd import PASSES as TSD_PASSES
 from skinlab.render.techniques.tsd.forward import TsdForward
 from skinlab.render.techniques.tsd.passes import STATE_KEY, TsdStore
@@ -41,7 +41,19 @@ class ExactTechnique(Technique):
     settings_type = ExactSettings
     passes = {**TSD_PASSES, "tsd_exact": TsdExactPass}
     state = (STATE_KEY, TsdStore)  # texture-space diffusion's per-mesh textures, shared
-    ledger = LedgerStyle("*", "black", {"tsd_size": "size"}, "exact {tsd_size}")
+    ledger = LedgerStyle(
+        "*",
+        "black",
+        {"tsd_size": "size"},
+        "exact {size}",
+        sweep={  # the reference at its base size; the smaller sizes show the irradiance texture's own error
+            "full": LedgerSweep({"size": 1024}, {"size": (256, 512)}),
+            "quick": LedgerSweep({"size": 256}),
+            "tiny": LedgerSweep({"size": 256}),
+        },
+        reference=True,
+        levels="tsd_blur",
+    )
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from skinlab.render.options import TechniqueSettings
-from skinlab.render.technique import LedgerStyle, PlanContext, Technique, TechniquePlan
+from skinlab.render.technique import LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 
 
 @dataclass(frozen=True)
@@ -18,7 +18,7 @@ class NoneTechnique(Technique):
     name = "none"
     description = "no subsurface scattering: plain Burley diffuse (the lower bound)"
     settings_type = NoneSettings
-    ledger = LedgerStyle("X", "tab:red")
+    ledger = LedgerStyle("X", "tab:red", sweep={"tiny": LedgerSweep()})  # tiny too: the baselines
     scatters = False
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:

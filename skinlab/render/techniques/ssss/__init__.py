@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from skinlab.gl.uniforms import set_uniform
 from skinlab.render.frame_plan import FramePlan, PlannedPass
 from skinlab.render.options import TechniqueSettings, option
-from skinlab.render.technique import ForwardHook, LedgerStyle, PlanContext, Technique, TechniquePlan
+from skinlab.render.technique import ForwardHook, LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from skinlab.scene.optics.edges import separable_edge
 
@@ -66,7 +66,13 @@ class SsssTechnique(Technique):
     description = "screen-space separable SSS (Jimenez et al.): a post-process blur of the diffuse light"
     settings_type = SsssSettings
     passes = {"ssss_blur": SsssBlurPass}
-    ledger = LedgerStyle("s", "tab:orange", {"ssss_taps": "taps"}, "ssss {ssss_taps}")
+    ledger = LedgerStyle(
+        "s",
+        "tab:orange",
+        {"ssss_taps": "taps"},
+        "ssss {taps}",
+        sweep={"full": LedgerSweep(axes={"taps": (11, 17, 25)}), "quick": LedgerSweep(axes={"taps": (11, 25)})},
+    )
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options

@@ -9,7 +9,15 @@ from dataclasses import dataclass, field
 from skinlab.gl.uniforms import set_uniform
 from skinlab.render.options import TechniqueSettings
 from skinlab.render.scattering import scattering_material
-from skinlab.render.technique import ForwardHook, LedgerStyle, NodeShading, PlanContext, Technique, TechniquePlan
+from skinlab.render.technique import (
+    ForwardHook,
+    LedgerStyle,
+    LedgerSweep,
+    NodeShading,
+    PlanContext,
+    Technique,
+    TechniquePlan,
+)
 from skinlab.scene.optics.tsd import material_medium, profile_tint
 
 HOOK = "techniques/tint/forward.glsl"
@@ -40,7 +48,7 @@ class TintTechnique(Technique):
     name = "tint"
     description = "per-pixel profile tint without convolution (the original study's baseline)"
     settings_type = TintSettings
-    ledger = LedgerStyle("^", "tab:green")
+    ledger = LedgerStyle("^", "tab:green", sweep={"tiny": LedgerSweep()})  # tiny too: the baselines
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         tints = {}

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 from skinlab.render.frame_plan import FramePlan
 from skinlab.render.options import TechniqueSettings, option
-from skinlab.render.technique import LedgerStyle, PlanContext, Technique, TechniquePlan
+from skinlab.render.technique import LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.scene.optics.edges import gaussians_edge, step_edge
 
 from .forward import TsdForward
@@ -64,7 +64,23 @@ class TsdTechnique(Technique):
     passes = PASSES
     state = (STATE_KEY, TsdStore)
     ledger = LedgerStyle(
-        "o", "tab:blue", {"K": "gaussians", "tsd_size": "size", "taps": "taps"}, "tsd K{K} {tsd_size} {taps}"
+        "o",
+        "tab:blue",
+        {"K": "gaussians", "tsd_size": "size", "taps": "taps"},
+        "tsd K{gaussians} {size} {taps}",
+        sweep={
+            "full": LedgerSweep(
+                {"size": 1024, "gaussians": 6},
+                {"gaussians": (1, 2, 3, 4, 5, 6), "size": (256, 512, 1024, 2048), "taps": (None, 7, 15, 31)},
+            ),
+            "quick": LedgerSweep(
+                {"size": 256, "gaussians": 6}, {"gaussians": (1, 3, 6), "size": (256, 512), "taps": (None, 7)}
+            ),
+            "tiny": LedgerSweep({"size": 256, "gaussians": 6}, {"gaussians": (1, 6)}),
+        },
+        proxy=("size", "gaussians", "taps"),
+        cost_axes={"size": ("texels", 2.0), "gaussians": ("K", 1.0)},
+        levels="tsd_blur",
     )
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
