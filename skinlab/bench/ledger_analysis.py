@@ -42,15 +42,11 @@ def sigma(r: dict, key: str) -> float:
 
 
 def difference_sigma(a: dict, b: dict, key: str) -> float:
-    """The standard error of a[key] - b[key]: paired over the truth's jackknife groups where both rows
-    have them (the noise they share cancels), else from the two uncertainties."""
-    from skinlab.truth.metrics import paired_sigma
-
-    ja, jb = (a.get("jackknife") or {}).get(key), (b.get("jackknife") or {}).get(key)
-    if ja and jb and len(ja) == len(jb):
-        s = paired_sigma(ja, jb)
-        if math.isfinite(s):
-            return s
+    """The standard error of a[key] - b[key] from the two uncertainties, sqrt(sigma_a^2 + sigma_b^2):
+    conservative (both are measured against the same truth, so part of its noise is shared; the
+    per-group values, ``jackknife``, give the paired figure, skinlab/truth/metrics.py paired_sigma, which
+    tells deterministic differences of a few hundredths of a per cent apart: real, but not what a ranking
+    should turn on)."""
     return math.hypot(sigma(a, key), sigma(b, key))
 
 
@@ -184,7 +180,7 @@ def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS, key: str 
             return False
         if best[s] is None:
             return r[key] <= floor[s] + tau
-        return r[key] - floor[s] - tau <= TIE_SIGMAS * difference_sigma(r, best[s], key)
+        return r[key] <= floor[s] + tau + TIE_SIGMAS * difference_sigma(r, best[s], key)
 
     dflt = default_technique()
     levels = get_technique(dflt).ledger.levels

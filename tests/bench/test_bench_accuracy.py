@@ -53,7 +53,7 @@ def read_rows(path):
 def test_csv_structure(tiny):
     out, _ = tiny
     header, rows = read_rows(out / "ledger.csv")
-    assert header == acc.CSV_COLUMNS
+    assert header == acc.csv_columns()
     settings = acc.sweep_settings(acc.TINY)
     assert [r["setting"] for r in rows] == [s.label for s in settings]  # one row per setting, in order
     assert {r["scene"] for r in rows} == {HEAD}
@@ -105,7 +105,7 @@ def test_markdown_json_and_figures(tiny):
         "mean ms (timed, 1 spp)",
         "| setting | technique | model |",
         "## Cost slopes",
-        "frame vs texels",
+        "| scene | series | frame vs it |",
         "## Peer: pyrender",
         "## Recommended defaults",
         "Rule:",
@@ -113,8 +113,9 @@ def test_markdown_json_and_figures(tiny):
         assert needle in md, needle
     assert md.index("## Recommended defaults") > md.index("## Cost slopes")
     table = [line for line in md.splitlines() if line.startswith("| ") and f" | {HEAD}" not in line]
-    # each setting in the per-scene table and in the two tables against the truth (error, 8x8 blocks)
-    assert sum(line.startswith(f"| {s.label} |") for s in acc.sweep_settings(acc.TINY) for line in table) == 15
+    # each setting in the per-scene table and in the tables against the truth (4x4, per pixel, FLIP, the edge
+    # region, 8x8 blocks; no profile: the head declares none)
+    assert sum(line.startswith(f"| {s.label} |") for s in acc.sweep_settings(acc.TINY) for line in table) == 30
     doc = json.loads((out / "ledger.json").read_text())
     assert len(doc["rows"]) == 5 and doc["meta"]["sweep"] == "tiny" and HEAD in doc["pareto"]
     assert doc["error_axis"] == "truth_rel_l1_block" and doc["meta"]["truth"]["missing"] == {}
@@ -128,8 +129,39 @@ def test_markdown_json_and_figures(tiny):
     maps = sorted((out / "error_maps").glob(f"{HEAD}-*.png"))
     assert len(maps) == 5 and all(read_image(m).shape[:2] == (32, 32) for m in maps)
     assert not [p for p in out.rglob(".*") if p.is_file()]  # no temporary files left behind
-    for name in ("ledger.csv", "ledger.md", "ledger.json", "pareto.png", "cost.png", "error_maps.png"):
+    for name in ("ledger.csv", "ledger.md", "ledger.html", "ledger.json", "pareto.png", "cost.png", "error_maps.png"):
         assert str((out / name).resolve()) in res.stdout
+    flips = sorted((out / "flip_maps").glob(f"{HEAD}-*.png"))
+    assert len(flips) == 5 and all(read_image(m).shape[:2] == (32, 32) for m in flips)
+
+
+def test_html_report_is_self_contained_with_narrow_tables(tiny):
+    import re
+
+    out, _ = tiny
+    page = (out / "ledger.html").read_text()
+    assert page.startswith("<!doctype html>") and page.rstrip().endswith("</html>")
+    srcs = re.findall(r'<img[^>]* src="([^"]+)"', page)
+    assert srcs and all(s.startswith("data:image/png;base64,") for s in srcs)  # every figure inlined
+    for table in re.findall(r"<table>(.*?)</table>", page, re.S):
+        header = re.search(r"<tr>(.*?)</tr>", table, re.S).group(1)
+        assert header.count("<th>") <= 10
+    assert f"<h2>{HEAD}</h2>" in page and "Recommended defaults" in page
+
+
+def test_rows_carry_uncertainties_and_ranks(tiny):
+    out, _ = tiny
+    doc = json.loads((out / "ledger.json").read_text())
+    rows = doc["rows"]
+    for r in rows:
+        for key in ("truth_rel_l1", "truth_rel_l1_block", "truth_flip", "truth_edge_rel_l1"):
+            assert r[key] is not None and r[f"{key}_sigma"] is not None and r[f"{key}_sigma"] >= 0, (r["setting"], key)
+            # the jackknife's per-group values: two groups for a 2-pass truth
+            assert len(r["jackknife"][key]) == 2
+        assert 0 <= r["truth_flip"] <= 1 and r["truth_edge_pixels"] > 0
+        assert r["truth_spp"] == 16 and r["truth_passes"] == 2
+    assert sum(r["ties_best"] == "best" for r in rows) == 1
+    assert doc["meta"]["truth"]["scenes"][HEAD]["edge_from"] == "plain frame"
 
 
 def test_truth_section_says_how_the_compared_frames_were_sampled():
@@ -144,7 +176,7 @@ def test_truth_section_says_how_the_compared_frames_were_sampled():
 
 def test_without_a_cached_reference_the_ledger_says_how_to_make_it(ctx, tmp_path, monkeypatch):
     monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path / "empty-cache"))
-    sweep = replace(acc.TINY, ks=(6,), frames=1, warmup=1)
+    sweep = replace(acc.TINY, frames=1, warmup=1)
     res = acc.run_sweep(sweep, tmp_path, peer=False, progress=False, images=False)
     assert all(math.isnan(r.get("truth_rel_l1_block", math.nan)) for r in res["rows"])
     assert res["error_axis"] == "image_rel_l1"  # falls back to the exact convolution
@@ -154,8 +186,8 @@ def test_without_a_cached_reference_the_ledger_says_how_to_make_it(ctx, tmp_path
 
 
 def test_failing_setting_is_an_error_row_and_the_sweep_goes_on(ctx, tmp_path):
-    bad = acc.Setting("ssss", ssss_taps=4)  # RenderSettings refuses an even tap count
-    sweep = replace(acc.TINY, ks=(6,), extra=(bad,), frames=1, warmup=1)
+    bad = acc.Setting.of("ssss", taps=4)  # RenderSettings refuses an even tap count
+    sweep = replace(acc.TINY, extra=(bad,), frames=1, warmup=1)
     res = acc.run_sweep(sweep, tmp_path, peer=False, progress=False, images=False)
     rows = {r["setting"]: r for r in res["rows"]}
     assert rows[bad.label]["status"] == "error" and "ssss setting taps" in rows[bad.label]["error"]
@@ -197,7 +229,7 @@ def test_pareto_front_and_recommendation_rule():
     recs = {r["threshold"]: r for r in acc.recommendations(rows, (0.01, 0.05, 0.001))}
     assert recs[0.01]["best"][1] == "z"  # y fails in scene a; z is within 1 % in both
     assert recs[0.05]["best"][1] == "x"
-    assert recs[0.001]["best"][1] == "ref" and recs[0.001]["best_tsd"] is None
+    assert recs[0.001]["best"][1] == "ref" and recs[0.001]["best_default"] is None
     # against the truth the budget counts from each scene's best setting
     for r in rows:
         r["truth_rel_l1_block"] = r["image_rel_l1"] + (0.12 if r["scene"] == "a" else 0.10)
@@ -263,3 +295,77 @@ def test_accuracy_registered_beside_peer_and_reload():
     assert res.returncode == 0 and "--quick" in res.stdout and "--scenes" in res.stdout and "--tiny" not in res.stdout
     for sub in ("peer", "reload"):
         assert cli(sub, "--help", timeout=60).returncode == 0
+
+
+def test_ranks_tell_apart_only_differences_larger_than_the_noise():
+    """Two settings whose errors differ by less than twice the standard error of their difference are
+    ties: not separate Pareto points, not a reason to recommend the dearer one; identical images tie."""
+    from skinlab.bench.ledger_analysis import mark_ties, told_apart
+
+    key = "truth_rel_l1_block"
+
+    def row(label, ms, err, sigma, tech="tsd", **kw):
+        return {"scene": "s", "setting": label, "technique": tech, "status": "ok", "frame_ms_median": ms,
+                key: err, f"{key}_sigma": sigma, **kw}  # fmt: skip
+
+    cheap = row("cheap", 1.0, 0.100, 0.003)
+    # 0.4 % better, but the noise of the difference (0.0042) is larger: a tie
+    close = row("close", 2.0, 0.096, 0.003)
+    # 3 % better: told apart
+    far = row("far", 3.0, 0.070, 0.003)
+    same = row("same", 4.0, 0.070, 0.003, same_image_as="far")
+    rows = [cheap, close, far, same]
+    assert not told_apart(cheap, close, key) and told_apart(cheap, far, key)
+    assert not told_apart(far, same, key)  # identical errors never differ
+    assert [r["setting"] for r in acc.pareto_front(rows, key)] == ["cheap", "far"]
+    mark_ties(rows, key)
+    assert far["ties_best"] == "best" and cheap["ties_best"] == "" and same["ties_best"] == ""
+    recs = {r["threshold"]: r for r in acc.recommendations(rows, (0.0, 0.02, 0.03), key=key)}
+    assert recs[0.0]["best"][1] == "far"
+    assert recs[0.02]["best"][1] == "close"  # within 2 % of the best once the noise is allowed
+    assert recs[0.03]["best"][1] == "cheap"
+
+
+def test_sweep_settings_come_from_the_techniques_declarations():
+    """A technique joins the ledger through its LedgerStyle alone: its declared base and axes, or its
+    defaults once; the ledger columns come from the registry."""
+    from skinlab.bench.sweep import Setting, declared_settings, setting_columns, sweep_settings
+    from skinlab.render import registry
+    from skinlab.render.options import TechniqueSettings, option
+    from skinlab.render.technique import LedgerStyle, LedgerSweep, Technique
+
+    full = sweep_settings(acc.SWEEPS["full"])
+    assert full[0] == Setting.of("exact", size=1024)  # the image reference first
+    assert len(full) == len(set(full))
+    labels = [s.label for s in full]
+    assert {"tsd K1 1024 auto", "tsd K6 2048 auto", "tsd K6 1024 31", "ssss 11", "disk 64", "exact 256"} <= set(labels)
+    assert Setting.of("tsd", size=1024, gaussians=6) == Setting.of("tsd", size=1024, gaussians=6, taps=None)
+    with pytest.raises(ValueError, match="albedo_mix"):
+        Setting.of("tsd", albedo_mix=0.2)  # not a ledger column of tsd
+
+    from dataclasses import dataclass
+
+    @dataclass(frozen=True)
+    class WobbleSettings(TechniqueSettings):
+        technique = "wobble"
+        width: int = option(3, "wobble width", "int", range=(1, 9))
+
+    class Wobble(Technique):
+        name = "wobble"
+        settings_type = WobbleSettings
+        ledger = LedgerStyle("h", "tab:olive", {"wobble_width": "width"}, "wobble {width}",
+                             sweep={"quick": LedgerSweep(axes={"width": (1, 9)})})  # fmt: skip
+
+    registry.register(Wobble())
+    try:
+        assert "wobble_width" in setting_columns() and "wobble_width" in acc.csv_columns()
+        assert [s.label for s in declared_settings("wobble", acc.SWEEPS["quick"])] == [
+            "wobble 3",
+            "wobble 1",
+            "wobble 9",
+        ]
+        assert [s.label for s in declared_settings("wobble", acc.SWEEPS["full"])] == ["wobble 3"]  # its defaults
+        assert declared_settings("wobble", acc.TINY) == []  # the tiny preset measures declared techniques only
+        assert Setting.of("wobble", width=9).cells()["wobble_width"] == 9
+    finally:
+        registry.unregister("wobble")

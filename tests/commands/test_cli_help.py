@@ -46,5 +46,8 @@ def test_accuracy_help_defaults_come_from_the_sweeps():
 
     bench = dict(_subparsers(build_parser()))[("bench", "accuracy")]
     helps = {a.dest: a.help for a in bench._actions}
-    assert f"default {SWEEPS['full'].exact_size}; --quick {SWEEPS['quick'].exact_size}" in helps["exact_size"]
+    from skinlab.bench.sweep import base_setting
+
+    size = {n: base_setting("exact", SWEEPS[n]).value("size") for n in ("full", "quick")}
+    assert f"default {size['full']}; --quick {size['quick']}" in helps["exact_size"]
     assert f"default {SWEEPS['full'].photons}; --quick {SWEEPS['quick'].photons}" in helps["photons"]
