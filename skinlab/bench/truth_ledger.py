@@ -412,8 +412,10 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
     L += [
         "",
         "Error maps: `error_maps/SCENE-SETTING.png` for every setting, `error_maps.png` for one setting per "
-        "technique: (frame - truth) / truth of luminance on 4x4 blocks, red brighter, blue darker, full colour "
-        "at +-50 %.",
+        "technique: (frame - truth) / truth of luminance per pixel (at the truth's size; the truth floored at 1 % "
+        "of its 99th percentile), red brighter, blue darker, full colour at +-50 %; `flip_maps/SCENE-SETTING.png`: "
+        "the FLIP map of the tone-mapped frames (magma, 0 to 1). Per-pixel errors include the truth's own "
+        "per-pixel noise (about half the `noise px` between the halves): a bias the jackknife does not remove.",
         "",
     ]
     return L
