@@ -291,6 +291,18 @@ def accuracy_sweep_from_args(args):
     return replace(sweep, **over)
 
 
+def truth_console_lines(res: dict) -> list[str]:
+    """What the console says about the truth: each scene measured without it, and what the ranks are then against."""
+    truth = res["meta"].get("truth") or {}
+    out = [
+        f"  {scene}: not measured against the path-traced truth: {why}"
+        for scene, why in (truth.get("missing") or {}).items()
+    ]
+    if truth and res["error_axis"] != "truth_rel_l1_block":
+        out.append("  the ranks and recommendations are against the exact convolution, not the truth (see ledger.md)")
+    return out
+
+
 def run_accuracy_bench(args) -> int:
     from skinlab.bench.accuracy import resolve_scene, run_sweep
 
@@ -328,11 +340,8 @@ def run_accuracy_bench(args) -> int:
         references=args.references,
     )
     rows = res["rows"]
-    truth = res["meta"].get("truth") or {}
-    for scene, why in (truth.get("missing") or {}).items():
-        print(f"  {scene}: not measured against the path-traced truth: {why}")
-    if truth and res["error_axis"] != "truth_rel_l1_block":
-        print("  the ranks and recommendations are against the exact convolution, not the truth (see ledger.md)")
+    for line in truth_console_lines(res):
+        print(line)
     n_ok = sum(r["status"] == "ok" for r in rows)
     print(f"{res['meta']['gl']}: {len(rows)} settings ({n_ok} ok) in {res['meta']['total_s']:.1f} s")
     for r in rows:

@@ -181,6 +181,12 @@ def test_without_a_cached_reference_the_ledger_says_how_to_make_it(ctx, tmp_path
     assert all(math.isnan(r.get("truth_rel_l1_block", math.nan)) for r in res["rows"])
     assert res["error_axis"] == "image_rel_l1"  # falls back to the exact convolution
     assert "--references" in (tmp_path / "ledger.md").read_text()
+    from skinlab.commands.bench import truth_console_lines
+
+    lines = truth_console_lines(res)  # the console says so too, not only the file
+    assert any(HEAD in line and "--references" in line for line in lines)
+    assert any("against the exact convolution" in line for line in lines)
+    assert "Not measured against the path-traced truth" in (tmp_path / "ledger.html").read_text()
     refs = tmp_path / "empty-cache" / "reference"  # no reference was rendered (tables may be cached beside it)
     assert not refs.exists() or not any(refs.rglob("*.npz"))
 
