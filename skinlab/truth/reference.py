@@ -136,14 +136,18 @@ def set_variant(variant: str):
     return mi
 
 
-def reference_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_version: str) -> str:
+def _content_key(desc: ReferenceDescription, head: dict) -> str:
     h = hashlib.sha256()
-    h.update(json.dumps({"export": EXPORT_VERSION, "mitsuba": mitsuba_version, "request": asdict(req)}).encode())
+    h.update(json.dumps(head).encode())
     h.update(json.dumps(desc.content(), sort_keys=True, default=float).encode())
     for a in desc.arrays():
         h.update(str(a.shape).encode())
         h.update(np.ascontiguousarray(a).tobytes())
     return h.hexdigest()[:24]
+
+
+def reference_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_version: str) -> str:
+    return _content_key(desc, {"export": EXPORT_VERSION, "mitsuba": mitsuba_version, "request": asdict(req)})
 
 
 def load_cached(key: str) -> Reference | None:
@@ -163,13 +167,7 @@ def load_cached(key: str) -> Reference | None:
 def series_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_version: str) -> str:
     """The key of the pass series `req` belongs to: everything but the samples and the passes."""
     what = {k: v for k, v in asdict(req).items() if k not in ("spp", "passes")}
-    h = hashlib.sha256()
-    h.update(json.dumps({"series": 1, "export": EXPORT_VERSION, "mitsuba": mitsuba_version, "request": what}).encode())
-    h.update(json.dumps(desc.content(), sort_keys=True, default=float).encode())
-    for a in desc.arrays():
-        h.update(str(a.shape).encode())
-        h.update(np.ascontiguousarray(a).tobytes())
-    return h.hexdigest()[:24]
+    return _content_key(desc, {"series": 1, "export": EXPORT_VERSION, "mitsuba": mitsuba_version, "request": what})
 
 
 def pass_store(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_version: str, use_cache: bool = True):
