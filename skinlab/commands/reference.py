@@ -105,7 +105,9 @@ def run(args) -> int:
         "key": ref.key,
     }
     if args.json:
-        print(json.dumps(result, indent=1))
+        from skinlab.commands.compare import finite_json
+
+        print(json.dumps(finite_json(result), indent=1, allow_nan=False))  # NaN (nothing in view) as null
         return 0
     for n in ref.meta["notes"]:
         print(f"note: {n}")
