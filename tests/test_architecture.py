@@ -81,7 +81,7 @@ def test_worked_example_is_measured_by_the_ledger(lambert):
     from skinlab.bench import sweep
 
     row = next(s for s in sweep.sweep_settings(sweep.QUICK) if s.technique == "lambert")
-    assert row.label == "lambert" and row.cells() == dict.fromkeys(sweep.SETTING_COLUMNS, "")
+    assert row.label == "lambert" and row.cells() == dict.fromkeys(sweep.setting_columns(), "")
     st = row.render_settings(sweep.QUICK)
     assert st.technique_name == "lambert" and st.technique.strength == 1.0 and st.size == sweep.QUICK.size
     assert "lambert" not in {s.technique for s in sweep.sweep_settings(sweep.TINY)}  # the tests' sweep

@@ -162,6 +162,18 @@ def _compare(*args):
                           text=True, timeout=120)  # fmt: skip
 
 
+def cli_in_process(capsys, *args) -> tuple[int, str, str]:
+    """skinlab's main() here (no interpreter start): exit status, stdout, stderr."""
+    from skinlab.cli import main
+
+    try:
+        code = main([str(a) for a in args])
+    except SystemExit as exc:  # argparse's usage errors
+        code = exc.code
+    got = capsys.readouterr()
+    return code, got.out, got.err
+
+
 def test_compare_command_measures_and_writes_maps(tmp_path):
     pytest.importorskip("flip_evaluator")
     ref = _img((0.2, 0.3, 0.4), 16, 12)
@@ -181,7 +193,7 @@ def test_compare_command_measures_and_writes_maps(tmp_path):
     assert r.returncode == 0 and "relative L1 0.00 %" in r.stdout and "FLIP mean 0.0000" in r.stdout
 
 
-def test_compare_command_bad_input_is_one_line(tmp_path):
+def test_compare_command_bad_input_is_one_line(tmp_path, capsys):
     ref = _img(0.5, 8, 8)
     b = _write(tmp_path / "b.exr", ref)
     small = _write(tmp_path / "small.exr", ref[:4])
@@ -195,7 +207,8 @@ def test_compare_command_bad_input_is_one_line(tmp_path):
         ((bad, b), "nan.exr: 1 pixel(s) are NaN or Inf"),
         ((tmp_path / "junk.exr", b), "junk.exr: cannot read it as an image"),
         ((b, b, "--out", tmp_path / "m.txt"), "--out"),
+        ((b, b, "--exposure", "0"), "--exposure"),
     ):
-        r = _compare(*args)
-        assert r.returncode == 2 and says in r.stderr, (args, r.stderr)
-        assert len(r.stderr.strip().splitlines()) == 1 and "Traceback" not in r.stderr
+        code, _, err = cli_in_process(capsys, "compare", *args)
+        assert code == 2 and says in err, (args, err)
+        assert len(err.strip().splitlines()) == 1 and "Traceback" not in err

@@ -90,17 +90,16 @@ def test_passes_add_up_across_runs_and_stop_at_the_noise_asked(tmp_path):
     assert info["passes"] == timed.meta["passes"] and info["spp"] == timed.meta["spp"]
 
 
-def test_bad_progressive_options_are_one_line(tmp_path):
+def test_bad_progressive_options_are_one_line(tmp_path, capsys):
+    from tests.truth.test_metrics import cli_in_process
+
     for args, says in (
         (["--until-noise", "0"], "--until-noise"),
         (["--until-noise", "lots"], "--until-noise"),
         (["--time", "-3"], "--time"),
     ):
-        r = subprocess.run(
-            [sys.executable, "-m", "skinlab.cli", "reference", "--out", str(tmp_path / "x.exr"), *args],
-            capture_output=True, text=True, timeout=120,
-        )  # fmt: skip
-        assert r.returncode == 2 and says in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
+        code, _, err = cli_in_process(capsys, "reference", "--out", tmp_path / "x.exr", *args)
+        assert code == 2 and says in err and len(err.strip().splitlines()) == 1, err
         assert not (tmp_path / "x.exr").exists()
 
 
@@ -111,7 +110,7 @@ def test_a_killed_reference_resumes_from_its_saved_passes(tmp_path):
     scene = ROOT / "skinlab" / "assets" / "scenes" / "reference" / "slab-edge-skin1.toml"
     out = tmp_path / "ref.exr"
     cmd = [sys.executable, "-m", "skinlab.cli", "reference", str(scene), "--out", str(out), "--size", "16x16",
-           "--spp", "1280", "--passes", "40", "--json"]  # fmt: skip
+           "--spp", "384", "--passes", "24", "--json"]  # fmt: skip
     env = {**os.environ, "SKINLAB_CACHE_DIR": str(tmp_path / "cache")}
     proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     passes = tmp_path / "cache" / "reference" / "passes"
@@ -124,11 +123,11 @@ def test_a_killed_reference_resumes_from_its_saved_passes(tmp_path):
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     saved = len(list(passes.glob("*/pass-*.npz")))
-    assert 3 <= saved < 40 and not out.exists()
+    assert 3 <= saved < 24 and not out.exists()
     r = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr
     res = json.loads(r.stdout)
-    assert res["passes"] == 40 and res["passes_rendered"] == 40 - saved and res["spp"] == 1280
+    assert res["passes"] == 24 and res["passes_rendered"] == 24 - saved and res["spp"] == 384
     assert res["render_seconds"] > 0 and res["noise_floor"]["pixels"] > 0
     assert res["pixel_standard_error"]["median"] > 0
     assert out.is_file() and out.with_name("ref-noise.png").is_file()
