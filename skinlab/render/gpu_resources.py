@@ -12,10 +12,11 @@ from skinlab.scene.mesh import Mesh
 from skinlab.scene.optics.preintegrated import vertex_curvature
 from skinlab.scene.textures import load_texture
 
-VERTEX_FORMAT = "3f 3f 2f 4f 1f"
+VERTEX_FORMAT = "3f 3f 2f 4f 1f 4f"
 # in_curvature: per-vertex mean curvature (1/scene unit; skinlab/scene/optics/preintegrated.py), for the
-# techniques that look it up (pre-integrated skin)
-VERTEX_ATTRS = ("in_position", "in_normal", "in_uv", "in_tangent", "in_curvature")
+# techniques that look it up (pre-integrated skin); in_color: the vertex colour (glTF COLOR_0, linear RGBA;
+# 1 where the mesh has none), multiplying the base colour and alpha
+VERTEX_ATTRS = ("in_position", "in_normal", "in_uv", "in_tangent", "in_curvature", "in_color")
 
 
 class GpuMesh:
@@ -29,7 +30,8 @@ class GpuMesh:
         else:
             tan = np.tile(np.array([1, 0, 0, 1], np.float32), (n, 1))
         curv = vertex_curvature(mesh.positions, mesh.normals, mesh.indices)[:, None]
-        data = np.concatenate([mesh.positions, mesh.normals, uv, tan, curv], axis=1).astype(np.float32)
+        col = mesh.colors if mesh.colors is not None else np.ones((n, 4), np.float32)
+        data = np.concatenate([mesh.positions, mesh.normals, uv, tan, curv, col], axis=1).astype(np.float32)
         self.vbo = ctx.buffer(np.ascontiguousarray(data).tobytes())
         self.ibo = ctx.buffer(mesh.indices.astype(np.uint32).tobytes())
         self.count = mesh.indices.size

@@ -26,7 +26,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
     meshes = scene.mesh_nodes()
     lights = scene.lights()
     n = settings.supersample
-    plan = FramePlan([])
+    plan = FramePlan([], warnings=list(getattr(scene, "warnings", ())))  # the scene's own first (loading)
     if len(lights) > settings.max_lights:
         plan.skipped.append(
             (

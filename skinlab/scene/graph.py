@@ -206,6 +206,7 @@ class Scene:
         self.environment = Environment()
         self.source = None  # path of the scene file, if any
         self.measure = None  # what the scene tests (skinlab/scene/measure.py MeasureSpec; a file's [measure])
+        self.warnings: list[str] = []  # what loading met and could not honour (listed by every frame plan)
 
     def add(self, node: Node, parent: Node | None = None) -> Node:
         (parent or self.root).add(node)

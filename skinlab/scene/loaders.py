@@ -1,4 +1,5 @@
-"""Mesh files through trimesh: glTF/GLB (keeping node hierarchy and names), OBJ, PLY."""
+"""Mesh files through trimesh: glTF/GLB (keeping node hierarchy and names, with each primitive's
+material and vertex colours: skinlab/scene/gltf_materials.py), OBJ, PLY."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import numpy as np
 
 from skinlab.cache import content_key, stored
 
+from .gltf_materials import FileMaterial
 from .mesh import Mesh
 
 SUPPORTED = (".glb", ".gltf", ".obj", ".ply", ".stl", ".off")
@@ -20,13 +22,15 @@ class LoadedNode:
     parent: str | None  # None: a root of the file
     matrix: np.ndarray  # local 4x4
     mesh: Mesh | None
+    material: FileMaterial | None = None  # the file's own material for the mesh (glTF), if any
 
 
-_CACHE: dict[tuple[str, float], list[LoadedNode]] = {}
+_CACHE: dict[tuple[str, float], tuple[list[LoadedNode], list[str]]] = {}
 
 
-def load_mesh_file(path: str | Path) -> list[LoadedNode]:
-    """Nodes of a mesh file, parents before children. Cached per (path, mtime)."""
+def load_mesh_file(path: str | Path, warnings: list[str] | None = None) -> list[LoadedNode]:
+    """Nodes of a mesh file, parents before children. Cached per (path, mtime). What the file holds
+    that Skinlab does not read (glTF extensions, a second UV set) is appended to `warnings`."""
     path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"mesh file not found: {path}")
@@ -38,10 +42,13 @@ def load_mesh_file(path: str | Path) -> list[LoadedNode]:
             "meshes", content_key(path.suffix.lower(), path.read_bytes()), lambda: _load(path), str(path), code=__name__
         )
     # fresh Mesh objects per call would re-upload; share them (meshes are data, not mutated by the renderer)
-    return _CACHE[key]
+    nodes, found = _CACHE[key]
+    if warnings is not None:
+        warnings.extend(w for w in found if w not in warnings)
+    return nodes
 
 
-def _mesh_from_trimesh(name: str, tm, source: str) -> Mesh:
+def _mesh_from_trimesh(name: str, tm, source: str, colors=None) -> Mesh:
     faces = np.asarray(tm.faces)
     n = len(tm.vertices)
     if faces.size and (faces.min() < 0 or faces.max() >= n):
@@ -61,10 +68,11 @@ def _mesh_from_trimesh(name: str, tm, source: str) -> Mesh:
         normals=normals,
         uvs=uv,
         source=source,
+        colors=colors,
     )
 
 
-def _load(path: Path) -> list[LoadedNode]:
+def _load(path: Path) -> tuple[list[LoadedNode], list[str]]:
     import trimesh
 
     try:
@@ -74,13 +82,14 @@ def _load(path: Path) -> list[LoadedNode]:
     if isinstance(loaded, trimesh.Trimesh):
         if len(loaded.faces) == 0:
             raise ValueError(f"{path}: contains no triangles")
-        return [LoadedNode(path.stem, None, np.eye(4), _mesh_from_trimesh(path.stem, loaded, str(path)))]
+        return [LoadedNode(path.stem, None, np.eye(4), _mesh_from_trimesh(path.stem, loaded, str(path)))], []
     if not isinstance(loaded, trimesh.Scene):
         raise ValueError(f"{path}: contains no triangle mesh (got {type(loaded).__name__})")
+    gltf = _GltfMaterials(path) if path.suffix.lower() in (".glb", ".gltf") else None
     graph = loaded.graph
     base = graph.base_frame
     out: list[LoadedNode] = []
-    meshes: dict[str, Mesh] = {}
+    meshes: dict[str, tuple[Mesh, FileMaterial | None]] = {}
     # breadth-first from the base frame so parents come first
     frontier = [base]
     seen = {base}
@@ -92,16 +101,49 @@ def _load(path: Path) -> list[LoadedNode]:
                     continue
                 seen.add(child)
                 matrix, geom_name = graph.get(frame_to=child, frame_from=parent)
-                mesh = None
+                mesh, material = None, None
                 if geom_name is not None and geom_name in loaded.geometry:
                     g = loaded.geometry[geom_name]
                     if isinstance(g, trimesh.Trimesh) and len(g.faces):
                         if geom_name not in meshes:
-                            meshes[geom_name] = _mesh_from_trimesh(geom_name, g, str(path))
-                        mesh = meshes[geom_name]
-                out.append(LoadedNode(str(child), None if parent == base else str(parent), np.asarray(matrix), mesh))
+                            material, colors = gltf.of(geom_name, g) if gltf is not None else (None, None)
+                            meshes[geom_name] = (_mesh_from_trimesh(geom_name, g, str(path), colors), material)
+                        mesh, material = meshes[geom_name]
+                parent_name = None if parent == base else str(parent)
+                out.append(LoadedNode(str(child), parent_name, np.asarray(matrix), mesh, material))
                 nxt.append(child)
         frontier = nxt
     if not any(n.mesh for n in out):
         raise ValueError(f"{path}: contains no triangle mesh")
-    return out
+    return out, gltf.warnings() if gltf is not None else []
+
+
+class _GltfMaterials:
+    """Each trimesh geometry's glTF material and vertex colours (skinlab/scene/gltf_materials.py)."""
+
+    def __init__(self, path: Path):
+        from .gltf_materials import GltfFile
+
+        self.file = GltfFile(path)
+        self.names = self.file.primitive_names()
+        self.materials: dict[int, FileMaterial] = {}
+
+    def of(self, geom_name: str, tm) -> tuple[FileMaterial | None, np.ndarray | None]:
+        from .gltf_materials import vertex_colours
+
+        f = self.file
+        where = self.names.get(geom_name)
+        if where is None or f.vertex_count(*where) != len(tm.vertices):
+            f.warn(f"{f.path.name}: mesh {geom_name!r}: its glTF primitive was not found; default material")
+            return None, None
+        prim = f.primitive(*where)
+        colors = vertex_colours(tm) if prim.attributes.COLOR_0 is not None else None
+        if prim.material is None:
+            return None, colors
+        if prim.material not in self.materials:
+            self.materials[prim.material] = f.material(prim.material)
+        return self.materials[prim.material], colors
+
+    def warnings(self) -> list[str]:
+        self.file.finish()
+        return list(self.file.warnings)

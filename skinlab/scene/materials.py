@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 SSS_MODELS = ("none", "dipole", "burley", "blender-burley", "gaussians", "pbd")
+ALPHA_MODES = ("opaque", "mask", "blend")
 
 
 @dataclass(frozen=True)
@@ -113,6 +114,42 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
     Param("normal_map", "texture", None, doc="tangent-space normal map (linear, OpenGL +Y)"),
     Param("normal_scale", "float", 1.0, (0.0, 4.0), doc="strength of the normal map (0: off)"),
     Param("occlusion_map", "texture", None, doc="ambient occlusion (R channel, linear); multiplies the ambient light"),
+    Param(
+        "occlusion_strength",
+        "float",
+        1.0,
+        (0.0, 1.0),
+        doc="how much of the occlusion map applies: ambient x (1 + strength (map - 1)) "
+        "(glTF occlusionTexture.strength)",
+    ),
+    Param("metallic_map", "texture", None, doc="metalness map (R channel, linear); multiplies metallic"),
+    Param(
+        "emissive",
+        "color",
+        (0.0, 0.0, 0.0),
+        (0.0, 1.0e4),
+        unit="linear RGB radiance",
+        doc="light the surface emits (added to what it reflects; glTF emissiveFactor x emissive_strength); "
+        "lights nothing else",
+    ),
+    Param("emissive_map", "texture", None, colorspace="srgb", doc="emission map (sRGB file); multiplies emissive"),
+    Param(
+        "alpha",
+        "float",
+        1.0,
+        (0.0, 1.0),
+        doc="opacity x the colour map's alpha channel x the vertex colour's alpha (glTF baseColorFactor[3]); "
+        "read only when alpha_mode is mask or blend",
+    ),
+    Param(
+        "alpha_mode",
+        "choice",
+        "opaque",
+        choices=ALPHA_MODES,
+        doc="opaque: alpha ignored; mask: a pixel with alpha < alpha_cutoff is not there (colour, shadows, the "
+        "path-traced truth); blend: drawn after the opaque meshes, far to near, over them (glTF alphaMode)",
+    ),
+    Param("alpha_cutoff", "float", 0.5, (0.0, 1.0), doc="the alpha below which a masked surface is cut away"),
     Param(
         "subsurface",
         "float",
@@ -207,9 +244,13 @@ class Material:
         }
 
     def defines(self) -> dict[str, str]:
-        """Shader-variant defines: ``HAS_<MAP>`` for the maps that are set (plain values are uniforms,
-        so materials that differ only in values share a program)."""
-        return {p.define: "1" for p in self.params if p.kind == "texture" and self.values[p.name] is not None}
+        """Shader-variant defines: ``HAS_<MAP>`` for the maps that are set and ``ALPHA_MASK`` /
+        ``ALPHA_BLEND`` for the alpha mode (plain values are uniforms, so materials that differ only in
+        values share a program)."""
+        out = {p.define: "1" for p in self.params if p.kind == "texture" and self.values[p.name] is not None}
+        if self.values.get("alpha_mode", "opaque") != "opaque":
+            out["ALPHA_" + self.values["alpha_mode"].upper()] = "1"
+        return out
 
     @property
     def has_subsurface(self) -> bool:

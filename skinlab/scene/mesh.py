@@ -27,6 +27,7 @@ class Mesh:
     _bounds: tuple | None = field(default=None, repr=False, metadata={"transient": True})
     # unique for the process (unlike id(), never reused after the mesh is freed): GPU caches key on it
     uid: int = field(default_factory=lambda: next(_UIDS), repr=False, compare=False, metadata={"transient": True})
+    colors: np.ndarray | None = field(default=None, repr=False)  # (N, 4) float32 linear RGBA (glTF COLOR_0)
 
     def __post_init__(self) -> None:
         self.positions = np.ascontiguousarray(self.positions, np.float32)
@@ -49,6 +50,15 @@ class Mesh:
             self.uvs = np.ascontiguousarray(self.uvs, np.float32)
         if self.tangents is not None:
             self.tangents = np.ascontiguousarray(self.tangents, np.float32)
+        if self.colors is not None:
+            c = np.asarray(self.colors, np.float32)
+            if c.ndim != 2 or c.shape[0] != len(self.positions) or c.shape[1] not in (3, 4):
+                raise ValueError(f"{where}: vertex colours must be (N, 3) or (N, 4) for N vertices, got {c.shape}")
+            if c.shape[1] == 3:
+                c = np.concatenate([c, np.ones((len(c), 1), np.float32)], axis=1)
+            if not np.isfinite(c).all():
+                raise ValueError(f"{where}: vertex colours contain NaN or Inf")
+            self.colors = np.ascontiguousarray(np.clip(c, 0.0, None))
 
     @property
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -85,7 +95,7 @@ def with_atlas(mesh: Mesh) -> Mesh:
     if mesh.uvs is not None:
         return mesh
     if mesh.uid not in _ATLASED:
-        copy = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, None, None, mesh.source)
+        copy = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, None, None, mesh.source, colors=mesh.colors)
         generate_atlas(copy)
         _ATLASED[mesh.uid] = copy
     return _ATLASED[mesh.uid]
@@ -190,6 +200,8 @@ def generate_atlas(mesh: Mesh, cache: bool = True) -> None:
         vmapping, idx, uvs = parametrize()
     mesh.positions = np.ascontiguousarray(mesh.positions[vmapping])
     mesh.normals = np.ascontiguousarray(mesh.normals[vmapping])
+    if mesh.colors is not None:
+        mesh.colors = np.ascontiguousarray(mesh.colors[vmapping])
     mesh.indices = np.ascontiguousarray(idx, np.uint32)
     mesh.uvs = np.ascontiguousarray(uvs, np.float32)
     mesh.tangents = None

@@ -10,6 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from .gltf_materials import GLTF_MAPPING
 from .materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
 from .scenefile import SCENE_FILE_KEYS
 
@@ -96,6 +97,26 @@ def _blender_section() -> str:
     )
 
 
+_GLTF_INTRO = """\
+A glTF/GLB file (`skinlab render model.glb`, or a `[[meshes]]` entry without `material`) brings its own
+materials, read with pygltflib (skinlab/scene/gltf_materials.py, from the table `GLTF_MAPPING` there). A
+`material` named in the scene file (on the entry or a node) replaces the file's; `overrides` apply on top
+of either. Textures embedded in the file are written once under `$SKINLAB_CACHE_DIR/gltf`, named by their
+content. An extension Skinlab does not read is named in one warning (the render summary, `skinlab render
+--json` `warnings`), never dropped silently.
+"""
+
+
+def _gltf_section() -> str:
+    rows = [f"| {_cell(a)} | {_cell(b)} |" for a, b in GLTF_MAPPING]
+    return (
+        "\n".join(
+            ["## From glTF 2.0 materials", "", _GLTF_INTRO, "| glTF | Skinlab material parameter |", "|---|---|", *rows]
+        )
+        + "\n"
+    )
+
+
 def _fmt_default(p: Param) -> str:
     if p.default is None:
         return "none"
@@ -144,6 +165,7 @@ def scenes_markdown() -> str:
     out.append("")
     out.append(f"Subsurface models (`sss_model`): {', '.join(f'`{m}`' for m in SSS_MODELS)}; see docs/tsd.md.\n")
     out.append(_blender_section())
+    out.append(_gltf_section())
     return "\n".join(out)
 
 

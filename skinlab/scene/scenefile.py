@@ -47,7 +47,7 @@ cast_shadow = true
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -57,7 +57,7 @@ from skinlab.resources import assets_root, bundled_scenes, scene_by_name
 
 from . import transform as tf
 from .graph import CameraNode, LightNode, MeshNode, Node, Scene
-from .loaders import SUPPORTED, LoadedNode, load_mesh_file
+from .loaders import SUPPORTED, load_mesh_file
 from .materials import Material
 from .mesh import Mesh, with_atlas
 
@@ -416,8 +416,17 @@ def _build(path: Path, data: dict) -> Scene:
         _check_textures(where, m)
         materials[name] = m
 
-    def material_for(where: str, name: Any, overrides: Any) -> Material:
-        if name is None:
+    file_materials: dict[tuple[str, int], Material] = {}
+
+    def material_for(where: str, name: Any, overrides: Any, own=None, mfile: Path | None = None) -> Material:
+        """The named [materials.NAME] table; without a name the file's own material `own` (glTF,
+        one Material per file and material), else the default; `overrides` on top (a copy)."""
+        if name is None and own is not None:
+            key = (str(mfile), own.index)
+            if key not in file_materials:
+                file_materials[key] = _file_material(f"{where} ({Path(mfile).name})", own)
+            mat = file_materials[key]
+        elif name is None:
             mat = Material("default")
         elif _str(f"{where}.material", name) not in materials:
             raise SceneFileError(
@@ -443,10 +452,9 @@ def _build(path: Path, data: dict) -> Scene:
         top.visible = _bool(f"{where}.visible", entry.get("visible", True))
         scene.add(top)
         mesh_overrides = _table(f"{where}.overrides", entry.get("overrides", {}))
-        default_mat = material_for(where, entry.get("material"), mesh_overrides)
         node_cfg = _table(f"{where}.nodes", entry.get("nodes", {}))
         try:
-            loaded = load_mesh_file(mpath)
+            loaded = load_mesh_file(mpath, scene.warnings)
         except (ValueError, FileNotFoundError) as exc:
             raise SceneFileError(f"{where}.file: {exc}") from None
         names = {n.name for n in loaded}
@@ -458,21 +466,28 @@ def _build(path: Path, data: dict) -> Scene:
                     f"(it has: {', '.join(sorted(names))})"
                 )
         if _bool(f"{where}.flip_v", entry.get("flip_v", False)):
-            loaded = [LoadedNode(ln.name, ln.parent, ln.matrix, flip_v(ln.mesh)) for ln in loaded]
+            loaded = [replace(ln, mesh=flip_v(ln.mesh)) for ln in loaded]
         if _bool(f"{where}.generate_uvs", entry.get("generate_uvs", False)):  # an xatlas atlas where none
-            loaded = [LoadedNode(ln.name, ln.parent, ln.matrix, ln.mesh and with_atlas(ln.mesh)) for ln in loaded]
+            loaded = [replace(ln, mesh=ln.mesh and with_atlas(ln.mesh)) for ln in loaded]
+        entry_mats: dict = {}  # the entry's material (with its overrides) per file material
         created: dict[str, Node] = {}
         for ln in loaded:
             nwhere = f"{where}.nodes.{ln.name}"
             cfg = node_cfg.get(ln.name, {})
             _known(nwhere, cfg, _keys("[meshes.nodes.NAME]"))
             if ln.mesh is not None:
-                mat = default_mat
+                own = ln.material if "material" not in entry else None  # a named material wins
+                key = own.index if own is not None else None
+                if key not in entry_mats:
+                    entry_mats[key] = material_for(where, entry.get("material"), mesh_overrides, own, mpath)
+                mat = entry_mats[key]
                 if "material" in cfg or "overrides" in cfg:
                     mat = material_for(
                         nwhere,
                         cfg.get("material", entry.get("material")),
                         {**mesh_overrides, **_table(f"{nwhere}.overrides", cfg.get("overrides", {}))},
+                        ln.material if "material" not in cfg and "material" not in entry else None,
+                        mpath,
                     )
                 node = MeshNode(ln.name, ln.mesh, mat)
             else:
@@ -544,19 +559,36 @@ def _build(path: Path, data: dict) -> Scene:
     return scene
 
 
+def _file_material(where: str, own) -> Material:
+    """A Material from a mesh file's own material (skinlab/scene/gltf_materials.py FileMaterial)."""
+    m = Material(own.name)
+    try:
+        m.update(own.values)
+    except ValueError as exc:
+        raise SceneFileError(f"{where}: {exc}") from None
+    _check_textures(f"{where}: material {own.name!r}", m)
+    return m
+
+
 def scene_from_mesh(path: str | Path, mm_per_unit: float = 1.0) -> Scene:
-    """A mesh file opened directly (``skinlab render model.obj``): its own nodes with the default
-    material (plain principled, no subsurface), a camera on +Z framing it, a shadow-casting key
-    light from the upper left and a cool fill, as a scene file with only ``[[meshes]] file``
-    would get plus lights."""
+    """A mesh file opened directly (``skinlab render model.obj``): its own nodes with the file's own
+    materials (glTF) or the default material (plain principled, no subsurface), a camera on +Z
+    framing it, a shadow-casting key light from the upper left and a cool fill, as a scene file with
+    only ``[[meshes]] file`` would get plus lights."""
     path = Path(path)
     scene = Scene(path.stem, mm_per_unit)
     scene.source = path
     top = scene.add(Node(path.stem))
-    loaded = load_mesh_file(path)
+    loaded = load_mesh_file(path, scene.warnings)
     created: dict[str, Node] = {}
-    material = Material("default")
+    default = Material("default")
+    own: dict[int, Material] = {}  # the file's own materials (glTF), one Material each
     for ln in loaded:
+        material = default
+        if ln.material is not None:
+            if ln.material.index not in own:
+                own[ln.material.index] = _file_material(path.name, ln.material)
+            material = own[ln.material.index]
         node = MeshNode(ln.name, ln.mesh, material) if ln.mesh is not None else Node(ln.name)
         node.set_matrix(ln.matrix)
         (created[ln.parent] if ln.parent else top).add(node)
@@ -582,7 +614,9 @@ def flip_v(mesh: Mesh | None) -> Mesh | None:
     if mesh.uid not in _FLIPPED:
         uv = mesh.uvs.copy()
         uv[:, 1] = 1.0 - uv[:, 1]
-        _FLIPPED[mesh.uid] = Mesh(mesh.name, mesh.positions, mesh.indices, mesh.normals, uv, None, mesh.source)
+        _FLIPPED[mesh.uid] = Mesh(
+            mesh.name, mesh.positions, mesh.indices, mesh.normals, uv, None, mesh.source, colors=mesh.colors
+        )
     return _FLIPPED[mesh.uid]
 
 

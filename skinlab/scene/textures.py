@@ -37,7 +37,10 @@ def load_texture(path: str | Path, colorspace: str = "linear") -> np.ndarray:
         return _CACHE[key]
     import OpenImageIO as oiio
 
-    inp = oiio.ImageInput.open(str(path))
+    # colour and alpha as stored (a glTF colour map's alpha is opacity, not premultiplied into the colour)
+    config = oiio.ImageSpec()
+    config.attribute("oiio:UnassociatedAlpha", 1)
+    inp = oiio.ImageInput.open(str(path), config)
     if inp is None:
         raise ValueError(f"{path}: cannot read texture: {oiio.geterror()}")
     try:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import moderngl
 
 from skinlab.gl.uniforms import set_uniforms
+from skinlab.render.alpha import bind_mask, blended, draw_order, mask_defines
 from skinlab.render.bounce import bind_bounce, bounce_defines
 from skinlab.render.boundary import bind_boundary
 from skinlab.render.frame_plan import ForwardParams
@@ -90,34 +91,56 @@ class ForwardPass:
 
     def depth_prepass(self, frame, per_frame) -> None:
         self._depth_fbo.use()
-        prog = self.r.programs.get("passes/forward.vert", "passes/depth_only.frag")
-        set_uniforms(prog, {"u_view_proj": per_frame["u_view_proj"]})
         for node in frame.scene.mesh_nodes():
+            if blended(node.material):
+                continue  # seen through: it hides nothing behind it
+            # a masked material's cut-away pixels write no depth (skinlab/render/alpha.py)
+            prog = self.r.programs.get("passes/forward.vert", "passes/depth_only.frag", mask_defines(node.material))
+            set_uniforms(prog, {"u_view_proj": per_frame["u_view_proj"]})
             set_uniforms(prog, node_uniforms(node))
+            bind_mask(self.r.resources, prog, node.material, TextureUnits(self.r.ctx))
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
 
     def shade(self, frame, prm: ForwardParams, per_frame) -> None:
+        """Every visible mesh: the opaque and masked ones first, then those with alpha_mode "blend" far
+        to near, premultiplied over what is behind them without writing depth (skinlab/render/alpha.py)."""
+        ctx = self.r.ctx
+        fbo = self._targets[2]
+        depth_mask = fbo.depth_mask
+        blending = False
+        try:
+            for node in draw_order(frame.scene.mesh_nodes(), frame.camera_pos):
+                if blended(node.material) and not blending:
+                    ctx.enable(moderngl.BLEND)
+                    ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
+                    fbo.depth_mask, blending = False, True
+                self.shade_node(frame, prm, per_frame, node)
+        finally:
+            ctx.disable(moderngl.BLEND)
+            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+            fbo.depth_mask = depth_mask
+
+    def shade_node(self, frame, prm: ForwardParams, per_frame, node) -> None:
         ctx, hook, nmax = self.r.ctx, prm.hook, frame.settings.max_lights
-        for node in frame.scene.mesh_nodes():
-            sh = hook.shading(node, frame) or NodeShading(node.material)
-            defines = {
-                **sh.material.defines(),
-                **light_defines(prm.shadow_lights, nmax),
-                **bounce_defines(frame, node),
-                **sh.defines,
-            }
-            prog = self.r.programs.get(
-                "passes/forward.vert", "passes/forward.frag", defines, includes={HOOK_INCLUDE: sh.hook}
-            )
-            units = TextureUnits(ctx)
-            set_uniforms(prog, per_frame)
-            bind_shadow_maps(self.r, frame, prog, units)
-            set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
-            set_uniforms(prog, node_uniforms(node))
-            bind_bounce(frame, node, prog, units)
-            self.r.resources.bind_material(prog, sh.material, units)
-            scatters = sh.hook != PLAIN_HOOK and sh.subsurface
-            bind_boundary(prog, sh.material if scatters else None)
-            if sh.bind is not None:
-                sh.bind(prog, units)
-            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        sh = hook.shading(node, frame) or NodeShading(node.material)
+        defines = {
+            **sh.material.defines(),
+            **light_defines(prm.shadow_lights, nmax),
+            **bounce_defines(frame, node),
+            **sh.defines,
+        }
+        prog = self.r.programs.get(
+            "passes/forward.vert", "passes/forward.frag", defines, includes={HOOK_INCLUDE: sh.hook}
+        )
+        units = TextureUnits(ctx)
+        set_uniforms(prog, per_frame)
+        bind_shadow_maps(self.r, frame, prog, units)
+        set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
+        set_uniforms(prog, node_uniforms(node))
+        bind_bounce(frame, node, prog, units)
+        self.r.resources.bind_material(prog, sh.material, units)
+        scatters = sh.hook != PLAIN_HOOK and sh.subsurface
+        bind_boundary(prog, sh.material if scatters else None)
+        if sh.bind is not None:
+            sh.bind(prog, units)
+        self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)

@@ -8,7 +8,9 @@ import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_uniforms
+from skinlab.render.alpha import bind_mask, mask_defines
 from skinlab.render.frame_plan import ShadowParams
+from skinlab.render.texture_units import TextureUnits
 from skinlab.scene import transform as tf
 from skinlab.scene.graph import LightNode
 
@@ -114,10 +116,7 @@ class ShadowPass:
         tex, fbo, dist = self.target(slot, p.resolution[0], distance)
         lo, hi = frame.scene.world_bounds()
         vp = light_view_proj(light, lo, hi)
-        prog = self.r.programs.get(
-            "passes/shadow.vert", "passes/shadow.frag", {"SHADOW_DISTANCE": 1} if distance else None
-        )
-        set_uniforms(prog, {"u_light_eye": light_eye(light)})
+        base = {"SHADOW_DISTANCE": 1} if distance else {}
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         if dist is not None:  # "no surface": as far as it gets
@@ -126,7 +125,13 @@ class ShadowPass:
         ctx.disable(moderngl.CULL_FACE)
         ctx.polygon_offset = (2.0, 2.0)
         for node in frame.scene.mesh_nodes():
+            # a masked material's cut-away pixels cast no shadow (skinlab/render/alpha.py)
+            prog = self.r.programs.get(
+                "passes/shadow.vert", "passes/shadow.frag", {**base, **mask_defines(node.material)}
+            )
+            set_uniforms(prog, {"u_light_eye": light_eye(light)})
             set_uniforms(prog, {"u_model": node.world_matrix, "u_light_view_proj": vp})
+            bind_mask(self.r.resources, prog, node.material, TextureUnits(ctx))
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         ctx.polygon_offset = (0.0, 0.0)
         self.publish(frame, p)

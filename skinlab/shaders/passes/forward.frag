@@ -1,7 +1,9 @@
 #version 330 core
 // Principled shading (Burley diffuse + GGX specular) with up to MAX_LIGHTS lights and two
-// shadow maps. Variants: HAS_BASE_COLOR_MAP, HAS_ROUGHNESS_MAP, HAS_NORMAL_MAP, HAS_OCCLUSION_MAP
-// (skinlab/material.glsl, generated from the material's parameter declarations). The subsurface part
+// shadow maps. Variants: HAS_<MAP> per map set (skinlab/material.glsl, generated from the material's
+// parameter declarations), ALPHA_MASK (pixels below the alpha cutoff discarded) and ALPHA_BLEND
+// (premultiplied colour and alpha, blended by passes/forward.py); lib/surface.glsl for occlusion
+// strength and opacity; the vertex colour multiplies the base colour and alpha; emission is added. The subsurface part
 // of the diffuse term is the technique's hook (skinlab/sss_hook.glsl, resolved per program to
 // skinlab/shaders/techniques/<name>/forward.glsl; the contract is in skinlab/render/technique.py): plain
 // Burley diffuse weighted by sss_plain_weight(), the hook told about each light, and its radiance
@@ -15,12 +17,14 @@
 #include "lib/sss_oblique.glsl"
 #include "lib/lights.glsl"
 #include "lib/ambient.glsl"
+#include "lib/surface.glsl"
 #include "skinlab/material.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_tangent;
+in vec4 v_color;  // the vertex colour (1 where the mesh has none)
 
 uniform vec3 u_camera_pos;
 
@@ -38,25 +42,34 @@ void main() {
     n = perturb_normal(ng, vec4(gl_FrontFacing ? v_tangent.xyz : -v_tangent.xyz, v_tangent.w),
                        texture(u_normal_map, v_uv).rgb, u_normal_scale);
 #endif
-    vec3 base = u_base_color;
+    vec4 base_map = vec4(1.0);
 #ifdef HAS_BASE_COLOR_MAP
-    base *= texture(u_base_color_map, v_uv).rgb;
+    base_map = texture(u_base_color_map, v_uv);
+#endif
+    vec3 base = u_base_color * base_map.rgb * v_color.rgb;
+    float alpha = surface_alpha(u_alpha, base_map.a, v_color.a);
+#ifdef ALPHA_MASK
+    if (!alpha_kept(alpha, u_alpha_cutoff)) discard;
 #endif
     float rough = u_roughness;
 #ifdef HAS_ROUGHNESS_MAP
     rough *= texture(u_roughness_map, v_uv).r;
 #endif
+    float metal = u_metallic;  // the subsurface hooks weigh their term by u_metallic (no map)
+#ifdef HAS_METALLIC_MAP
+    metal *= texture(u_metallic_map, v_uv).r;
+#endif
     float occlusion = 1.0;
 #ifdef HAS_OCCLUSION_MAP
-    occlusion = texture(u_occlusion_map, v_uv).r;
+    occlusion = occlusion_at_strength(texture(u_occlusion_map, v_uv).r, u_occlusion_strength);
 #endif
     float plain = sss_plain_weight();    // weight of the surface's own Burley diffuse
-    vec3 f0 = principled_f0(base, u_metallic, u_specular);
+    vec3 f0 = principled_f0(base, metal, u_specular);
     float a = ggx_alpha(rough);
     float NoV = dot(n, v);
     vec3 color = vec3(0.0);
     bool single = any(greaterThan(u_sss_single, vec3(0.0)));
-    vec3 single_w = base * ((1.0 - u_metallic) * sss_weight_at(v_uv));  // x the weight map
+    vec3 single_w = base * ((1.0 - metal) * sss_weight_at(v_uv));  // x the weight map
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, e;
@@ -66,7 +79,7 @@ void main() {
         float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
         vec3 h = half_vector(n, v, l);
         float LoH = dot(l, h);
-        vec3 diffuse = base * ((1.0 - u_metallic) * plain * burley_diffuse(NoL, NoV, LoH, rough));
+        vec3 diffuse = base * ((1.0 - metal) * plain * burley_diffuse(NoL, NoV, LoH, rough));
         vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
         color += e * vis * (diffuse + spec) * NoL;
         if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
@@ -76,8 +89,17 @@ void main() {
         sss_add_light(e, u_light_shadow[i] >= 0 ? light_visibility(i, entry, dot(ng, l)) : 1.0, NoL);
     }
     vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
-    color += ambient * (base * ((1.0 - u_metallic) * plain) + f0);
+    color += ambient * (base * ((1.0 - metal) * plain) + f0);
     if (single) color += ambient * single_w * sss_single_ambient(NoV);  // its single scattering
     color += sss_radiance(base, NoV, occlusion, v_uv);
+    vec3 emission = u_emissive;
+#ifdef HAS_EMISSIVE_MAP
+    emission *= texture(u_emissive_map, v_uv).rgb;
+#endif
+    color += emission;
+#ifdef ALPHA_BLEND
+    f_color = vec4(color * alpha, alpha);  // premultiplied: blended over what lies behind (passes/forward.py)
+#else
     f_color = vec4(color, 1.0);
+#endif
 }

@@ -19,11 +19,13 @@
 #include "lib/sss_oblique.glsl"
 #include "skinlab/material.glsl"
 #include "lib/sss_maps.glsl"
+#include "lib/surface.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_tangent;
+in vec4 v_color;  // the vertex colour (1 where the mesh has none)
 
 uniform float u_tsd_mix;
 uniform int u_slot_light[2];              // the light each shadow slot holds (lib/lights.glsl slots)
@@ -78,13 +80,13 @@ void main() {
 #ifdef HAS_NORMAL_MAP
     n = perturb_normal(ng, v_tangent, texture(u_normal_map, v_uv).rgb, u_normal_scale);
 #endif
-    vec3 base = u_base_color;
+    vec3 base = u_base_color * v_color.rgb;
 #ifdef HAS_BASE_COLOR_MAP
     base *= texture(u_base_color_map, v_uv).rgb;
 #endif
     float occlusion = 1.0;
 #ifdef HAS_OCCLUSION_MAP
-    occlusion = texture(u_occlusion_map, v_uv).r;
+    occlusion = occlusion_at_strength(texture(u_occlusion_map, v_uv).r, u_occlusion_strength);
 #endif
     vec3 e_in = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {   // the lights without a shadow map

@@ -5,6 +5,7 @@ in vec3 in_position;
 in vec3 in_normal;
 in vec2 in_uv;
 in vec4 in_tangent;
+in vec4 in_color;  // the vertex colour (1 where the mesh has none)
 #include "lib/bounce_vertex.glsl"
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
@@ -12,12 +13,14 @@ out vec3 v_world;
 out vec3 v_normal;
 out vec2 v_uv;
 out vec4 v_tangent;
+out vec4 v_color;
 void main() {
     vec4 w = u_model * vec4(in_position, 1.0);
     v_world = w.xyz;
     v_normal = u_normal_matrix * in_normal;
     v_tangent = vec4(mat3(u_model) * in_tangent.xyz, in_tangent.w);
     v_uv = in_uv;
+    v_color = in_color;
     bounce_vertex();
     gl_Position = vec4(in_uv * 2.0 - 1.0, 0.0, 1.0);
 }
