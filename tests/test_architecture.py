@@ -54,9 +54,10 @@ def test_worked_example_renders_what_it_says(renderer, lambert):
     res = {s: renderer.render(scene, RenderSettings.for_technique("lambert", 16, 16, strength=s)) for s in (0.0, 2.0)}
     # subsurface 1: no plain Burley diffuse, specular 0; the light falls straight on the slab. What is
     # left at strength 0 is the single scattering the forward pass adds for every scattering mesh
-    # (Jensen's term at normal light and view, per unit base colour, times the base colour 1)
+    # (Jensen's term at normal light and view, per unit subsurface albedo, times the subsurface colour:
+    # the colour rule, docs/scenes.md)
     mat = scene.find("slab").material
-    single = light.radiance * material_boundary(mat).single / (8 * np.pi)  # p = 1/(4 pi), 1/(mu + mu0) = 1/2
+    single = light.radiance * material_boundary(mat).single * np.array([0.8, 0.5, 0.25]) / (8 * np.pi)
     np.testing.assert_allclose(res[0.0].hdr[8, 8, :3], single, rtol=2e-3)
     expected = 2.0 * np.array([0.8, 0.5, 0.25]) * light.radiance / np.pi + single
     np.testing.assert_allclose(res[2.0].hdr[8, 8, :3], expected, rtol=1e-3)
@@ -325,7 +326,7 @@ def test_every_program_binding_materials_uses_the_declared_uniforms(renderer):
             assert {"u_normal_map", "u_normal_scale"} <= active, key
     irr = [e.program for k, e in renderer.programs.entries.items() if k[1] == "passes/tsd_irradiance.frag"]
     # the irradiance pass weighs each light by the shared entry factor (skinlab/render/boundary.py)
-    assert irr and all({"u_base_color", "u_sss_entry"} <= set(p) for p in irr)
+    assert irr and all({"u_subsurface_color", "u_sss_entry"} <= set(p) for p in irr)
 
 
 def test_texture_units_are_handed_out_once_per_sampler(ctx):

@@ -11,8 +11,9 @@ from skinlab.cache import table
 from skinlab.gl.uniforms import set_array, set_uniforms
 from skinlab.scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables
 from skinlab.scene.optics.fresnel import fdr
+from skinlab.scene.optics.similarity import real_albedo
 from skinlab.scene.optics.slab import LN_FLOOR, SLAB_MU_NODES, SLAB_TAU_NODES, slab_decay, slab_exit_tables, slab_table
-from skinlab.scene.optics.tsd import material_medium
+from skinlab.scene.optics.tsd import material_medium, subsurface_albedo
 
 _ZERO_TABLE = np.zeros((ANGULAR_NODES, 3))
 _SLAB_ROWS = SLAB_MU_NODES * SLAB_TAU_NODES
@@ -35,7 +36,20 @@ def material_boundary(material) -> BoundaryTables | None:
     if material is None or not material.has_subsurface:
         return None
     medium = material_medium(material.values)
-    return boundary_tables(medium.alpha_arr, material["subsurface_color"], medium.eta, boundary_ggx_alpha(material))
+    colour = subsurface_albedo(material.values)  # what the frame's subsurface albedo stands for, on average
+    return boundary_tables(medium.alpha_arr, colour, medium.eta, boundary_ggx_alpha(material))
+
+
+def single_scattering_factor(material, tables: BoundaryTables) -> np.ndarray:
+    """u_sss_single: Jensen's term per unit subsurface albedo with the medium's real single-scattering
+    albedo (similarity: a = a' / (1 - g + g a'), skinlab/scene/optics/similarity.py); g = 0 keeps the
+    tables' a' / A_colour."""
+    g = float(material.values.get("subsurface_scatter_anisotropy", 0.0))
+    if g == 0.0:
+        return tables.single
+    reduced = material_medium(material.values).alpha_arr
+    ratio = np.where(reduced > 0, real_albedo(reduced, g) / np.where(reduced > 0, reduced, 1.0), 0.0)
+    return tables.single * ratio
 
 
 def boundary_ggx_alpha(material) -> float:
@@ -51,7 +65,7 @@ def bind_boundary(prog, material) -> None:
         set_array(prog, "u_sss_exit", _ZERO_TABLE, ANGULAR_NODES)
         set_array(prog, "u_sss_single_ambient", _ZERO_TABLE, ANGULAR_NODES)
         zero = (0.0, 0.0, 0.0)
-        set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0})
+        set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0, "u_sss_g": 0.0})
         set_array(prog, "u_sss_slab", _DARK_SLAB, _SLAB_ROWS)
         set_array(prog, "u_sss_slab_norm", _DARK_NORM, SLAB_TAU_NODES)
         set_array(prog, "u_sss_slab_h", _ZERO_H, _SLAB_ROWS)
@@ -61,11 +75,14 @@ def bind_boundary(prog, material) -> None:
     set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
     set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
     set_array(prog, "u_sss_single_ambient", t.single_ambient, ANGULAR_NODES)
-    set_uniforms(prog, {"u_sss_entry_diffuse": t.entry_diffuse, "u_sss_single": t.single, "u_sss_eta": t.eta})
-    medium = material_medium(material.values)
-    table, (norm, h, ab) = _slab_tables(
-        tuple(medium.alpha_arr), tuple(np.ravel(material["subsurface_color"])), float(medium.eta)
+    g = float(material.values.get("subsurface_scatter_anisotropy", 0.0))
+    single = single_scattering_factor(material, t)
+    set_uniforms(
+        prog, {"u_sss_entry_diffuse": t.entry_diffuse, "u_sss_single": single, "u_sss_eta": t.eta, "u_sss_g": g}
     )
+    medium = material_medium(material.values)
+    colour = subsurface_albedo(material.values)
+    table, (norm, h, ab) = _slab_tables(tuple(medium.alpha_arr), tuple(float(x) for x in colour), float(medium.eta))
     set_array(prog, "u_sss_slab", table, _SLAB_ROWS)
     set_array(prog, "u_sss_slab_norm", norm, SLAB_TAU_NODES)
     set_array(prog, "u_sss_slab_h", h, _SLAB_ROWS)

@@ -20,6 +20,9 @@ mesh's :class:`NodeShading` resolves to a technique's file (skinlab/shaders/tech
     void  sss_add_light(vec3 e, float vis, float NoL);  // per light: irradiance e, shadow vis, cosine
     vec3  sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv);  // after the lights: the
                                                      // subsurface radiance added toward the viewer
+
+``base`` is the subsurface albedo at the fragment: subsurface_color x the colour map x the vertex
+colour (the colour rule, docs/scenes.md), not the plain part's base colour.
 """
 
 from __future__ import annotations

@@ -104,9 +104,16 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         (0.8, 0.8, 0.8),
         (0.0, 1.0),
         unit="linear RGB",
-        doc="diffuse albedo of the surface without subsurface scattering, or the F0 of a metal",
+        doc="albedo of the plain diffuse part (weight 1 - subsurface) and a metal's F0; x the colour map",
     ),
-    Param("base_color_map", "texture", None, colorspace="srgb", doc="colour map (sRGB file); multiplies base_color"),
+    Param(
+        "base_color_map",
+        "texture",
+        None,
+        colorspace="srgb",
+        doc="colour map (sRGB file): multiplies base_color and subsurface_color per texel; its mean colour "
+        "also goes into the medium's albedo (the colour rule above)",
+    ),
     Param("roughness", "float", 0.5, (0.0, 1.0), doc="perceptual roughness; GGX alpha = roughness^2"),
     Param("roughness_map", "texture", None, doc="roughness map (R channel, linear); multiplies roughness"),
     Param("metallic", "float", 0.0, (0.0, 1.0), doc="0 dielectric, 1 metal (base_color becomes the specular F0)"),
@@ -186,8 +193,18 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         (0.8, 0.4, 0.3),
         (0.0, 1.0),
         unit="linear RGB",
-        doc="surface albedo of the scattering medium: its total diffuse reflectance, the colour seen from afar "
-        "(inverted to the single-scattering albedo by photon beam diffusion)",
+        doc="the subsurface albedo (OpenPBR's subsurface_color: the multiple-scattering albedo, the colour the "
+        "scattering part shows from afar), x the colour map per texel; the medium's single-scattering albedo is "
+        "inverted from it x the map's mean by photon beam diffusion at the material's index",
+    ),
+    Param(
+        "subsurface_scatter_anisotropy",
+        "float",
+        0.0,
+        (-0.95, 0.95),
+        doc="the medium's Henyey-Greenstein g (OpenPBR's name): > 0 forward scattering. subsurface_color and "
+        "subsurface_radius give the reduced (similarity) medium the diffusion uses, so g changes the "
+        "single-scattering term (Jensen's phase) and the path-traced truth's phase and coefficients",
     ),
     Param(
         "sss_model",
@@ -197,6 +214,31 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         doc="diffusion profile for subsurface scattering (none: plain diffuse)",
     ),
 )
+
+
+# Other names users know for a parameter, each with exactly its meaning (OpenPBR Surface's subsurface set:
+# docs/scenes.md; the rest of that set, the radius pair in scene units, is in skinlab/scene/openpbr.py).
+PARAM_ALIASES: dict[str, str] = {"subsurface_weight": "subsurface"}
+
+
+def canonical_names(values: Mapping[str, Any], where: str = "") -> dict[str, Any]:
+    """`values` with aliases replaced by the parameter they name; both given is an error naming them."""
+    out = dict(values)
+    for alias, name in PARAM_ALIASES.items():
+        if alias in out:
+            if name in out:
+                raise ValueError(f"{where}give {name} or its alias {alias}, not both")
+            out[name] = out.pop(alias)
+    return out
+
+
+def preset_values(name: str) -> dict[str, Any]:
+    """What ``preset = NAME`` sets (scene files, ``Material.apply_preset``, the viewer, ``--preset``): a
+    Jensen et al. 2001 medium (skinlab/assets/presets/) as base and subsurface colour, radius,
+    subsurface weight 1 and the specular of its index (:func:`medium_values`)."""
+    from skinlab.scene.optics.media import preset
+
+    return medium_values(preset(name))
 
 
 @dataclass
@@ -217,12 +259,28 @@ class Material:
         return {p.name: p for p in self.params}
 
     def update(self, values: Mapping[str, Any]) -> Material:
+        """Set parameters (validated; errors name the material and parameter). ``"preset"`` first
+        applies a measured medium (:meth:`apply_preset`), then the other values; aliases
+        (``subsurface_weight``) name their parameter."""
         pm = self.param_map
+        values = canonical_names(values, f"material {self.name!r}: ")
+        if "preset" in values:
+            self.apply_preset(values.pop("preset"))
         for k, v in values.items():
             if k not in pm:
                 raise ValueError(f"material {self.name!r}: unknown parameter {k!r}; known: {', '.join(pm)}")
             self.values[k] = pm[k].validate(v, where=f"material {self.name!r}: ")
         return self
+
+    def apply_preset(self, name: str) -> Material:
+        """Take a Jensen et al. 2001 medium by name (``"marble"``, ``"skin1"``): :func:`preset_values`."""
+        if not isinstance(name, str):
+            raise ValueError(f"material {self.name!r}: preset: expected a preset name (string), got {name!r}")
+        try:
+            values = preset_values(name)
+        except ValueError as exc:
+            raise ValueError(f"material {self.name!r}: preset: {str(exc).removeprefix('preset: ')}") from None
+        return self.update(values)
 
     def __getitem__(self, name: str) -> Any:
         return self.values[name]

@@ -47,8 +47,8 @@ are sRGB files and are decoded).
 _BLENDER_ROWS = (
     (
         "Base Color",
-        "`base_color` (and `subsurface_color`: Blender 4 scatters the base colour; 3.x had a separate "
-        "Subsurface Color)",
+        "`base_color` and `subsurface_color` (Blender 4 scatters the base colour: give both the same; a texture "
+        "on it is `base_color_map`, which multiplies both; 3.x had a separate Subsurface Color)",
     ),
     ("Subsurface Weight (3.x: Subsurface)", "`subsurface`"),
     (
@@ -65,7 +65,8 @@ _BLENDER_ROWS = (
         'no random walk in real time: `"pbd"` (photon beam diffusion) has the smallest profile error against '
         "our Monte Carlo random walk (docs/accuracy.md)",
     ),
-    ("Subsurface IOR, Anisotropy", "not modelled: the index comes from `specular`, the phase function is isotropic"),
+    ("Subsurface IOR", "not separate: the medium's index comes from `specular`"),
+    ("Subsurface Anisotropy", "`subsurface_scatter_anisotropy` (Henyey-Greenstein g)"),
     ("Roughness, Metallic", "`roughness`, `metallic` (same meaning)"),
     ("Specular IOR Level (3.x: Specular)", "`specular` (0.5 = F0 4 %, index 1.5)"),
     ("IOR", "`specular = ((ior - 1) / (ior + 1))^2 / 0.08`"),
@@ -117,6 +118,63 @@ def _gltf_section() -> str:
     )
 
 
+_COLOUR_RULE = """\
+## The colour rule
+
+One rule, the same in scene files, presets, the viewer and the API (`Material.update`,
+`Material.apply_preset`): **the colour a material shows is its albedo times the colour map (and the
+vertex colour)**, as a texture plugged into both colour inputs does in Blender and OpenPBR.
+
+- The scattering part (weight `subsurface`, x `subsurface_map`) shows `subsurface_color` x
+  `base_color_map` x the vertex colour, per texel.
+- The plain diffuse part (weight 1 - `subsurface`) and a metal's F0 show `base_color` x `base_color_map`
+  x the vertex colour.
+- The medium (the diffusion profile, the mean free path from `subsurface_radius`, the path-traced
+  truth's coefficients) is one homogeneous medium per material, inverted from its mean subsurface
+  albedo: `subsurface_color` x the mean colour of `base_color_map` (photon beam diffusion at the
+  material's index, skinlab/scene/optics/media.py). The map changes the colour per texel, not how far
+  light travels.
+- `preset = NAME` (scene files), `Material.apply_preset(NAME)` or `update({"preset": NAME})` (the
+  API), the viewer's preset list and `skinlab render --preset NAME` set the same five parameters:
+  `base_color` and `subsurface_color` (the medium's surface albedo), `subsurface_radius`,
+  `subsurface = 1` and the `specular` of its index. A colour map stays and multiplies that colour; for
+  the measured medium alone leave `base_color_map` out.
+
+So a map that holds the skin's colour goes with a white `subsurface_color` (the bundled head), and
+`subsurface_color = [0.2, 0.8, 0.2]` on a textured head tints it green.
+"""
+
+_OPENPBR_INTRO = """\
+## From OpenPBR Surface
+
+OpenPBR Surface's subsurface parameters (docs/references.md#openpbr) with one meaning each.
+`subsurface_weight` is an exact alias of `subsurface`; `subsurface_color` and
+`subsurface_scatter_anisotropy` are Skinlab's own parameters of the same meaning. OpenPBR's
+`subsurface_radius` is not Skinlab's (a real mean free path in scene units, times
+`subsurface_radius_scale` per channel, where Skinlab's is Blender's artist radius in mm), so the whole
+set goes in its own table, where every name has OpenPBR's meaning:
+
+```toml
+[materials.skin.openpbr]
+subsurface_weight = 1.0
+subsurface_color = [0.85, 0.55, 0.45]
+subsurface_radius = 0.03                 # scene units
+subsurface_radius_scale = [1.0, 0.35, 0.2]
+subsurface_scatter_anisotropy = 0.8
+```
+
+The conversion, stated once (skinlab/scene/openpbr.py): the real mean free path l_c = radius x scale_c x
+`mm_per_unit` (mm); the reduced albedo a' is Skinlab's inversion of the subsurface albedo (photon beam
+diffusion at the material's index; OpenPBR suggests van de Hulst's index-matched fit, which agrees with
+it within 0.042 in albedo at index 1 over colours 0.1-0.95: skinlab/scene/optics/similarity.py); the
+real albedo a = a' / (1 - g + g a') (similarity theory); Skinlab's `subsurface_radius` = 4 pi l_c / (1 -
+a_c g). g reaches the single-scattering term (Jensen's Henyey-Greenstein phase, with the real albedo)
+and the path-traced truth (a `hg` phase with the real coefficients); the diffusion profiles and the
+boundary's angular tables use the reduced (isotropic) medium, as similarity theory has it, in every
+technique.
+"""
+
+
 def _fmt_default(p: Param) -> str:
     if p.default is None:
         return "none"
@@ -164,6 +222,8 @@ def scenes_markdown() -> str:
         )
     out.append("")
     out.append(f"Subsurface models (`sss_model`): {', '.join(f'`{m}`' for m in SSS_MODELS)}; see docs/tsd.md.\n")
+    out.append(_COLOUR_RULE)
+    out.append(_OPENPBR_INTRO)
     out.append(_blender_section())
     out.append(_gltf_section())
     return "\n".join(out)

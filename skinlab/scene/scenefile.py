@@ -60,6 +60,7 @@ from .graph import CameraNode, LightNode, MeshNode, Node, Scene
 from .loaders import SUPPORTED, load_mesh_file
 from .materials import Material
 from .mesh import Mesh, with_atlas
+from .scene_edits import apply_edits
 
 ASSETS = assets_root()
 DEFAULT_SCENE = ASSETS / "scenes" / "head.toml"
@@ -110,6 +111,41 @@ SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
             "none",
             "a Jensen et al. 2001 medium (assets/presets/): sets base_color, subsurface_color, subsurface_radius, "
             "subsurface = 1 and specular first; the table's other keys then override",
+        ),
+        Key(
+            "openpbr",
+            "table",
+            "{}",
+            "OpenPBR Surface's subsurface parameters with OpenPBR's meanings, applied after the table's other keys "
+            "([materials.NAME.openpbr] below)",
+        ),
+        Key("subsurface_weight", "number in [0, 1]", "0", "an exact alias of subsurface (OpenPBR's name)"),
+    ),
+    "[materials.NAME.openpbr]": (
+        Key("subsurface_weight", "number in [0, 1]", "the material's subsurface", "weight of subsurface scattering"),
+        Key(
+            "subsurface_color",
+            "3 numbers in [0, 1]",
+            "the material's",
+            "the multiple-scattering albedo (Skinlab's subsurface_color, the same meaning)",
+        ),
+        Key(
+            "subsurface_radius",
+            "number >= 0",
+            "1 (with subsurface_radius_scale)",
+            "length scale of the mean free path, scene units",
+        ),
+        Key(
+            "subsurface_radius_scale",
+            "1 or 3 numbers >= 0",
+            "[1, 0.5, 0.25] (with subsurface_radius)",
+            "per-channel multiplier: radius x scale is the real mean free path 1/sigma_t per channel",
+        ),
+        Key(
+            "subsurface_scatter_anisotropy",
+            "number in [-0.95, 0.95]",
+            "the material's",
+            "Henyey-Greenstein g (Skinlab's parameter of the same name)",
         ),
     ),
     "[[meshes]]": (
@@ -308,6 +344,12 @@ def _material_values(where: str, material: Material, values: dict) -> Material:
     """material.update(values) with errors naming the table: unknown parameters, types and ranges."""
     pm = material.param_map
     for k, v in values.items():
+        if k == "subsurface_radius_scale":
+            raise SceneFileError(
+                f"{where}.subsurface_radius_scale: OpenPBR's radius pair (a mean free path in scene units) goes "
+                "in an openpbr table with its subsurface_radius ([materials.NAME.openpbr]); Skinlab's "
+                "subsurface_radius is the artist radius in mm (docs/scenes.md)"
+            )
         if k not in pm:
             raise SceneFileError(f"{where}: unknown material parameter {k!r}; known: {', '.join(pm)}")
         if pm[k].kind in ("float", "color", "vec3") and not (
@@ -321,6 +363,36 @@ def _material_values(where: str, material: Material, values: dict) -> Material:
             material.values[k] = pm[k].validate(v)
         except ValueError as exc:
             raise SceneFileError(f"{where}.{exc}") from None
+    return material
+
+
+def _material_table(where: str, material: Material, values: dict, base: Path, mm_per_unit: float) -> Material:
+    """A [materials.NAME] table (or overrides) onto `material`: ``preset`` first (a Jensen 2001
+    medium), then the parameters (aliases such as subsurface_weight name theirs), then ``openpbr``
+    (OpenPBR's subsurface set, skinlab/scene/openpbr.py, converted with the scene's mm_per_unit)."""
+    from .materials import canonical_names
+    from .openpbr import openpbr_to_skinlab
+
+    values = dict(values)
+    preset_name = values.pop("preset", None)
+    openpbr = values.pop("openpbr", None)
+    if preset_name is not None:  # a measured medium (skinlab/assets/presets/jensen2001_table1.csv) first
+        try:
+            material.apply_preset(_str(f"{where}.preset", preset_name))
+        except ValueError as e:
+            raise SceneFileError(f"{where}.{str(e).split(': ', 1)[-1]}") from None
+    try:
+        values = canonical_names(values, f"{where}: ")
+    except ValueError as e:
+        raise SceneFileError(str(e)) from None
+    _material_values(where, material, _resolve_paths(where, values, base, material))
+    if openpbr is not None:
+        ow = f"{where}.openpbr"
+        try:
+            material.update(openpbr_to_skinlab(_table(ow, openpbr), material.values, mm_per_unit, ow))
+        except ValueError as e:
+            raise SceneFileError(str(e)) from None
+    _check_textures(where, material)
     return material
 
 
@@ -356,15 +428,27 @@ def resolve_scene_path(path: str | Path | None) -> Path:
     )
 
 
-def load_scene(path: str | Path | None = None) -> Scene:
+def load_scene(path: str | Path | None = None, edits=None) -> Scene:
     """Read a TOML scene file (or a mesh file: see :func:`scene_from_mesh`), or a bundled scene by
     name (``"head"``, ``"bunny-marble"``: ``skinlab scenes`` lists them); errors name the file and
-    the offending key."""
+    the offending key. ``edits`` (skinlab/scene/scene_edits.py SceneEdits: a preset, mm_per_unit,
+    --set KEY=VALUE) change the file's data before it is built, validated like the file's own keys."""
     path = resolve_scene_path(path)
     if path.is_dir():
         raise SceneFileError(f"{path}: is a folder, expected a scene file (.toml) or a mesh file")
     if path.suffix.lower() in SUPPORTED:
-        return scene_from_mesh(path)
+        return scene_from_mesh(path, edits=edits)
+    data = read_scene_data(path)
+    try:
+        return _build(path, apply_edits(data, edits))
+    except SceneFileError as exc:
+        raise SceneFileError(f"{path}: {exc}") from None
+    except (ValueError, FileNotFoundError) as exc:
+        raise SceneFileError(f"{path}: {exc}") from None
+
+
+def read_scene_data(path: Path) -> dict:
+    """A scene file's TOML data (errors name the file)."""
     try:
         text = path.read_bytes().decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -373,12 +457,7 @@ def load_scene(path: str | Path | None = None) -> Scene:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneFileError(f"{path}: not valid TOML: {exc}") from None
-    try:
-        return _build(path, data)
-    except SceneFileError as exc:
-        raise SceneFileError(f"{path}: {exc}") from None
-    except (ValueError, FileNotFoundError) as exc:
-        raise SceneFileError(f"{path}: {exc}") from None
+    return data
 
 
 def _build(path: Path, data: dict) -> Scene:
@@ -401,20 +480,7 @@ def _build(path: Path, data: dict) -> Scene:
     materials: dict[str, Material] = {}
     for name, values in _table("[materials]", data.get("materials", {})).items():
         where = f"[materials.{name}]"
-        values = dict(_table(where, values))
-        m = Material(name)
-        preset_name = values.pop("preset", None)
-        if preset_name is not None:  # a measured medium (skinlab/assets/presets/jensen2001_table1.csv) first
-            from skinlab.scene.materials import medium_values
-            from skinlab.scene.optics.media import preset
-
-            try:
-                m.update(medium_values(preset(_str(f"{where}.preset", preset_name))))
-            except ValueError as e:
-                raise SceneFileError(f"{where}.preset: {e}") from None
-        _material_values(where, m, _resolve_paths(where, values, base, m))
-        _check_textures(where, m)
-        materials[name] = m
+        materials[name] = _material_table(where, Material(name), _table(where, values), base, mm)
 
     file_materials: dict[tuple[str, int], Material] = {}
 
@@ -437,8 +503,7 @@ def _build(path: Path, data: dict) -> Scene:
         if overrides:
             ow = f"{where}.overrides"
             mat = Material(f"{mat.name}+overrides", dict(mat.values), mat.params)
-            _material_values(ow, mat, _resolve_paths(ow, overrides, base, mat))
-            _check_textures(ow, mat)
+            _material_table(ow, mat, _table(ow, overrides), base, mm)
         return mat
 
     for i, entry in enumerate(_tables("[meshes]", data.get("meshes", []))):
@@ -450,6 +515,11 @@ def _build(path: Path, data: dict) -> Scene:
         mpath = mpath if mpath.is_absolute() else base / mpath
         top = Node(_str(f"{where}.name", entry.get("name", mpath.stem)), **_trs(where, entry))
         top.visible = _bool(f"{where}.visible", entry.get("visible", True))
+        top.file_info = {
+            "file": mpath,
+            "flip_v": bool(entry.get("flip_v", False)),
+            "generate_uvs": bool(entry.get("generate_uvs", False)),
+        }
         scene.add(top)
         mesh_overrides = _table(f"{where}.overrides", entry.get("overrides", {}))
         node_cfg = _table(f"{where}.nodes", entry.get("nodes", {}))
@@ -570,38 +640,39 @@ def _file_material(where: str, own) -> Material:
     return m
 
 
-def scene_from_mesh(path: str | Path, mm_per_unit: float = 1.0) -> Scene:
+# What a mesh file opened directly gets: a key light with a shadow from the upper left, a cool fill.
+MESH_FILE_LIGHTS = (
+    {
+        "name": "key",
+        "direction": [-0.55, -0.35, -0.75],
+        "color": [1.0, 0.96, 0.9],
+        "intensity": 3.0,
+        "cast_shadow": True,
+    },
+    {"name": "fill", "direction": [0.7, -0.1, -0.5], "color": [0.55, 0.65, 0.85], "intensity": 0.6},
+)
+
+
+def mesh_file_data(path: Path, mm_per_unit: float = 1.0) -> dict:
+    """The scene-file data a mesh file opened directly stands for (:func:`scene_from_mesh`)."""
+    return {
+        "scene": {"name": path.stem, "mm_per_unit": mm_per_unit},
+        "meshes": [{"file": str(path.resolve()), "name": path.stem}],
+        "lights": [dict(light, type="directional") for light in MESH_FILE_LIGHTS],
+    }
+
+
+def scene_from_mesh(path: str | Path, mm_per_unit: float = 1.0, edits=None) -> Scene:
     """A mesh file opened directly (``skinlab render model.obj``): its own nodes with the file's own
     materials (glTF) or the default material (plain principled, no subsurface), a camera on +Z
-    framing it, a shadow-casting key light from the upper left and a cool fill, as a scene file with
-    only ``[[meshes]] file`` would get plus lights."""
+    framing it, a shadow-casting key light from the upper left and a cool fill: the scene file with
+    only ``[[meshes]] file`` and those lights (:func:`mesh_file_data`), `edits` applied to it."""
     path = Path(path)
-    scene = Scene(path.stem, mm_per_unit)
-    scene.source = path
-    top = scene.add(Node(path.stem))
-    loaded = load_mesh_file(path, scene.warnings)
-    created: dict[str, Node] = {}
-    default = Material("default")
-    own: dict[int, Material] = {}  # the file's own materials (glTF), one Material each
-    for ln in loaded:
-        material = default
-        if ln.material is not None:
-            if ln.material.index not in own:
-                own[ln.material.index] = _file_material(path.name, ln.material)
-            material = own[ln.material.index]
-        node = MeshNode(ln.name, ln.mesh, material) if ln.mesh is not None else Node(ln.name)
-        node.set_matrix(ln.matrix)
-        (created[ln.parent] if ln.parent else top).add(node)
-        created[ln.name] = node
-    for name, direction, color, intensity, shadow in (
-        ("key", (-0.55, -0.35, -0.75), (1.0, 0.96, 0.9), 3.0, True),
-        ("fill", (0.7, -0.1, -0.5), (0.55, 0.65, 0.85), 0.6, False),
-    ):
-        light = LightNode(name, "directional", color, intensity, shadow)
-        light.rotation = tf.look_at_rotation(np.zeros(3), np.asarray(direction))
-        scene.add(light)
-    scene.add(default_camera(scene))
-    return scene
+    load_mesh_file(path)  # the file's own errors first, without a scene-file key around them
+    try:
+        return _build(path, apply_edits(mesh_file_data(path, mm_per_unit), edits))
+    except (ValueError, FileNotFoundError) as exc:
+        raise SceneFileError(f"{path}: {exc}") from None
 
 
 _FLIPPED: dict[int, Mesh] = {}

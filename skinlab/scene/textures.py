@@ -2,6 +2,7 @@
 
 Arrays are float32 (H, W, C) with row 0 at the *top* of the image as stored in the file; the
 renderer flips rows on upload so that v = 0 (OpenGL, as trimesh gives UVs) is the bottom row.
+Colour and alpha are read as stored (unassociated: a glTF colour map's alpha is its opacity).
 """
 
 from __future__ import annotations
@@ -62,3 +63,18 @@ def load_texture(path: str | Path, colorspace: str = "linear") -> np.ndarray:
         raise ValueError(f"{path}: texture contains NaN or Inf")
     _CACHE[key] = img
     return img
+
+
+_MEANS: dict[tuple[str, float, str], np.ndarray] = {}
+
+
+def texture_mean(path: str | Path, colorspace: str = "linear") -> np.ndarray:
+    """The mean of a texture's first three channels (linear values; one channel repeated), cached
+    by file and modification time: what a colour map contributes to a material's medium."""
+    path = Path(path)
+    key = (str(path.resolve()), path.stat().st_mtime, colorspace)
+    if key not in _MEANS:
+        img = load_texture(path, colorspace)
+        rgb = img[..., :3] if img.shape[2] >= 3 else np.repeat(img[..., :1], 3, axis=2)
+        _MEANS[key] = rgb.reshape(-1, 3).astype(np.float64).mean(axis=0)
+    return _MEANS[key]

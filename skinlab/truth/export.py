@@ -20,7 +20,9 @@ What the reference models (docs/ground-truth.md):
   derives from the material (``skinlab.scene.optics.tsd.material_medium``: subsurface_color is the surface
   albedo, subsurface_radius the artist radius R = 4 pi l, specular gives the index): reduced
   single-scattering albedo and reduced extinction 1/l per channel with an isotropic phase function
-  (similarity theory, as the diffusion profiles assume), in 1/mm (the reference frame's unit);
+  (similarity theory, as the diffusion profiles assume), in 1/mm (the reference frame's unit); a
+  material with subsurface_scatter_anisotropy g != 0 gets the real coefficients of that reduced medium
+  and a Henyey-Greenstein phase of that g (skinlab/scene/optics/similarity.py);
   Mitsuba's RGB values must lie in [0, 1], so sigma_t is passed normalised, with ``scale``;
 * the boundary: none at all (``null`` BSDF) where the material's index is 1 (specular 0), otherwise a
   rough dielectric with GGX alpha = roughness^2 (a smooth one below alpha 1e-3) and the index;
@@ -44,6 +46,7 @@ import numpy as np
 from skinlab.scene.graph import LightNode, MeshNode, Scene
 from skinlab.scene.optics.constants import MIN_MFP_MM
 from skinlab.scene.optics.rough_dielectric import SMOOTH_ALPHA  # below it a smooth dielectric (rough one degenerates)
+from skinlab.scene.optics.similarity import real_albedo, real_mfp
 from skinlab.scene.optics.tsd import eta_from_specular, material_medium
 
 # the description and its Mitsuba objects live in a module that needs no scene (it runs where only
@@ -67,14 +70,19 @@ def medium_dict(values: dict, mm_per_unit: float = 1.0) -> dict:
     mm_per_unit millimetres per unit (the reference frame's: 1)."""
     m = material_medium(values)
     mfp = np.maximum(m.mfp_arr, REFERENCE_MIN_MFP_MM)
+    albedo, phase = np.clip(m.alpha_arr, 0.0, 1.0), {"type": "isotropic"}
+    g = float(values.get("subsurface_scatter_anisotropy", 0.0))
+    if g != 0.0:  # the real coefficients of the reduced medium (similarity), with its HG phase
+        mfp, albedo = real_mfp(mfp, albedo, g), real_albedo(albedo, g)
+        phase = {"type": "hg", "g": g}
     sigma_t = mm_per_unit / mfp  # 1/mm -> 1/scene-unit
     scale = float(sigma_t.max())
     return {
         "type": "homogeneous",
-        "albedo": _rgb(np.clip(m.alpha_arr, 0.0, 1.0)),
+        "albedo": _rgb(albedo),
         "sigma_t": _rgb(sigma_t / scale),
         "scale": scale,
-        "phase": {"type": "isotropic"},
+        "phase": phase,
     }
 
 
@@ -295,7 +303,12 @@ def describe(
                     f"{node.name}: subsurface = {values['subsurface']:g} is rendered as a full medium "
                     "(the realtime frame mixes in plain diffuse)"
                 )
-            for key in ("base_color_map", "normal_map", "roughness_map", "occlusion_map"):
+            if values.get("base_color_map") is not None:
+                notes.append(
+                    f"{node.name}: base_color_map's mean colour is in the medium's albedo; its variation is not "
+                    "(the reference medium is homogeneous)"
+                )
+            for key in ("normal_map", "roughness_map", "occlusion_map"):
                 if values.get(key) is not None:
                     notes.append(f"{node.name}: {key} is ignored (the reference medium is homogeneous)")
             if values["metallic"] > 0:

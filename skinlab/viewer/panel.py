@@ -6,11 +6,11 @@ new parameter appears in the panel without GUI code: ``float`` -> slider over it
 file path, ``choice`` -> combo box. Edits are clamped into the declared range and then applied
 through ``Material.update`` (which validates again and names the parameter on error).
 
-Presets map a Jensen et al. 2001 medium onto the principled parameters the way Blender's
-Principled BSDF takes them: ``subsurface_color`` is the medium's diffuse surface albedo
-(``Medium.surface_albedo()``, photon-beam-diffusion total reflectance) and ``subsurface_radius``
+Presets map a Jensen et al. 2001 medium onto the principled parameters as a scene file's ``preset``
+does (skinlab.scene.materials.medium_values): base and ``subsurface_color`` the medium's diffuse surface
+albedo (``Medium.surface_albedo()``, photon-beam-diffusion total reflectance), ``subsurface_radius``
 its artist radius ``R = 4 pi l`` in mm (``Medium.artist_radius_mm``; Cycles' convention, see
-``skinlab/scene/optics/media.py``).
+``skinlab/scene/optics/media.py``), subsurface 1 and the specular of its index.
 """
 
 from __future__ import annotations
@@ -116,13 +116,14 @@ def material_widgets(material: Material) -> list[Widget]:
     return [widget_for(p, material.values.get(p.name)) for p in material.params]
 
 
-def medium_to_params(medium) -> dict[str, tuple[float, float, float]]:
-    """subsurface_color = diffuse surface albedo, subsurface_radius = artist radius (mm): the
-    scattering part of skinlab.scene.materials.medium_values (the material's own colour map stays)."""
+def medium_to_params(medium) -> dict:
+    """What a preset sets, the same in the viewer as in a scene file (``preset = NAME``), the API
+    (``Material.apply_preset``) and ``skinlab render --preset``: skinlab.scene.materials.medium_values
+    (base and subsurface colour, radius, subsurface 1, the specular of its index; a colour map stays
+    and multiplies the colour: the colour rule, docs/scenes.md)."""
     from skinlab.scene.materials import medium_values
 
-    v = medium_values(medium)
-    return {"subsurface_color": v["subsurface_color"], "subsurface_radius": v["subsurface_radius"]}
+    return medium_values(medium)
 
 
 def direction_from_angles(azimuth_deg: float, elevation_deg: float) -> np.ndarray:

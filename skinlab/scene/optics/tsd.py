@@ -75,11 +75,25 @@ def eta_from_specular(specular: float) -> float:
     return float(min(max((1.0 + s) / (1.0 - s), 1.0), 2.5))
 
 
+def subsurface_albedo(values) -> np.ndarray:
+    """The medium's surface albedo (the colour the scattering part shows from afar, on average): the
+    subsurface colour x the mean of the colour map, if the material has one (docs/scenes.md, the colour
+    rule: the map multiplies the subsurface colour per texel; one homogeneous medium per material)."""
+    albedo = np.asarray(values["subsurface_color"], np.float64).reshape(3)
+    cmap = values.get("base_color_map")
+    if cmap is not None:
+        from skinlab.scene.textures import texture_mean
+
+        albedo = albedo * texture_mean(cmap, "srgb")
+    return np.clip(albedo, 0.0, 1.0)
+
+
 def material_medium(values) -> Medium:
-    """The homogeneous medium of a principled material: subsurface_color is the surface albedo,
-    subsurface_radius the artist radius per channel (Blender's convention, l = R / 4 pi)."""
+    """The homogeneous medium of a principled material: its subsurface albedo (:func:`subsurface_albedo`)
+    is the surface albedo, subsurface_radius the artist radius per channel (Blender's convention,
+    l = R / 4 pi): the reduced medium (similarity), whatever subsurface_scatter_anisotropy is."""
     return Medium.from_artist_radius(
-        values["subsurface_color"], values["subsurface_radius"], eta=eta_from_specular(values["specular"])
+        subsurface_albedo(values), values["subsurface_radius"], eta=eta_from_specular(values["specular"])
     )
 
 

@@ -16,6 +16,7 @@ uniform vec3 u_sss_single_ambient[SSS_ANGULAR_NODES];  // A_ss(mu) / A_colour: s
 uniform vec3 u_sss_entry_diffuse;  // A_ms_d / A_colour: uniform (ambient) light
 uniform vec3 u_sss_single;         // alpha / A_colour (0: no single-scattering term)
 uniform float u_sss_eta;           // relative index of the boundary (1: index-matched)
+uniform float u_sss_g;             // Henyey-Greenstein g of the medium (material subsurface_scatter_anisotropy)
 
 vec3 sss_entry(float mu) {
     float x = clamp(mu, 0.0, 1.0) * float(SSS_ANGULAR_NODES - 1);
@@ -38,9 +39,10 @@ vec3 sss_single_ambient(float mu) {
 }
 
 // Single scattering toward v of light from l (per unit irradiance on a surface facing the light,
-// i.e. multiply by e NoL), per unit base colour.
+// i.e. multiply by e NoL), per unit subsurface albedo; the medium's phase function has g = u_sss_g (its
+// real single-scattering albedo is in u_sss_single: skinlab/render/boundary.py single_scattering_factor).
 vec3 sss_single_brdf(vec3 n, vec3 l, vec3 v) {
-    return single_scatter_brdf(n, l, v, u_sss_single, max(u_sss_eta, 1.0), 0.0);
+    return single_scatter_brdf(n, l, v, u_sss_single, max(u_sss_eta, 1.0), u_sss_g);
 }
 
 // Light through thin parts (NumPy twin: skinlab/scene/optics/slab.py slab_through): of the irradiance (normal

@@ -25,7 +25,9 @@ void main() {
         return;
     }
     vec3 n = normalize(v_normal);
-    vec3 base = u_base_color;
+    // the diffuse albedo seen: the plain part's base colour and the scattering part's subsurface
+    // colour, by the subsurface weight, both x the colour map (the colour rule, docs/scenes.md)
+    vec3 base = mix(u_base_color, u_subsurface_color, clamp(u_subsurface, 0.0, 1.0));
 #ifdef HAS_BASE_COLOR_MAP
     base *= textureLod(u_base_color_map, v_uv, u_albedo_lod).rgb;
 #endif

@@ -46,7 +46,10 @@ void main() {
 #ifdef HAS_BASE_COLOR_MAP
     base_map = texture(u_base_color_map, v_uv);
 #endif
-    vec3 base = u_base_color * base_map.rgb * v_color.rgb;
+    vec3 base = u_base_color * base_map.rgb * v_color.rgb;  // the plain diffuse part's albedo, a metal's F0
+    // the colour rule (docs/scenes.md): the colour map and vertex colour multiply the subsurface
+    // colour too; the hooks and single scattering take this albedo
+    vec3 sss_albedo = u_subsurface_color * base_map.rgb * v_color.rgb;
     float alpha = surface_alpha(u_alpha, base_map.a, v_color.a);
 #ifdef ALPHA_MASK
     if (!alpha_kept(alpha, u_alpha_cutoff)) discard;
@@ -69,7 +72,7 @@ void main() {
     float NoV = dot(n, v);
     vec3 color = vec3(0.0);
     bool single = any(greaterThan(u_sss_single, vec3(0.0)));
-    vec3 single_w = base * ((1.0 - metal) * sss_weight_at(v_uv));  // x the weight map
+    vec3 single_w = sss_albedo * ((1.0 - metal) * sss_weight_at(v_uv));  // x the weight map
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, e;
@@ -91,7 +94,7 @@ void main() {
     vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
     color += ambient * (base * ((1.0 - metal) * plain) + f0);
     if (single) color += ambient * single_w * sss_single_ambient(NoV);  // its single scattering
-    color += sss_radiance(base, NoV, occlusion, v_uv);
+    color += sss_radiance(sss_albedo, NoV, occlusion, v_uv);
     vec3 emission = u_emissive;
 #ifdef HAS_EMISSIVE_MAP
     emission *= texture(u_emissive_map, v_uv).rgb;

@@ -80,7 +80,7 @@ void main() {
 #ifdef HAS_NORMAL_MAP
     n = perturb_normal(ng, v_tangent, texture(u_normal_map, v_uv).rgb, u_normal_scale);
 #endif
-    vec3 base = u_base_color * v_color.rgb;
+    vec3 base = u_subsurface_color * v_color.rgb;  // the subsurface albedo (the colour rule, docs/scenes.md)
 #ifdef HAS_BASE_COLOR_MAP
     base *= texture(u_base_color_map, v_uv).rgb;
 #endif

@@ -143,7 +143,7 @@ def test_sphere_follows_the_table(renderer, multiple_only):
     b = material_boundary(mat)
     flat = np.maximum(nol, 0.0)[:, None]
     entering = flat * table_lookup(b.entry, flat[:, 0]) + (D - flat) * b.entry_diffuse[None, :]
-    base = np.asarray(mat["base_color"])
+    base = np.asarray(mat["subsurface_color"])  # the subsurface albedo (the colour rule, docs/scenes.md)
     ref = base * entering * table_lookup(b.exit, nov) / math.pi  # E = 1
     np.testing.assert_allclose(row[inside], ref[inside], rtol=0.05, atol=2e-3)
     past = inside & (nol < -0.05)

@@ -37,13 +37,15 @@ def settings(technique, **kw):
 
 
 def expected_radiance(thickness_mm):
-    """NumPy: the light through the sheet at normal incidence (irradiance 1, base colour 1, subsurface
-    1) leaving toward a viewer straight in front: through(1, d) x exit_T(1; 1, d) / pi, the exit factor
-    of light that came through (skinlab/scene/optics/slab.py slab_exit)."""
+    """NumPy: the light through the sheet at normal incidence (irradiance 1, subsurface 1) leaving toward
+    a viewer straight in front: through(1, d) x exit_T(1; 1, d) / pi x the subsurface albedo, the exit
+    factor of light that came through (skinlab/scene/optics/slab.py slab_exit; the colour rule,
+    docs/scenes.md)."""
     mat = skin(radius=(8.0, 4.0, 2.0))
     tabs, medium = material_boundary(mat), material_medium(mat.values)
-    through = tr.through([1.0], [thickness_mm], tabs, medium, mat["subsurface_color"])[0]
-    return through * tr.translucent_exit(1.0, 1.0, thickness_mm, tabs, medium, mat["subsurface_color"])[0] / np.pi
+    colour = np.asarray(mat["subsurface_color"])
+    through = tr.through([1.0], [thickness_mm], tabs, medium, colour)[0]
+    return colour * through * tr.translucent_exit(1.0, 1.0, thickness_mm, tabs, medium, colour)[0] / np.pi
 
 
 @pytest.mark.parametrize("technique", SCREEN)

@@ -196,7 +196,7 @@ def test_bunny_preset_scene_generates_uvs_and_scatters(renderer, tmp_path):
     assert 0.1 < cover.mean() < 0.9 and res.hdr[cover, :3].mean() > 0.05
     bad = tmp_path / "b.toml"
     bad.write_text('[materials.m]\npreset = "jam"\n[[meshes]]\nfile = "x.ply"\nmaterial = "m"\n')
-    with pytest.raises(ValueError, match=r"\[materials.m\].preset: preset: unknown material 'jam'"):
+    with pytest.raises(ValueError, match=r"\[materials.m\].preset: unknown material 'jam'"):
         load_scene(bad)
 
 
@@ -204,7 +204,7 @@ def test_bunny_preset_scene_generates_uvs_and_scatters(renderer, tmp_path):
 def test_sub_texel_profile_is_scattered_locally_with_the_boundary(renderer, technique):
     """A profile narrower than a texel needs no blur, but the light still enters and leaves through
     the medium's boundary: the slab lit at 45 degrees and seen from above reads
-    E mu0 base (entry(mu0) exit(mu) / pi + Jensen's single scattering), from the NumPy tables (not
+    E mu0 albedo (entry(mu0) exit(mu) / pi + Jensen's single scattering), from the NumPy tables (not
     the plain Burley diffuse the planner used to fall back to)."""
     from skinlab.scene.optics.boundary import boundary_tables, table_lookup
     from skinlab.scene.optics.single_scattering import single_scatter_brdf
@@ -220,7 +220,8 @@ def test_sub_texel_profile_is_scattered_locally_with_the_boundary(renderer, tech
     mu0 = np.sqrt(0.5)
     n, l, v = np.array([0.0, 0.0, 1.0]), np.array([-mu0, 0.0, mu0]), np.array([0.0, 0.0, 1.0])
     ss = single_scatter_brdf(n, l, v, t.single, m.eta, 0.0)
-    want = mu0 * (table_lookup(t.entry, mu0) * table_lookup(t.exit, 1.0) / np.pi + ss)
+    colour = np.asarray(mat["subsurface_color"])  # the subsurface albedo (the colour rule, docs/scenes.md)
+    want = colour * mu0 * (table_lookup(t.entry, mu0) * table_lookup(t.exit, 1.0) / np.pi + ss)
     got = res.hdr[23:25, 23:25, :3].reshape(-1, 3).mean(0)
     np.testing.assert_allclose(got, want, rtol=2e-3)
     plain = renderer.render(scene, RenderSettings.for_technique("none", 48, 48)).hdr[23:25, 23:25, :3]

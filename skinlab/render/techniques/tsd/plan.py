@@ -22,7 +22,14 @@ from skinlab.render.translucency import plan_translucency
 from skinlab.scene.mesh import with_atlas
 from skinlab.scene.mesh_thickness import thinner_than
 from skinlab.scene.optics.translucency_reach import REACH_EPS, translucency_reach_mm
-from skinlab.scene.optics.tsd import BlurStep, DiffusionKernel, design_kernel, material_medium, profile_fit
+from skinlab.scene.optics.tsd import (
+    BlurStep,
+    DiffusionKernel,
+    design_kernel,
+    material_medium,
+    profile_fit,
+    subsurface_albedo,
+)
 from skinlab.scene.uv_checks import analyse_uvs
 
 from .seams import node_seams, seam_band_texels, seams_summary
@@ -190,7 +197,7 @@ def can_shine_through(t: TsdNodePlan, scene, plan) -> bool:
     lookups, no slab evaluation) and the plan says so."""
     mat, node = t.material, t.node
     medium = material_medium(mat.values)
-    reach_mm = translucency_reach_mm(medium.alpha_arr, medium.mfp_arr, medium.eta, mat["subsurface_color"])
+    reach_mm = translucency_reach_mm(medium.alpha_arr, medium.mfp_arr, medium.eta, subsurface_albedo(mat.values))
     if not math.isfinite(reach_mm):
         return True
     # the node's world transform shrinks no length by more than its smallest singular value
