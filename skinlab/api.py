@@ -18,8 +18,9 @@ unknown one is an error naming it), plus ``exposure`` (a linear
 multiplier, as ``[environment] exposure``) and ``camera_orbit`` (degrees about the vertical axis
 through the meshes' centre, as ``skinlab render --camera-orbit``); both apply to this render only.
 Materials are edited with ``node.material.update({"roughness": 0.3})``, which validates each
-value against its declaration (docs/scenes.md). Errors are ``ValueError`` naming the file or
-parameter. A library module: it never imports the command line.
+value against its declaration (docs/scenes.md), and take a measured medium with
+``node.material.apply_preset("marble")`` (or ``update({"preset": "marble"})``). Errors are
+``ValueError`` naming the file or parameter. A library module: it never imports the command line.
 """
 
 from __future__ import annotations
@@ -35,10 +36,20 @@ from skinlab.scene.scenefile import load_scene
 __all__ = ["Skinlab", "load", "render"]
 
 
-def load(path: str | Path | None = None) -> Scene:
+def load(
+    path: str | Path | None = None,
+    *,
+    preset: str | None = None,
+    mm_per_unit: float | None = None,
+    set: dict | None = None,
+) -> Scene:
     """A bundled scene by name (``"head"``, ``"bunny-marble"``; ``skinlab scenes`` lists them), a scene
-    file (TOML) or a mesh file (.glb .gltf .obj .ply .stl .off); None: the bundled head."""
-    return load_scene(path)
+    file (TOML) or a mesh file (.glb .gltf .obj .ply .stl .off); None: the bundled head. ``preset``,
+    ``mm_per_unit`` and ``set`` (``{"roughness": 0.3, "environment.exposure": 2}``) edit it before it is
+    built, as ``skinlab render --preset --mm-per-unit --set KEY=VALUE`` do (skinlab/scene/scene_edits.py)."""
+    from skinlab.scene.scene_edits import make_edits
+
+    return load_scene(path, make_edits(preset, mm_per_unit, list((set or {}).items())))
 
 
 class Skinlab:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 
+from skinlab.commands.scene_options import add_scene_edit_options, scene_edits_from_args
 from skinlab.render.settings import parse_size
 
 
@@ -56,6 +57,7 @@ def register(sub) -> None:
     )  # fmt: skip
     p.add_argument("--no-cache", action="store_true", help="render even when an identical reference is cached")
     p.add_argument("--json", action="store_true", help="print the result (path, noise floor, time, notes) as JSON")
+    add_scene_edit_options(p)  # --preset, --set KEY=VALUE, --mm-per-unit, as skinlab render's
     p.set_defaults(func=run)
 
 
@@ -74,7 +76,7 @@ def run(args) -> int:
         w, h, spp=args.spp, passes=args.passes, seed=args.seed, variant=args.variant,
         sun_deg=args.sun_deg, max_depth=args.max_depth,
     )  # fmt: skip
-    scene = load_scene(args.scene)
+    scene = load_scene(args.scene, scene_edits_from_args(args))
     try:
         ref = render_reference(
             scene, req, progress=not args.json, use_cache=not args.no_cache, until_noise=args.until_noise,

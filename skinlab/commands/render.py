@@ -1,6 +1,7 @@
-"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--supersample N] [--technique NAME] [--json] [--explain]
-[--reuse]`: the technique options come from the registered techniques and --supersample from RenderSettings'
-declaration (skinlab/commands/technique_options.py)."""
+"""`skinlab render [SCENE|MESH] --out PATH --size WxH [--supersample N] [--technique NAME] [--preset NAME]
+[--set KEY=VALUE] [--mm-per-unit MM] [--json] [--explain] [--reuse]`: the technique options come from the
+registered techniques and --supersample from RenderSettings' declaration (skinlab/commands/technique_options.py);
+--preset/--set/--mm-per-unit edit the scene before it is built (skinlab/commands/scene_options.py)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import json
 import sys
 from pathlib import Path
 
+from skinlab.commands.scene_options import add_scene_edit_options, scene_edits_from_args
 from skinlab.commands.technique_options import (
     add_render_options,
     add_technique_options,
@@ -57,6 +59,7 @@ def register(sub) -> None:
         help="subsurface model for every material (default: each material's own sss_model)",
     )
     add_technique_options(p)  # an option of another technique than --technique is an error naming it
+    add_scene_edit_options(p)  # --preset, --set KEY=VALUE, --mm-per-unit
     p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
     p.add_argument(
@@ -69,10 +72,13 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
-def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, prepare=None, reuse: bool = False):
+def render_to_files(
+    scene_path, outputs: list[Path], settings: RenderSettings, prepare=None, reuse: bool = False, edits=None
+):
     """Render once and write each output (PNG from the tone-mapped image, EXR linear).
-    ``prepare(scene)`` may adjust the loaded scene (camera, exposure) before rendering. A warm-up
-    frame comes first; with `reuse` the written frame reuses its view-independent results."""
+    ``prepare(scene)`` may adjust the loaded scene (camera, exposure) before rendering; ``edits``
+    (SceneEdits: --preset, --set, --mm-per-unit) change it before it is built. A warm-up frame comes
+    first; with `reuse` the written frame reuses its view-independent results."""
     from skinlab.gl.context import create_headless_context
     from skinlab.image_output import check_output_path, image_format, write_image
     from skinlab.render.renderer import Renderer
@@ -80,7 +86,7 @@ def render_to_files(scene_path, outputs: list[Path], settings: RenderSettings, p
 
     for o in outputs:
         check_output_path(o, "--out")  # fail before rendering
-    scene = load_scene(scene_path)
+    scene = load_scene(scene_path, edits)
     if prepare is not None:
         prepare(scene)
     ctx = create_headless_context()
@@ -110,6 +116,7 @@ def settings_from_args(args, w: int, h: int) -> RenderSettings:
 def run(args) -> int:
     w, h = parse_size(args.size)
     settings = settings_from_args(args, w, h)
+    edits = scene_edits_from_args(args)
     if args.exposure is not None and not (args.exposure > 0 and args.exposure < float("inf")):
         raise ValueError(f"--exposure: expected a finite multiplier > 0, got {args.exposure}")
     if args.camera_orbit != args.camera_orbit or abs(args.camera_orbit) == float("inf"):
@@ -121,7 +128,7 @@ def run(args) -> int:
         if args.camera_orbit:
             scene.orbit_camera(args.camera_orbit)
 
-    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare, args.reuse)
+    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare, args.reuse, edits)
     for warning in result.plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     if args.explain:  # the warnings were printed above, once

@@ -36,6 +36,8 @@ class Node:
         self._s = np.asarray(scale, np.float64).copy()
         self._world: np.ndarray | None = None
         self.world_updates = 0  # how often the world matrix was recomputed (for tests/profiling)
+        # a scene file's [[meshes]] entry: {"file", "flip_v", "generate_uvs"} on its top node (scene_save.py)
+        self.file_info: dict | None = None
 
     # -- hierarchy ------------------------------------------------------------------
     def add(self, child: Node) -> Node:

@@ -353,6 +353,17 @@ class ViewerCore:
         self.note("info", f"screenshot: {Path(out).resolve()}")
         return Path(out)
 
+    # -- the edited scene --------------------------------------------------------------------------
+    def save_scene(self, path) -> Path:
+        """The scene as it is now (materials edited in the panel, the orbited camera, the key light) as a
+        scene file (skinlab/scene/scene_save.py); loading it gives the same materials, camera and lights."""
+        from skinlab.scene.scene_save import save_scene
+
+        self.orbit.apply(self.scene.camera)
+        out = save_scene(self.scene, path)
+        self.note("info", f"scene saved: {Path(out).resolve()}")
+        return Path(out)
+
     def close(self) -> None:
         for w in (self.shaders, self.scene_src, self.presets):
             if w is not None:

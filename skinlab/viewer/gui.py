@@ -34,6 +34,8 @@ YELLOW = imgui.ImVec4(1.0, 0.85, 0.4, 1.0)
 
 
 class Gui:
+    on_save_scene = None  # set by the window: Ctrl+S's action
+
     def __init__(self, core: ViewerCore):
         self.core = core
         self.show_panel = True
@@ -141,6 +143,9 @@ class Gui:
         self._render_options()
         if imgui.button("Reset camera (R)"):
             core.reset_camera()
+        imgui.same_line()
+        if imgui.button("Save scene (Ctrl+S)") and self.on_save_scene is not None:
+            self.on_save_scene()
 
     def _technique_options(self) -> None:
         """The current technique's settings (panel.technique_widgets: from its declaration)."""

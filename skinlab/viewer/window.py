@@ -123,6 +123,7 @@ class ViewerWindow:
         imgui.get_io().set_ini_filename(None)  # no imgui.ini in the working folder
         self.imgui_impl = pyglet_backend.create_renderer(self.window, attach_callbacks=False)
         self.gui = Gui(self.core)
+        self.gui.on_save_scene = self.save_scene
         self.gui.show_panel = show_ui
         self.show_ui = show_ui
 
@@ -178,6 +179,8 @@ class ViewerWindow:
         elif symbol in (key.P, key.TAB):
             name = core.inspector.cycle(core.targets(), -1 if shift else 1)
             core.note("info", f"inspecting {name}")
+        elif symbol == key.S and modifiers & key.MOD_CTRL:
+            self.save_scene()
         elif symbol == key.S:
             self.save_screenshot("exr" if shift else "png")
         elif symbol == key.H:
@@ -201,6 +204,17 @@ class ViewerWindow:
             return self.core.screenshot(path)
         except (OSError, ValueError) as exc:
             self.core.note("error", f"screenshot failed: {exc}")
+            return None
+
+    def save_scene(self, path=None) -> Path | None:
+        """Ctrl+S: the edited scene as TOML beside the screenshots (skinlab/scene/scene_save.py)."""
+        if path is None:
+            stamp = datetime.now().strftime("%Y%m%d-%H%M%S")
+            path = self.screenshot_dir / f"{self.core.scene.name}-edited-{stamp}.toml"
+        try:
+            return self.core.save_scene(path)
+        except (OSError, ValueError) as exc:
+            self.core.note("error", f"saving the scene failed: {exc}")
             return None
 
     # -- the loop -----------------------------------------------------------------------------

@@ -747,3 +747,21 @@ def test_window_keeps_answering_while_a_preset_is_prepared(xdisplay, tmp_path):
     assert r.returncode == 0, r.stderr[-3000:]
     steps, handled, error, tsd_lines = r.stdout.split()[-4:]
     assert int(steps) >= 5 and handled == "True" and error == "None" and int(tsd_lines) > 0, r.stdout
+
+
+def test_the_viewer_saves_the_edited_scene_as_toml(ctx, tmp_path):
+    from skinlab.scene.scenefile import load_scene
+
+    obj = tmp_path / "quad.obj"
+    obj.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n")
+    c = ViewerCore(ctx, obj, RenderSettings(32, 32, **SMALL), watch=False)
+    try:
+        c.panel.edit("roughness", 0.2)
+        c.panel.edit("subsurface_color", [0.1, 0.7, 0.3])
+        c.orbit.yaw += 0.5
+        saved = c.save_scene(tmp_path / "saved.toml")
+        back = load_scene(saved)
+        assert back.mesh_nodes()[0].material.values == c.panel.material.values
+        assert np.allclose(back.camera.world_matrix, c.scene.camera.world_matrix, atol=1e-9)
+    finally:
+        c.close()

@@ -46,7 +46,11 @@ class TintForward(ForwardHook):
 
 class TintTechnique(Technique):
     name = "tint"
-    description = "per-pixel profile tint without convolution (the original study's baseline)"
+    description = (
+        "a baseline to compare the others against, not a look: each pixel's subsurface light times the "
+        "profile's colour at one radius, no light moved across the surface (the original study's; it shifts "
+        "the colour toward the channels that scatter least far, e.g. a skin head turns yellow)"
+    )
     settings_type = TintSettings
     ledger = LedgerStyle("^", "tab:green", sweep={"tiny": LedgerSweep()})  # tiny too: the baselines
 
