@@ -298,7 +298,7 @@ def test_material_uniforms_are_declared_only_by_the_generated_include():
 
     generated = glsl_material_uniforms()
     for p in PRINCIPLED_PARAMS:
-        if p.kind in ("float", "color", "vec3", "texture"):
+        if p.kind in ("float", "color", "vec3", "vec2", "texture"):
             assert re.search(rf"uniform \w+ {p.uniform};", generated), p.name
     for f in (ROOT / "shaders").rglob("*"):
         if f.suffix in (".glsl", ".frag", ".vert"):

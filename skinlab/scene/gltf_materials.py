@@ -29,6 +29,11 @@ READ_EXTENSIONS = (
     "KHR_materials_emissive_strength",
     "KHR_materials_ior",
     "KHR_materials_specular",
+    "KHR_texture_transform",
+    "KHR_materials_diffuse_transmission",
+    "KHR_materials_volume",
+    "KHR_materials_volume_scatter",
+    "KHR_materials_scatter",
 )
 
 # The mapping of glTF material properties onto Skinlab's parameters (docs/scenes.md).
@@ -50,6 +55,27 @@ GLTF_MAPPING: tuple[tuple[str, str], ...] = (
     ("alphaMode, alphaCutoff", '`alpha_mode` ("opaque", "mask", "blend"), `alpha_cutoff`'),
     ("doubleSided", "always: Skinlab shades both sides of every surface"),
     (
+        "KHR_texture_transform (offset, rotation, scale)",
+        "`uv_offset`, `uv_rotation`, `uv_scale` (one per material: textures with different transforms keep the "
+        "first's, with a warning); texCoord other than 0 is warned about",
+    ),
+    (
+        "KHR_materials_diffuse_transmission (no scattering volume)",
+        "`diffuse_transmission` (diffuseTransmissionFactor), `diffuse_transmission_color` "
+        "(diffuseTransmissionColorFactor): a thin surface's Lambertian transmission; textures are warned about",
+    ),
+    (
+        "KHR_materials_volume_scatter or KHR_materials_scatter, with KHR_materials_volume (thicknessFactor > 0)",
+        "subsurface scattering: `subsurface` = diffuseTransmissionFactor (1 without the extension), "
+        "`subsurface_color` = multiscatterColor(Factor) x scatterStrengthFactor, `subsurface_scatter_anisotropy` = "
+        "scatterAnisotropy; the extinction sigma_a = -ln(attenuationColor) / attenuationDistance, sigma_t = "
+        "sigma_a / (1 - rho_ss) with rho_ss from the multi-scatter colour by van de Hulst's fit (1 / "
+        "attenuationDistance where attenuationColor is 1), and `subsurface_radius` = 4 pi / (sigma_t (1 - rho_ss g)) "
+        "x mm_per_unit (the reduced mean free path, Skinlab's artist radius); thicknessTexture ignored (thickness "
+        "comes from the geometry); thicknessFactor 0: read as diffuse transmission of the multi-scatter colour",
+    ),
+    ("KHR_materials_volume alone", "not modelled (a clear absorbing volume needs refraction): a warning"),
+    (
         "KHR_materials_ior, KHR_materials_specular",
         "`specular` = F0 / 0.08 with F0 = ((ior - 1)/(ior + 1))^2 x specularFactor x the mean of "
         "specularColorFactor (Skinlab's specular is one number: a coloured one is averaged, with a warning); "
@@ -68,6 +94,7 @@ class FileMaterial:
     index: int
     name: str
     values: dict = field(default_factory=dict)
+    volume: dict | None = None  # KHR_materials_volume's extinction, made a radius with the scene's scale
 
 
 def _cache_root() -> Path:
@@ -123,6 +150,7 @@ class GltfFile:
         self._images: dict[int, Path] = {}
         self._buffers: dict[int, bytes] = {}
         self.unread: set[str] = set()  # extensions met and not read
+        self._transforms: list[tuple[str, tuple]] = []  # the current material's textures' transforms
 
     def warn(self, text: str) -> None:
         if text not in self.warnings:
@@ -176,7 +204,18 @@ class GltfFile:
         d = info if isinstance(info, dict) else {"index": info.index, "texCoord": info.texCoord}
         if (d.get("texCoord") or 0) != 0:
             self.warn(f"{self.path.name}: {what} uses TEXCOORD_{d['texCoord']}; Skinlab reads TEXCOORD_0 only")
-        ext = (d.get("extensions") if isinstance(info, dict) else info.extensions) or {}
+        ext = dict((d.get("extensions") if isinstance(info, dict) else info.extensions) or {})
+        tt = _dict(ext.pop("KHR_texture_transform", {}))
+        if (tt.get("texCoord") or 0) != 0:
+            self.warn(
+                f"{self.path.name}: {what}'s texture transform uses TEXCOORD_{tt['texCoord']}; Skinlab reads TEXCOORD_0"
+            )
+        transform = (
+            tuple(_finite(tt.get("offset", [0.0, 0.0]), 2)),
+            tuple(_finite(tt.get("scale", [1.0, 1.0]), 2)),
+            float(_finite([tt.get("rotation", 0.0)], 1)[0]),
+        )
+        self._transforms.append((what, transform))
         for name in ext:
             self.unread.add(name)
         try:
@@ -196,6 +235,7 @@ class GltfFile:
         name = m.name or f"material{index}"
         values: dict = {}
         where = f"{self.path.name}: material {name!r}"
+        self._transforms = []
         pbr = m.pbrMetallicRoughness
         factor = (pbr.baseColorFactor if pbr is not None and pbr.baseColorFactor is not None else None) or [1.0] * 4
         values["base_color"] = tuple(_unit(factor[:3]))
@@ -232,10 +272,83 @@ class GltfFile:
         values["alpha_mode"] = mode.lower()
         values["alpha_cutoff"] = float(_unit([0.5 if m.alphaCutoff is None else m.alphaCutoff])[0])
         values["specular"] = self._specular(ext, where)
+        volume = self._volume(ext, values, where)
+        values.update(self._texture_transform(where))
         self.unread.update(k for k in ext if k not in READ_EXTENSIONS)
         # paths as strings: the loaded file is cached on disk (skinlab/cache.py stores no Path)
         values = {k: str(v) if isinstance(v, Path) else v for k, v in values.items() if v is not None}
-        return FileMaterial(index, name, values)
+        return FileMaterial(index, name, values, volume)
+
+    def _texture_transform(self, where: str) -> dict:
+        """uv_offset, uv_scale, uv_rotation: the material's one KHR_texture_transform (Skinlab has one per
+        material: textures with different ones keep the first's, with a warning)."""
+        if not self._transforms:
+            return {}
+        first_what, first = self._transforms[0]
+        if any(t != first for _, t in self._transforms[1:]):
+            self.warn(
+                f"{where}: its textures have different KHR_texture_transforms; Skinlab has one per material and uses "
+                f"{first_what.split(': ')[-1]}'s"
+            )
+        (ox, oy), (sx, sy), rot = first
+        if not all(abs(x) <= 1000 for x in (ox, oy, sx, sy)) or abs(rot) > 100:
+            self.warn(f"{where}: KHR_texture_transform {first} out of Skinlab's range; ignored")
+            return {}
+        return {"uv_offset": (ox, oy), "uv_scale": (sx, sy), "uv_rotation": rot}
+
+    def _volume(self, ext: dict, values: dict, where: str) -> dict | None:
+        """KHR_materials_diffuse_transmission, KHR_materials_volume and the scattering drafts
+        KHR_materials_volume_scatter / KHR_materials_scatter onto Skinlab's parameters (GLTF_MAPPING).
+        Returns the medium's extinction data for :func:`volume_radius_mm` (it needs the scene's scale)."""
+        dt = (
+            _dict(ext.pop("KHR_materials_diffuse_transmission", {}))
+            if "KHR_materials_diffuse_transmission" in ext
+            else None
+        )
+        vol = _dict(ext.pop("KHR_materials_volume", {})) if "KHR_materials_volume" in ext else None
+        scatter = None
+        for key in ("KHR_materials_scatter", "KHR_materials_volume_scatter"):
+            if key in ext:
+                if scatter is not None:
+                    self.warn(f"{where}: both scattering drafts given; KHR_materials_scatter is read")
+                    ext.pop(key)
+                    continue
+                scatter = _dict(ext.pop(key))
+        for d, key in ((dt, "diffuseTransmissionTexture"), (dt, "diffuseTransmissionColorTexture"),
+                       (vol, "thicknessTexture"), (scatter, "multiscatterColorTexture"),
+                       (scatter, "scatterStrengthTexture")):  # fmt: skip
+            if d is not None and key in d:
+                self.warn(f"{where}: {key} ignored (Skinlab reads the factor alone)")
+        dt_factor = float(np.clip(_finite([dt.get("diffuseTransmissionFactor", 0.0)], 1)[0], 0, 1)) if dt else 0.0
+        dt_colour = tuple(_unit((dt or {}).get("diffuseTransmissionColorFactor", [1.0, 1.0, 1.0])))
+        thick = vol is not None and float(_finite([vol.get("thicknessFactor", 0.0)], 1)[0]) > 0
+        if scatter is None:
+            if vol is not None:
+                self.warn(f"{where}: KHR_materials_volume without scattering (a clear absorbing volume needs "
+                          "refraction, which Skinlab does not render); ignored")  # fmt: skip
+            if dt is not None:
+                values["diffuse_transmission"], values["diffuse_transmission_color"] = dt_factor, dt_colour
+            return None
+        colour = np.asarray(_unit(scatter.get("multiscatterColorFactor", scatter.get("multiscatterColor", [0.0] * 3))))
+        colour = colour * float(np.clip(_finite([scatter.get("scatterStrengthFactor", 1.0)], 1)[0], 0.0, 1.0))
+        g = float(np.clip(_finite([scatter.get("scatterAnisotropy", 0.0)], 1)[0], -0.95, 0.95))
+        if not thick:  # thin-walled: a sheet that scatters light through, as diffuse transmission
+            values["diffuse_transmission"] = dt_factor if dt is not None else 1.0
+            values["diffuse_transmission_color"] = tuple(float(x) for x in colour)
+            self.warn(
+                f"{where}: thin-walled scattering (no KHR_materials_volume thickness) read as diffuse transmission"
+            )
+            return None
+        values["subsurface"] = dt_factor if dt is not None else 1.0
+        values["subsurface_color"] = tuple(float(x) for x in colour)
+        values["subsurface_scatter_anisotropy"] = g
+        distance = float(vol.get("attenuationDistance", math.inf))
+        att = np.asarray(_finite(vol.get("attenuationColor", [1.0, 1.0, 1.0]), 3), np.float64)
+        if not math.isfinite(distance) or distance <= 0:
+            self.warn(f"{where}: KHR_materials_volume has no finite attenuationDistance; Skinlab's default radius kept")
+            return None
+        return {"distance": distance, "attenuation": tuple(np.clip(att, 1e-12, 1.0).tolist()),
+                "multiscatter": tuple(colour.tolist()), "g": g}  # fmt: skip
 
     def _specular(self, ext: dict, where: str) -> float:
         """specular = F0 / 0.08, F0 = ((ior - 1)/(ior + 1))^2 x specularFactor x mean(specularColorFactor)."""
@@ -289,6 +402,32 @@ class GltfFile:
     def vertex_count(self, mi: int, pi: int) -> int | None:
         pos = self.primitive(mi, pi).attributes.POSITION
         return None if pos is None else int(self.gltf.accessors[pos].count)
+
+
+def volume_sigma_t(volume: dict) -> np.ndarray:
+    """The real extinction per channel (1/scene unit) of a scattering volume: sigma_a = -ln(attenuationColor)
+    / attenuationDistance, sigma_t = sigma_a / (1 - rho_ss) with rho_ss the single-scattering albedo of
+    the multi-scatter colour by van de Hulst's fit (the drafts' Kulla-Conty mapping); 1 / attenuationDistance
+    where nothing is absorbed (attenuationColor 1)."""
+    from .optics.similarity import van_de_hulst_albedo
+
+    d = float(volume["distance"])
+    sigma_a = -np.log(np.asarray(volume["attenuation"], np.float64)) / d
+    rho = van_de_hulst_albedo(np.asarray(volume["multiscatter"], np.float64), volume["g"])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        st = np.where(sigma_a > 0, sigma_a / np.maximum(1.0 - rho, 1e-12), 1.0 / d)
+    return st
+
+
+def volume_radius_mm(volume: dict, mm_per_unit: float) -> tuple[float, float, float]:
+    """Skinlab's subsurface_radius (4 pi / sigma_t', mm) of a glTF scattering volume in a scene of
+    mm_per_unit: sigma_t' = sigma_t (1 - rho_ss g), the reduced extinction (similarity)."""
+    from .optics.similarity import van_de_hulst_albedo
+
+    rho = van_de_hulst_albedo(np.asarray(volume["multiscatter"], np.float64), volume["g"])
+    reduced = volume_sigma_t(volume) * (1.0 - rho * float(volume["g"]))
+    r = 4.0 * math.pi * mm_per_unit / np.maximum(reduced, 1e-300)
+    return tuple(float(x) for x in np.clip(r, 0.0, 1000.0))
 
 
 def _dict(v) -> dict:

@@ -1,7 +1,7 @@
 """Materials declare their parameters once; uniforms, shader variants and UI derive from that.
 
 A :class:`Param` has a name, a kind, a default and a valid range. Kinds:
-- ``float`` / ``color`` / ``vec3``: plain values, uploaded as uniforms ``u_<name>``;
+- ``float`` / ``color`` / ``vec3`` / ``vec2``: plain values, uploaded as uniforms ``u_<name>``;
 - ``texture``: a file path; when set it selects a shader variant (``HAS_<NAME>``) and binds a sampler;
 - ``choice``: an option the renderer reads on the CPU (the SSS model picks the profile a technique
   plans with); it is no uniform and no define.
@@ -22,12 +22,13 @@ import numpy as np
 
 SSS_MODELS = ("none", "dipole", "burley", "blender-burley", "gaussians", "pbd")
 ALPHA_MODES = ("opaque", "mask", "blend")
+NUMERIC_KINDS = ("float", "color", "vec3", "vec2")  # uploaded as uniforms
 
 
 @dataclass(frozen=True)
 class Param:
     name: str
-    kind: str  # float | color | vec3 | texture | choice
+    kind: str  # float | color | vec3 | vec2 | texture | choice
     default: Any
     range: tuple[float, float] | None = None
     choices: tuple[str, ...] = ()
@@ -44,7 +45,7 @@ class Param:
         return f"HAS_{self.name.upper()}"
 
     def _numbers(self, value: Any, label: str) -> np.ndarray:
-        """A float or colour/vec3 value as an array (1 or 3 numbers; a scalar fills R, G, B)."""
+        """A float, colour/vec3 or vec2 value as an array (1, 3 or 2 numbers; a scalar fills them all)."""
         if self.kind == "float":
             try:
                 return np.array([float(value)])
@@ -52,14 +53,16 @@ class Param:
                 raise ValueError(
                     f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}"
                 ) from None
+        n = 2 if self.kind == "vec2" else 3
         try:
             arr = np.asarray(value, dtype=np.float64).reshape(-1)
         except (TypeError, ValueError):
-            raise ValueError(f"{label}: expected 3 numbers, got {value!r}") from None
+            raise ValueError(f"{label}: expected {n} numbers, got {value!r}") from None
         if arr.size == 1:
-            arr = np.repeat(arr, 3)
-        if arr.size != 3:
-            raise ValueError(f"{label}: expected 3 numbers (R, G, B), got {arr.size}")
+            arr = np.repeat(arr, n)
+        if arr.size != n:
+            what = "(u, v)" if n == 2 else "(R, G, B)"
+            raise ValueError(f"{label}: expected {n} numbers {what}, got {arr.size}")
         return arr
 
     def _canonical(self, arr: np.ndarray):
@@ -88,7 +91,7 @@ class Param:
     def clamp(self, value: Any) -> Any:
         """Like validate, but numbers out of range are clamped into it and NaN becomes the default
         (for UI widgets); malformed values and unknown choices still raise, naming the parameter."""
-        if self.kind not in ("float", "color", "vec3"):
+        if self.kind not in NUMERIC_KINDS:
             return self.validate(value)
         arr = self._numbers(value, self.name)
         arr = np.where(np.isnan(arr), np.asarray(self._numbers(self.default, self.name)), arr)
@@ -157,6 +160,40 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         "path-traced truth); blend: drawn after the opaque meshes, far to near, over them (glTF alphaMode)",
     ),
     Param("alpha_cutoff", "float", 0.5, (0.0, 1.0), doc="the alpha below which a masked surface is cut away"),
+    Param(
+        "uv_offset",
+        "vec2",
+        (0.0, 0.0),
+        (-1000.0, 1000.0),
+        doc="texture transform (glTF KHR_texture_transform, in its UV convention, origin at the image's top-left): "
+        "every map is read at uv_offset + R(uv_rotation) diag(uv_scale) uv; texture-space diffusion's layout keeps "
+        "the mesh's own UVs",
+    ),
+    Param("uv_scale", "vec2", (1.0, 1.0), (-1000.0, 1000.0), doc="the texture transform's scale (see uv_offset)"),
+    Param(
+        "uv_rotation",
+        "float",
+        0.0,
+        (-100.0, 100.0),
+        unit="radians",
+        doc="the texture transform's rotation of the UVs, counter-clockwise (see uv_offset)",
+    ),
+    Param(
+        "diffuse_transmission",
+        "float",
+        0.0,
+        (0.0, 1.0),
+        doc="the share of the plain diffuse part sent through a thin surface to the other side, Lambertian "
+        "(glTF KHR_materials_diffuse_transmission: leaves, paper, lash cards); light from behind shows through",
+    ),
+    Param(
+        "diffuse_transmission_color",
+        "color",
+        (1.0, 1.0, 1.0),
+        (0.0, 1.0),
+        unit="linear RGB",
+        doc="the colour of the light diffuse_transmission lets through",
+    ),
     Param(
         "subsurface",
         "float",
@@ -291,7 +328,7 @@ class Material:
 
     # -- what the renderer derives from the declaration -------------------------------
     def uniforms(self) -> dict[str, Any]:
-        return {p.uniform: self.values[p.name] for p in self.params if p.kind in ("float", "color", "vec3")}
+        return {p.uniform: self.values[p.name] for p in self.params if p.kind in NUMERIC_KINDS}
 
     def textures(self) -> dict[str, tuple[Path, str]]:
         """sampler uniform -> (path, colorspace) for the maps that are set."""
@@ -308,6 +345,11 @@ class Material:
         out = {p.define: "1" for p in self.params if p.kind == "texture" and self.values[p.name] is not None}
         if self.values.get("alpha_mode", "opaque") != "opaque":
             out["ALPHA_" + self.values["alpha_mode"].upper()] = "1"
+        if self.values.get("diffuse_transmission", 0.0) > 0.0:
+            out["DIFFUSE_TRANSMISSION"] = "1"
+        if any(self.values.get(k, d) != d for k, d in (("uv_offset", (0.0, 0.0)), ("uv_scale", (1.0, 1.0)),
+                                                          ("uv_rotation", 0.0))):  # fmt: skip
+            out["UV_TRANSFORM"] = "1"
         return out
 
     @property
@@ -319,7 +361,7 @@ class Material:
         )
 
 
-_GLSL_TYPES = {"float": "float", "color": "vec3", "vec3": "vec3"}
+_GLSL_TYPES = {"float": "float", "color": "vec3", "vec3": "vec3", "vec2": "vec2"}
 
 
 def glsl_material_uniforms(params: tuple[Param, ...] = PRINCIPLED_PARAMS) -> str:

@@ -20,6 +20,7 @@ _KIND = {
     "float": "number",
     "color": "3 numbers (or 1 for grey)",
     "vec3": "3 numbers (or 1 for all)",
+    "vec2": "2 numbers (or 1 for both)",
     "texture": "file path (string)",
     "choice": "string",
 }

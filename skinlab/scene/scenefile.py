@@ -352,10 +352,10 @@ def _material_values(where: str, material: Material, values: dict) -> Material:
             )
         if k not in pm:
             raise SceneFileError(f"{where}: unknown material parameter {k!r}; known: {', '.join(pm)}")
-        if pm[k].kind in ("float", "color", "vec3") and not (
+        if pm[k].kind in ("float", "color", "vec3", "vec2") and not (
             _is_number(v) or (isinstance(v, list) and all(_is_number(x) for x in v))
         ):
-            n = "a number" if pm[k].kind == "float" else "3 numbers"
+            n = {"float": "a number", "vec2": "2 numbers"}.get(pm[k].kind, "3 numbers")
             raise SceneFileError(f"{where}.{k}: expected {n}, got {_kind(v)} {_show(v)}")
         if pm[k].kind == "choice" and not isinstance(v, str):
             raise SceneFileError(f"{where}.{k}: expected one of {', '.join(pm[k].choices)}; got {_show(v)}")
@@ -490,7 +490,7 @@ def _build(path: Path, data: dict) -> Scene:
         if name is None and own is not None:
             key = (str(mfile), own.index)
             if key not in file_materials:
-                file_materials[key] = _file_material(f"{where} ({Path(mfile).name})", own)
+                file_materials[key] = _file_material(f"{where} ({Path(mfile).name})", own, mm)
             mat = file_materials[key]
         elif name is None:
             mat = Material("default")
@@ -629,11 +629,17 @@ def _build(path: Path, data: dict) -> Scene:
     return scene
 
 
-def _file_material(where: str, own) -> Material:
-    """A Material from a mesh file's own material (skinlab/scene/gltf_materials.py FileMaterial)."""
+def _file_material(where: str, own, mm_per_unit: float) -> Material:
+    """A Material from a mesh file's own material (skinlab/scene/gltf_materials.py FileMaterial); a
+    scattering volume's extinction becomes the radius at the scene's scale."""
+    from .gltf_materials import volume_radius_mm
+
     m = Material(own.name)
+    values = dict(own.values)
+    if own.volume is not None:
+        values["subsurface_radius"] = volume_radius_mm(own.volume, mm_per_unit)
     try:
-        m.update(own.values)
+        m.update(values)
     except ValueError as exc:
         raise SceneFileError(f"{where}: {exc}") from None
     _check_textures(f"{where}: material {own.name!r}", m)

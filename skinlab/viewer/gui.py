@@ -260,6 +260,9 @@ class Gui:
                 ch, v = imgui.drag_float3(
                     label, [float(x) for x in w.value], speed, w.range[0], w.range[1], "%.3f", flags
                 )
+            elif w.widget == "drag_float2":
+                speed = max((w.range[1] - w.range[0]) * 1e-5, 1e-3)
+                ch, v = imgui.drag_float2(label, [float(x) for x in w.value], speed, w.range[0], w.range[1], "%.3f")
             elif w.widget == "combo":
                 ch, v = False, w.value
                 if imgui.begin_combo(label, str(w.value)):

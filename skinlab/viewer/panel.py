@@ -32,6 +32,7 @@ WIDGETS = {
     "float": "slider_float",
     "color": "color_edit3",
     "vec3": "drag_float3",
+    "vec2": "drag_float2",
     "texture": "file_path",
     "choice": "combo",
 }
@@ -100,7 +101,7 @@ def clamp_value(param: Param, value: Any) -> Any:
     """The value a widget hands back, made valid for ``param``: numbers are clamped into the
     range (NaN -> the default), colours/vec3 element-wise; choices must be one of the options;
     textures must name an existing file (or be empty: no map). Errors name the parameter."""
-    if param.kind in ("float", "color", "vec3", "choice"):
+    if param.kind in ("float", "color", "vec3", "vec2", "choice"):
         return param.clamp(value)
     if param.kind == "texture":
         if value is None or str(value).strip() == "":

@@ -189,3 +189,104 @@ def test_a_scene_file_material_wins_over_the_files_own(tmp_path):
     )
     (node,) = load_scene(tmp_path / "named.toml").mesh_nodes()
     assert node.material["base_color"] == (0.5, 0.5, 0.5)
+
+
+def test_texture_transform_moves_the_map(tmp_path, renderer):
+    px = np.zeros((4, 4, 3), np.uint8)
+    px[:, :2] = (250, 250, 250)  # left half white, right half black
+    renders = {}
+    for name, ext in (("plain", None), ("shifted", {"KHR_texture_transform": {"offset": [0.5, 0.0]}})):
+        b = GlbBuilder()
+        info = {"index": b.image(px)}
+        if ext:
+            info["extensions"] = ext
+            b.extensions_used.add("KHR_texture_transform")
+        b.quad("q", b.material(name=name, pbr={"baseColorTexture": info, "metallicFactor": 0.0}))
+        scene = load_scene(b.save(tmp_path / f"{name}.glb"))
+        renders[name] = (scene.mesh_nodes()[0].material, render(renderer, scene).hdr[..., :3].mean(2))
+    m = renders["shifted"][0]
+    assert m["uv_offset"] == (0.5, 0.0) and m["uv_scale"] == (1.0, 1.0) and m["uv_rotation"] == 0.0
+    assert "UV_TRANSFORM" in m.defines() and "UV_TRANSFORM" not in renders["plain"][0].defines()
+    h, q = SIZE // 2, SIZE // 4
+    plain, shifted = renders["plain"][1], renders["shifted"][1]
+    assert plain[h, h - q] > 5 * plain[h, h + q]  # left bright
+    assert shifted[h, h + q] > 5 * shifted[h, h - q]  # offset by half a texture: right bright
+
+
+def test_ior_and_specular_extensions_set_specular(tmp_path):
+    b = GlbBuilder()
+    b.quad("q", b.material(name="c", extensions={"KHR_materials_ior": {"ior": 1.376},
+                                                 "KHR_materials_specular": {"specularFactor": 0.5}}))  # fmt: skip
+    (node,) = load_scene(b.save(tmp_path / "c.glb")).mesh_nodes()
+    f0 = ((1.376 - 1) / (1.376 + 1)) ** 2
+    assert node.material["specular"] == pytest.approx(f0 * 0.5 / 0.08)
+
+
+def _volume_glb(tmp_path, name, scatter_ext, scatter, thickness=1.0, dt=None):
+    b = GlbBuilder()
+    ext = {
+        "KHR_materials_volume": {
+            "thicknessFactor": thickness,
+            "attenuationDistance": 0.5,
+            "attenuationColor": [0.9, 0.5, 0.2],
+        },  # fmt: skip
+        scatter_ext: scatter,
+    }
+    if dt is not None:
+        ext["KHR_materials_diffuse_transmission"] = {"diffuseTransmissionFactor": dt}
+    b.quad("q", b.material(name=name, extensions=ext, pbr={"metallicFactor": 0.0}))
+    return b.save(tmp_path / f"{name}.glb")
+
+
+@pytest.mark.parametrize("ext", ["KHR_materials_volume_scatter", "KHR_materials_scatter"])
+def test_scattering_volume_drafts_become_the_subsurface_medium(tmp_path, ext):
+    from skinlab.scene.optics.similarity import van_de_hulst_albedo
+    from skinlab.scene.optics.tsd import material_medium
+
+    scatter = {"multiscatterColorFactor": [0.8, 0.6, 0.4], "scatterAnisotropy": 0.5}
+    if ext == "KHR_materials_scatter":
+        scatter["scatterStrengthFactor"] = 0.5
+    glb = _volume_glb(tmp_path, "v", ext, scatter, dt=0.8)
+    (tmp_path / "s.toml").write_text(f'[scene]\nmm_per_unit = 10.0\n[[meshes]]\nfile = "{glb}"\n')
+    scene = load_scene(tmp_path / "s.toml")
+    m = scene.mesh_nodes()[0].material
+    colour = np.array([0.8, 0.6, 0.4]) * (0.5 if ext == "KHR_materials_scatter" else 1.0)
+    assert m["subsurface"] == 0.8 and m["subsurface_color"] == pytest.approx(tuple(colour))
+    assert m["subsurface_scatter_anisotropy"] == 0.5 and m.has_subsurface
+    # the medium's real extinction is the draft's: sigma_a / (1 - rho_ss), per scene unit
+    rho = van_de_hulst_albedo(colour, 0.5)
+    sigma_a = -np.log([0.9, 0.5, 0.2]) / 0.5
+    sigma_t = sigma_a / (1 - rho)
+    reduced_mm = np.asarray(m["subsurface_radius"]) / (4 * np.pi)  # Skinlab's l' in mm
+    assert 1.0 / (reduced_mm / 10.0) == pytest.approx(sigma_t * (1 - rho * 0.5), rel=1e-9)
+    assert material_medium(m.values).mfp_arr == pytest.approx(reduced_mm)
+    assert not [w for w in scene.warnings if "not read by Skinlab" in w]
+
+
+def test_diffuse_transmission_lets_light_from_behind_through(tmp_path, renderer):
+    imgs = {}
+    for name, dt in (("opaque", None), ("leaf", 0.6)):
+        b = GlbBuilder()
+        dtx = {"diffuseTransmissionFactor": dt, "diffuseTransmissionColorFactor": [0.2, 0.9, 0.2]}
+        ext = {"KHR_materials_diffuse_transmission": dtx} if dt else None
+        b.quad("q", b.material(name=name, extensions=ext, pbr={"metallicFactor": 0.0}))
+        scene = load_scene(b.save(tmp_path / f"{name}.glb"))
+        if dt:
+            m = scene.mesh_nodes()[0].material
+            assert m["diffuse_transmission"] == 0.6 and m["diffuse_transmission_color"] == (0.2, 0.9, 0.2)
+        for light in scene.lights():  # the key light from behind the quad, the fill off
+            light.rotation = (0.0, 1.0, 0.0, 0.0)  # travels +Z: from behind toward the camera
+            light.intensity = light.intensity if light.name == "key" else 0.0
+        scene.environment.ambient = np.zeros(3)
+        imgs[name] = centre(render(renderer, scene).hdr)
+    assert imgs["opaque"].max() < 1e-6
+    r, g, b_ = imgs["leaf"]
+    assert g > 0.05 and g > 3 * r and g > 3 * b_  # green light through the leaf
+
+
+def test_a_volume_without_scattering_is_warned_about(tmp_path):
+    b = GlbBuilder()
+    b.quad("q", b.material(name="glass", extensions={"KHR_materials_volume": {"thicknessFactor": 1.0}}))
+    scene = load_scene(b.save(tmp_path / "glass.glb"))
+    assert any("KHR_materials_volume without scattering" in w for w in scene.warnings)
+    assert not scene.mesh_nodes()[0].material.has_subsurface

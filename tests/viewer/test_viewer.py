@@ -211,7 +211,7 @@ def test_every_param_kind_has_a_widget():
     for p in PRINCIPLED_PARAMS:
         w = widget_for(p)
         assert w.widget == WIDGETS[p.kind] and w.param == p.name
-        if p.kind in ("float", "color", "vec3"):
+        if p.kind in ("float", "color", "vec3", "vec2"):
             assert w.range == tuple(p.range)
         if p.kind == "choice":
             assert w.choices == p.choices and len(w.choices) > 1

@@ -1,5 +1,6 @@
 """NumPy twins of skinlab/shaders/lib/surface.glsl: the surface inputs a glTF material brings beyond the
-principled BRDF (occlusion strength, opacity and its mask). Same names, same clamps."""
+principled BRDF (occlusion strength, opacity and its mask, the texture transform, diffuse transmission).
+Same names, same clamps."""
 
 from __future__ import annotations
 
@@ -19,3 +20,21 @@ def surface_alpha(alpha, map_a, vertex_a):
 def alpha_kept(a, cutoff):
     """A masked surface is there where its opacity reaches the cutoff (glTF alphaMode MASK)."""
     return np.asarray(a) >= cutoff
+
+
+def texture_transform(uv, offset, scale, rotation):
+    """glTF KHR_texture_transform of OpenGL-convention uvs (..., 2): in glTF's convention g = (u, 1 - v),
+    g' = offset + R S g, R = [[cos, sin], [-sin, cos]], S = diag(scale); back as (g'_u, 1 - g'_v)."""
+    uv = np.asarray(uv, np.float64)
+    g = np.stack([uv[..., 0], 1.0 - uv[..., 1]], axis=-1) * np.asarray(scale, np.float64)
+    c, s = np.cos(rotation), np.sin(rotation)
+    t = np.asarray(offset, np.float64) + np.stack([c * g[..., 0] + s * g[..., 1], -s * g[..., 0] + c * g[..., 1]], -1)
+    return np.stack([t[..., 0], 1.0 - t[..., 1]], axis=-1)
+
+
+def diffuse_transmission_btdf(NoL, weight, colour):
+    """The Lambertian BTDF of glTF KHR_materials_diffuse_transmission: colour x weight / pi for light from
+    the other side (NoL < 0), else 0; (..., 3)."""
+    NoL = np.asarray(NoL, np.float64)[..., None]
+    w = np.clip(np.asarray(weight, np.float64), 0.0, 1.0)[..., None] if np.ndim(weight) else np.clip(weight, 0, 1)
+    return np.where(NoL < 0.0, np.asarray(colour, np.float64) * w / np.pi, 0.0)

@@ -7,6 +7,7 @@
 #include "lib/lights.glsl"
 #include "lib/bounce.glsl"
 #include "skinlab/material.glsl"
+#include "lib/material_uv.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -29,7 +30,7 @@ void main() {
     // colour, by the subsurface weight, both x the colour map (the colour rule, docs/scenes.md)
     vec3 base = mix(u_base_color, u_subsurface_color, clamp(u_subsurface, 0.0, 1.0));
 #ifdef HAS_BASE_COLOR_MAP
-    base *= textureLod(u_base_color_map, v_uv, u_albedo_lod).rgb;
+    base *= textureLod(u_base_color_map, material_uv(v_uv), u_albedo_lod).rgb;
 #endif
     vec3 e = PI * u_ambient;
     for (int i = 0; i < MAX_LIGHTS; ++i) {

@@ -18,6 +18,7 @@
 #include "lib/lights.glsl"
 #include "lib/ambient.glsl"
 #include "lib/surface.glsl"
+#include "lib/material_uv.glsl"
 #include "skinlab/material.glsl"
 
 in vec3 v_world;
@@ -34,17 +35,18 @@ layout(location = 0) out vec4 f_color;
 #include "lib/sss_maps.glsl"
 
 void main() {
+    vec2 muv = material_uv(v_uv);  // where the material's maps are read (its texture transform)
     vec3 ng = normalize(v_normal);
     vec3 v = normalize(u_camera_pos - v_world);
     if (!gl_FrontFacing) ng = -ng;
     vec3 n = ng;
 #ifdef HAS_NORMAL_MAP
     n = perturb_normal(ng, vec4(gl_FrontFacing ? v_tangent.xyz : -v_tangent.xyz, v_tangent.w),
-                       texture(u_normal_map, v_uv).rgb, u_normal_scale);
+                       texture(u_normal_map, muv).rgb, u_normal_scale);
 #endif
     vec4 base_map = vec4(1.0);
 #ifdef HAS_BASE_COLOR_MAP
-    base_map = texture(u_base_color_map, v_uv);
+    base_map = texture(u_base_color_map, muv);
 #endif
     vec3 base = u_base_color * base_map.rgb * v_color.rgb;  // the plain diffuse part's albedo, a metal's F0
     // the colour rule (docs/scenes.md): the colour map and vertex colour multiply the subsurface
@@ -56,15 +58,15 @@ void main() {
 #endif
     float rough = u_roughness;
 #ifdef HAS_ROUGHNESS_MAP
-    rough *= texture(u_roughness_map, v_uv).r;
+    rough *= texture(u_roughness_map, muv).r;
 #endif
     float metal = u_metallic;  // the subsurface hooks weigh their term by u_metallic (no map)
 #ifdef HAS_METALLIC_MAP
-    metal *= texture(u_metallic_map, v_uv).r;
+    metal *= texture(u_metallic_map, muv).r;
 #endif
     float occlusion = 1.0;
 #ifdef HAS_OCCLUSION_MAP
-    occlusion = occlusion_at_strength(texture(u_occlusion_map, v_uv).r, u_occlusion_strength);
+    occlusion = occlusion_at_strength(texture(u_occlusion_map, muv).r, u_occlusion_strength);
 #endif
     float plain = sss_plain_weight();    // weight of the surface's own Burley diffuse
     vec3 f0 = principled_f0(base, metal, u_specular);
@@ -78,11 +80,22 @@ void main() {
         vec3 l, e;
         light_incidence(i, v_world, n, l, e);
         float NoL = dot(n, l);
+#ifdef DIFFUSE_TRANSMISSION
+        // a thin surface lit from behind: its Lambertian transmission (lib/surface.glsl), shadowed as the far face
+        if (NoL < 0.0) {
+            float back = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, -dot(ng, l)) : 1.0;
+            color += e * (back * -NoL) * (1.0 - metal) * plain
+                     * diffuse_transmission_btdf(NoL, u_diffuse_transmission, u_diffuse_transmission_color);
+        }
+#endif
         if (NoL <= 0.0) continue;
         float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
         vec3 h = half_vector(n, v, l);
         float LoH = dot(l, h);
         vec3 diffuse = base * ((1.0 - metal) * plain * burley_diffuse(NoL, NoV, LoH, rough));
+#ifdef DIFFUSE_TRANSMISSION
+        diffuse *= 1.0 - u_diffuse_transmission;  // what is not sent through
+#endif
         vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
         color += e * vis * (diffuse + spec) * NoL;
         if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
@@ -92,12 +105,16 @@ void main() {
         sss_add_light(e, u_light_shadow[i] >= 0 ? light_visibility(i, entry, dot(ng, l)) : 1.0, NoL);
     }
     vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
-    color += ambient * (base * ((1.0 - metal) * plain) + f0);
+    float kept = 1.0;
+#ifdef DIFFUSE_TRANSMISSION
+    kept = 1.0 - u_diffuse_transmission;  // the sky behind shows through as much as the front one is sent away
+#endif
+    color += ambient * (base * ((1.0 - metal) * plain * kept) + f0);
     if (single) color += ambient * single_w * sss_single_ambient(NoV);  // its single scattering
     color += sss_radiance(sss_albedo, NoV, occlusion, v_uv);
     vec3 emission = u_emissive;
 #ifdef HAS_EMISSIVE_MAP
-    emission *= texture(u_emissive_map, v_uv).rgb;
+    emission *= texture(u_emissive_map, muv).rgb;
 #endif
     color += emission;
 #ifdef ALPHA_BLEND

@@ -20,6 +20,7 @@
 #include "skinlab/material.glsl"
 #include "lib/sss_maps.glsl"
 #include "lib/surface.glsl"
+#include "lib/material_uv.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -78,15 +79,15 @@ void main() {
     vec3 ng = normalize(v_normal);
     vec3 n = ng;
 #ifdef HAS_NORMAL_MAP
-    n = perturb_normal(ng, v_tangent, texture(u_normal_map, v_uv).rgb, u_normal_scale);
+    n = perturb_normal(ng, v_tangent, texture(u_normal_map, material_uv(v_uv)).rgb, u_normal_scale);
 #endif
     vec3 base = u_subsurface_color * v_color.rgb;  // the subsurface albedo (the colour rule, docs/scenes.md)
 #ifdef HAS_BASE_COLOR_MAP
-    base *= texture(u_base_color_map, v_uv).rgb;
+    base *= texture(u_base_color_map, material_uv(v_uv)).rgb;
 #endif
     float occlusion = 1.0;
 #ifdef HAS_OCCLUSION_MAP
-    occlusion = occlusion_at_strength(texture(u_occlusion_map, v_uv).r, u_occlusion_strength);
+    occlusion = occlusion_at_strength(texture(u_occlusion_map, material_uv(v_uv)).r, u_occlusion_strength);
 #endif
     vec3 e_in = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {   // the lights without a shadow map
