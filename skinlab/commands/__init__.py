@@ -12,4 +12,5 @@ COMMAND_MODULES = [
     "skinlab.commands.reference",
     "skinlab.commands.scenes",
     "skinlab.commands.compare",
+    "skinlab.commands.export",
 ]

@@ -57,6 +57,12 @@ def register(sub) -> None:
     )  # fmt: skip
     p.add_argument("--no-cache", action="store_true", help="render even when an identical reference is cached")
     p.add_argument("--json", action="store_true", help="print the result (path, noise floor, time, notes) as JSON")
+    p.add_argument(
+        "--export-xml",
+        metavar="DIR",
+        help="write the path tracer's scene as a Mitsuba 3 scene file, DIR/scene.xml with its meshes (PLY) and "
+        "textures (EXR), for Mitsuba alone (`mitsuba DIR/scene.xml`), instead of rendering (default: render)",
+    )
     add_scene_edit_options(p)  # --preset, --set KEY=VALUE, --mm-per-unit, as skinlab render's
     p.set_defaults(func=run)
 
@@ -67,6 +73,8 @@ def run(args) -> int:
     from skinlab.scene.scenefile import load_scene
     from skinlab.truth.reference import ReferenceRequest, ReferenceUnavailable, render_reference
 
+    if args.export_xml:
+        return export_xml(args)
     out = check_output_path(args.out, "--out")  # before minutes of path tracing
     check_output_path(out.with_suffix(".png"), "--out")
     if image_format(out) != "exr":
@@ -166,6 +174,33 @@ def noise_map_rgb(ref):
     rgb = magma_rgb(np.nan_to_num(rel) / 0.1)
     rgb[~m] = (40, 40, 40)
     return rgb
+
+
+def export_xml(args) -> int:
+    """--export-xml DIR: the description the reference would render, as Mitsuba XML and meshes."""
+    from pathlib import Path
+
+    from skinlab.scene.scenefile import load_scene
+    from skinlab.truth.export import describe
+    from skinlab.truth.mitsuba_xml import write_mitsuba_xml
+    from skinlab.truth.reference import ReferenceRequest
+
+    folder = Path(args.export_xml)
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"--export-xml: {folder} exists and is not a folder")
+    w, h = parse_size(args.size)
+    req = ReferenceRequest(w, h, spp=args.spp, passes=args.passes, seed=args.seed, sun_deg=args.sun_deg,
+                           max_depth=args.max_depth)  # fmt: skip
+    scene = load_scene(args.scene, scene_edits_from_args(args))
+    desc = describe(scene, w, h, sun_deg=req.sun_deg, max_depth=req.max_depth, rr_depth=req.rr_depth)
+    path = write_mitsuba_xml(desc, folder, spp=req.spp)
+    if args.json:
+        print(json.dumps({"scene": scene.name, "xml": str(path.resolve()), "notes": desc.notes}, indent=1))
+        return 0
+    for n in desc.notes:
+        print(f"note: {n}")
+    print(f"wrote {path.resolve()} ({len(desc.shapes)} shape(s); render it with: mitsuba {path})")
+    return 0
 
 
 def tone_mapped(hdr, exposure: float = 1.0):

@@ -113,19 +113,22 @@ def _store(data: bytes, suffix: str) -> Path:
     return path
 
 
-def _channel_map(image: Path, channel: int, tag: str) -> Path:
+def _channel_map(image: Path, channel: int, tag: str) -> Path | None:
     """One channel of a texture (0 R, 1 G, 2 B) as a one-channel 16-bit PNG read through its R
-    channel, cached by the source file's content."""
+    channel, cached by the source file's content; None where the channel is 1 everywhere (the map
+    would change nothing)."""
     from skinlab.atomic_write import atomic_path
 
     from .textures import load_texture
 
+    img = load_texture(image, "linear")
+    c = img[..., min(channel, img.shape[2] - 1)]
+    if c.min() >= 1.0 - 1e-6:
+        return None
     digest = hashlib.sha256(image.read_bytes()).hexdigest()[:32]
     path = _cache_root() / f"{digest}-{tag}.png"
     if path.is_file():
         return path
-    img = load_texture(image, "linear")
-    c = img[..., min(channel, img.shape[2] - 1)]
     from PIL import Image
 
     with atomic_path(path) as tmp:
@@ -215,7 +218,8 @@ class GltfFile:
             tuple(_finite(tt.get("scale", [1.0, 1.0]), 2)),
             float(_finite([tt.get("rotation", 0.0)], 1)[0]),
         )
-        self._transforms.append((what, transform))
+        if "extras.skinlab" not in what:  # Skinlab's own maps share the material's transform
+            self._transforms.append((what, transform))
         for name in ext:
             self.unread.add(name)
         try:
@@ -245,7 +249,7 @@ class GltfFile:
         if pbr is not None:
             values["base_color_map"] = self.texture_file(pbr.baseColorTexture, f"{where}: baseColorTexture")
             mr = self.texture_file(pbr.metallicRoughnessTexture, f"{where}: metallicRoughnessTexture")
-            if mr is not None:
+            if mr is not None:  # None values are dropped below: no map where a channel is all 1
                 values["roughness_map"] = _channel_map(mr, 1, "roughness")
                 values["metallic_map"] = _channel_map(mr, 2, "metallic")
             self.unread.update((pbr.extensions or {}).keys())
@@ -274,10 +278,23 @@ class GltfFile:
         values["specular"] = self._specular(ext, where)
         volume = self._volume(ext, values, where)
         values.update(self._texture_transform(where))
+        values.update(self._skinlab_extras(m, where))
         self.unread.update(k for k in ext if k not in READ_EXTENSIONS)
         # paths as strings: the loaded file is cached on disk (skinlab/cache.py stores no Path)
         values = {k: str(v) if isinstance(v, Path) else v for k, v in values.items() if v is not None}
         return FileMaterial(index, name, values, volume)
+
+    def _skinlab_extras(self, m, where: str) -> dict:
+        """What Skinlab's glTF export keeps in the material's extras.skinlab (skinlab/scene/gltf_export.py):
+        sss_model and the subsurface weight and radius maps (texture indices)."""
+        sk = _dict(_dict(m.extras).get("skinlab"))
+        out: dict = {}
+        if isinstance(sk.get("sss_model"), str):
+            out["sss_model"] = sk["sss_model"]
+        for key in ("subsurface_map", "subsurface_radius_map"):
+            if key in sk:
+                out[key] = self.texture_file({"index": sk[key]}, f"{where}: extras.skinlab.{key}")
+        return out
 
     def _texture_transform(self, where: str) -> dict:
         """uv_offset, uv_scale, uv_rotation: the material's one KHR_texture_transform (Skinlab has one per
@@ -315,8 +332,7 @@ class GltfFile:
                     continue
                 scatter = _dict(ext.pop(key))
         for d, key in ((dt, "diffuseTransmissionTexture"), (dt, "diffuseTransmissionColorTexture"),
-                       (vol, "thicknessTexture"), (scatter, "multiscatterColorTexture"),
-                       (scatter, "scatterStrengthTexture")):  # fmt: skip
+                       (vol, "thicknessTexture"), (scatter, "scatterStrengthTexture")):  # fmt: skip
             if d is not None and key in d:
                 self.warn(f"{where}: {key} ignored (Skinlab reads the factor alone)")
         dt_factor = float(np.clip(_finite([dt.get("diffuseTransmissionFactor", 0.0)], 1)[0], 0, 1)) if dt else 0.0
@@ -342,13 +358,24 @@ class GltfFile:
         values["subsurface"] = dt_factor if dt is not None else 1.0
         values["subsurface_color"] = tuple(float(x) for x in colour)
         values["subsurface_scatter_anisotropy"] = g
+        mean = np.ones(3)  # the multi-scatter texture's mean colour (the medium's albedo: the colour rule)
+        if "multiscatterColorTexture" in scatter:
+            tex = self.texture_file(scatter["multiscatterColorTexture"], f"{where}: multiscatterColorTexture")
+            if tex is not None and values.get("base_color_map") in (None, tex):
+                from .textures import texture_mean
+
+                values["base_color_map"] = tex  # Skinlab's one colour map multiplies both colours
+                mean = texture_mean(tex, "srgb")
+            elif tex is not None:
+                self.warn(f"{where}: multiscatterColorTexture differs from baseColorTexture; Skinlab has one colour "
+                          "map (the base colour's) and ignores it")  # fmt: skip
         distance = float(vol.get("attenuationDistance", math.inf))
         att = np.asarray(_finite(vol.get("attenuationColor", [1.0, 1.0, 1.0]), 3), np.float64)
         if not math.isfinite(distance) or distance <= 0:
             self.warn(f"{where}: KHR_materials_volume has no finite attenuationDistance; Skinlab's default radius kept")
             return None
         return {"distance": distance, "attenuation": tuple(np.clip(att, 1e-12, 1.0).tolist()),
-                "multiscatter": tuple(colour.tolist()), "g": g}  # fmt: skip
+                "multiscatter": tuple(np.clip(colour * mean, 0.0, 1.0).tolist()), "g": g}  # fmt: skip
 
     def _specular(self, ext: dict, where: str) -> float:
         """specular = F0 / 0.08, F0 = ((ior - 1)/(ior + 1))^2 x specularFactor x mean(specularColorFactor)."""

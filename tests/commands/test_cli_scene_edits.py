@@ -77,3 +77,15 @@ def test_scene_file_edits_do_not_change_the_file(tmp_path):
     before = load_scene("head").mesh_nodes()[0].material["roughness"]
     load("head", set={"roughness": 0.9})
     assert load_scene("head").mesh_nodes()[0].material["roughness"] == before
+
+
+def test_export_a_mesh_with_a_preset_as_gltf(tmp_path, capsys):
+    out = tmp_path / "bunny.glb"
+    assert main(["export", BUNNY, "--preset", "marble", "--mm-per-unit", "1000", "--out", str(out)]) == 0
+    assert "wrote" in capsys.readouterr().out
+    m = load(out, mm_per_unit=1000.0).mesh_nodes()[0].material
+    want = preset_values("marble")
+    assert m["subsurface"] == 1.0 and m["subsurface_color"] == pytest.approx(want["subsurface_color"])
+    assert m["subsurface_radius"] == pytest.approx(want["subsurface_radius"], rel=1e-6)
+    assert main(["export", BUNNY, "--out", str(tmp_path / "b.obj")]) == 2
+    assert "--out: expected a .glb or .gltf path" in capsys.readouterr().err

@@ -1,0 +1,192 @@
+"""A path-traced reference's scene as a Mitsuba 3 scene file (``skinlab reference --export-xml DIR``):
+``DIR/scene.xml`` with its meshes as binary PLY files (``DIR/meshes/``) and baked textures as EXR
+(``DIR/textures/``), so that Mitsuba alone renders what ``skinlab reference`` renders:
+
+    mitsuba -o image.exr DIR/scene.xml        # or mitsuba.load_file("DIR/scene.xml") in Python
+
+It is written from the same :class:`~skinlab.truth.description.ReferenceDescription` the reference renders
+(integrator, sensor, emitters, shapes with their BSDFs and interior media), so the two cannot drift apart:
+each dictionary of the description becomes the XML element of the same plugin
+(:func:`dict_to_xml`). The reference frame is millimetres, centred on the media (skinlab/truth/export.py).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from .description import ReferenceDescription, ShapeDesc
+
+_PLUGIN_TAGS = {
+    # the keys under which the description nests plugins -> the XML tag of that plugin
+    "bsdf": "bsdf",
+    "interior": "medium",
+    "exterior": "medium",
+    "phase": "phase",
+    "emitter": "emitter",
+    "base_color": "texture",
+    "reflectance": "texture",
+    "opacity": "texture",
+    "albedo": "texture",
+    "sigma_t": "texture",
+}
+
+
+def _float(x) -> str:
+    return repr(float(x))
+
+
+def _value(name: str, v, indent: str) -> list[str]:
+    """One property as XML lines."""
+    if isinstance(v, dict):
+        if v.get("type") == "rgb":
+            rgb = ", ".join(_float(x) for x in v["value"])
+            return [f'{indent}<rgb name="{name}" value="{rgb}"/>']
+        return dict_to_xml(v, _PLUGIN_TAGS.get(name, "bsdf"), name, indent)
+    if isinstance(v, bool):
+        return [f'{indent}<boolean name="{name}" value="{"true" if v else "false"}"/>']
+    if isinstance(v, int | np.integer):
+        return [f'{indent}<integer name="{name}" value="{int(v)}"/>']
+    if isinstance(v, float | np.floating):
+        return [f'{indent}<float name="{name}" value="{_float(v)}"/>']
+    if isinstance(v, str):
+        return [f"{indent}<string name={quoteattr(name)} value={quoteattr(v)}/>"]
+    raise ValueError(f"Mitsuba XML: no element for {name} = {v!r}")
+
+
+def dict_to_xml(d: dict, tag: str, name: str | None = None, indent: str = "    ") -> list[str]:
+    """A Mitsuba plugin dictionary (``{"type": ..., property: value, nested plugin: {...}}``) as XML."""
+    attrs = f' type="{d["type"]}"' + (f' name="{name}"' if name and tag in ("texture", "bsdf") else "")
+    if tag in ("medium",) and name:
+        attrs += f' name="{name}"'
+    body = []
+    for k, v in d.items():
+        if k == "type":
+            continue
+        body += _value(k, v, indent + "    ")
+    if not body:
+        return [f"{indent}<{tag}{attrs}/>"]
+    return [f"{indent}<{tag}{attrs}>", *body, f"{indent}</{tag}>"]
+
+
+def _matrix(m: np.ndarray, indent: str) -> list[str]:
+    vals = " ".join(_float(x) for x in np.asarray(m, np.float64).reshape(-1))
+    return [f'{indent}<transform name="to_world">', f'{indent}    <matrix value="{vals}"/>', f"{indent}</transform>"]
+
+
+def write_ply(path: Path, s: ShapeDesc) -> None:
+    """A binary little-endian PLY with positions, normals, texture coordinates (if any), triangles."""
+    pos = np.ascontiguousarray(s.positions, np.float32)
+    nrm = np.ascontiguousarray(s.normals, np.float32)
+    cols = [pos, nrm]
+    props = ["x", "y", "z", "nx", "ny", "nz"]
+    if s.texcoords is not None:
+        cols.append(np.ascontiguousarray(s.texcoords, np.float32))
+        props += ["u", "v"]
+    verts = np.concatenate(cols, axis=1).astype("<f4")
+    faces = np.ascontiguousarray(s.faces, np.uint32)
+    header = ["ply", "format binary_little_endian 1.0", f"element vertex {len(verts)}"]
+    header += [f"property float {p}" for p in props]
+    header += [f"element face {len(faces)}", "property list uchar uint vertex_indices", "end_header"]
+    rec = np.empty(len(faces), dtype=[("n", "u1"), ("i", "<u4", (3,))])
+    rec["n"], rec["i"] = 3, faces
+    from skinlab.atomic_write import atomic_path
+
+    with atomic_path(path) as tmp, open(tmp, "wb") as f:
+        f.write(("\n".join(header) + "\n").encode("ascii"))
+        f.write(verts.tobytes())
+        f.write(rec.tobytes())
+
+
+def _emitter(e: dict, indent: str) -> list[str]:
+    i2 = indent + "    "
+    rgb = lambda name, v: f'{i2}<rgb name="{name}" value="{", ".join(_float(x) for x in v)}"/>'  # noqa: E731
+    if e["kind"] == "directional":
+        d = ", ".join(_float(x) for x in e["direction"])
+        return [f'{indent}<emitter type="directional">', f'{i2}<vector name="direction" value="{d}"/>',
+                rgb("irradiance", e["irradiance"]), f"{indent}</emitter>"]  # fmt: skip
+    if e["kind"] == "point":
+        p = ", ".join(_float(x) for x in e["position"])
+        return [f'{indent}<emitter type="point">', f'{i2}<point name="position" value="{p}"/>',
+                rgb("intensity", e["intensity"]), f"{indent}</emitter>"]  # fmt: skip
+    if e["kind"] == "constant":
+        return [f'{indent}<emitter type="constant">', rgb("radiance", e["radiance"]), f"{indent}</emitter>"]
+    if e["kind"] == "sun_disk":
+        c, n, r = np.asarray(e["centre"]), np.asarray(e["normal"]), float(e["radius"])
+        up = [0.0, 0.0, 1.0] if abs(n[1]) > 0.9 else [0.0, 1.0, 0.0]
+        j = ", ".join
+        return [
+            f'{indent}<shape type="disk">',
+            f'{i2}<transform name="to_world">',
+            f'{i2}    <scale value="{_float(r)}"/>',
+            f'{i2}    <lookat origin="{j(map(_float, c))}" target="{j(map(_float, c + n))}" '
+            f'up="{j(map(_float, up))}"/>',
+            f"{i2}</transform>",
+            f'{i2}<emitter type="area">',
+            f'{i2}    <rgb name="radiance" value="{j(map(_float, e["radiance"]))}"/>',
+            f"{i2}</emitter>",
+            f"{indent}</shape>",
+        ]
+    raise ValueError(f"Mitsuba XML: emitter kind {e['kind']!r} unknown")
+
+
+def _bsdf(s: ShapeDesc, texture_file: str | None) -> dict:
+    """The shape's BSDF with a baked texture's reference as a bitmap file."""
+    b = dict(s.bsdf)
+    if b.get("type") == "twosided" and isinstance(b["bsdf"].get("base_color"), dict):
+        if b["bsdf"]["base_color"].get("type") == "texture_ref":
+            inner = dict(b["bsdf"])
+            inner["base_color"] = {"type": "bitmap", "filename": texture_file, "raw": True}
+            b = {"type": "twosided", "bsdf": inner}
+    return b
+
+
+def write_mitsuba_xml(desc: ReferenceDescription, folder: str | Path, spp: int = 256) -> Path:
+    """``folder/scene.xml`` and its meshes and textures; returns the XML's path."""
+    from skinlab.atomic_write import write_text_atomic
+    from skinlab.image_output import write_image
+
+    folder = Path(folder)
+    (folder / "meshes").mkdir(parents=True, exist_ok=True)
+    lines = ['<?xml version="1.0" encoding="utf-8"?>', "<!-- written by skinlab reference --export-xml -->",
+             '<scene version="3.0.0">']  # fmt: skip
+    lines += dict_to_xml(desc.integrator, "integrator")
+    cam = np.asarray(desc.camera_to_world, np.float64)
+    lines += [
+        '    <sensor type="perspective">',
+        f'        <float name="fov" value="{_float(desc.fov_y_deg)}"/>',
+        '        <string name="fov_axis" value="y"/>',
+        f'        <float name="near_clip" value="{_float(desc.near)}"/>',
+        f'        <float name="far_clip" value="{_float(desc.far)}"/>',
+        *_matrix(cam, "        "),
+        f'        <sampler type="independent"><integer name="sample_count" value="{int(spp)}"/></sampler>',
+        '        <film type="hdrfilm">',
+        f'            <integer name="width" value="{desc.width}"/>',
+        f'            <integer name="height" value="{desc.height}"/>',
+        '            <string name="pixel_format" value="rgba"/>',
+        '            <rfilter type="box"/>',
+        "        </film>",
+        "    </sensor>",
+    ]
+    for e in desc.emitters:
+        lines += _emitter(e, "    ")
+    for i, s in enumerate(desc.shapes):
+        stem = f"{i:03d}-{''.join(c if c.isalnum() or c in '-_' else '_' for c in s.name)}"
+        write_ply(folder / "meshes" / f"{stem}.ply", s)
+        tex = None
+        if s.texture is not None:
+            (folder / "textures").mkdir(exist_ok=True)
+            tex = f"textures/{stem}.exr"
+            rgba = np.concatenate([s.texture, np.ones(s.texture.shape[:2] + (1,), np.float32)], axis=2)
+            write_image(folder / tex, rgba.astype(np.float32))
+        lines.append(f'    <shape type="ply" id={quoteattr(stem)}>')
+        lines.append(f'        <string name="filename" value="meshes/{stem}.ply"/>')
+        lines.append('        <boolean name="face_normals" value="false"/>')
+        lines += dict_to_xml(_bsdf(s, tex), "bsdf", None, "        ")
+        if s.interior is not None:
+            lines += dict_to_xml(s.interior, "medium", "interior", "        ")
+        lines.append("    </shape>")
+    lines.append("</scene>")
+    return write_text_atomic(folder / "scene.xml", "\n".join(lines) + "\n")
