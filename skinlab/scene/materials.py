@@ -157,7 +157,8 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         "opaque",
         choices=ALPHA_MODES,
         doc="opaque: alpha ignored; mask: a pixel with alpha < alpha_cutoff is not there (colour, shadows, the "
-        "path-traced truth); blend: drawn after the opaque meshes, far to near, over them (glTF alphaMode)",
+        "path-traced truth); blend: drawn after the opaque meshes, far to near, over them, casting no shadow "
+        "(glTF alphaMode)",
     ),
     Param("alpha_cutoff", "float", 0.5, (0.0, 1.0), doc="the alpha below which a masked surface is cut away"),
     Param(

@@ -31,6 +31,7 @@ class ShapeDesc:
     bsdf: dict
     interior: dict | None = None  # homogeneous medium, for subsurface materials
     texture: np.ndarray | None = None  # baked linear base colour (H, W, 3), row 0 at the top
+    opacity: np.ndarray | None = None  # (H, W, 1) the mask BSDF's opacity (alpha modes), row 0 at the top
 
 
 @dataclass
@@ -72,6 +73,8 @@ class ReferenceDescription:
                 out.append(s.texcoords)
             if s.texture is not None:
                 out.append(s.texture)
+            if s.opacity is not None:
+                out.append(s.opacity)
         return out
 
     def to_mitsuba(self, spp: int, seed: int = 0) -> dict:
@@ -128,6 +131,12 @@ def _any_up(n: np.ndarray) -> list[float]:
 
 def _mitsuba_bsdf(mi, s: ShapeDesc) -> dict:
     b = dict(s.bsdf)
+    if b["type"] == "mask":  # alpha modes: the opacity (a value or the baked texture) around the surface's BSDF
+        inner = _mitsuba_bsdf(mi, ShapeDesc(**{**s.__dict__, "bsdf": b["bsdf"]}))
+        op = b["opacity"]
+        if isinstance(op, dict) and op.get("type") == "opacity_ref":
+            op = {"type": "bitmap", "bitmap": mi.Bitmap(np.ascontiguousarray(s.opacity)), "raw": True}
+        return {"type": "mask", "opacity": op, "bsdf": inner}
     if b["type"] == "twosided" and b["bsdf"].get("base_color", {}).get("type") == "texture_ref":
         inner = dict(b["bsdf"])
         inner["base_color"] = {"type": "bitmap", "bitmap": mi.Bitmap(np.ascontiguousarray(s.texture)), "raw": True}
@@ -158,7 +167,7 @@ def _mitsuba_mesh(mi, s: ShapeDesc):
 
 # -- carrying a description to another machine -------------------------------------------------------
 
-_ARRAYS = ("positions", "normals", "faces", "texcoords", "texture")
+_ARRAYS = ("positions", "normals", "faces", "texcoords", "texture", "opacity")
 
 
 def save(desc: ReferenceDescription, path: Path) -> None:

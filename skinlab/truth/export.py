@@ -27,7 +27,9 @@ What the reference models (docs/ground-truth.md):
 * the boundary: none at all (``null`` BSDF) where the material's index is 1 (specular 0), otherwise a
   rough dielectric with GGX alpha = roughness^2 (a smooth one below alpha 1e-3) and the index;
 * materials without subsurface scattering as two-sided principled surfaces (base colour map baked
-  with base_color; UVs flipped to Mitsuba's top-left origin);
+  with base_color; UVs flipped to Mitsuba's top-left origin); alpha_mode "mask" and "blend" inside
+  Mitsuba's ``mask`` BSDF with the material's opacity (alpha x the colour map's alpha; cut at
+  alpha_cutoff for "mask", as the frame discards: skinlab/render/alpha.py);
 * ambient light as a constant environment of that radiance (Skinlab's ambient term is unshadowed,
   the environment is not);
 * optionally (``sun_deg`` > 0) each directional light as a distant disk of that angular diameter
@@ -200,6 +202,30 @@ def _baked_base_color(values: dict) -> np.ndarray:
     return (tex * np.asarray(values["base_color"], np.float32)).astype(np.float32)
 
 
+def _opacity(values: dict) -> np.ndarray | float:
+    """The surface's opacity: alpha x the colour map's alpha (a texture, row 0 at the top), or alpha."""
+    alpha = float(values.get("alpha", 1.0))
+    if values.get("base_color_map") is None:
+        return alpha
+    from skinlab.scene.textures import load_texture
+
+    tex = load_texture(values["base_color_map"], "srgb")
+    a = tex[..., 3] if tex.shape[2] == 4 else np.ones(tex.shape[:2], np.float32)
+    return (a * alpha).astype(np.float32)
+
+
+def _alpha_bsdf(values: dict, bsdf: dict, has_uv: bool) -> tuple[dict, np.ndarray | None]:
+    """alpha_mode "mask": Mitsuba's mask BSDF with the opacity cut at alpha_cutoff (0 or 1, as the frame
+    discards); "blend": the mask with the opacity itself (the frame's premultiplied blend). A texture
+    (the colour map's alpha) needs UVs."""
+    op = _opacity(values)
+    if values["alpha_mode"] == "mask":
+        op = (np.asarray(op) >= float(values["alpha_cutoff"])).astype(np.float32)
+    if np.ndim(op) == 0 or not has_uv:
+        return {"type": "mask", "opacity": float(np.mean(op)), "bsdf": bsdf}, None
+    return {"type": "mask", "opacity": {"type": "opacity_ref"}, "bsdf": bsdf}, np.ascontiguousarray(op[..., None])
+
+
 def _scatters(values: dict) -> bool:
     return values["subsurface"] > 0 and max(values["subsurface_radius"]) > 0
 
@@ -328,9 +354,11 @@ def describe(
             for key in ("normal_map", "roughness_map", "occlusion_map"):
                 if values.get(key) is not None:
                     notes.append(f"{node.name}: {key} is not exported")
+            bsdf, opacity = surface_bsdf(values, tex is not None), None
+            if values.get("alpha_mode", "opaque") != "opaque":  # cut-outs and see-through surfaces
+                bsdf, opacity = _alpha_bsdf(values, bsdf, uv is not None)
             shapes.append(
-                ShapeDesc(node.name, mat.name, pos, nrm, mesh.indices, uv, surface_bsdf(values, tex is not None),
-                          None, tex)
+                ShapeDesc(node.name, mat.name, pos, nrm, mesh.indices, uv, bsdf, None, tex, opacity)
             )  # fmt: skip
     if not shapes:
         raise ReferenceError(f"scene {scene.name!r}: no visible mesh")

@@ -29,6 +29,8 @@ _PLUGIN_TAGS = {
     "base_color": "texture",
     "reflectance": "texture",
     "opacity": "texture",
+    "bsdf_0": "bsdf",
+    "bsdf_1": "bsdf",
     "albedo": "texture",
     "sigma_t": "texture",
 }
@@ -132,9 +134,14 @@ def _emitter(e: dict, indent: str) -> list[str]:
     raise ValueError(f"Mitsuba XML: emitter kind {e['kind']!r} unknown")
 
 
-def _bsdf(s: ShapeDesc, texture_file: str | None) -> dict:
-    """The shape's BSDF with a baked texture's reference as a bitmap file."""
-    b = dict(s.bsdf)
+def _bsdf(s: ShapeDesc, texture_file: str | None, opacity_file: str | None = None, b: dict | None = None) -> dict:
+    """The shape's BSDF with a baked texture's (and opacity's) reference as a bitmap file."""
+    b = dict(s.bsdf if b is None else b)
+    if b.get("type") == "mask":
+        op = b["opacity"]
+        if isinstance(op, dict) and op.get("type") == "opacity_ref":
+            op = {"type": "bitmap", "filename": opacity_file, "raw": True}
+        return {"type": "mask", "opacity": op, "bsdf": _bsdf(s, texture_file, opacity_file, b["bsdf"])}
     if b.get("type") == "twosided" and isinstance(b["bsdf"].get("base_color"), dict):
         if b["bsdf"]["base_color"].get("type") == "texture_ref":
             inner = dict(b["bsdf"])
@@ -175,16 +182,21 @@ def write_mitsuba_xml(desc: ReferenceDescription, folder: str | Path, spp: int =
     for i, s in enumerate(desc.shapes):
         stem = f"{i:03d}-{''.join(c if c.isalnum() or c in '-_' else '_' for c in s.name)}"
         write_ply(folder / "meshes" / f"{stem}.ply", s)
-        tex = None
+        tex = opacity = None
         if s.texture is not None:
             (folder / "textures").mkdir(exist_ok=True)
             tex = f"textures/{stem}.exr"
             rgba = np.concatenate([s.texture, np.ones(s.texture.shape[:2] + (1,), np.float32)], axis=2)
             write_image(folder / tex, rgba.astype(np.float32))
+        if s.opacity is not None:
+            (folder / "textures").mkdir(exist_ok=True)
+            opacity = f"textures/{stem}-opacity.exr"
+            op = np.repeat(np.asarray(s.opacity, np.float32).reshape(s.opacity.shape[:2] + (1,)), 3, axis=2)
+            write_image(folder / opacity, np.concatenate([op, np.ones(op.shape[:2] + (1,), np.float32)], axis=2))
         lines.append(f'    <shape type="ply" id={quoteattr(stem)}>')
         lines.append(f'        <string name="filename" value="meshes/{stem}.ply"/>')
         lines.append('        <boolean name="face_normals" value="false"/>')
-        lines += dict_to_xml(_bsdf(s, tex), "bsdf", None, "        ")
+        lines += dict_to_xml(_bsdf(s, tex, opacity), "bsdf", None, "        ")
         if s.interior is not None:
             lines += dict_to_xml(s.interior, "medium", "interior", "        ")
         lines.append("    </shape>")

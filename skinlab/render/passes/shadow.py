@@ -8,7 +8,7 @@ import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_uniforms
-from skinlab.render.alpha import bind_mask, mask_defines
+from skinlab.render.alpha import bind_mask, blended, mask_defines
 from skinlab.render.frame_plan import ShadowParams
 from skinlab.render.texture_units import TextureUnits
 from skinlab.scene import transform as tf
@@ -125,6 +125,8 @@ class ShadowPass:
         ctx.disable(moderngl.CULL_FACE)
         ctx.polygon_offset = (2.0, 2.0)
         for node in frame.scene.mesh_nodes():
+            if blended(node.material):
+                continue  # a see-through surface (alpha_mode "blend") casts no shadow
             # a masked material's cut-away pixels cast no shadow (skinlab/render/alpha.py)
             prog = self.r.programs.get(
                 "passes/shadow.vert", "passes/shadow.frag", {**base, **mask_defines(node.material)}
