@@ -280,7 +280,7 @@ def _metallic_roughness_map(v: dict) -> Path | None:
         return None
     import hashlib
 
-    from .mesh import cache_dir
+    from .gltf_materials import cache_root
     from .textures import load_texture
 
     maps = [load_texture(p, "linear")[..., 0] if p is not None else None for p in (rough, metal)]
@@ -292,7 +292,7 @@ def _metallic_roughness_map(v: dict) -> Path | None:
     g_, b_ = (m if m is not None else np.ones(shape, np.float32) for m in maps)
     rgb = np.stack([np.zeros(shape, np.float32), g_, b_], axis=-1)
     data = _png16(rgb)
-    path = cache_dir() / "gltf" / f"{hashlib.sha256(data).hexdigest()[:32]}-mr.png"
+    path = cache_root() / f"{hashlib.sha256(data).hexdigest()[:32]}-mr.png"
     if not path.is_file():
         from skinlab.atomic_write import write_bytes_atomic
 

@@ -97,17 +97,31 @@ class FileMaterial:
     volume: dict | None = None  # KHR_materials_volume's extinction, made a radius with the scene's scale
 
 
-def _cache_root() -> Path:
-    from .mesh import cache_dir
+_SESSION_DIR: list[Path] = []  # with SKINLAB_CACHE_DIR=off: a folder of this process, removed at exit
 
-    return cache_dir() / "gltf"
+
+def cache_root() -> Path:
+    """Where textures taken out of glTF files are written: $SKINLAB_CACHE_DIR/gltf, or a temporary
+    folder of this process when the disk cache is off."""
+    from skinlab.cache import cache_dir, disk_enabled
+
+    if disk_enabled():
+        return cache_dir() / "gltf"
+    if not _SESSION_DIR:
+        import atexit
+        import shutil
+        import tempfile
+
+        _SESSION_DIR.append(Path(tempfile.mkdtemp(prefix="skinlab-gltf-")))
+        atexit.register(shutil.rmtree, _SESSION_DIR[0], ignore_errors=True)
+    return _SESSION_DIR[0]
 
 
 def _store(data: bytes, suffix: str) -> Path:
     """`data` written once under the cache, named by its content."""
     from skinlab.atomic_write import write_bytes_atomic
 
-    path = _cache_root() / f"{hashlib.sha256(data).hexdigest()[:32]}{suffix}"
+    path = cache_root() / f"{hashlib.sha256(data).hexdigest()[:32]}{suffix}"
     if not path.is_file():
         write_bytes_atomic(path, data)
     return path
@@ -126,7 +140,7 @@ def _channel_map(image: Path, channel: int, tag: str) -> Path | None:
     if c.min() >= 1.0 - 1e-6:
         return None
     digest = hashlib.sha256(image.read_bytes()).hexdigest()[:32]
-    path = _cache_root() / f"{digest}-{tag}.png"
+    path = cache_root() / f"{digest}-{tag}.png"
     if path.is_file():
         return path
     from PIL import Image

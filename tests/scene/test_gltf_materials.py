@@ -290,3 +290,12 @@ def test_a_volume_without_scattering_is_warned_about(tmp_path):
     scene = load_scene(b.save(tmp_path / "glass.glb"))
     assert any("KHR_materials_volume without scattering" in w for w in scene.warnings)
     assert not scene.mesh_nodes()[0].material.has_subsurface
+
+
+def test_embedded_textures_are_written_even_with_the_disk_cache_off(tmp_path, monkeypatch):
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", "off")
+    b = GlbBuilder()
+    b.quad("q", b.material(name="chk", pbr={"baseColorTexture": {"index": b.image(checker(4, 2))}}))
+    (node,) = load_scene(b.save(tmp_path / "off.glb")).mesh_nodes()
+    path = node.material["base_color_map"]
+    assert path.is_file() and "skinlab-gltf-" in str(path) and not (tmp_path / "off").exists()
