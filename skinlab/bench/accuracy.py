@@ -165,11 +165,13 @@ def run_sweep(
     images: bool = True,
     command: str | None = None,
     references: bool = False,
+    blender: bool | tuple = False,
 ) -> dict:
     """Run the whole ledger and write DIR/ledger.csv, ledger.md, ledger.html, ledger.json, pareto.png and
     cost.png; with the sweep's truth, error_maps/, flip_maps/, error_maps.png and profiles.png.
     references: path-trace the references that are not cached yet (else a scene without a cached
-    reference has no truth columns)."""
+    reference has no truth columns). blender: Blender's EEVEE and Cycles as peer rows in the same run
+    (skinlab/bench/blender_peer.py; True: the sweep's PEER_SETTINGS, or a tuple of PeerSetting)."""
     from tqdm import tqdm
 
     from skinlab.gl.context import create_headless_context, describe
@@ -195,6 +197,11 @@ def run_sweep(
     gl = describe(ctx)
     renderer = Renderer(ctx)
     renderer.reuse = False  # each setting's cost is that of a full frame (no pass kept from the last)
+    peers = None
+    if blender:
+        from .blender_peer import LedgerPeers
+
+        peers = LedgerPeers(sweep.name, None if blender is True else tuple(blender))
     rows: list[dict] = []
     truth_notes: dict[str, str] = {}
     truth_quiet: dict[str, str] = {}  # scenes compared with a quieter reference than the sweep's
@@ -363,9 +370,17 @@ def run_sweep(
                 if same is not None:
                     row["image_rel_l1_same_size"] = image_error(hdrs[st], same)["image_rel_l1"]
             del hdrs
+            if peers is not None:  # Blender's rows, against the same truth and image reference
+                prows, pmaps = peers.scene_rows(scene, label, sweep, truth, tctx, out, renderer, ref, mask,
+                                                profiles.get(label), progress=bar.set_postfix_str)  # fmt: skip
+                rows += prows
+                if pmaps:
+                    sheet.setdefault(label, {}).update(pmaps)
     finally:
         bar.close()
         renderer.release()
+        if peers is not None:
+            peers.close()
     sweep_s = time.perf_counter() - t_start
     if sheet:
         error_map_sheet(
@@ -406,6 +421,7 @@ def run_sweep(
         "sweep_s": sweep_s,
         "total_s": time.perf_counter() - t_start,
         "peer": peer_res,
+        "blender": None if peers is None else peers.meta,
         "loadavg_start": load_start,
         "loadavg_end": _loadavg(),
         "command": command,

@@ -6,6 +6,7 @@ import csv
 import io
 import math
 
+from .blender_peer import PEER_COLUMNS
 from .truth_ledger import TRUTH_COLUMNS
 
 
@@ -39,6 +40,7 @@ def csv_columns() -> list[str]:
         "profile_err_model",
         "reference",
         *TRUTH_COLUMNS,
+        *PEER_COLUMNS,
         "same_image_as",
         "ties_best",
         "status",
@@ -62,6 +64,7 @@ NUMERIC_COLUMNS = [
     "profile_err_mc",
     "profile_err_model",
     *TRUTH_COLUMNS,
+    *PEER_COLUMNS,
 ]
 
 

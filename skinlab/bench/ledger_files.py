@@ -33,14 +33,15 @@ def write_ledger(rows: list[dict], meta: dict, out: Path, sweep=None, profiles: 
 
     sweep = sweep or SWEEPS.get(meta.get("sweep"), SWEEPS["full"])
     out = Path(out)
-    key = error_key(rows)
-    mark_ties(rows, key)
+    own = [r for r in rows if not r.get("peer")]  # the fronts, ties and defaults are Skinlab's; peers drawn beside
+    key = error_key(own)
+    mark_ties(own, key)
     fronts = {}
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        fronts[scene] = pareto_front([r for r in rows if r["scene"] == scene], key)
-    series = cost_series(rows, sweep)
+    for scene in dict.fromkeys(r["scene"] for r in own):
+        fronts[scene] = pareto_front([r for r in own if r["scene"] == scene], key)
+    series = cost_series(own, sweep)
     sl = slopes(series)
-    recs = recommendations(rows, key=key)
+    recs = recommendations(own, key=key)
     write_text_atomic(out / "ledger.csv", csv_text(rows))
     pareto_plot(rows, fronts, out / "pareto.png", key=key, label=ERROR_LABELS[key])
     cost_plot(series, sl, out / "cost.png")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from .blender_peer import blender_markdown
 from .image_error import LUM_FRACTION
 from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, error_key
 from .ledger_csv import fmt_cell
@@ -225,6 +226,7 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
             )
         L.append(f"| pyrender | {p['pyrender_ms']:.2f} | 1 |")
     L.append("")
+    L += blender_markdown(rows, meta)
     key = recs[0]["key"] if recs else "image_rel_l1"
     dflt = recs[0]["default"] if recs else "the default technique"
     rule = (

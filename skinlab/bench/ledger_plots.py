@@ -13,6 +13,7 @@ import numpy as np
 from skinlab.atomic_write import write_bytes_atomic
 from skinlab.render.registry import techniques
 
+from .blender_peer import PEER_STYLES
 from .ledger_analysis import usable
 
 
@@ -77,20 +78,25 @@ def pareto_plot(
     for ax, scene in zip(axes[0], scenes):
         pts = [r for r in rows if r["scene"] == scene and usable(r, key) and not r.get("same_image_as")]
         floor = _floor(pts, key)
-        for t in techniques():  # each technique's marker and colour
-            sel = [r for r in pts if r["technique"] == t.name]
+        # each technique's marker and colour; the Blender peers' (skinlab/bench/blender_peer.py) from PEER_STYLES
+        for name in [*(t.name for t in techniques()), *PEER_STYLES]:
+            sel = [r for r in pts if r["technique"] == name]
             if not sel:
                 continue
-            marker, colour = styles[t.name]
+            marker, colour = styles[name] if name in styles else PEER_STYLES[name]
             x = [r["frame_ms_median"] for r in sel]
             y = [max(r[key], floor) for r in sel]
             err = [2 * sigma(r, key) for r in sel]  # TIE_SIGMAS standard errors: the noise the ranks allow
             if any(e > 0 for e in err):
                 ax.errorbar(x, y, yerr=err, fmt="none", ecolor=colour, elinewidth=0.8, alpha=0.6, zorder=2)
             ax.scatter(
-                x, y, marker=marker, c=colour, s=70 if marker == "*" else 40, label=t.name, edgecolors="none",
+                x, y, marker=marker, c=colour, s=70 if marker == "*" else 40, label=name, edgecolors="none",
                 zorder=3,
             )  # fmt: skip
+            for r, xi, yi in zip(sel, x, y) if name in PEER_STYLES else ():
+                ax.annotate(
+                    r["setting"], (xi, yi), textcoords="offset points", xytext=(5, -9), fontsize=6, color=colour
+                )
         fr = fronts.get(scene, [])
         if fr:
             x = [r["frame_ms_median"] for r in fr]

@@ -41,6 +41,27 @@ def register(sub) -> None:
     )
     peer.add_argument("--json", action="store_true", help="print the result as JSON")
     peer.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    peer.add_argument(
+        "--blender",
+        action="store_true",
+        help="instead: Blender's EEVEE and Cycles beside Skinlab's default frame on the reference scenes, against "
+        "the path-traced truth, in one ledger run (--quick sizes; writes the ledger to --out; see docs/ledger.md)",
+    )
+    peer.add_argument("--out", default="out/peer-blender", help="with --blender: the ledger's folder")
+    peer.add_argument(
+        "--scenes",
+        default=None,
+        help="with --blender: comma-separated scene names (default: every reference scene)",
+    )
+    peer.add_argument(
+        "--references", action="store_true", help="with --blender: path-trace the references not cached yet"
+    )
+    peer.add_argument(
+        "--cycles-truth",
+        action="store_true",
+        help="with --blender: Cycles at 1024 spp (random walk and random walk skin) as a second truth against "
+        "Mitsuba's, instead of the EEVEE/Cycles frame-time rows (docs/ground-truth.md)",
+    )
     peer.set_defaults(func=run_peer_bench)
     orb = bsub.add_parser(
         "orbit",
@@ -150,6 +171,12 @@ def register(sub) -> None:
         f"--quick {ref_size['quick']})",
     )
     acc.add_argument("--no-peer", action="store_true", help="skip the pyrender comparison")
+    acc.add_argument(
+        "--blender",
+        action="store_true",
+        help="add Blender's EEVEE and Cycles as peer rows (bpy in a child process: `make test` or `make bench` "
+        "installs it into .venv-blender)",
+    )
     acc.add_argument("--no-images", action="store_true", help="do not write images/SCENE-SETTING.png")
     acc.add_argument("--no-progress", action="store_true", help="no progress bar")
     acc.set_defaults(func=run_accuracy_bench)
@@ -175,7 +202,50 @@ def run_startup_bench(args) -> int:
     return 0
 
 
+def blender_peer_sweep(scenes: str | None):
+    """The sweep of `skinlab bench peer --blender`: the quick conditions, Skinlab's default frame with the
+    image reference (its quick base setting), no scattering and the tint beside it, every reference scene."""
+    from dataclasses import replace
+
+    from skinlab.bench.accuracy import SWEEPS
+    from skinlab.bench.blender_peer import default_setting
+    from skinlab.bench.sweep import REFERENCE_SCENE_NAMES, Setting, base_setting, reference_technique
+
+    quick = SWEEPS["quick"]
+    ref = reference_technique()
+    extra = [base_setting(ref, quick)] if ref else []
+    extra += [Setting.of("none"), Setting.of("tint"), default_setting()]
+    names = tuple(s.strip() for s in scenes.split(",") if s.strip()) if scenes else REFERENCE_SCENE_NAMES
+    return replace(quick, name="peer", extra=tuple(x for x in extra if x is not None), every_technique=False,
+                   scenes=names)  # fmt: skip
+
+
 def run_peer_bench(args) -> int:
+    if args.blender:
+        from skinlab.bench.accuracy import resolve_scene, run_sweep
+
+        sweep = blender_peer_sweep(args.scenes)
+        for s in sweep.scenes:
+            resolve_scene(s)
+        cmd = "skinlab bench peer --blender" + (f" --scenes {args.scenes}" if args.scenes else "")
+        cmd += (" --references" if args.references else "") + (" --cycles-truth" if args.cycles_truth else "")
+        cmd += f" --out {args.out}"
+        from skinlab.bench.blender_peer import PEER_SETTINGS
+
+        blender = PEER_SETTINGS["cycles-truth"] if args.cycles_truth else True
+        res = run_sweep(
+            sweep,
+            Path(args.out),
+            peer=False,
+            progress=not args.no_progress,
+            command=cmd,
+            references=args.references,
+            blender=blender,
+        )
+        print("\n".join(blender_summary(res["rows"], res["meta"])))
+        for f in res["files"]:
+            print(f"  {Path(f).resolve()}")
+        return 0 if not (res["meta"].get("blender") or {}).get("error") else 1
     res = peer_bench(parse_size(args.size), args.frames, progress=not args.no_progress, rounds=args.rounds)
     if args.json:
         print(json.dumps(res, indent=2))
@@ -200,6 +270,12 @@ def run_peer_bench(args) -> int:
             f"{res['skinlab_default_ms']:8.2f} ms/frame, ratio {res['ratio_default_over_pyrender']:.2f}"
         )
     return 0
+
+
+def blender_summary(rows: list[dict], meta: dict) -> list[str]:
+    from skinlab.bench.blender_peer import blender_markdown
+
+    return blender_markdown(rows, meta) or ["the Blender peers were not run"]
 
 
 def run_orbit_bench(args) -> int:
@@ -314,6 +390,7 @@ def run_accuracy_bench(args) -> int:
         ("--tiny", args.tiny),
         ("--no-peer", args.no_peer),
         ("--references", args.references),
+        ("--blender", args.blender),
     ]
     opts = [
         ("--size", args.size),
@@ -338,6 +415,7 @@ def run_accuracy_bench(args) -> int:
         images=not args.no_images,
         command=command,
         references=args.references,
+        blender=args.blender,
     )
     rows = res["rows"]
     for line in truth_console_lines(res):
