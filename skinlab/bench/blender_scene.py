@@ -5,7 +5,7 @@ The Blender scene is the path-traced truth's scene (``skinlab.truth.export.descr
 meshes in the same reference frame (millimetres, centred on the media; holes capped so each medium is
 closed; vertex normals and UVs), the same camera, the same lights, and each subsurface material as the
 same homogeneous medium, written as a Principled BSDF. What each Blender input is and why
-(docs/ground-truth.md "Blender as a peer and a second truth"; Cycles' code cited there):
+(docs/ground-truth.md "Blender as a peer and a second truth"; Cycles' code: docs/references.md#cycles-random-walk):
 
 * units: one Blender unit is one millimetre (the reference frame's unit), so the subsurface radii
   are in millimetres as in Skinlab's materials;
@@ -141,7 +141,9 @@ def cycles_base_color(alpha, g: float = 0.0) -> np.ndarray:
     return 0.5 * (lo + hi)
 
 
-def _dipole_rd(alpha_prime, fourthird_a):
+def dipole_rd(alpha_prime, fourthird_a):
+    """The classical dipole's diffuse reflectance of reduced albedo alpha' with A = fourthird_a / (4/3)
+    (Cycles' bssrdf_dipole_compute_Rd)."""
     s = np.sqrt(3.0 * (1.0 - alpha_prime))
     return 0.5 * alpha_prime * (1.0 + np.exp(-fourthird_a * s)) * np.exp(-s)
 
@@ -158,7 +160,7 @@ def cycles_dipole_alpha_prime(rd, eta: float) -> np.ndarray:
     mid = 0.5 * (x0 + x1)
     for _ in range(12):
         mid = 0.5 * (x0 + x1)
-        below = _dipole_rd(mid, k) < rd
+        below = dipole_rd(mid, k) < rd
         x0, x1 = np.where(below, mid, x0), np.where(below, x1, mid)
     return np.where(rd < 1e-4, 0.0, np.where(rd >= 0.995, 0.999999, mid))
 

@@ -50,7 +50,7 @@ def test_dipole_inversion_and_skin_radius():
     f_dr = inv * (-1.44 * inv + 0.71) + 0.668 + 0.0636 * eta
     k = 4 / 3 * (1 + f_dr) / (1 - f_dr)
     mid, want = ap[2:5], rd[2:5]  # 12 bisection steps: alpha' within 1/4096 of the root
-    assert np.all((bs._dipole_rd(mid - 2**-12, k) <= want) & (want <= bs._dipole_rd(np.minimum(mid + 2**-12, 1), k)))
+    assert np.all((bs.dipole_rd(mid - 2**-12, k) <= want) & (want <= bs.dipole_rd(np.minimum(mid + 2**-12, 1), k)))
     assert ap[5] > 0.999  # beyond the dipole's largest reflectance: alpha' goes to 1
     mfp = np.array([1.2, 0.8, 0.3])
     base = np.array([0.5, 0.3, 0.1])
