@@ -3,12 +3,15 @@ straight from above by a far, narrow camera (nearly orthographic), lit by a dire
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from skinlab.scene import transform as tf
 from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Scene
 from skinlab.scene.materials import Material
 from skinlab.scene.mesh import Mesh
+from skinlab.scene.primitives import box_mesh
 
 
 def quad_mesh(name, x0, x1, y0, y1, z=0.0, uv=((0, 0), (1, 1))) -> Mesh:
@@ -98,3 +101,16 @@ def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab") -> float:
     to_light = -scene.lights()[0].direction
     off = entry_offset(np.array([[0.0, 0.0, 1.0]]), to_light[None], z0, medium.eta, 1.0)[0]
     return float(np.round(-off[0] / grid_mm) * grid_mm)
+
+
+def sky_slab(color, mfp=(1.0, 1.0, 1.0)) -> Scene:
+    """A slab many mean free paths wide and deep (index-matched) under a uniform sky of radiance 1,
+    seen straight from above through a narrow camera (the path tracers' flat-medium tests)."""
+    s = Scene("sky-slab", 1.0)
+    s.environment.ambient = np.ones(3)
+    mat = skin(radius=tuple(4 * math.pi * l for l in mfp), color=color, specular=0.0)
+    s.add(MeshNode("slab", box_mesh((800.0, 800.0, 400.0)), mat, translation=(0.0, 0.0, -200.0)))
+    cam = CameraNode("cam", yfov=math.radians(2.0), znear=100.0, zfar=3000.0)
+    cam.look_at((0.0, 0.0, 1000.0), (0.0, 0.0, 0.0))
+    s.add(cam)
+    return s

@@ -18,7 +18,7 @@ from skinlab.scene.optics.tsd import material_medium
 from skinlab.scene.primitives import box_mesh
 from skinlab.scene.scenefile import load_scene
 from skinlab.truth.export import describe
-from tests.tsd_scenes import light_from, skin
+from tests.tsd_scenes import light_from, skin, sky_slab
 
 # -- the mapping's numerics (no Blender) ----------------------------------------------------------------
 
@@ -166,19 +166,6 @@ def test_bpy_holds_the_mapped_scene(blender):
     assert info["render"]["size"] == [24, 16] and info["render"]["film_transparent"]
 
 
-def _sky_slab(color, mfp=(1.0, 1.0, 1.0)) -> Scene:
-    """The Mitsuba test's slab (tests/truth/test_truth_render.py): index-matched, many mean free paths
-    wide and deep, under a uniform sky of radiance 1, seen straight from above."""
-    s = Scene("sky-slab", 1.0)
-    s.environment.ambient = np.ones(3)
-    mat = skin(radius=tuple(4 * math.pi * l for l in mfp), color=color, specular=0.0)
-    s.add(MeshNode("slab", box_mesh((800.0, 800.0, 400.0)), mat, translation=(0.0, 0.0, -200.0)))
-    cam = CameraNode("cam", yfov=math.radians(2.0), znear=100.0, zfar=3000.0)
-    cam.look_at((0.0, 0.0, 1000.0), (0.0, 0.0, 0.0))
-    s.add(cam)
-    return s
-
-
 def test_cycles_random_walk_slab_reflects_chandrasekhars_albedo(blender):
     """Cycles' random walk at an index-matched boundary continues the camera ray into the medium and
     leaves through a Lambertian exit: under a uniform sky of radiance 1 it reads, by reciprocity,
@@ -187,7 +174,7 @@ def test_cycles_random_walk_slab_reflects_chandrasekhars_albedo(blender):
     the mean of that albedo and the diffuse one."""
     from skinlab.scene.optics.boundary import hemispherical
 
-    s = _sky_slab((0.2, 0.5, 0.8), (4.0, 1.0, 0.5))
+    s = sky_slab((0.2, 0.5, 0.8), (4.0, 1.0, 0.5))
     alpha = material_medium(s.find("slab").material.values).alpha_arr
     blender.load(bs.blender_spec(s, 8, 8))
     a1 = np.array([float(albedo_isotropic(a, 1.0)) for a in alpha])

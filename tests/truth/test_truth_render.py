@@ -14,7 +14,7 @@ from skinlab.scene.optics.tsd import material_medium
 from skinlab.scene.primitives import box_mesh
 from skinlab.truth.compare import image_error, object_mask
 from skinlab.truth.reference import ReferenceRequest, render_reference
-from tests.tsd_scenes import light_from, skin
+from tests.tsd_scenes import light_from, skin, sky_slab
 
 pytest.importorskip("mitsuba")
 
@@ -22,19 +22,6 @@ pytest.importorskip("mitsuba")
 @pytest.fixture(autouse=True)
 def _cache(tmp_path, monkeypatch):
     monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path / "cache"))
-
-
-def sky_slab(color, mfp=(1.0, 1.0, 1.0)) -> Scene:
-    """A slab many mean free paths wide and deep (index-matched) under a uniform sky of radiance 1,
-    seen straight from above through a narrow camera."""
-    s = Scene("sky-slab", 1.0)
-    s.environment.ambient = np.ones(3)
-    mat = skin(radius=tuple(4 * math.pi * l for l in mfp), color=color, specular=0.0)
-    s.add(MeshNode("slab", box_mesh((800.0, 800.0, 400.0)), mat, translation=(0.0, 0.0, -200.0)))
-    cam = CameraNode("cam", yfov=math.radians(2.0), znear=100.0, zfar=3000.0)
-    cam.look_at((0.0, 0.0, 1000.0), (0.0, 0.0, 0.0))
-    s.add(cam)
-    return s
 
 
 @pytest.mark.parametrize("mfp", [(1.0, 1.0, 1.0), (4.0, 1.0, 0.5)])
