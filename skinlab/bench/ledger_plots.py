@@ -198,11 +198,15 @@ def profile_plot(profiles: dict, rows: list[dict], path: Path) -> Path:
         for r in rows:
             if r["scene"] != scene or r["setting"] not in p or r.get("same_image_as"):
                 continue
+            if r.get("peer"):  # each peer row its own line (skinlab/bench/blender_peer.py)
+                by_tech[r["setting"]] = r["setting"]
+                continue
             default = Setting.of(r["technique"]).label
             if r["technique"] not in by_tech or r["setting"] == default:
                 by_tech[r["technique"]] = r["setting"]
+        peer_tech = {r["setting"]: r["technique"] for r in rows if r.get("peer")}
         for tech, labl in by_tech.items():
-            marker, colour = styles.get(tech, ("o", "grey"))
+            marker, colour = styles.get(tech) or PEER_STYLES.get(peer_tech.get(tech), ("o", "grey"))
             pr = p[labl]
             every = max(len(pr.x_mm) // 25, 1)
             ax.plot(pr.x_mm, lum(pr) / peak, color=colour, lw=1, marker=marker, ms=3, markevery=every, label=labl)

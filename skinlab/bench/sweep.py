@@ -213,13 +213,17 @@ def sheet_settings(settings: list[Setting]) -> list[Setting]:
 
 
 def sheet_settings_of_rows(rows: list[dict]) -> dict[str, list[str]]:
-    """Per scene, the labels of one ok row per technique (as sheet_settings picks them)."""
+    """Per scene, the labels of one ok row per technique (as sheet_settings picks them); every row of a
+    peer (a renderer that is not a registered technique: skinlab/bench/blender_peer.py)."""
     out: dict[str, list[str]] = {}
     for scene in dict.fromkeys(r["scene"] for r in rows):
         srows = [r for r in rows if r["scene"] == scene and r.get("status") == "ok"]
         labels = []
         for tech in dict.fromkeys(r["technique"] for r in srows):
             cands = [r["setting"] for r in srows if r["technique"] == tech]
+            if any(r.get("peer") for r in srows if r["technique"] == tech):
+                labels += cands
+                continue
             default = Setting.of(tech).label
             labels.append(default if default in cands and not _style(tech).reference else cands[0])
         out[scene] = labels
