@@ -368,6 +368,7 @@ def interleaved_ratio(
     }
 
 
+RATIO_ROUNDS = {"tiny": {"rounds": 1, "frames": 1}}  # the tests' sweep: one round of one frame each
 PEER_COLUMNS = ["samples", "first_frame_ms", "truth_frame_ms", "peer_noise", "peer_noise_block"]
 
 
@@ -415,7 +416,7 @@ class LedgerPeers:
                 rs = default_setting().render_settings(sweep)
                 self.meta["ratios"][label] = {
                     "skinlab_setting": default_setting().label,
-                    **interleaved_ratio(self.session, renderer, scene, rs),
+                    **interleaved_ratio(self.session, renderer, scene, rs, **RATIO_ROUNDS.get(sweep.name, {})),
                 }
             except Exception as exc:
                 self.meta["ratios"][label] = {"error": f"{type(exc).__name__}: {exc}".splitlines()[0][:300]}

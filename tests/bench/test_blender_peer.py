@@ -228,3 +228,35 @@ def test_eevee_frame_with_subsurface_scattering(blender):
     below = img[8, 4:12, :3].mean(0)  # the first row past the shadow edge (y = 20 mm, the frame's centre)
     assert below[0] > 0.01 * lit[0] and below[0] > 3 * below[2], (below, lit)
     assert np.all(img[13:, :, :3] < 0.01 * lit)  # far into the shadow: dark
+
+
+def test_ledger_rows_of_the_peers(blender, tmp_path):
+    """`skinlab bench accuracy --blender` on the tests' tiny sweep: the peer rows carry the ledger's truth
+    columns and their own, appear in the tables, the error maps and ledger.md's peer section with the
+    interleaved ratio, and stay out of the Pareto fronts and the recommended defaults."""
+    import json
+
+    from skinlab.bench.accuracy import TINY, run_sweep
+    from skinlab.bench.blender_peer import PeerSetting
+
+    blender.close()  # the ledger starts its own session
+    peers = (PeerSetting("eevee", 1), PeerSetting("cycles", 4, timed=False))
+    res = run_sweep(TINY, tmp_path, peer=False, progress=False, images=False, references=True, blender=peers)
+    rows = [r for r in res["rows"] if r.get("peer")]
+    assert [r["setting"] for r in rows] == ["eevee 1 spp", "cycles rw 4 spp"]
+    for r in rows:
+        assert r["status"] == "ok", r["error"]
+        assert np.isfinite(r["truth_rel_l1_block"]) and np.isfinite(r["truth_flip"]) and r["frame_ms_median"] > 0
+        assert (tmp_path / "error_maps" / f"head-skin1-matched-{r['setting'].replace(' ', '-')}.png").is_file()
+    ee, cy = rows
+    assert ee["width"] == TINY.size[0] and np.isfinite(ee["first_frame_ms"]) and np.isfinite(ee["image_rel_l1"])
+    assert cy["width"] == TINY.truth.size[0] and np.isfinite(cy["peer_noise_block"]) and cy["samples"] == 4
+    fronts = {r["setting"] for f in res["fronts"].values() for r in f}
+    assert not fronts & {"eevee 1 spp", "cycles rw 4 spp"}
+    meta = json.loads((tmp_path / "ledger.json").read_text())["meta"]["blender"]
+    ratio = meta["ratios"]["head-skin1-matched"]
+    assert ratio["ratio"] > 0 and ratio["skinlab_setting"] == "tsd K6 512 auto"
+    md = (tmp_path / "ledger.md").read_text()
+    assert "## Peers: Blender (EEVEE, Cycles)" in md and "| head-skin1-matched | eevee 1 spp |" in md
+    header = (tmp_path / "ledger.csv").read_text().splitlines()[0].split(",")
+    assert {"samples", "first_frame_ms", "peer_noise_block"} <= set(header)
