@@ -47,7 +47,9 @@ def register(sub) -> None:
         help="instead: Blender's EEVEE and Cycles beside Skinlab's default frame on the reference scenes, against "
         "the path-traced truth, in one ledger run (--quick sizes; writes the ledger to --out; see docs/ledger.md)",
     )
-    peer.add_argument("--out", default="out/peer-blender", help="with --blender: the ledger's folder")
+    peer.add_argument(
+        "--out", default="out/peer-blender", help="with --blender: the ledger's folder (default out/peer-blender)"
+    )
     peer.add_argument(
         "--scenes",
         default=None,
