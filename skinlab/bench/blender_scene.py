@@ -23,7 +23,9 @@ same homogeneous medium, written as a Principled BSDF. What each Blender input i
   albedo alpha: :func:`cycles_base_color` inverts :func:`cycles_rw_alpha`; for Random Walk (Skin),
   whose radius Cycles first multiplies by sqrt(3 (1 - alpha'_dipole(A, ior))), the radius is divided
   by that (:func:`cycles_skin_radius`), so both methods walk the truth's medium;
-  ``Subsurface Anisotropy`` 0 (the medium is the reduced, isotropic one the profiles assume);
+  ``Subsurface Anisotropy`` the medium's Henyey-Greenstein g where the material has one (the truth then
+  holds the real coefficients; the radius is 4 pi / (sigma_t (1 - g)), since Cycles walks
+  sigma_t = 1 / (d (1 - g))), else 0 (the reduced, isotropic medium);
   ``IOR`` the material's index (1 and ``Specular IOR Level`` 0 where it is index-matched: no
   specular layer), ``Subsurface IOR`` the index clamped as Cycles clamps it, [1.01, 3.8];
   ``Roughness``, the material's;
@@ -48,6 +50,7 @@ FOUR_PI = 4.0 * math.pi
 SSS_IOR_RANGE = (1.01, 3.8)  # Cycles' bssrdf_setup clamps the subsurface index to this
 CYCLES_MIN_ALPHA = 0.2  # Cycles raises a lower single-scattering albedo to this, scaling the path's weight
 CYCLES_MAX_ALPHA = 0.999999  # and clamps a higher one
+CYCLES_MAX_G = 0.9  # bssrdf_setup clamps the anisotropy to [0, 0.9]
 CYCLES_WALK_BOUNCES = 256  # BSSRDF_MAX_BOUNCES: a walk still inside after this many scatterings is dropped
 
 
@@ -281,10 +284,17 @@ def subsurface_inputs(interior: dict, values: dict) -> tuple[dict, dict, list[st
     from skinlab.scene.optics.tsd import eta_from_specular
 
     alpha = np.asarray(interior["albedo"]["value"], np.float64)
-    mfp = 1.0 / (np.asarray(interior["sigma_t"]["value"], np.float64) * float(interior["scale"]))  # mm
+    sigma_t = np.asarray(interior["sigma_t"]["value"], np.float64) * float(interior["scale"])  # 1/mm
+    phase = interior.get("phase") or {"type": "isotropic"}
+    g = float(phase.get("g", 0.0)) if phase.get("type") == "hg" else 0.0
+    gc = min(max(g, 0.0), CYCLES_MAX_G)
+    # Cycles walks sigma_t = 1 / (d (1 - g)) with d the radius after its setup: d = 1 / (sigma_t (1 - g))
+    mfp = 1.0 / (sigma_t * (1.0 - gc))
     eta = eta_from_specular(values["specular"])
-    base = cycles_base_color(alpha)
+    base = cycles_base_color(alpha, gc)
     notes = []
+    if gc != g:
+        notes.append(f"anisotropy g = {g:g} is outside Cycles' [0, {CYCLES_MAX_G}]: walked at {gc:g}")
     low = [c for c, a in zip("RGB", alpha) if a < CYCLES_MIN_ALPHA]
     if low:
         notes.append(
@@ -298,7 +308,7 @@ def subsurface_inputs(interior: dict, values: dict) -> tuple[dict, dict, list[st
     common = {
         "Base Color": [*base.tolist(), 1.0],
         "Subsurface Weight": 1.0,
-        "Subsurface Anisotropy": 0.0,
+        "Subsurface Anisotropy": gc,
         "Subsurface IOR": clamp_sss_ior(eta),
         "IOR": max(eta, 1.0),
         "Specular IOR Level": 0.0 if eta <= 1.0 else 0.5,

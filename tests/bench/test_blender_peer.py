@@ -260,3 +260,27 @@ def test_ledger_rows_of_the_peers(blender, tmp_path):
     assert "## Peers: Blender (EEVEE, Cycles)" in md and "| head-skin1-matched | eevee 1 spp |" in md
     header = (tmp_path / "ledger.csv").read_text().splitlines()[0].split(",")
     assert {"samples", "first_frame_ms", "peer_noise_block"} <= set(header)
+
+
+def test_anisotropic_medium_maps_to_cycles_anisotropy():
+    """A material with a Henyey-Greenstein g: the truth holds the real coefficients and the hg phase;
+    Blender gets that g, the Base Color whose remap at g is the real albedo, and the radius Cycles turns
+    into the same sigma_t = 1 / (d (1 - g))."""
+    s = Scene("aniso", 1.0)
+    s.environment.ambient = np.zeros(3)
+    mat = skin(radius=(8.0, 4.0, 2.0), color=(0.6, 0.4, 0.3), specular=0.0)
+    mat.values["subsurface_scatter_anisotropy"] = 0.5
+    s.add(MeshNode("cube", box_mesh((20.0, 20.0, 20.0)), mat))
+    s.add(light_from((0, 0, -1)))
+    cam = CameraNode("cam", yfov=math.radians(30), znear=1.0, zfar=200.0)
+    cam.look_at((0.0, 0.0, 60.0), (0.0, 0.0, 0.0))
+    s.add(cam)
+    interior = describe(s, 8, 8).shapes[0].interior
+    assert interior["phase"] == {"type": "hg", "g": 0.5}
+    o = bs.blender_spec(s, 8, 8).objects[0].material
+    inp, rw = o["inputs"], o["subsurface"]["RANDOM_WALK"]
+    assert inp["Subsurface Anisotropy"] == 0.5
+    np.testing.assert_allclose(bs.cycles_rw_alpha(inp["Base Color"][:3], 0.5), interior["albedo"]["value"], atol=1e-9)
+    d = np.asarray(rw["Subsurface Radius"]) * rw["Subsurface Scale"] / (4 * math.pi)
+    sigma_t = np.asarray(interior["sigma_t"]["value"]) * interior["scale"]
+    np.testing.assert_allclose(1 / (d * (1 - 0.5)), sigma_t, rtol=1e-9)
