@@ -49,9 +49,13 @@ class Node:
         return child
 
     def walk(self) -> Iterator[Node]:
-        yield self
-        for c in self.children:
-            yield from c.walk()
+        """This node and its descendants, parents first, children in order (iterative: a file may
+        nest thousands of nodes)."""
+        stack = [self]
+        while stack:
+            n = stack.pop()
+            yield n
+            stack.extend(reversed(n.children))
 
     def is_visible(self) -> bool:
         n: Node | None = self
@@ -113,9 +117,13 @@ class Node:
     @property
     def world_matrix(self) -> np.ndarray:
         if self._world is None:
-            local = self.local_matrix
-            self._world = local if self.parent is None else self.parent.world_matrix @ local
-            self.world_updates += 1
+            chain = [self]  # the ancestors whose world matrix is stale, nearest first (no recursion)
+            while chain[-1].parent is not None and chain[-1].parent._world is None:
+                chain.append(chain[-1].parent)
+            for n in reversed(chain):
+                local = n.local_matrix
+                n._world = local if n.parent is None else n.parent._world @ local
+                n.world_updates += 1
         return self._world
 
     @property

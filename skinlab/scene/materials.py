@@ -49,14 +49,14 @@ class Param:
         if self.kind == "float":
             try:
                 return np.array([float(value)])
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):  # OverflowError: an int beyond float range
                 raise ValueError(
                     f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}"
                 ) from None
         n = 2 if self.kind == "vec2" else 3
         try:
             arr = np.asarray(value, dtype=np.float64).reshape(-1)
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise ValueError(f"{label}: expected {n} numbers, got {value!r}") from None
         if arr.size == 1:
             arr = np.repeat(arr, n)

@@ -46,6 +46,7 @@ cast_shadow = true
 
 from __future__ import annotations
 
+import sys
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -57,9 +58,10 @@ from skinlab.resources import assets_root, bundled_scenes, scene_by_name
 
 from . import transform as tf
 from .graph import CameraNode, LightNode, MeshNode, Node, Scene
-from .loaders import SUPPORTED, load_mesh_file
+from .loaders import SUPPORTED, TRANSFORM_RANGE, load_mesh_file, transform_problem
 from .materials import Material
 from .mesh import Mesh, with_atlas
+from .paths import absolute
 from .scene_edits import apply_edits
 
 ASSETS = assets_root()
@@ -234,6 +236,8 @@ def _kind(value: Any) -> str:
 
 
 def _show(value: Any) -> str:
+    if _too_big(value):
+        return f"of {len(str(abs(value)))} digits (beyond the range of a float)"
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
@@ -265,8 +269,18 @@ def _bool(where: str, value: Any) -> bool:
     return value
 
 
+_FLOAT_MAX = int(sys.float_info.max)
+
+
+def _too_big(value: Any) -> bool:
+    """An integer no float can hold (``1`` followed by 400 zeros): TOML integers are unbounded."""
+    return isinstance(value, int) and not isinstance(value, bool) and abs(value) > _FLOAT_MAX
+
+
 def _is_number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
+    """A TOML integer or float (not a boolean) that converts to a float: every numeric key and vector
+    component is read through here, so an integer beyond float range is a wrong value naming its key."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and not _too_big(value)
 
 
 def _num(where: str, value: Any, lo: float | None = None, hi: float | None = None, lo_open: bool = False) -> float:
@@ -288,6 +302,7 @@ MAX_MAGNITUDE = 1e12  # coordinates, scales, colours: larger ones overflow float
 def _vec(where: str, value: Any, n: int = 3, lo: float | None = None) -> np.ndarray:
     """n finite numbers (a single number fills all n) of magnitude <= MAX_MAGNITUDE, each >= lo if given."""
     items = value if isinstance(value, list) else [value]
+    _no_huge_items(where, items)
     if not all(_is_number(v) for v in items):
         raise SceneFileError(f"{where}: expected {n} numbers, got {_kind(value)} {_show(value)}")
     a = np.asarray(items, np.float64).reshape(-1)
@@ -300,6 +315,13 @@ def _vec(where: str, value: Any, n: int = 3, lo: float | None = None) -> np.ndar
     if (np.abs(a) > MAX_MAGNITUDE).any():
         raise SceneFileError(f"{where}: expected numbers of magnitude at most {MAX_MAGNITUDE:g}, got {_show(value)}")
     return a
+
+
+def _no_huge_items(where: str, items: list) -> None:
+    """An integer no float can hold, named by its position in the array."""
+    for i, v in enumerate(items):
+        if _too_big(v):
+            raise SceneFileError(f"{where}: component {i + 1} is an integer {_show(v)}")
 
 
 def _known(where: str, table: dict, keys: set[str]) -> None:
@@ -327,6 +349,10 @@ def _trs(where: str, t: dict) -> dict:
         s = _vec(f"{where}.scale", t["scale"])
         if (s == 0).any():
             raise SceneFileError(f"{where}.scale: must be non-zero, got {t['scale']!r}")
+        if (np.abs(s) < 1.0 / MAX_MAGNITUDE).any():
+            raise SceneFileError(
+                f"{where}.scale: expected factors of magnitude {1 / MAX_MAGNITUDE:g} or more, got {_show(t['scale'])}"
+            )
         out["scale"] = s
     return out
 
@@ -336,7 +362,7 @@ def _resolve_paths(where: str, values: dict, base: Path, material: Material) -> 
     for p in material.params:
         if p.kind == "texture" and p.name in out and out[p.name] not in (None, ""):
             path = Path(_str(f"{where}.{p.name}", out[p.name]))
-            out[p.name] = path if path.is_absolute() else (base / path).resolve()
+            out[p.name] = path if path.is_absolute() else absolute(base / path)
     return out
 
 
@@ -352,6 +378,8 @@ def _material_values(where: str, material: Material, values: dict) -> Material:
             )
         if k not in pm:
             raise SceneFileError(f"{where}: unknown material parameter {k!r}; known: {', '.join(pm)}")
+        if isinstance(v, list):
+            _no_huge_items(f"{where}.{k}", v)
         if pm[k].kind in ("float", "color", "vec3", "vec2") and not (
             _is_number(v) or (isinstance(v, list) and all(_is_number(x) for x in v))
         ):
@@ -404,8 +432,6 @@ def _check_textures(where: str, material: Material) -> None:
         tex = material.values.get(p.name) if p.kind == "texture" else None
         if tex is None:
             continue
-        if not Path(tex).is_file():
-            raise SceneFileError(f"{where}.{p.name}: texture file not found: {tex}")
         try:
             load_texture(tex, p.colorspace)
         except (ValueError, OSError) as exc:
@@ -457,6 +483,10 @@ def read_scene_data(path: Path) -> dict:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneFileError(f"{path}: not valid TOML: {exc}") from None
+    except ValueError as exc:  # Python's limit on integer digits (4300)
+        raise SceneFileError(f"{path}: a number too long to read ({str(exc).split(';')[0]})") from None
+    except RecursionError:  # tomllib parses nested arrays and inline tables recursively
+        raise SceneFileError(f"{path}: arrays or inline tables nested too deeply (hundreds of levels)") from None
     return data
 
 
@@ -466,7 +496,7 @@ def _build(path: Path, data: dict) -> Scene:
     sc = _table("[scene]", data.get("scene", {}))
     _known("[scene]", sc, _keys("[scene]"))
     name = _str("[scene].name", sc["name"]) if "name" in sc else path.stem
-    mm = _num("[scene].mm_per_unit", sc["mm_per_unit"], 0.0, lo_open=True) if "mm_per_unit" in sc else 1.0
+    mm = _num("[scene].mm_per_unit", sc["mm_per_unit"], 1e-12) if "mm_per_unit" in sc else 1.0
     scene = Scene(name, mm)
     scene.source = path
 
@@ -566,6 +596,7 @@ def _build(path: Path, data: dict) -> Scene:
             node.visible = _bool(f"{nwhere}.visible", cfg.get("visible", True))
             (created[ln.parent] if ln.parent else top).add(node)
             created[ln.name] = node
+        _check_world_transforms(where, top)
 
     for i, entry in enumerate(_tables("[lights]", data.get("lights", []))):
         where = f"[[lights]] #{i + 1}"
@@ -627,6 +658,17 @@ def _build(path: Path, data: dict) -> Scene:
     if scene.camera is None:
         scene.add(default_camera(scene))
     return scene
+
+
+def _check_world_transforms(where: str, top: Node) -> None:
+    """The entry's scale, rotation and translation times the file's own transforms stay renderable."""
+    for node in top.walk():
+        problem = transform_problem(node.world_matrix) if isinstance(node, MeshNode) else None
+        if problem:
+            raise SceneFileError(
+                f"{where}: mesh node {node.name!r}: with this entry's translation, rotation and scale its world "
+                f"transform {problem}; {TRANSFORM_RANGE}"
+            )
 
 
 def _file_material(where: str, own, mm_per_unit: float) -> Material:
