@@ -64,6 +64,9 @@ def node_uniforms(node) -> dict:
     return {"u_model": model, "u_normal_matrix": np.linalg.inv(model[:3, :3]).T}
 
 
+HALF_MAX = float(np.finfo(np.float16).max)
+
+
 class GpuResources:
     """Caches GPU meshes (by Mesh identity and version) and textures (by path and colour space)."""
 
@@ -91,9 +94,12 @@ class GpuResources:
             if c == 2:
                 img = np.concatenate([img, np.zeros((h, w, 1), np.float32)], 2)
                 c = 3
-            # row 0 of the file is the top; OpenGL's v = 0 is the bottom row
-            data = np.ascontiguousarray(img[::-1].astype(np.float16))
-            tex = self.ctx.texture((w, h), c, data.tobytes(), dtype="f2")
+            # row 0 of the file is the top; OpenGL's v = 0 is the bottom row. Half floats hold what 8-bit
+            # and most float maps need in half the memory; a map beyond their range (65504: an EXR of
+            # 1e6) would overflow to Inf, so it stays float32
+            dtype = "f2" if float(np.abs(img).max(initial=0.0)) <= HALF_MAX else "f4"
+            data = np.ascontiguousarray(img[::-1].astype(np.float16 if dtype == "f2" else np.float32))
+            tex = self.ctx.texture((w, h), c, data.tobytes(), dtype=dtype)
             tex.build_mipmaps()
             tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
             tex.anisotropy = 8.0

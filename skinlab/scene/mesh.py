@@ -24,15 +24,16 @@ class Mesh:
     tangents: np.ndarray | None = None  # (N, 4) float32, w = handedness
     source: str = ""
     version: int = 0  # bump when geometry changes (GPU buffers and stretch maps key on it)
+    notes: tuple[str, ...] = ()  # what was repaired on the way in (normals recomputed): the loader warns of it
     _bounds: tuple | None = field(default=None, repr=False, metadata={"transient": True})
     # unique for the process (unlike id(), never reused after the mesh is freed): GPU caches key on it
     uid: int = field(default_factory=lambda: next(_UIDS), repr=False, compare=False, metadata={"transient": True})
     colors: np.ndarray | None = field(default=None, repr=False)  # (N, 4) float32 linear RGBA (glTF COLOR_0)
 
     def __post_init__(self) -> None:
-        self.positions = np.ascontiguousarray(self.positions, np.float32)
-        self.indices = np.ascontiguousarray(self.indices, np.uint32).reshape(-1, 3)
         where = f"mesh {self.name!r}" + (f" ({self.source})" if self.source else "")
+        self.positions = _float32_positions(where, self.positions)
+        self.indices = np.ascontiguousarray(self.indices, np.uint32).reshape(-1, 3)
         if self.positions.ndim != 2 or self.positions.shape[1] != 3:
             raise ValueError(f"{where}: positions must be (N, 3), got {self.positions.shape}")
         if len(self.indices) == 0:
@@ -45,6 +46,10 @@ class Mesh:
             raise ValueError(f"{where}: positions contain NaN or Inf")
         if self.normals is None:
             self.normals = vertex_normals(self.positions, self.indices)
+        else:
+            self.normals, note = _valid_normals(where, self.normals, self.positions, self.indices)
+            if note:
+                self.notes = (*self.notes, note)
         self.normals = np.ascontiguousarray(self.normals, np.float32)
         if self.uvs is not None:
             self.uvs = np.ascontiguousarray(self.uvs, np.float32)
@@ -84,6 +89,48 @@ class Mesh:
         if not generate:
             raise ValueError(f"mesh {self.name!r} ({self.source or 'no file'}) has no UV coordinates, and {reason}")
         generate_atlas(self)
+
+
+def _float32_positions(where: str, positions) -> np.ndarray:
+    """Positions as float32, refusing NaN, Inf and coordinates beyond float32 range (1e39 would
+    become Inf) with the vertex named, before the cast (no numpy overflow warning on stderr)."""
+    p = np.asarray(positions)
+    if p.dtype != np.float32 and p.size:
+        p64 = np.asarray(p, np.float64)
+        bad = ~np.isfinite(p64) | (np.abs(p64) > np.finfo(np.float32).max)
+        if bad.any():
+            v = int(np.argwhere(bad)[0][0])
+            raise ValueError(
+                f"{where}: vertex {v} is at {p64[v].tolist()}: positions must be finite and within float32 range"
+            )
+    return np.ascontiguousarray(p, np.float32)
+
+
+def _valid_normals(where: str, normals, positions: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, str]:
+    """The given vertex normals with those that are zero, NaN, Inf or of the wrong count replaced by
+    the triangles' area-weighted normals, and a note saying how many were replaced ("" if none)."""
+    n = np.asarray(normals, np.float64)
+    if n.shape != positions.shape:
+        return vertex_normals(positions, indices), (
+            f"{where}: {n.shape[0] if n.ndim else 0} normals for {len(positions)} vertices; "
+            "recomputed from the triangles"
+        )
+    with np.errstate(all="ignore"):
+        length = np.linalg.norm(n, axis=1)
+    bad = ~np.isfinite(length) | (length < 1e-6)
+    if not bad.any():
+        return n, ""
+    n = n.copy()
+    used = np.zeros(len(n), bool)
+    used[indices.reshape(-1)] = True
+    n[bad & ~used] = 0.0  # a vertex no triangle uses is never drawn: a zero normal (no rays), without a word
+    bad &= used
+    if not bad.any():
+        return n, ""
+    n[bad] = vertex_normals(positions, indices)[bad]
+    return n, (
+        f"{where}: {int(bad.sum())} of {len(n)} vertex normals were zero, NaN or Inf; recomputed from the triangles"
+    )
 
 
 _ATLASED: dict[int, Mesh] = {}

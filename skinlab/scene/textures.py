@@ -11,7 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
+from skinlab.native_stderr import silenced
+
 from .optics.color import srgb_decode
+from .paths import absolute, existing_file
 
 _CACHE: dict[tuple[str, float, str], np.ndarray] = {}
 
@@ -27,13 +30,19 @@ def _srgb_to_linear(x: np.ndarray, eight_bit: bool) -> np.ndarray:
     return srgb_decode(x).astype(np.float32)
 
 
+def _first_line(message: str) -> str:
+    """OIIO's error text, which may repeat what libpng said in several sentences, cut to its first."""
+    text = " ".join(message.split())
+    for stop in (" PNG read error", " PNG library error"):
+        text = text.split(stop)[0]
+    return text or "unknown error"
+
+
 def load_texture(path: str | Path, colorspace: str = "linear") -> np.ndarray:
     if colorspace not in ("srgb", "linear"):
         raise ValueError(f"texture {path}: colorspace must be 'srgb' or 'linear', got {colorspace!r}")
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"texture file not found: {path}")
-    key = (str(path.resolve()), path.stat().st_mtime, colorspace)
+    path = existing_file(path, "texture file")
+    key = (str(absolute(path)), path.stat().st_mtime, colorspace)
     if key in _CACHE:
         return _CACHE[key]
     import OpenImageIO as oiio
@@ -41,19 +50,22 @@ def load_texture(path: str | Path, colorspace: str = "linear") -> np.ndarray:
     # colour and alpha as stored (a glTF colour map's alpha is opacity, not premultiplied into the colour)
     config = oiio.ImageSpec()
     config.attribute("oiio:UnassociatedAlpha", 1)
-    inp = oiio.ImageInput.open(str(path), config)
-    if inp is None:
-        raise ValueError(f"{path}: cannot read texture: {oiio.geterror()}")
-    try:
-        spec = inp.spec()
-        data = inp.read_image(0, 0, 0, spec.nchannels, "float")
-        # a truncated or corrupt file may still decode partly (grey rows below the damage): refuse it
-        if inp.has_error:
-            raise ValueError(f"{path}: cannot decode texture: {inp.geterror()}")
-    finally:
-        inp.close()
+    with silenced():  # libpng and libjpeg print their complaints on stderr: OIIO's error says it once
+        inp = oiio.ImageInput.open(str(path), config)
+        if inp is None:
+            raise ValueError(f"{path}: cannot read texture: {_first_line(oiio.geterror())}")
+        try:
+            spec = inp.spec()
+            data = inp.read_image(0, 0, 0, spec.nchannels, "float")
+            # a truncated or corrupt file may still decode partly (grey rows below the damage): refuse it
+            if inp.has_error:
+                raise ValueError(
+                    f"{path}: cannot decode texture (truncated or corrupt?): {_first_line(inp.geterror())}"
+                )
+        finally:
+            inp.close()
     if data is None:
-        raise ValueError(f"{path}: cannot decode texture: {oiio.geterror()}")
+        raise ValueError(f"{path}: cannot decode texture: {_first_line(oiio.geterror())}")
     img = np.asarray(data, np.float32).reshape(spec.height, spec.width, spec.nchannels)
     if colorspace == "srgb":
         rgb = min(3, img.shape[2])
@@ -72,7 +84,7 @@ def texture_mean(path: str | Path, colorspace: str = "linear") -> np.ndarray:
     """The mean of a texture's first three channels (linear values; one channel repeated), cached
     by file and modification time: what a colour map contributes to a material's medium."""
     path = Path(path)
-    key = (str(path.resolve()), path.stat().st_mtime, colorspace)
+    key = (str(absolute(path)), path.stat().st_mtime, colorspace)
     if key not in _MEANS:
         img = load_texture(path, colorspace)
         rgb = img[..., :3] if img.shape[2] >= 3 else np.repeat(img[..., :1], 3, axis=2)
