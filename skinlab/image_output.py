@@ -10,11 +10,12 @@ Each file is written to a temporary name beside the target and renamed into plac
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from skinlab.atomic_write import atomic_path
+from skinlab.atomic_write import atomic_path, check_writable
 
 FORMATS = {".png": "png", ".exr": "exr"}
 
@@ -38,14 +39,29 @@ def check_output_path(path: str | Path, option: str = "") -> Path:
         image_format(path)
     except ValueError as exc:
         raise ValueError(f"{label}{exc}") from None
+    try:
+        check_writable(path)
+    except OSError as exc:
+        raise ValueError(f"{label}{path}: {exc.strerror}") from None
     for parent in path.parents:
         if parent.exists():
             if not parent.is_dir():
                 raise ValueError(f"{label}{path}: {parent} is a file, not a folder")
             if not os.access(parent, os.W_OK):
                 raise ValueError(f"{label}{path}: folder {parent} is not writable")
+            _probe_folder(parent, path, label)
             break
     return path
+
+
+def _probe_folder(folder: Path, path: Path, label: str) -> None:
+    """A folder that says it is writable but takes no new file (/proc, a read-only mount for root)."""
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".skinlab-probe.", dir=folder)
+    except OSError as exc:
+        raise ValueError(f"{label}{path}: cannot create a file in {folder}: {exc.strerror or exc}") from None
+    os.close(fd)
+    os.unlink(probe)
 
 
 def write_image(path: str | Path, pixels: np.ndarray) -> Path:
