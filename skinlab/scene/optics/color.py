@@ -21,5 +21,5 @@ def srgb_decode(x):
 
 
 def tonemap_aces(x):
-    x = np.maximum(np.asarray(x, np.float64), 0.0)
+    x = np.clip(np.asarray(x, np.float64), 0.0, 1e4)  # 1 from x = 7.25 on; x * x stays finite in float32
     return np.clip((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0)

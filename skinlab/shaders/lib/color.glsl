@@ -17,6 +17,8 @@ vec3 srgb_decode(vec3 x) {
 }
 
 vec3 tonemap_aces(vec3 x) {
-    x = max(x, vec3(0.0));
+    // from x = 7.25 on the curve is clamped to 1; capping x at 1e4 changes nothing there and keeps
+    // x * x finite (a huge exposure, 1e30, made inf / inf = NaN: a black image)
+    x = clamp(x, vec3(0.0), vec3(1e4));
     return clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
 }

@@ -27,3 +27,12 @@ def test_tonemap_twin_is_monotonic_and_bounded(glsl, values):
     x = np.geomspace(1e-6, 1e4, 1000)
     y = color.tonemap_aces(x)
     assert (np.diff(y) >= 0).all() and y.min() >= 0 and y.max() <= 1
+
+
+def test_tonemap_of_huge_values_is_white_not_nan(glsl):
+    """An exposure of 1e30 (or a light that bright): x * x overflowed float32, inf / inf = NaN, black."""
+    x = np.array([[7.3, 1e4, 1e5], [1e19, 1e30, 3e38], [1e20, 1e25, 0.5]])
+    gpu = glsl.evaluate("lib/color.glsl", "tonemap_aces(x)", {"x": x}, out_components=3)
+    assert np.isfinite(gpu).all()
+    assert_close_fp32(gpu, color.tonemap_aces(x), what="tonemap_aces (huge)")
+    assert (color.tonemap_aces(x)[:, :2] == 1.0).all() and color.tonemap_aces(x)[2, 2] < 1.0
