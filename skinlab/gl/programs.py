@@ -72,6 +72,9 @@ def _diagnose(ctx: moderngl.Context, srcs: dict[str, ExpandedSource]) -> ShaderE
             if stage.split("_")[0] not in log and "link" in log.lower() and not locs:
                 continue  # a link error against the trivial partner: not this stage's fault
             msg, where = parse_errors(log, src, stage.split("_")[0])
+            if not where:  # a link error ("vertex shader lacks `main'") has no line: the stage's file
+                where = [(src.files[0], 1)]
+                msg = msg.replace(" failed to compile:\n", f" failed to compile:\n{src.files[0]}:1: ", 1)
             messages.append(msg)
             locs.extend(where)
     if not messages:

@@ -26,6 +26,7 @@ SHADER_ROOT = shader_root()
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+[<"]([^">]+)[">]\s*(//.*)?$')
 _VERSION = re.compile(r"^\s*#\s*version\b")
+_INCLUDE_WORD = re.compile(r"#\s*include\b")
 # Mesa: "0:12(5): error: ..."; NVIDIA: "0(12) : error C0000: ..."; AMD/Intel Windows: "ERROR: 0:12: ..."
 _ERROR_LOC = [
     re.compile(r"^(?P<pre>.*?)(?P<src>\d+):(?P<line>\d+)\((?P<col>\d+)\):\s*(?P<msg>.*)$"),
@@ -40,6 +41,30 @@ class ShaderError(Exception):
     def __init__(self, message: str, locations: list[tuple[str, int]] | None = None):
         super().__init__(message)
         self.locations = locations or []
+
+
+class _NotFound(ShaderError):
+    """An included file that does not exist (the include site adds its file and line)."""
+
+
+def _code_outside_comments(line: str, in_comment: bool) -> tuple[str, bool]:
+    """The line's text outside // and /* */ comments, and whether a /* */ comment is still open at
+    its end (``in_comment``: one was open at its start)."""
+    code, i = [], 0
+    while i < len(line):
+        if in_comment:
+            end = line.find("*/", i)
+            if end < 0:
+                return "".join(code), True
+            in_comment, i = False, end + 2
+        elif line.startswith("//", i):
+            break
+        elif line.startswith("/*", i):
+            in_comment, i = True, i + 2
+        else:
+            code.append(line[i])
+            i += 1
+    return "".join(code), in_comment
 
 
 @dataclass
@@ -89,6 +114,7 @@ class ShaderLibrary:
             return str(path)
 
     def _read(self, name: str, including: Path | None) -> tuple[str, Path | None, str]:
+        """(text, path, display name) of an include; _NotFound (a ShaderError) naming where it looked."""
         if name in self.virtual:
             return self.virtual[name](), None, f"<{name}>"
         candidates = []
@@ -103,7 +129,7 @@ class ShaderLibrary:
                 except (OSError, UnicodeDecodeError) as exc:
                     raise ShaderError(f"{self.display_name(c)}: cannot read shader file: {exc}") from exc
         where = f" (included from {self.display_name(including)})" if including else ""
-        raise ShaderError(f"shader file '{name}' not found{where}; looked in: " + ", ".join(str(c) for c in candidates))
+        raise _NotFound(f"shader file '{name}' not found{where}; looked in: " + ", ".join(str(c) for c in candidates))
 
     # -- expansion -----------------------------------------------------------------------
     def expand(
@@ -146,15 +172,31 @@ class ShaderLibrary:
                 for k, v in (defines or {}).items():
                     emit(f"#define {k} {'' if v is True else v}".rstrip(), idx, 0)
             out.append(f"#line {first + 1} {idx}")
+            in_comment = False  # inside a /* */ comment at the start of the line
             for i in range(first, len(lines)):
-                m = _INCLUDE.match(lines[i])
+                code, after = _code_outside_comments(lines[i], in_comment)
+                m = _INCLUDE.match(lines[i]) if not in_comment else None
+                in_comment = after
                 if m:
-                    visit(m.group(1), path, (idx, i + 1))
+                    try:
+                        visit(m.group(1), path, (idx, i + 1))
+                    except _NotFound as exc:
+                        raise ShaderError(f"{shown}:{i + 1}: {exc}", [(shown, i + 1)]) from None
                     out.append(f"#line {i + 2} {idx}")
                     continue
-                if _VERSION.match(lines[i]):
-                    raise ShaderError(f"{shown}:{i + 1}: #version is only allowed on the first line of a pass file")
-                emit(lines[i], idx, i + 1)
+                if _INCLUDE_WORD.search(code):  # an include line an edit mangled: say where, not moderngl's KeyError
+                    raise ShaderError(
+                        f'{shown}:{i + 1}: malformed #include (expected #include "file" alone on its line)\n'
+                        f"    {i + 1:>4} | {lines[i].strip()}",
+                        [(shown, i + 1)],
+                    )
+                if _VERSION.match(code):
+                    raise ShaderError(
+                        f"{shown}:{i + 1}: #version is only allowed on the first line of a pass file",
+                        [(shown, i + 1)],
+                    )
+                # moderngl scans the whole source for #include "..." again, comments too: defuse it there
+                emit(_INCLUDE_WORD.sub("# include", lines[i]), idx, i + 1)
 
         visit(name, None, None)
         return ExpandedSource("\n".join(out) + "\n", "\n".join(flat) + "\n", line_map, files, paths)
@@ -166,7 +208,9 @@ def parse_errors(log: str, src: ExpandedSource, stage: str) -> tuple[str, list[t
     locs: list[tuple[str, int]] = []
     for raw in log.splitlines():
         raw = raw.rstrip()
-        if not raw or set(raw) <= {"="} or raw in ("GLSL Compiler failed",) or raw.endswith("_shader"):
+        if not raw or set(raw) <= {"="} or raw in ("GLSL Compiler failed", "GLSL Linker failed", "Program"):
+            continue
+        if raw.endswith("_shader"):
             continue
         for pat in _ERROR_LOC:
             m = pat.match(raw)
