@@ -67,12 +67,27 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+SEED_LIMIT = 1 << 32  # Mitsuba's sampler seed is a 32-bit unsigned integer
+DEPTH_LIMIT = (1 << 31) - 1  # and its path depths 32-bit signed ones
+
+
+def _check_path_options(args) -> None:
+    """--seed and --max-depth in what Mitsuba takes (past it: its RuntimeError, a traceback)."""
+    if not 0 <= args.seed < SEED_LIMIT:
+        raise ValueError(f"--seed: expected an integer in [0, {SEED_LIMIT - 1}], got {args.seed}")
+    if not (args.max_depth == -1 or 1 <= args.max_depth <= DEPTH_LIMIT):
+        raise ValueError(
+            f"--max-depth: expected -1 (no limit) or a path length in [1, {DEPTH_LIMIT}], got {args.max_depth}"
+        )
+
+
 def run(args) -> int:
     from skinlab.cli import UserError
     from skinlab.image_output import check_output_path, image_format, write_image
     from skinlab.scene.scenefile import load_scene
     from skinlab.truth.reference import ReferenceRequest, ReferenceUnavailable, render_reference
 
+    _check_path_options(args)
     if args.export_xml:
         return export_xml(args)
     out = check_output_path(args.out, "--out")  # before minutes of path tracing
