@@ -21,6 +21,16 @@ def plan_translucency(ctx, needed: bool, enabled: bool) -> bool:
     (`needed`), the technique's setting allows it (`enabled`) and a light casts a shadow (its
     distance map gives the thickness). Records why not in the plan's skips."""
     use = needed and enabled and bool(ctx.shadow_lights)
+    if use:  # the thickness is a distance through the mesh: across a hole it reads the far side, or nothing
+        from skinlab.scene.mesh_topology import open_mesh_warning
+
+        from .scattering import effective_material
+
+        for node in ctx.meshes:
+            if effective_material(node, ctx.settings).has_subsurface:
+                line = open_mesh_warning(node.mesh, "translucency (light through thin parts)")
+                if line is not None and line not in ctx.plan.warnings:
+                    ctx.plan.warnings.append(line)
     if needed and not use:
         ctx.plan.skipped.append(
             ("translucency", "disabled in the settings" if not enabled else "no shadow-casting light")

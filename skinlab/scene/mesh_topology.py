@@ -1,0 +1,208 @@
+"""Is a mesh closed? Open edges (used by one triangle: a hole) and non-manifold edges (used by three
+or more), counted per mesh, and a small repair for scans: drop duplicated triangles, cut the sheets
+meeting at non-manifold edges apart, fill the holes (``tools/repair_bunny.py`` made the bundled
+bunny with it).
+
+A closed mesh matters where light is followed inside the medium: the path-traced truth (Mitsuba's
+medium needs an inside) and the thickness a technique reads for light through thin parts; at a hole
+the light leaks out and the surface shows dark specks. Open meshes are warned about where such a
+frame or reference is made (``skinlab/render/scattering.py``, ``skinlab/truth/export.py``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class EdgeReport:
+    edges: int
+    open: int  # used by one triangle
+    non_manifold: int  # used by three or more
+
+    @property
+    def closed(self) -> bool:
+        return self.open == 0 and self.non_manifold == 0
+
+    def describe(self) -> str:
+        parts = [
+            f"{n} {what} edge{'s' if n != 1 else ''}"
+            for n, what in ((self.open, "open"), (self.non_manifold, "non-manifold"))
+            if n
+        ]
+        return " and ".join(parts) if parts else "closed"
+
+
+def _undirected_edges(indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct edges (a < b) of a triangle list and how many triangles use each."""
+    f = np.asarray(indices, np.int64).reshape(-1, 3)
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    n = int(e.max()) + 1 if e.size else 1
+    codes, counts = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)  # one int per edge: a 1-D sort
+    return np.stack([codes // n, codes % n], axis=1), counts
+
+
+def _welded(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
+    """Triangle indices with vertices at the same position merged: a UV seam or a hard edge splits
+    vertices, which is no hole."""
+    p = np.ascontiguousarray(np.asarray(positions, np.float32) + np.float32(0.0))  # -0.0 -> 0.0
+    rows = p.view(np.dtype((np.void, 12))).reshape(-1)  # each position's 12 bytes as one sortable key
+    _, inverse = np.unique(rows, return_inverse=True)
+    return inverse.reshape(-1)[np.asarray(indices, np.int64)]
+
+
+_REPORTS: dict[tuple[int, int], EdgeReport] = {}
+
+
+def edge_report(mesh) -> EdgeReport:
+    """Open and non-manifold edges of ``mesh`` (vertices at one position count as one), once per mesh
+    version."""
+    key = (mesh.uid, mesh.version)
+    if key not in _REPORTS:
+        _, counts = _undirected_edges(_welded(mesh.positions, mesh.indices))
+        _REPORTS[key] = EdgeReport(int(counts.size), int((counts == 1).sum()), int((counts > 2).sum()))
+        if len(_REPORTS) > 256:
+            _REPORTS.pop(next(iter(_REPORTS)))
+    return _REPORTS[key]
+
+
+def open_mesh_warning(mesh, needs: str) -> str | None:
+    """One line for a mesh that is not closed, saying what needs it closed; None for a closed one."""
+    report = edge_report(mesh)
+    if report.closed:
+        return None
+    where = f"mesh {mesh.name!r}" + (f" ({mesh.source})" if mesh.source else "")
+    return (
+        f"{where} is not closed ({report.describe()}): {needs} needs a closed surface, light leaks out at the "
+        "holes (dark specks); fill them (Blender: Select > All by Trait > Non Manifold, then Face > Fill)"
+    )
+
+
+def _face_pairs(f: np.ndarray) -> np.ndarray:
+    """(P, 2) the pairs of triangles sharing an edge that exactly two triangles use."""
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    n = int(f.max()) + 1
+    code = e[:, 0] * n + e[:, 1]
+    face = np.tile(np.arange(len(f)), 3)
+    order = np.argsort(code, kind="stable")
+    code, face = code[order], face[order]
+    _, first, count = np.unique(code, return_index=True, return_counts=True)
+    two = first[count == 2]
+    return np.stack([face[two], face[two + 1]], axis=1)
+
+
+def _folds(p: np.ndarray, f: np.ndarray, ignore: np.ndarray | None = None) -> np.ndarray:
+    """Triangles meeting a neighbour at more than 90 degrees: a scan's folded-over triangles (pairs
+    with a triangle in ``ignore``, a boolean mask, left out)."""
+    fn = np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]])
+    fn /= np.maximum(np.linalg.norm(fn, axis=1, keepdims=True), 1e-300)
+    pairs = _face_pairs(f)
+    if ignore is not None:
+        pairs = pairs[~(ignore[pairs[:, 0]] | ignore[pairs[:, 1]])]
+    folded = pairs[np.einsum("ij,ij->i", fn[pairs[:, 0]], fn[pairs[:, 1]]) < 0.0]
+    return np.unique(folded.reshape(-1))
+
+
+def unfold(
+    positions: np.ndarray, indices: np.ndarray, rounds: int = 10, ignore: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """A scan's folds (adjacent triangles facing more than 90 degrees apart: dark specks, the vertex
+    normal points inward) smoothed out: each fold's vertices moved to the mean of their neighbours,
+    ``rounds`` times; the triangles around folds that remain are removed (close_mesh fills the holes)
+    unless ``ignore`` is given (a mask of triangles whose creases are meant: a flat cap's rim)."""
+    p = np.asarray(positions, np.float64).copy()
+    f = np.asarray(indices, np.int64).reshape(-1, 3)
+    edges, _ = _undirected_edges(f)
+    degree = np.bincount(edges.reshape(-1), minlength=len(p)).astype(np.float64)
+    for _ in range(rounds):
+        folded = _folds(p, f, ignore)
+        if not len(folded):
+            return p, f
+        moving = np.unique(f[folded].reshape(-1))
+        total = np.zeros_like(p)
+        np.add.at(total, edges[:, 0], p[edges[:, 1]])
+        np.add.at(total, edges[:, 1], p[edges[:, 0]])
+        p[moving] = total[moving] / np.maximum(degree[moving], 1.0)[:, None]
+    if ignore is not None:
+        return p, f
+    stuck = np.unique(f[_folds(p, f)].reshape(-1))
+    return p, f[~np.isin(f, stuck).any(axis=1)]
+
+
+BIG_HOLE = 16  # a hole of this many edges or more is a cut (the bunny's flat base): its rim is a real crease
+
+
+def close_mesh(positions: np.ndarray, indices: np.ndarray, unfold_rounds: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """A scan made closed: duplicated triangles (both copies: they are fins of zero volume) and the
+    triangles at non-manifold edges removed, with ``unfold_rounds`` > 0 its folds smoothed
+    (:func:`unfold`), then every hole filled by a fan around a new vertex at the hole's centroid,
+    wound like its neighbours. Raises ValueError if the result is still open."""
+    p = np.asarray(positions, np.float64)
+    f = np.asarray(indices, np.int64).reshape(-1, 3)
+    _, inverse, counts = np.unique(np.sort(f, axis=1), axis=0, return_inverse=True, return_counts=True)
+    f = f[counts[inverse.reshape(-1)] == 1]
+    for _ in range(8):  # removing triangles can leave new non-manifold corners; a few rounds settle it
+        edges, counts = _undirected_edges(f)
+        bad = edges[counts > 2]
+        if not len(bad):
+            break
+        e = np.sort(np.stack([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]], axis=1), axis=2)  # (F, 3, 2)
+        bad_set = {tuple(x) for x in bad.tolist()}
+        keep = np.array([not any(tuple(x) in bad_set for x in tri) for tri in e.tolist()])
+        f = f[keep]
+    if unfold_rounds:
+        p, f = unfold(p, f, unfold_rounds)
+    big = np.zeros(len(f), bool)
+    for _ in range(3):
+        p, f, big = _fill_holes(p, f, big)
+        if not unfold_rounds:
+            break
+        # a small hole's fan in a curved place may fold against its rim: smooth it in, else cut it out
+        # with its surroundings and fill the larger hole again
+        p, f = unfold(p, f, unfold_rounds, ignore=big)
+        stuck = np.unique(f[_folds(p, f, big)].reshape(-1))
+        if not len(stuck):
+            break
+        keep = ~np.isin(f, stuck).any(axis=1)
+        f, big = f[keep], big[keep]
+    _, counts = _undirected_edges(f)
+    if (counts != 2).any():
+        raise ValueError(f"close_mesh: {int((counts != 2).sum())} edges are still open or non-manifold")
+    used = np.unique(f.reshape(-1))  # vertices of removed caps: dropped, the rest renumbered in order
+    renumber = np.full(len(p), -1, np.int64)
+    renumber[used] = np.arange(len(used))
+    return p[used], renumber[f]
+
+
+def _fill_holes(p: np.ndarray, f: np.ndarray, big: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every hole filled by a fan around its centroid; ``big`` (a mask of the triangles of fans of
+    holes of BIG_HOLE edges or more) extended to the new triangles."""
+    directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    present = {tuple(x) for x in directed.tolist()}
+    # a boundary edge a->b has no b->a; the fill runs the other way, b->a
+    step: dict[int, list[int]] = {}
+    for a, b in directed.tolist():
+        if (b, a) not in present:
+            step.setdefault(b, []).append(a)
+    new_p, new_f, big = [p], [f], [big]
+    n = len(p)
+    while step:
+        start = next(iter(step))
+        loop = [start]
+        while True:
+            nxt = step[loop[-1]].pop()
+            if not step[loop[-1]]:
+                del step[loop[-1]]
+            if nxt == start:
+                break
+            loop.append(nxt)
+            if nxt not in step:
+                raise ValueError(f"close_mesh: a hole's boundary does not close at vertex {nxt}")
+        centre = p[loop].mean(axis=0)
+        new_p.append(centre[None])
+        new_f.append(np.array([[loop[i], loop[(i + 1) % len(loop)], n] for i in range(len(loop))], np.int64))
+        big.append(np.full(len(loop), len(loop) >= BIG_HOLE))
+        n += 1
+    return np.concatenate(new_p), np.concatenate(new_f), np.concatenate(big)
