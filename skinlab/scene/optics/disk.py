@@ -63,7 +63,7 @@ def _scatter(medium: Medium) -> np.ndarray:
 @table(disk=True, maxsize=256)
 def disk_kernel(model: str, medium: Medium, samples: int) -> DiskKernel:
     """The disk samples for a material's sss_model and medium (cached per medium and count)."""
-    from .gaussians import _energy_radius
+    from .gaussians import NoEnergy, _energy_radius
     from .profiles import get_profile
     from .tsd import MODEL_PROFILES
 
@@ -78,7 +78,10 @@ def disk_kernel(model: str, medium: Medium, samples: int) -> DiskKernel:
         return DiskKernel(np.zeros(samples), np.zeros((samples, 3)), 0.0, 0.0)
     prof = get_profile(MODEL_PROFILES[model])
     fn = lambda r: np.asarray(prof.evaluate(np.asarray(r, np.float64), medium), np.float64) * scatter[None, :]
-    reach = _energy_radius(fn, SAMPLE_ENERGY)
+    try:
+        reach = _energy_radius(fn, SAMPLE_ENERGY)
+    except NoEnergy:  # the light spreads less than 1e-5 mm in every scattering channel: none scatters
+        return DiskKernel(np.zeros(samples), np.zeros((samples, 3)), 0.0, 0.0)
     x_e = float(burley_sample_golubev(SAMPLE_ENERGY, 1.0))  # r/d where the Burley CDF reaches it
     d = reach / x_e
     xi = (np.arange(samples) + 0.5) / samples

@@ -58,16 +58,28 @@ class GaussianFit:
         return gaussian_sum_profile(r, self.variances_mm2, self.weights)
 
 
+class NoEnergy(ValueError):
+    """The profile carries no energy between 1e-5 mm and 10 m in any channel: nothing to fit (a
+    channel of albedo 0, or one whose light spreads less than 1e-5 mm: no scattering at any scale a
+    frame resolves)."""
+
+
+ENERGY_GRID_MM = (1e-5, 1e4)  # where _energy_radius looks for a profile's energy
+
+
 def _energy_radius(profile_fn, fraction):
-    """Smallest radius holding `fraction` of every channel's energy (int R 2 pi r dr)."""
-    r = np.geomspace(1e-5, 1e4, 2000)
+    """Smallest radius holding `fraction` of every channel's energy (int R 2 pi r dr); NoEnergy if
+    no channel has any on ENERGY_GRID_MM."""
+    r = np.geomspace(*ENERGY_GRID_MM, 2000)
     f = np.maximum(f64(profile_fn(r)).reshape(len(r), -1), 0.0) * 2 * PI * r[:, None] ** 2
     cum = np.concatenate(
         [np.zeros((1, f.shape[1])), np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(np.log(r))[:, None], axis=0)]
     )
     tot = cum[-1]
-    if not np.all(np.isfinite(tot)) or np.all(tot <= 0):
-        raise ValueError("profile_fn: profile has no finite positive energy to fit")
+    if not np.all(np.isfinite(tot)):
+        raise ValueError("profile_fn: profile has no finite energy to fit")
+    if np.all(tot <= 0):
+        raise NoEnergy("profile_fn: profile has no positive energy to fit")
     idx = [np.searchsorted(cum[:, c], fraction * tot[c]) for c in range(f.shape[1]) if tot[c] > 0]
     return float(r[min(max(idx), len(r) - 1)])
 

@@ -43,7 +43,7 @@ from .constants import (
     TSD_MIN_MM_PER_TEXEL,
     TSD_TAP_RANGE,
 )
-from .gaussians import fit_gaussians
+from .gaussians import NoEnergy, fit_gaussians
 from .media import Medium
 from .profiles import get_profile
 
@@ -134,8 +134,11 @@ def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
         prof = get_profile(MODEL_PROFILES[model])
         # fit only the scattering channels; the others are identity
         fn = lambda r: prof.evaluate(np.asarray(r, np.float64), medium) * scatter[None, :]
-        fit = fit_gaussians(fn, K)
-        v, w, err = fit.variances_mm2, fit.weights.copy(), np.where(scatter, fit.rel_error, 0.0)
+        try:
+            fit = fit_gaussians(fn, K)
+            v, w, err = fit.variances_mm2, fit.weights.copy(), np.where(scatter, fit.rel_error, 0.0)
+        except NoEnergy:  # the light spreads less than 1e-5 mm in every scattering channel: none scatters
+            v, w, err = np.zeros(0), np.zeros((0, 3)), np.zeros(3)
     w = np.where(scatter[None, :], w, 0.0)
     tot = w.sum(axis=0)
     ok = tot > 0
@@ -413,9 +416,12 @@ def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float = 
     fn = lambda r: np.asarray(prof.evaluate(np.asarray(r, np.float64), medium), np.float64) * scatter[None, :]
     if not scatter.any():
         return 1e-3, np.zeros((n, 3)), np.ones((n, 3))
-    from .gaussians import _energy_radius
+    from .gaussians import NoEnergy, _energy_radius
 
-    r_max = _energy_radius(fn, energy)
+    try:
+        r_max = _energy_radius(fn, energy)
+    except NoEnergy:  # the light spreads less than 1e-5 mm: a delta in every channel
+        return 1e-3, np.zeros((n, 3)), np.ones((n, 3))
     r = np.linspace(0.0, r_max, n)
     # fine quadrature of the cumulative energy (the profile may be singular at 0: Burley ~ 1/r)
     rf = np.concatenate([[0.0], np.geomspace(r_max * 1e-7, r_max, 20000)])
