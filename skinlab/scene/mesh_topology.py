@@ -15,16 +15,25 @@ from dataclasses import dataclass
 
 import numpy as np
 
+SHEET_HOLES = 0.25  # holes this large against the surface's area (a quad: 1, a plane: 1) make a sheet, not a solid
+
 
 @dataclass(frozen=True)
 class EdgeReport:
     edges: int
     open: int  # used by one triangle
     non_manifold: int  # used by three or more
+    hole_area: float = 0.0  # the holes' area (each loop capped flat) over the surface's area
 
     @property
     def closed(self) -> bool:
         return self.open == 0 and self.non_manifold == 0
+
+    @property
+    def sheet(self) -> bool:
+        """Open on purpose: a quad, a ground plane, a leaf (its holes as large as a good part of it),
+        no non-manifold edge."""
+        return self.open > 0 and self.non_manifold == 0 and self.hole_area >= SHEET_HOLES
 
     def describe(self) -> str:
         parts = [
@@ -44,13 +53,13 @@ def _undirected_edges(indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([codes // n, codes % n], axis=1), counts
 
 
-def _welded(positions: np.ndarray, indices: np.ndarray) -> np.ndarray:
-    """Triangle indices with vertices at the same position merged: a UV seam or a hard edge splits
-    vertices, which is no hole."""
+def _welded(positions: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(positions, triangle indices) with vertices at the same position merged: a UV seam or a hard
+    edge splits vertices, which is no hole."""
     p = np.ascontiguousarray(np.asarray(positions, np.float32) + np.float32(0.0))  # -0.0 -> 0.0
     rows = p.view(np.dtype((np.void, 12))).reshape(-1)  # each position's 12 bytes as one sortable key
-    _, inverse = np.unique(rows, return_inverse=True)
-    return inverse.reshape(-1)[np.asarray(indices, np.int64)]
+    _, first, inverse = np.unique(rows, return_index=True, return_inverse=True)
+    return p[first].astype(np.float64), inverse.reshape(-1)[np.asarray(indices, np.int64)]
 
 
 _REPORTS: dict[tuple[int, int], EdgeReport] = {}
@@ -61,17 +70,37 @@ def edge_report(mesh) -> EdgeReport:
     version."""
     key = (mesh.uid, mesh.version)
     if key not in _REPORTS:
-        _, counts = _undirected_edges(_welded(mesh.positions, mesh.indices))
-        _REPORTS[key] = EdgeReport(int(counts.size), int((counts == 1).sum()), int((counts > 2).sum()))
+        p, f = _welded(mesh.positions, mesh.indices)
+        _, counts = _undirected_edges(f)
+        holes = _hole_area(p, f) if (counts == 1).any() else 0.0
+        _REPORTS[key] = EdgeReport(int(counts.size), int((counts == 1).sum()), int((counts > 2).sum()), holes)
         if len(_REPORTS) > 256:
             _REPORTS.pop(next(iter(_REPORTS)))
     return _REPORTS[key]
 
 
+def _hole_area(p: np.ndarray, f: np.ndarray) -> float:
+    """The area of the surface's holes, each boundary loop capped by a fan from its centroid, over
+    the surface's own area (inf where the boundary does not form loops)."""
+    t = p[f]
+    area = 0.5 * float(np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum())
+    try:
+        loops = _boundary_loops(f)
+    except ValueError:
+        return float("inf")
+    holes = 0.0
+    for loop in loops:
+        ring = p[loop]
+        c = ring.mean(axis=0)
+        holes += 0.5 * float(np.linalg.norm(np.cross(ring - c, np.roll(ring, -1, axis=0) - c).sum(axis=0)))
+    return holes / area if area > 0 else float("inf")
+
+
 def open_mesh_warning(mesh, needs: str) -> str | None:
-    """One line for a mesh that is not closed, saying what needs it closed; None for a closed one."""
+    """One line for a mesh that is not closed, saying what needs it closed; None for a closed one
+    and for a sheet (EdgeReport.sheet: a quad is open on purpose)."""
     report = edge_report(mesh)
-    if report.closed:
+    if report.closed or report.sheet:
         return None
     where = f"mesh {mesh.name!r}" + (f" ({mesh.source})" if mesh.source else "")
     return (
@@ -176,9 +205,9 @@ def close_mesh(positions: np.ndarray, indices: np.ndarray, unfold_rounds: int = 
     return p[used], renumber[f]
 
 
-def _fill_holes(p: np.ndarray, f: np.ndarray, big: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every hole filled by a fan around its centroid; ``big`` (a mask of the triangles of fans of
-    holes of BIG_HOLE edges or more) extended to the new triangles."""
+def _boundary_loops(f: np.ndarray) -> list[list[int]]:
+    """The boundary's loops, each in the order a cap must run (against its neighbours' winding);
+    ValueError where an open boundary does not close."""
     directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     present = {tuple(x) for x in directed.tolist()}
     # a boundary edge a->b has no b->a; the fill runs the other way, b->a
@@ -186,8 +215,7 @@ def _fill_holes(p: np.ndarray, f: np.ndarray, big: np.ndarray) -> tuple[np.ndarr
     for a, b in directed.tolist():
         if (b, a) not in present:
             step.setdefault(b, []).append(a)
-    new_p, new_f, big = [p], [f], [big]
-    n = len(p)
+    loops = []
     while step:
         start = next(iter(step))
         loop = [start]
@@ -200,6 +228,16 @@ def _fill_holes(p: np.ndarray, f: np.ndarray, big: np.ndarray) -> tuple[np.ndarr
             loop.append(nxt)
             if nxt not in step:
                 raise ValueError(f"close_mesh: a hole's boundary does not close at vertex {nxt}")
+        loops.append(loop)
+    return loops
+
+
+def _fill_holes(p: np.ndarray, f: np.ndarray, big: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every hole filled by a fan around its centroid; ``big`` (a mask of the triangles of fans of
+    holes of BIG_HOLE edges or more) extended to the new triangles."""
+    new_p, new_f, big = [p], [f], [big]
+    n = len(p)
+    for loop in _boundary_loops(f):
         centre = p[loop].mean(axis=0)
         new_p.append(centre[None])
         new_f.append(np.array([[loop[i], loop[(i + 1) % len(loop)], n] for i in range(len(loop))], np.int64))

@@ -3,6 +3,7 @@ and 150 non-manifold edges and folded triangles: dark specks), and a warning whe
 reads the thickness of an open mesh."""
 
 import numpy as np
+import pytest
 
 from skinlab.render.plan import plan_frame
 from skinlab.render.settings import RenderSettings
@@ -65,17 +66,26 @@ def test_bundled_bunny_is_closed_without_folds_above_its_base():
     assert not mesh.notes  # no normal had to be recomputed
 
 
+def test_a_sheet_is_open_on_purpose():
+    quad = quad_mesh("q", -1, 1, -1, 1)
+    assert edge_report(quad).sheet and open_mesh_warning(quad, "translucency") is None
+    open_box = Mesh("box", CUBE_P, CUBE_F[2:])
+    assert edge_report(open_box).hole_area == pytest.approx(0.2) and not edge_report(open_box).sheet
+
+
 def test_translucency_on_an_open_mesh_warns_once():
-    scene = slab_scene()
-    scene.add(light_from((0.3, 0.0, -1.0), shadow=True))
     settings = RenderSettings(32, 32, shadow_size=64)  # tsd with translucency (its default)
-    plan = plan_frame(scene, settings)
-    warnings = [w for w in plan.warnings if "not closed" in w]
-    assert len(warnings) == 1 and "translucency" in warnings[0] and "'slab'" in warnings[0], plan.warnings
-    closed = slab_scene(mesh=Mesh("cube", CUBE_P, CUBE_F))
-    closed.add(light_from((0.3, 0.0, -1.0), shadow=True))
-    assert not [w for w in plan_frame(closed, settings).warnings if "not closed" in w]
-    # no translucency (no shadow-casting light): nothing reads the thickness, nothing to say
-    assert not [
-        w for w in plan_frame(slab_scene(mesh=quad_mesh("q", -1, 1, -1, 1)), settings).warnings if "closed" in w
-    ]
+
+    def warnings(mesh, shadow=True):
+        scene = slab_scene(mesh=mesh)
+        scene.add(light_from((0.3, 0.0, -1.0), shadow=shadow))
+        return [w for w in plan_frame(scene, settings).warnings if "not closed" in w]
+
+    box = Mesh("box", CUBE_P - 0.5, CUBE_F[2:])  # a cube with one side missing
+    (line,) = warnings(box)
+    assert "translucency" in line and "'box'" in line and "4 open edges" in line
+    assert warnings(Mesh("cube", CUBE_P - 0.5, CUBE_F)) == []
+    assert warnings(quad_mesh("q", -1, 1, -1, 1)) == []  # a sheet
+    # no shadow-casting light, no translucency: nothing reads the thickness, nothing to say
+    scene = slab_scene(mesh=box)
+    assert not [w for w in plan_frame(scene, settings).warnings if "closed" in w]
