@@ -91,15 +91,38 @@ def render_to_files(
         prepare(scene)
     ctx = create_headless_context()
     renderer = Renderer(ctx)
-    renderer.render(scene, settings, readback=False)  # warm-up: compiles and uploads are not frame time
+    # warm-up: compiles and uploads are not frame time
+    render_with_progress(renderer, scene, settings, "warm-up frame", readback=False)
     if not reuse:
         renderer.forget_reuse()  # the timed frame runs every pass
-    result = renderer.render(scene, settings)
+    result = render_with_progress(renderer, scene, settings, "timed frame")
     written = []
     for o in outputs:
         pixels = result.ldr if image_format(o) == "png" else result.hdr
         written.append(str(write_image(o, pixels)))
     return scene, result, written, ctx
+
+
+PROGRESS_AFTER_S = 2.0
+
+
+def render_with_progress(renderer, scene, settings, what: str, readback=True):
+    """Renderer.render, with a progress bar on a terminal's stderr once a frame has taken
+    PROGRESS_AFTER_S (a scene of many scattering meshes runs hundreds of passes); the frame's timings
+    count the passes only, not the bar."""
+    from tqdm import tqdm
+
+    steps = renderer.frame_steps(scene, settings, readback)
+    shown = sys.stderr.isatty()
+    bar = tqdm(desc=what, unit=" passes", delay=PROGRESS_AFTER_S, leave=False, file=sys.stderr, disable=not shown)
+    with bar:
+        while True:
+            try:
+                name = next(steps)
+            except StopIteration as done:
+                return done.value
+            bar.set_postfix_str(name, refresh=False)
+            bar.update()
 
 
 def settings_from_args(args, w: int, h: int) -> RenderSettings:
@@ -146,6 +169,7 @@ def run(args) -> int:
                     "timings": result.timings.as_dict(),
                     "plan": result.plan.as_dict(),
                     "warnings": result.plan.warnings,
+                    "notes": result.plan.notes,
                 },
                 indent=2,
             )
@@ -153,6 +177,8 @@ def run(args) -> int:
     else:
         for path in written:
             print(f"wrote {path}")
+        for note in result.plan.notes:  # what a setting costs this image, and what would change it
+            print(f"note: {note}")
         print(result.timings.table())
         for name in result.plan.reused():
             print(f"  {name}: reused, inputs unchanged since the warm-up frame")

@@ -52,6 +52,9 @@ class FramePlan:
     passes: list[PlannedPass]
     skipped: list[tuple[str, str]] = field(default_factory=list)  # (what, why not)
     warnings: list[str] = field(default_factory=list)
+    # hints a user should see beside the result (the render summary prints them): what a setting costs
+    # the image and what would change it; not problems
+    notes: list[str] = field(default_factory=list)
 
     def names(self) -> list[str]:
         return [p.name for p in self.passes]
@@ -71,6 +74,8 @@ class FramePlan:
             lines.append(f"  {i}. {p.name:<18} -> {p.target} {p.resolution[0]}x{p.resolution[1]}: {why}")
         for what, why in self.skipped:
             lines.append(f"  -  {what:<18} skipped: {why}")
+        for n in self.notes:
+            lines.append(f"  *  note: {n}")
         for w in self.warnings if warnings else ():
             lines.append(f"  !  warning: {w}")
         return "\n".join(lines)
@@ -90,4 +95,5 @@ class FramePlan:
             ],
             "skipped": [{"what": w, "why": y} for w, y in self.skipped],
             "warnings": list(self.warnings),
+            "notes": list(self.notes),
         }

@@ -260,7 +260,8 @@ def test_the_record_is_filled_wherever_a_fragment_can_read_it(renderer):
     the gather's nearest lookup inside a chart can read, which the fill's border strips must cover -
     and such texels exist that the irradiance pass itself left empty."""
     scene = load_scene("reference/slab-thin-backlit-skin1")
-    renderer.render(scene, RenderSettings(48, 48), readback=False)
+    # the full 512 texels (a 48-pixel frame would fit the texture space to the slab's pixels)
+    renderer.render(scene, RenderSettings.for_technique("tsd", 48, 48, fit_size=False), readback=False)
     node = scene.mesh_nodes()[0]
     t = frame_nodes(renderer.last_frame)[node.uid].targets
     raw = read_texture(t.raw)

@@ -39,7 +39,20 @@ class TsdSettings(TechniqueSettings):
     # defaults from the accuracy/time ledger (docs/ledger.md): the cheapest setting within 1 % image
     # error of the exact reference on the head and the bunny
     technique = "tsd"
-    size: int = option(512, "irradiance texels per side", "int", range=(16, 8192), unit="texels", flags=("--tsd-size",))
+    size: int = option(
+        512,
+        "irradiance texels per side (with fit_size: the most a mesh gets)",
+        "int",
+        range=(16, 8192),
+        unit="texels",
+        flags=("--tsd-size",),
+    )
+    fit_size: bool = option(
+        True,
+        "size each mesh's texture space from its area and its size on screen, 2 texels a pixel, at most `size` "
+        "(off: every mesh gets `size`)",
+        "bool",
+    )
     gaussians: int = option(
         6, "K: Gaussians fitted to the diffusion profile", "int", range=(1, 6), flags=("--gaussians",)
     )
@@ -86,7 +99,7 @@ class TsdTechnique(Technique):
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options
         passes, nodes, translucency, local = plan_tsd(
-            ctx, o.size, o.gaussians, o.taps, o.albedo_mix, o.translucency, seams=o.seams
+            ctx, o.size, o.gaussians, o.taps, o.albedo_mix, o.translucency, seams=o.seams, fit_size=o.fit_size
         )
         return TechniquePlan(
             TsdForward(len(nodes), local, translucency=translucency),

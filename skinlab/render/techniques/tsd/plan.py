@@ -23,6 +23,8 @@ from skinlab.scene.mesh import with_atlas
 from skinlab.scene.mesh_thickness import thinner_than
 from skinlab.scene.optics.translucency_reach import REACH_EPS, translucency_reach_mm
 from skinlab.scene.optics.tsd import (
+    NEGLIGIBLE_WEIGHT,
+    TSD_SUBTEXEL_SIGMA,
     BlurStep,
     DiffusionKernel,
     design_kernel,
@@ -35,6 +37,15 @@ from skinlab.scene.uv_checks import analyse_uvs
 from .seams import node_seams, seam_band_texels, seams_summary
 
 DILATE_RINGS = 4  # texels of dilation past chart borders (irradiance and stretch)
+
+# A mesh's texture space is sized from its surface and its size on screen: this many texels per
+# screen pixel, along a line, where the mesh comes nearest the camera (the whole surface counted, the
+# back too, over the part of the UV square its charts cover), rounded up to a power of two, at least
+# FITTED_MIN and at most the `size` setting (TsdSettings.fit_size). The head in a 96-pixel frame gets
+# 512 texels, in a 48-pixel one 256; a quad 8 pixels wide gets 32, not 512: 80 of them cost about
+# what their pixels cost.
+TEXELS_PER_PIXEL = 2.0
+FITTED_MIN = 32
 
 
 def model_scale(world: np.ndarray) -> float:
@@ -49,12 +60,112 @@ def uv_report(node, mm_per_unit: float, size: int):
     key = (mesh.uid, mesh.version, float(mm_per_unit), round(model_scale(node.world_matrix), 9), size)
     r = _UV_CACHE.get(key)
     if r is None:
-        if len(_UV_CACHE) > 64:
-            _UV_CACHE.clear()
+        if len(_UV_CACHE) > 512:  # a scene of hundreds of parts keeps them all from frame to frame
+            _UV_CACHE.pop(next(iter(_UV_CACHE)))
         r = _UV_CACHE[key] = analyse_uvs(
-            mesh, mm_per_unit, texels=size, grid=512, model_scale=model_scale(node.world_matrix)
+            mesh, mm_per_unit, texels=size, grid=min(512, size), model_scale=model_scale(node.world_matrix)
         )
     return r
+
+
+_SURFACE: dict = {}
+
+
+def _surface(mesh) -> tuple[float, float]:
+    """(surface area in the mesh's units squared, fraction of the UV square its triangles cover),
+    once per mesh version."""
+    key = (mesh.uid, mesh.version)
+    if key not in _SURFACE:
+        f = mesh.indices.astype(np.int64)
+        p = mesh.positions.astype(np.float64)
+        area = 0.5 * float(np.linalg.norm(np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]), axis=1).sum())
+        cover = 1.0
+        if mesh.uvs is not None:
+            t = mesh.uvs.astype(np.float64)[f]
+            d1, d2 = t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]
+            cover = float(np.nansum(0.5 * np.abs(d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0])))
+        if len(_SURFACE) > 512:
+            _SURFACE.clear()
+        _SURFACE[key] = (area, min(max(cover, 0.05), 1.0))
+    return _SURFACE[key]
+
+
+def pixels_per_unit(node, scene, settings) -> float | None:
+    """Screen pixels per scene unit where the node's bounds come nearest the camera (None: no
+    camera, or the node is behind it)."""
+    cam = scene.camera
+    if cam is None:
+        return None
+    world = np.asarray(node.world_matrix, np.float64)
+    view = np.asarray(cam.view_matrix(), np.float64)
+    corners = node.mesh.bound_corners() @ world[:3, :3].T + world[:3, 3]
+    depth = -(corners @ view[:3, :3].T + view[:3, 3])[:, 2]  # distance in front of the camera
+    if depth.max() <= 0:
+        return None
+    nearest = max(float(depth.min()), cam.znear)
+    return settings.render_size[1] / (2.0 * nearest * math.tan(cam.yfov / 2.0))
+
+
+def fitted_size(node, scene, settings, size: int) -> tuple[int, str]:
+    """Texels per side for the node's texture space (see TEXELS_PER_PIXEL) and a reason for the plan."""
+    if scene.camera is None:
+        return size, ""
+    ppu = pixels_per_unit(node, scene, settings)
+    if ppu is None:
+        return min(FITTED_MIN, size), "behind the camera"
+    area, cover = _surface(node.mesh)
+    area_world = area * model_scale(np.asarray(node.world_matrix, np.float64)) ** 2
+    side = math.sqrt(area_world / cover) * ppu * TEXELS_PER_PIXEL
+    if not math.isfinite(side):
+        return size, ""
+    fitted = max(1 << max(int(math.ceil(math.log2(max(side, 1.0)))), 0), FITTED_MIN)
+    if fitted >= size:
+        return size, ""
+    return fitted, (
+        f"{fitted} texels a side, from the mesh's ~{side / TEXELS_PER_PIXEL:.0f} pixels on screen at "
+        f"{TEXELS_PER_PIXEL:g} texels a pixel; the size setting, {size}, is the most"
+    )
+
+
+CHANNELS = ("red", "green", "blue")
+MAX_SIZE = 8192  # TsdSettings.size's range
+
+
+def subtexel_note(mesh_name: str, fit, p50: float, size: int, mm_per_pixel: float) -> str | None:
+    """A note for the render summary when the Gaussians narrower than a texel (folded into the
+    unblurred term) carry most of some channel's light: the texels per side that would blur at least
+    half of it in every such channel, or that it would hardly show (they are narrower than half a
+    pixel on screen too). None when no channel loses most of its blur."""
+    sigma = np.sqrt(np.maximum(np.asarray(fit.variances_mm2, np.float64), 0.0))
+    w = np.asarray(fit.weights, np.float64).reshape(len(sigma), 3)
+    used = w.max(axis=1) >= NEGLIGIBLE_WEIGHT
+    sub = used & (sigma / p50 < TSD_SUBTEXEL_SIGMA)
+    total = w[used].sum(axis=0)
+    lost = np.where(total > 0, w[sub].sum(axis=0) / np.where(total > 0, total, 1.0), 0.0)
+    channels = [c for c in range(3) if lost[c] > 0.5]
+    if not channels:
+        return None
+    names = [CHANNELS[c] for c in channels]
+    names = ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
+    head = (
+        f"mesh {mesh_name!r}: {int(sub.sum())} of {int(used.sum())} Gaussians of the profile are narrower than a "
+        f"texel ({p50:.2g} mm at {size} texels a side) and not blurred, so most {names} light leaves where it "
+        "entered"
+    )
+    visible = sub & (sigma >= 0.5 * mm_per_pixel)  # the ones a blur would show at this image's pixel size
+    if not visible.any():
+        return (
+            head
+            + f"; they are narrower than half a pixel here too ({mm_per_pixel:.2g} mm): more texels would hardly show"
+        )
+    need = float(sigma[visible].min())
+    side = 1 << int(math.ceil(math.log2(max(size * p50 * TSD_SUBTEXEL_SIGMA / max(need, 1e-12), 1.0))))
+    which = f"the {int(visible.sum())} of them wider than half a pixel ({mm_per_pixel:.2g} mm) here"
+    if side > MAX_SIZE:
+        return (
+            head + f"; blurring {which} would take {side} texels a side, more than the {MAX_SIZE} a texture space takes"
+        )
+    return head + f"; {side} texels a side would blur {which} (--tsd-size {side})"
 
 
 @dataclass
@@ -65,6 +176,7 @@ class TsdNodePlan:
     size: int
     seams: object = None  # the mesh's SeamExtension (skinlab/scene/uv_seams.py), None: no seams or switched off
     seam_band: int = 0  # texels the extension reaches past each seam
+    size_note: str = ""  # why the texture space is smaller than the size setting (fitted_size)
 
 
 # -- the passes' typed parameters ----------------------------------------------------------------------
@@ -106,15 +218,25 @@ UNIT_KERNEL = DiffusionKernel((BlurStep(0, 0.0, 0.0, 0, (1.0, 1.0, 1.0)),), np.z
 
 
 def plan_tsd_node(
-    node, ctx, size: int, gaussians: int, taps: int | None, seams: bool = True, local: dict | None = None
+    node,
+    ctx,
+    size: int,
+    gaussians: int,
+    taps: int | None,
+    seams: bool = True,
+    local: dict | None = None,
+    fit_size: bool = False,
 ) -> TsdNodePlan | None:
     """Decide TSD for one visible mesh node (PlanContext `ctx`); record skips and warnings in its plan.
-    A scattering node whose profile is narrower than a texel goes into `local` (uid -> material)."""
+    A scattering node whose profile is narrower than a texel goes into `local` (uid -> material).
+    The node's texture space is `size` texels per side, or with `fit_size` fewer for a mesh small on
+    screen (:func:`fitted_size`)."""
     label = f"tsd[{node.name}]"
     plan, scene = ctx.plan, ctx.scene
     mat = scattering_material(node, ctx.settings, plan, label)
     if mat is None:
         return None
+    size, size_note = fitted_size(node, scene, ctx.settings, size) if fit_size else (size, "")
     mesh = node.mesh
     if mesh.uvs is None:
         plan.warnings.append(
@@ -140,6 +262,11 @@ def plan_tsd_node(
         return None
     fit = profile_fit(mat["sss_model"], material_medium(mat.values), gaussians)
     kernel = design_kernel(fit, max(p10, 1e-9), p50, taps=taps)
+    ppu = pixels_per_unit(node, scene, ctx.settings)
+    mm_per_pixel = scene.mm_per_unit / ppu if ppu else math.inf
+    note = subtexel_note(mesh.name, fit, p50, size, mm_per_pixel)
+    if note and note not in plan.notes:
+        plan.notes.append(note)
     for what, why in kernel.skipped:
         plan.skipped.append((f"{label} {what}", why))
     if kernel.levels == 0:
@@ -151,12 +278,12 @@ def plan_tsd_node(
         return None
     if not seams:
         plan.skipped.append((f"tsd_seams[{node.name}]", "switched off in the settings: blurs stop at UV seams"))
-        return TsdNodePlan(node, mat, kernel, size)
+        return TsdNodePlan(node, mat, kernel, size, size_note=size_note)
     band = seam_band_texels(kernel, p10)
     ext = node_seams(mesh, band, size)
     if ext is None:
         plan.skipped.append((f"tsd_seams[{node.name}]", f"mesh {mesh.name!r} has no UV seam"))
-    return TsdNodePlan(node, mat, kernel, size, ext, band)
+    return TsdNodePlan(node, mat, kernel, size, ext, band, size_note)
 
 
 def plan_tsd(
@@ -168,6 +295,7 @@ def plan_tsd(
     translucency: bool,
     exact: bool = False,
     seams: bool = True,
+    fit_size: bool = False,
 ):
     """The texture-space passes of every scattering mesh (stretch, the seam map where the mesh has
     UV seams and `seams` is on, irradiance, dilation, then the Gaussian blurs, or with `exact` the
@@ -176,7 +304,9 @@ def plan_tsd(
     plan = ctx.plan
     local: dict = {}
     nodes = [
-        t for t in (plan_tsd_node(n, ctx, size, gaussians, taps, seams, local) for n in ctx.meshes) if t is not None
+        t
+        for t in (plan_tsd_node(n, ctx, size, gaussians, taps, seams, local, fit_size) for n in ctx.meshes)
+        if t is not None
     ]
     use_translucency = plan_translucency(ctx, bool(nodes), translucency)
     if not nodes and not local:
@@ -287,6 +417,7 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
             "tsd_irradiance",
             res,
             f"material '{t.material.name}' scatters ({t.material['sss_model']}): light entering the surface in UV space"
+            + (f"; {t.size_note}" if t.size_note else "")
             + (
                 ", translucency through thin parts (its record's gutter filled "
                 + ("across UV seams and " if t.seams is not None else "")
