@@ -1,14 +1,28 @@
-"""`skinlab mc --albedo A --eta ETA --incidence diffuse|normal --photons N [--g G] [--seed S] --json`:
-Monte Carlo reference profile of a semi-infinite medium in mean-free-path units."""
+"""`skinlab mc (--single-albedo A [--eta ETA] | --preset NAME) --incidence diffuse|normal --photons N [--g G]
+[--seed S] --json`: Monte Carlo reference profile of a semi-infinite medium in mean-free-path units.
+
+One name, one meaning, in every command: ``--single-albedo`` is the single-scattering albedo
+sigma_s / sigma_t (what a random walk takes), ``skinlab profile --surface-albedo`` the surface albedo
+(the colour seen from afar, a scene's subsurface_color). A bare ``--albedo`` is refused with both
+names."""
 
 from __future__ import annotations
 
+import argparse
 import json
 import os
 
 import numpy as np
 
+from skinlab.commands import refused_option
+
 UNITS = "r in mean free paths 1/sigma_t; R(r) in 1/mfp^2 (per unit area) per photon entering"
+
+
+ALBEDO = (
+    "say which albedo: --single-albedo A (sigma_s/sigma_t, what the random walk takes) or "
+    "--preset NAME; the surface albedo (the colour seen from afar) is skinlab profile --surface-albedo"
+)  # one meaning per name: two albedos, two names
 
 
 def register(sub) -> None:
@@ -18,8 +32,26 @@ def register(sub) -> None:
         description="Random walk in a semi-infinite homogeneous medium (the ground truth for the "
         f"diffusion profiles). Units: {UNITS}; multiply r by the mean free path in mm to get mm.",
     )
-    p.add_argument("--albedo", type=float, required=True, help="single-scattering albedo sigma_s/sigma_t in [0, 1]")
-    p.add_argument("--eta", type=float, default=1.3, help="relative index of refraction, medium/outside (default 1.3)")
+    src = p.add_mutually_exclusive_group(required=True)
+    src.add_argument(
+        "--single-albedo",
+        type=float,
+        metavar="A",
+        help="single-scattering albedo sigma_s/sigma_t in [0, 1] (not the surface albedo: skinlab profile "
+        "--surface-albedo)",
+    )
+    src.add_argument(
+        "--preset",
+        help="a Jensen 2001 Table 1 medium (e.g. skin1, marble): one walk per channel, R, G and B, each with that "
+        "channel's single-scattering albedo, at the preset's index (unless --eta)",
+    )
+    src.add_argument("--albedo", action=refused_option(ALBEDO), help=argparse.SUPPRESS)
+    p.add_argument(
+        "--eta",
+        type=float,
+        default=None,
+        help="relative index of refraction, medium/outside (default 1.3, or the preset's)",
+    )
     p.add_argument(
         "--incidence",
         choices=("normal", "diffuse"),
@@ -60,18 +92,51 @@ def run(args) -> int:
     if not np.isfinite(args.photons) or args.photons != int(args.photons) or args.photons < 2:
         raise ValueError(f"--photons: expected an integer >= 2, got {args.photons!r}")
     workers = args.workers or (os.cpu_count() or 1)
-    res = simulate(
-        args.albedo,
-        args.eta,
-        args.g,
-        args.incidence,
-        int(args.photons),
-        args.seed,
-        max_steps=args.max_steps,
-        entry_fresnel=args.entry_fresnel,
-        progress=not args.no_progress,
-        workers=workers,
-    )
+
+    def walk(albedo, eta):
+        return simulate(
+            albedo,
+            eta,
+            args.g,
+            args.incidence,
+            int(args.photons),
+            args.seed,
+            max_steps=args.max_steps,
+            entry_fresnel=args.entry_fresnel,
+            progress=not args.no_progress,
+            workers=workers,
+        )
+
+    if args.preset is not None:
+        return _run_preset(args, walk)
+    res = walk(args.single_albedo, 1.3 if args.eta is None else args.eta)
+    if args.json:
+        print(json.dumps(_result(res)))
+        return 0
+    _print_result(res)
+    return 0
+
+
+def _run_preset(args, walk) -> int:
+    """One walk per channel of a preset medium; r also in mm (each channel's mean free path)."""
+    from skinlab.scene.optics.media import preset
+
+    m = preset(args.preset)
+    eta = m.eta if args.eta is None else args.eta
+    channels = []
+    for c, name in enumerate("RGB"):
+        res = walk(m.alpha[c], eta)
+        channels.append({"channel": name, "mfp_mm": m.mfp_mm[c], **_result(res)})
+        if not args.json:
+            print(f"channel {name} of {m.name}: mean free path {m.mfp_mm[c]:.4g} mm (multiply r by it for mm)")
+            _print_result(res)
+            print()
+    if args.json:
+        print(json.dumps({"units": UNITS, "preset": m.name, "eta": eta, "channels": channels}))
+    return 0
+
+
+def _result(res) -> dict:
     out = {
         "units": UNITS,
         "params": res.params,
@@ -84,12 +149,14 @@ def run(args) -> int:
         "total_se": res.total_se,
         "capped": res.capped,
     }
-    if args.json:
-        print(json.dumps(out))
-        return 0
+    return out
+
+
+def _print_result(res) -> None:
     pr = res.params
     print(
-        f"Monte Carlo: albedo {pr['albedo']:g}, eta {pr['eta']:g}, g {pr['g']:g}, {pr['incidence']} incidence, "
+        f"Monte Carlo: single-scattering albedo {pr['albedo']:g}, eta {pr['eta']:g}, g {pr['g']:g}, "
+        f"{pr['incidence']} incidence, "
         f"{res.photons:.4g} photons, seed {pr['seed']}, max {pr['max_steps']} collisions per walk"
         + (", weighted by entry transmittance" if pr["entry_fresnel"] else "")
     )
@@ -108,4 +175,3 @@ def run(args) -> int:
             f"(no photon left beyond r = {res.r_edges[last]:.4g} mfp: the {len(res.R) - last} outer bins up to "
             f"{res.r_edges[-1]:.4g} mfp are zero and not listed; --json has them)"
         )
-    return 0

@@ -1,15 +1,19 @@
-"""`skinlab profile MODEL [--preset NAME | --albedo R,G,B --mfp R,G,B] [--r LIST] [--json] [--plot PATH]`:
+"""`skinlab profile MODEL [--preset NAME | --surface-albedo R,G,B --mfp R,G,B] [--r LIST] [--json] [--plot PATH]`:
 evaluate a diffusion profile (skinlab/scene/optics/profiles.py) for a medium; optionally plot every model
-against the Monte Carlo reference."""
+against the Monte Carlo reference. ``--surface-albedo`` is the colour seen from afar (a scene's
+subsurface_color); ``skinlab mc --single-albedo`` the single-scattering albedo: a bare ``--albedo`` is
+refused with both names."""
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
 import numpy as np
 
 from skinlab.atomic_write import atomic_path
+from skinlab.commands import refused_option
 
 MAX_LENGTH_MM = 1e6  # a kilometre of mean free path: beyond it the profiles underflow to nothing
 DEFAULT_R = "0,0.01,0.02,0.05,0.1,0.2,0.5,1,2,5,10"
@@ -39,6 +43,12 @@ def _radii(text: str):
     return r
 
 
+ALBEDO = (
+    "say which albedo: --surface-albedo R,G,B (the colour seen from afar, a scene's "
+    "subsurface_color); the single-scattering albedo is skinlab mc --single-albedo"
+)  # one meaning per name: two albedos, two names
+
+
 def register(sub) -> None:
     from skinlab.scene.optics.profiles import profile_names
 
@@ -47,14 +57,17 @@ def register(sub) -> None:
     src = p.add_mutually_exclusive_group()
     src.add_argument("--preset", help="Jensen 2001 Table 1 material (e.g. skin1, marble)")
     src.add_argument(
-        "--albedo",
-        help="surface albedo (total diffuse reflectance, the colour seen from afar) R,G,B in [0, 1]; "
-        "needs --mfp or --radius",
+        "--surface-albedo",
+        dest="albedo",
+        metavar="R,G,B",
+        help="surface albedo (total diffuse reflectance, the colour seen from afar: a scene's subsurface_color) "
+        "R,G,B in [0, 1]; needs --mfp or --radius. Not the single-scattering albedo (skinlab mc --single-albedo)",
     )
-    p.add_argument("--mfp", help="mean free path l = 1/sigma_t' in mm, R,G,B (with --albedo)")
+    src.add_argument("--albedo", action=refused_option(ALBEDO), help=argparse.SUPPRESS)
+    p.add_argument("--mfp", help="mean free path l = 1/sigma_t' in mm, R,G,B (with --surface-albedo)")
     p.add_argument(
         "--radius",
-        help="artist radius R = 4 pi l in mm, R,G,B (with --albedo): the scene files' subsurface_radius "
+        help="artist radius R = 4 pi l in mm, R,G,B (with --surface-albedo): the scene files' subsurface_radius "
         "and Blender's Subsurface Radius x Scale",
     )
     p.add_argument(
@@ -64,7 +77,7 @@ def register(sub) -> None:
         "--albedo-method",
         choices=("pbd", "dipole", "cycles"),
         default="pbd",
-        help="how --albedo is inverted to the single-scattering albedo (default pbd)",
+        help="how --surface-albedo is inverted to the single-scattering albedo (default pbd)",
     )
     p.add_argument("--r", default=DEFAULT_R, help=f"radii in mm (default {DEFAULT_R})")
     p.add_argument("--json", action="store_true", help="print JSON")
@@ -84,14 +97,14 @@ def medium_from_args(args):
 
     if args.albedo is not None:
         if (args.mfp is None) == (args.radius is None):
-            raise ValueError("mfp: --albedo needs exactly one of --mfp or --radius (mm)")
+            raise ValueError("mfp: --surface-albedo needs exactly one of --mfp or --radius (mm)")
         eta = 1.3 if args.eta is None else args.eta
         A = _triple(args.albedo, "albedo")
         if args.mfp is not None:
             return Medium.from_surface_albedo(A, _triple(args.mfp, "mfp"), eta, args.albedo_method, "custom")
         return Medium.from_artist_radius(A, _triple(args.radius, "radius"), eta, args.albedo_method, "custom")
     if args.mfp is not None or args.radius is not None:
-        raise ValueError("albedo: --mfp/--radius need --albedo R,G,B")
+        raise ValueError("albedo: --mfp/--radius need --surface-albedo R,G,B")
     m = preset(args.preset or "skin1")
     if args.eta is not None:
         from skinlab.scene.optics.media import Medium as M

@@ -76,7 +76,7 @@ _BLENDER_ROWS = (
 
 _BLENDER_AFTER = """\
 Both use the same radius convention: the artist radius R is 4 pi times the mean free path l, and the
-colour is the surface albedo, the reflectance seen from afar (`skinlab profile --albedo A --radius R`
+colour is the surface albedo, the reflectance seen from afar (`skinlab profile --surface-albedo A --radius R`
 shows the profile a pair gives). A scene file's `preset = "skin1"` takes both from Jensen et al. 2001's
 measurements.
 """

@@ -137,16 +137,16 @@ CASES = [
     ),
     ("exposure", {}, ["render", "--out", "{tmp}/x.png", "--exposure", "-1"], ["--exposure"]),
     ("camera-orbit", {}, ["render", "--out", "{tmp}/x.png", "--camera-orbit", "nan"], ["orbit"]),
-    ("mc-photons-huge", {}, ["mc", "--albedo", "0.5", "--photons", "1e30"], ["photons"]),
-    ("mc-photons-inf", {}, ["mc", "--albedo", "0.5", "--photons", "inf"], ["--photons"]),
-    ("mc-max-steps", {}, ["mc", "--albedo", "0.5", "--max-steps", "0"], ["--max-steps"]),
-    ("mc-max-steps-negative", {}, ["mc", "--albedo", "0.5", "--max-steps", "-3"], ["--max-steps"]),
-    ("mc-workers", {}, ["mc", "--albedo", "0.5", "--workers", "-1"], ["--workers"]),
-    ("mc-albedo", {}, ["mc", "--albedo", "1.5"], ["albedo"]),
-    ("mc-seed", {}, ["mc", "--albedo", "0.5", "--seed", "-1"], ["--seed"]),
+    ("mc-photons-huge", {}, ["mc", "--single-albedo", "0.5", "--photons", "1e30"], ["photons"]),
+    ("mc-photons-inf", {}, ["mc", "--single-albedo", "0.5", "--photons", "inf"], ["--photons"]),
+    ("mc-max-steps", {}, ["mc", "--single-albedo", "0.5", "--max-steps", "0"], ["--max-steps"]),
+    ("mc-max-steps-negative", {}, ["mc", "--single-albedo", "0.5", "--max-steps", "-3"], ["--max-steps"]),
+    ("mc-workers", {}, ["mc", "--single-albedo", "0.5", "--workers", "-1"], ["--workers"]),
+    ("mc-albedo", {}, ["mc", "--single-albedo", "1.5"], ["albedo"]),
+    ("mc-seed", {}, ["mc", "--single-albedo", "0.5", "--seed", "-1"], ["--seed"]),
     ("profile-seed", {}, ["profile", "burley", "--seed", "-1"], ["--seed"]),
-    ("profile-mfp-huge", {}, ["profile", "all", "--albedo", "0.5", "--mfp", "1e300"], ["mfp", "mm"]),
-    ("profile-needs-mfp", {}, ["profile", "burley", "--albedo", "0.5"], ["--mfp", "--radius"]),
+    ("profile-mfp-huge", {}, ["profile", "all", "--surface-albedo", "0.5", "--mfp", "1e300"], ["mfp", "mm"]),
+    ("profile-needs-mfp", {}, ["profile", "burley", "--surface-albedo", "0.5"], ["--mfp", "--radius"]),
     ("profile-radii", {}, ["profile", "burley", "--r", "-1"], ["r:", "mm"]),
     ("profile-preset", {}, ["profile", "burley", "--preset", "cheese"], ["cheese"]),
     ("profile-plot-ext", {}, ["profile", "burley", "--plot", "{tmp}/p.jpg"], ["--plot", "p.jpg"]),
@@ -239,5 +239,5 @@ def test_ctrl_c_is_one_line_not_a_traceback(monkeypatch, capsys):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(mc, "run", interrupted)
-    assert main(["mc", "--albedo", "0.5"]) == 130
+    assert main(["mc", "--single-albedo", "0.5"]) == 130
     assert capsys.readouterr().err == "skinlab mc: interrupted\n"

@@ -24,11 +24,11 @@ def test_profile_json_preset(capsys):
 
 
 def test_profile_albedo_mfp_round_trips_colour(capsys):
-    rc, out, _ = run(capsys, "profile", "burley", "--albedo", "0.8,0.5,0.3", "--mfp", "1,0.5,0.2", "--json")
+    rc, out, _ = run(capsys, "profile", "burley", "--surface-albedo", "0.8,0.5,0.3", "--mfp", "1,0.5,0.2", "--json")
     d = json.loads(out)
     assert rc == 0 and np.allclose(d["total"], [0.8, 0.5, 0.3], atol=1e-3)
     assert np.allclose(d["medium"]["surface_albedo"], [0.8, 0.5, 0.3], atol=1e-3)
-    rc, out, _ = run(capsys, "profile", "all", "--albedo", "0.5", "--radius", "3", "--r", "1", "--json")
+    rc, out, _ = run(capsys, "profile", "all", "--surface-albedo", "0.5", "--radius", "3", "--r", "1", "--json")
     assert rc == 0 and set(json.loads(out)["models"]) >= {
         "dipole",
         "burley",
@@ -42,14 +42,14 @@ def test_profile_albedo_mfp_round_trips_colour(capsys):
 @pytest.mark.parametrize(
     "argv,word",
     [
-        (["profile", "pbd", "--albedo", "1.5,0.5,0.5", "--mfp", "1"], "albedo"),
-        (["profile", "pbd", "--albedo", "0.5", "--mfp", "-1"], "mfp"),
-        (["profile", "pbd", "--albedo", "0.5"], "mfp"),
+        (["profile", "pbd", "--surface-albedo", "1.5,0.5,0.5", "--mfp", "1"], "albedo"),
+        (["profile", "pbd", "--surface-albedo", "0.5", "--mfp", "-1"], "mfp"),
+        (["profile", "pbd", "--surface-albedo", "0.5"], "mfp"),
         (["profile", "pbd", "--preset", "jade"], "preset"),
         (["profile", "pbd", "--preset", "skin1", "--eta", "0"], "eta"),
         (["profile", "pbd", "--preset", "skin1", "--r", "1,-2"], "r"),
-        (["mc", "--albedo", "2", "--photons", "100"], "albedo"),
-        (["mc", "--albedo", "0.5", "--eta", "-1", "--photons", "100"], "eta"),
+        (["mc", "--single-albedo", "2", "--photons", "100"], "albedo"),
+        (["mc", "--single-albedo", "0.5", "--eta", "-1", "--photons", "100"], "eta"),
     ],
 )
 def test_bad_input_is_one_line_exit_2(capsys, argv, word):
@@ -61,7 +61,7 @@ def test_mc_json(capsys):
     rc, out, _ = run(
         capsys,
         "mc",
-        "--albedo",
+        "--single-albedo",
         "0.9",
         "--eta",
         "1.3",
@@ -88,17 +88,21 @@ def test_profile_plot(tmp_path, capsys):
 
 
 def test_mc_table_has_units_echoes_its_parameters_and_omits_empty_outer_bins(capsys):
-    rc, out, _ = run(capsys, "mc", "--albedo", "0.5", "--photons", "3000", "--seed", "2", "--no-progress")
+    rc, out, _ = run(capsys, "mc", "--single-albedo", "0.5", "--photons", "3000", "--seed", "2", "--no-progress")
     assert rc == 0
     lines = out.splitlines()
-    assert lines[0].startswith("Monte Carlo: albedo 0.5, eta 1.3, g 0, normal incidence, 3000 photons, seed 2")
+    assert lines[0].startswith(
+        "Monte Carlo: single-scattering albedo 0.5, eta 1.3, g 0, normal incidence, 3000 photons, seed 2"
+    )
     assert "mean free paths" in out and "R(r) (1/mfp^2)" in out
     rows = [l.split() for l in lines if l[:1] == " " and l.split()[0][0].isdigit()]
     values = np.array([[float(x) for x in r] for r in rows])
     assert values[-1, 2] > 0  # the last row listed is not a zero row
     assert "outer bins" in lines[-1] and "are zero and not listed" in lines[-1]
     # the rows are the bins' edges and agree with the JSON
-    rc, js, _ = run(capsys, "mc", "--albedo", "0.5", "--photons", "3000", "--seed", "2", "--no-progress", "--json")
+    rc, js, _ = run(
+        capsys, "mc", "--single-albedo", "0.5", "--photons", "3000", "--seed", "2", "--no-progress", "--json"
+    )
     d = json.loads(js)
     n = len(values)
     assert np.allclose(values[:, 0], d["r_edges"][:n], rtol=1e-3) and np.allclose(values[:, 2], d["R"][:n], rtol=1e-5)
@@ -106,7 +110,7 @@ def test_mc_table_has_units_echoes_its_parameters_and_omits_empty_outer_bins(cap
 
 
 def test_profile_json_is_strict_with_null_and_a_reason(capsys):
-    rc, out, _ = run(capsys, "profile", "all", "--albedo", "0.5", "--mfp", "0", "--json")
+    rc, out, _ = run(capsys, "profile", "all", "--surface-albedo", "0.5", "--mfp", "0", "--json")
     assert rc == 0 and "Infinity" not in out and "NaN" not in out
 
     def refuse(token):
@@ -126,3 +130,32 @@ def test_profile_text_explains_none_and_the_burley_singularity(capsys):
     assert "note: no subsurface transport" in blocks["none"] and "surface albedo" in blocks["none"]
     assert "note: R(r) diverges like 1/r at r = 0" in blocks["burley"]
     assert "note" not in blocks["dipole"]
+
+
+def test_one_meaning_per_albedo_name(capsys):
+    """`--albedo` meant the single-scattering albedo in mc and the surface albedo in profile: now each
+    has its own name, and the bare name is refused naming both."""
+    for argv in (["mc", "--albedo", "0.5"], ["profile", "burley", "--albedo", "0.5", "--mfp", "1"]):
+        with pytest.raises(SystemExit) as usage:  # a usage error, as argparse's own
+            main(argv)
+        rc, err = usage.value.code, capsys.readouterr().err
+        assert rc == 2 and err.count("\n") == 1 and "--single-albedo" in err and "--surface-albedo" in err, err
+    rc, out, _ = run(capsys, "profile", "burley", "--surface-albedo", "0.5", "--mfp", "1", "--r", "1", "--json")
+    assert rc == 0 and json.loads(out)["medium"]["name"] == "custom"
+
+
+def test_mc_takes_a_preset_one_walk_per_channel(capsys):
+    rc, out, _ = run(
+        capsys, "mc", "--preset", "skin1", "--photons", "2000", "--no-progress", "--workers", "1", "--json"
+    )
+    d = json.loads(out)
+    assert rc == 0 and d["preset"] == "skin1" and [c["channel"] for c in d["channels"]] == ["R", "G", "B"]
+    from skinlab.scene.optics.media import preset
+
+    skin = preset("skin1")
+    assert [c["params"]["albedo"] for c in d["channels"]] == pytest.approx(list(skin.alpha))
+    assert [c["mfp_mm"] for c in d["channels"]] == pytest.approx(list(skin.mfp_mm))
+    totals = [c["total"] for c in d["channels"]]
+    assert totals[0] > totals[1] > totals[2] > 0  # skin: red reflects most
+    rc, out, _ = run(capsys, "mc", "--preset", "skin1", "--photons", "2000", "--no-progress", "--workers", "1")
+    assert rc == 0 and out.count("Monte Carlo: single-scattering albedo") == 3 and "channel B of skin1" in out
