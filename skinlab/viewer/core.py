@@ -26,7 +26,7 @@ from skinlab.render.settings import RenderSettings
 from skinlab.scene.materials import SSS_MODELS
 
 from .camera import OrbitCamera
-from .inspector import FINAL, Inspector, fit_viewport
+from .inspector import FINAL, Inspector, display_mode, fit_viewport, texel_at
 from .panel import PanelModel
 from .watch import preset_reloader, scene_reloader
 
@@ -317,6 +317,19 @@ class ViewerCore:
         targets = self.targets()
         name = self.inspector.resolve(targets)
         return (name, targets[name]) if name is not None else (None, None)
+
+    def readout(self, x: float, y: float, size: tuple[int, int]):
+        """What the inspected target holds under window point (x, y from the bottom, framebuffer
+        pixels) of a window of ``size``: (target, column, row from the top, raw values), or None off
+        the target (the panel's pixel read-out)."""
+        name, tex = self.current_target()
+        if tex is None or display_mode(tex) is None:
+            return None
+        where = texel_at(fit_viewport(tex.size, size), tex.size, x, y)
+        if where is None:
+            return None
+        values = self.inspector.texel((name, self.renderer.frame_number), tex, *where)
+        return name, where[0], where[1], values
 
     def draw(self, framebuffer, size: tuple[int, int], background=(0.1, 0.1, 0.12)) -> str | None:
         """Show the inspected target in ``framebuffer`` (e.g. ``ctx.screen``), letterboxed."""

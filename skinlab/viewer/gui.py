@@ -16,8 +16,11 @@ from skinlab.render.registry import techniques
 from skinlab.scene.materials import SSS_MODELS
 
 from .core import ViewerCore
-from .inspector import display_mode
+from .inspector import colour_bar, display_mode, shown_aspect
 from .panel import (
+    EXPOSURE,
+    LIGHT_COLOR_MAX,
+    LIGHT_INTENSITY,
     angles_from_direction,
     direction_from_angles,
     render_widgets,
@@ -31,6 +34,52 @@ from .panel import (
 RED = imgui.ImVec4(1.0, 0.45, 0.4, 1.0)
 GREY = imgui.ImVec4(0.7, 0.7, 0.7, 1.0)
 YELLOW = imgui.ImVec4(1.0, 0.85, 0.4, 1.0)
+
+
+def apply_style() -> None:
+    """Slider grabs narrow and see-through, so a slider's digits stay readable under its handle."""
+    style = imgui.get_style()
+    style.grab_min_size = 6.0
+    c = style.color_(imgui.Col_.slider_grab)
+    style.set_color_(imgui.Col_.slider_grab, imgui.ImVec4(c.x, c.y, c.z, 0.45))
+    c = style.color_(imgui.Col_.slider_grab_active)
+    style.set_color_(imgui.Col_.slider_grab_active, imgui.ImVec4(c.x, c.y, c.z, 0.6))
+
+
+LAYOUT: dict[str, float] = {}  # row label -> its top on screen in the last frame (tests check it stays put)
+
+
+class Rows:
+    """Rows of 'label | widget' in a two-column table: the label column as wide as its longest
+    label, the widget column the rest. No label is cut off at the panel's edge and no widget (a
+    long file name) runs into its label. Widgets drawn in a row take hidden labels ("##...")."""
+
+    def __init__(self, table_id: str, labels):
+        self.id = table_id
+        self.width = max((imgui.calc_text_size(l).x for l in labels), default=0.0) + 8.0
+        self.open = False
+
+    def __enter__(self) -> Rows:
+        self.open = imgui.begin_table(self.id, 2, imgui.TableFlags_.sizing_fixed_fit)
+        if self.open:
+            imgui.table_setup_column("label", imgui.TableColumnFlags_.width_fixed, self.width)
+            imgui.table_setup_column("widget", imgui.TableColumnFlags_.width_stretch)
+        return self
+
+    def row(self, label: str, tip: str = "") -> None:
+        imgui.table_next_row()
+        imgui.table_next_column()
+        LAYOUT[f"{self.id}/{label}"] = imgui.get_cursor_screen_pos().y
+        imgui.align_text_to_frame_padding()
+        imgui.text(label)
+        if tip and imgui.is_item_hovered():
+            imgui.set_tooltip(tip)
+        imgui.table_next_column()
+        imgui.set_next_item_width(-1.0)
+
+    def __exit__(self, *exc) -> None:
+        if self.open:
+            imgui.end_table()
 
 
 class Gui:
@@ -108,73 +157,96 @@ class Gui:
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self.panel_rect = (pos.x, pos.y, size.x, size.y)
         if expanded:
-            if self.core.waiting:  # slow work runs off this thread: say what the next frame waits on
-                imgui.text_colored(YELLOW, self.core.waiting)
+            # slow work runs off this thread: say what the next frame waits on. The line is always
+            # there, so that it appearing cannot move the rows under a dragging mouse
+            waiting = self.core.waiting
+            imgui.text_colored(YELLOW if waiting else GREY, waiting or "frame up to date")
             self._render_section()
             self._inspector_section()
             self._scene_section()
             self._material_section()
-            self._light_section()
+            self._lights_section()
         imgui.end()
 
     def _render_section(self) -> None:
         core = self.core
         if not imgui.collapsing_header("Render", imgui.TreeNodeFlags_.default_open):
             return
-        options = ["per material", *SSS_MODELS]
-        cur = core.settings.sss_model or "per material"
-        if imgui.begin_combo("SSS model (M)", cur):
-            for o in options:
-                clicked, _ = imgui.selectable(o, o == cur)
-                if clicked:
-                    core.set_sss_model(None if o == "per material" else o)
-            imgui.end_combo()
-        cur = core.settings.technique_name
-        if imgui.begin_combo("technique (T)", cur):
-            for t in techniques():  # T skips the slow ones; here they are, marked
-                text = f"{t.name}  ({t.slow})" if t.slow else t.name
-                clicked, _ = imgui.selectable(f"{text}##{t.name}", t.name == cur)
-                if imgui.is_item_hovered():
-                    imgui.set_tooltip(t.description)
-                if clicked:
-                    core.set_technique(t.name)
-            imgui.end_combo()
-        self._technique_options()
-        self._render_options()
+        tech, rend = technique_widgets(core.settings.technique), render_widgets(core.settings)
+        labels = ["SSS model (M)", "technique (T)", "exposure"] + [self._option_label(w) for w in tech + rend]
+        with Rows("render", labels) as rows:
+            if not rows.open:
+                return
+            options = ["per material", *SSS_MODELS]
+            cur = core.settings.sss_model or "per material"
+            rows.row("SSS model (M)")
+            if imgui.begin_combo("##sss_model", cur):
+                for o in options:
+                    clicked, _ = imgui.selectable(o, o == cur)
+                    if clicked:
+                        core.set_sss_model(None if o == "per material" else o)
+                imgui.end_combo()
+            cur = core.settings.technique_name
+            rows.row("technique (T)")
+            if imgui.begin_combo("##technique", cur):
+                for t in techniques():  # T skips the slow ones; here they are, marked
+                    text = f"{t.name}  ({t.slow})" if t.slow else t.name
+                    clicked, _ = imgui.selectable(f"{text}##{t.name}", t.name == cur)
+                    if imgui.is_item_hovered():
+                        imgui.set_tooltip(t.description)
+                    if clicked:
+                        core.set_technique(t.name)
+                imgui.end_combo()
+            rows.row(
+                "exposure", "linear multiplier on radiance before tone mapping (the scene's [environment] exposure)"
+            )
+            ch, v = imgui.slider_float(
+                "##exposure", core.panel.exposure(), *EXPOSURE, "%.3g", imgui.SliderFlags_.logarithmic
+            )
+            if ch:
+                core.panel.set_exposure(v)
+            st = core.settings.technique
+            self._option_rows(rows, tech, st, st.technique, core.set_technique_option)
+            self._option_rows(rows, rend, core.settings, "render", core.set_render_option)
         if imgui.button("Reset camera (R)"):
             core.reset_camera()
         imgui.same_line()
         if imgui.button("Save scene (Ctrl+S)") and self.on_save_scene is not None:
             self.on_save_scene()
 
-    def _technique_options(self) -> None:
-        """The current technique's settings (panel.technique_widgets: from its declaration)."""
-        st = self.core.settings.technique
-        self._option_widgets(technique_widgets(st), st, st.technique, self.core.set_technique_option)
+    @staticmethod
+    def _option_label(w) -> str:
+        return widget_label(w)
 
-    def _render_options(self) -> None:
-        """The declared render settings (panel.render_widgets): supersampling, interreflection."""
-        st = self.core.settings
-        self._option_widgets(render_widgets(st), st, "render", self.core.set_render_option)
-
-    def _option_widgets(self, widgets, st, scope: str, apply) -> None:
+    def _option_rows(self, rows: Rows, widgets, st, scope: str, apply) -> None:
+        """One row per declared setting (a technique's, or RenderSettings'): a checkbox, an integer or
+        a number slider; a setting that may be automatic gets an 'auto' box before its slider."""
         core = self.core
         for w in widgets:
-            label = f"{widget_label(w)}##{scope}"
-            new = w.value
+            rows.row(self._option_label(w), w.doc)
+            new, changed = w.value, False
             if w.widget.endswith("_or_auto"):
-                changed, auto = imgui.checkbox(f"{w.param} automatic##{scope}", w.value is None)
+                changed, auto = imgui.checkbox(f"auto##{scope}.{w.param}.auto", w.value is None)
+                if imgui.is_item_hovered():
+                    imgui.set_tooltip(w.doc)
                 new = None if auto else (w.value if w.value is not None else w.range[0])
-            else:
-                changed = False
-            if new is not None:
+                imgui.same_line()
+                imgui.set_next_item_width(-1.0)
+            hidden = f"##{scope}.{w.param}"
+            if new is not None or w.widget.endswith("_or_auto"):
+                with_value = new if new is not None else (w.range[0] if w.range else 0)
+                if new is None:
+                    imgui.begin_disabled()
                 if w.widget.startswith("checkbox"):
-                    c, new = imgui.checkbox(label, bool(new))
+                    c, got = imgui.checkbox(hidden, bool(with_value))
                 elif w.widget.startswith("slider_int"):
-                    c, new = imgui.slider_int(label, int(new), int(w.range[0]), int(w.range[1]))
+                    c, got = imgui.slider_int(hidden, int(with_value), int(w.range[0]), int(w.range[1]))
                 else:
-                    c, new = imgui.slider_float(label, float(new), float(w.range[0]), float(w.range[1]))
-                changed = changed or c
+                    c, got = imgui.slider_float(hidden, float(with_value), float(w.range[0]), float(w.range[1]))
+                if new is None:
+                    imgui.end_disabled()
+                else:
+                    new, changed = got, changed or c
             if imgui.is_item_hovered():
                 imgui.set_tooltip(w.doc)
             if changed:
@@ -184,32 +256,87 @@ class Gui:
                     core.note("error", str(exc))
 
     def _inspector_section(self) -> None:
+        """Target, scale, offset, auto range, the colour bar and the pixel under the mouse: every row
+        is always there (greyed where the target has no such setting), so the layout never jumps."""
         core = self.core
         if not imgui.collapsing_header("Pass inspector (P / Tab)", imgui.TreeNodeFlags_.default_open):
             return
         targets = core.targets()
         cur = core.inspector.resolve(targets) or "-"
-        if imgui.begin_combo("target", cur):
-            for n in core.inspector.names(targets):
-                tex = targets[n]
-                mode = display_mode(tex)
-                label = f"{n}  {tex.size[0]}x{tex.size[1]} {mode or 'not viewable'}"
-                clicked, _ = imgui.selectable(label, n == cur)
-                if clicked:
-                    core.inspector.current = n
-            imgui.end_combo()
-        if cur in targets:
-            view = core.inspector.view(cur, targets[cur])
-            mode = display_mode(targets[cur])
-            if mode in ("color", "grey", "rg"):
-                ch, v = imgui.slider_float("scale", view.scale, 1e-3, 1e4, "%.4g", imgui.SliderFlags_.logarithmic)
-                if ch:
-                    view.scale = v
-                ch, v = imgui.input_float("offset", view.offset, 0.0, 0.0, "%.5g")
-                if ch and math.isfinite(v):
-                    view.offset = v
-                if imgui.button("Auto range (N)"):
-                    core.inspector.auto_range_now(targets)
+        tex = targets.get(cur)
+        mode = display_mode(tex) if tex is not None else None
+        view = core.inspector.view(cur, tex) if tex is not None else None
+        with Rows("inspector", ["target", "scale", "offset", "pixel"]) as rows:
+            if not rows.open:
+                return
+            rows.row("target")
+            if imgui.begin_combo("##target", cur):
+                for n in core.inspector.names(targets):
+                    t = targets[n]
+                    label = f"{n}  {t.size[0]}x{t.size[1]} {display_mode(t) or 'not viewable'}"
+                    clicked, _ = imgui.selectable(label, n == cur)
+                    if clicked:
+                        core.inspector.current = n
+                imgui.end_combo()
+            ranged = view is not None and mode in ("color", "grey", "rg")
+            imgui.begin_disabled(not ranged)
+            rows.row("scale", "display = (value - offset) x scale ([ / ] halve / double)")
+            ch, v = imgui.slider_float(
+                "##scale", view.scale if ranged else 1.0, 1e-3, 1e4, "%.4g", imgui.SliderFlags_.logarithmic
+            )
+            if ch and ranged:
+                view.scale = v
+            rows.row("offset")
+            ch, v = imgui.input_float("##offset", view.offset if ranged else 0.0, 0.0, 0.0, "%.5g")
+            if ch and ranged and math.isfinite(v):
+                view.offset = v
+            imgui.end_disabled()
+            rows.row("pixel", "the inspected target's raw values under the mouse")
+            imgui.text(self._readout() or "(move the mouse over the image)")
+        imgui.begin_disabled(not (view is not None and mode in ("color", "grey", "rg")))
+        if imgui.button("Auto range (N)"):
+            core.inspector.auto_range_now(targets)
+        imgui.end_disabled()
+        if tex is not None:
+            stretch = shown_aspect(tex.size)[1]
+            note = f"{tex.size[0]}x{tex.size[1]} {mode or 'not viewable'}"
+            imgui.same_line()
+            imgui.text_colored(GREY, note + (f", shown stretched {stretch:.3g} x" if stretch > 1.0 else ""))
+        if view is not None and mode is not None:
+            self._colour_bar(view, mode)
+
+    def _readout(self) -> str:
+        """'target (x, y): values' for the texel under the mouse, '' off the image or over the panel."""
+        io = imgui.get_io()
+        m = io.mouse_pos
+        if not math.isfinite(m.x) or self.over_panel(m.x, m.y):
+            return ""
+        sx, sy = io.display_framebuffer_scale.x, io.display_framebuffer_scale.y
+        size = (round(io.display_size.x * sx), round(io.display_size.y * sy))
+        hit = self.core.readout(m.x * sx, (io.display_size.y - m.y) * sy, size)
+        if hit is None:
+            return ""
+        name, col, row, values = hit
+        return f"({col}, {row}): " + "  ".join(f"{float(v):.4g}" for v in np.atleast_1d(values))
+
+    def _colour_bar(self, view, mode: str) -> None:
+        """The display range as a bar of colours, its end values beneath (panel.colour_bar stops)."""
+        stops = colour_bar(view, mode)
+        draw = imgui.get_window_draw_list()
+        p = imgui.get_cursor_screen_pos()
+        width = max(imgui.get_content_region_avail().x, 40.0)
+        height = imgui.get_frame_height() * 0.6
+        step = width / (len(stops) - 1)
+        for i in range(len(stops) - 1):
+            a = imgui.get_color_u32(imgui.ImVec4(*stops[i][1], 1.0))
+            b = imgui.get_color_u32(imgui.ImVec4(*stops[i + 1][1], 1.0))
+            x0 = p.x + i * step
+            draw.add_rect_filled_multi_color(imgui.ImVec2(x0, p.y), imgui.ImVec2(x0 + step, p.y + height), a, b, b, a)
+        imgui.dummy(imgui.ImVec2(width, height))
+        lo, hi = f"{stops[0][0]:.4g}", f"{stops[-1][0]:.4g}"
+        imgui.text_colored(GREY, lo)
+        imgui.same_line(max(width - imgui.calc_text_size(hi).x, imgui.calc_text_size(lo).x + 8.0))
+        imgui.text_colored(GREY, hi)
 
     def _scene_section(self) -> None:
         panel = self.core.panel
@@ -243,69 +370,94 @@ class Gui:
             imgui.text_colored(YELLOW, note)
             imgui.pop_text_wrap_pos()
         widgets = panel.widgets()
-        # widgets leave room for the longest label, so no label is cut off at the panel's edge
-        label_w = max((imgui.calc_text_size(widget_label(w)).x for w in widgets), default=0.0)
-        imgui.push_item_width(-(label_w + imgui.get_style().item_inner_spacing.x + 4.0))
-        for w in widgets:
-            label = widget_label(w)
-            if w.param == "sss_model" and note:
-                label = f"{w.param} (M overrides)"
-            if w.widget == "slider_float":
-                ch, v = imgui.slider_float(label, float(w.value), w.range[0], w.range[1])
-            elif w.widget == "color_edit3":  # linear values 0-1, as in the scene file
-                ch, v = imgui.color_edit3(label, [float(x) for x in w.value], imgui.ColorEditFlags_.float)
-            elif w.widget == "drag_float3":
-                speed = max((w.range[1] - w.range[0]) * 1e-4, 1e-3)
-                flags = imgui.SliderFlags_.logarithmic if w.logarithmic else 0
-                ch, v = imgui.drag_float3(
-                    label, [float(x) for x in w.value], speed, w.range[0], w.range[1], "%.3f", flags
-                )
-            elif w.widget == "drag_float2":
-                speed = max((w.range[1] - w.range[0]) * 1e-5, 1e-3)
-                ch, v = imgui.drag_float2(label, [float(x) for x in w.value], speed, w.range[0], w.range[1], "%.3f")
-            elif w.widget == "combo":
-                ch, v = False, w.value
-                if imgui.begin_combo(label, str(w.value)):
-                    for c in w.choices:
-                        clicked, _ = imgui.selectable(c, c == w.value)
-                        if clicked:
-                            ch, v = True, c
-                    imgui.end_combo()
-            elif w.widget == "file_path":
-                key = f"{id(m)}:{w.param}"
-                text = self._text.get(key, texture_text(w.value))
-                ch_text, text = imgui.input_text(label, text, imgui.InputTextFlags_.enter_returns_true)
-                self._text[key] = text
-                ch, v = ch_text, text
-                if ch:
-                    self._text.pop(key, None)
-            else:  # widget_for() only returns the kinds above
-                raise ValueError(f"parameter {w.param}: no drawing code for widget {w.widget!r}")
-            if imgui.is_item_hovered() and (w.doc or w.widget == "file_path"):
+        labels = [f"{w.param} (M overrides)" if w.param == "sss_model" and note else widget_label(w) for w in widgets]
+        with Rows("material", labels) as rows:
+            for w, label in zip(widgets, labels) if rows.open else ():
                 tip = w.doc
                 if w.widget == "file_path":
                     tip += f"\n{w.value or 'no map'}\n(a name alone: next to the current map)"
-                imgui.set_tooltip(tip)
-            if ch:
-                self._try(panel.edit, w.param, v)
-        imgui.pop_item_width()
+                rows.row(label, tip)
+                hidden = f"##material.{w.param}"
+                if w.widget == "slider_float":
+                    ch, v = imgui.slider_float(hidden, float(w.value), w.range[0], w.range[1])
+                elif w.widget == "color_edit3":  # linear values 0-1, as in the scene file
+                    ch, v = imgui.color_edit3(hidden, [float(x) for x in w.value], imgui.ColorEditFlags_.float)
+                elif w.widget == "drag_float3":
+                    speed = max((w.range[1] - w.range[0]) * 1e-4, 1e-3)
+                    flags = imgui.SliderFlags_.logarithmic if w.logarithmic else 0
+                    ch, v = imgui.drag_float3(
+                        hidden, [float(x) for x in w.value], speed, w.range[0], w.range[1], "%.3f", flags
+                    )
+                elif w.widget == "drag_float2":
+                    speed = max((w.range[1] - w.range[0]) * 1e-5, 1e-3)
+                    ch, v = imgui.drag_float2(
+                        hidden, [float(x) for x in w.value], speed, w.range[0], w.range[1], "%.3f"
+                    )
+                elif w.widget == "combo":
+                    ch, v = False, w.value
+                    if imgui.begin_combo(hidden, str(w.value)):
+                        for c in w.choices:
+                            clicked, _ = imgui.selectable(c, c == w.value)
+                            if clicked:
+                                ch, v = True, c
+                        imgui.end_combo()
+                elif w.widget == "file_path":
+                    key = f"{id(m)}:{w.param}"
+                    text = self._text.get(key, texture_text(w.value))
+                    ch_text, text = imgui.input_text(hidden, text, imgui.InputTextFlags_.enter_returns_true)
+                    self._text[key] = text
+                    ch, v = ch_text, text
+                    if ch:
+                        self._text.pop(key, None)
+                else:  # widget_for() only returns the kinds above
+                    raise ValueError(f"parameter {w.param}: no drawing code for widget {w.widget!r}")
+                if imgui.is_item_hovered() and tip:
+                    imgui.set_tooltip(tip)
+                if ch:
+                    self._try(panel.edit, w.param, v)
         if panel.error:
             imgui.push_text_wrap_pos(0.0)
             imgui.text_colored(RED, panel.error)
             imgui.pop_text_wrap_pos()
 
-    def _light_section(self) -> None:
+    def _lights_section(self) -> None:
+        """Every light (the key light first, then the fill and the others): intensity, colour and,
+        for a directional light, azimuth and elevation."""
         panel = self.core.panel
-        light = panel.key_light()
-        if light is None or not imgui.collapsing_header("Key light", imgui.TreeNodeFlags_.default_open):
+        lights = panel.lights()
+        if not lights or not imgui.collapsing_header("Lights", imgui.TreeNodeFlags_.default_open):
             return
-        d = panel.light_direction()
-        az, el = angles_from_direction(d)
-        imgui.text(f"'{light.name}' ({light.kind}) travels {np.round(d, 3).tolist()}")
-        ch1, az = imgui.slider_float("azimuth (deg)", az, -180.0, 180.0)
-        ch2, el = imgui.slider_float("elevation (deg)", el, -89.0, 89.0)
+        labels = ["intensity", "color (linear)", "azimuth (deg)", "elevation (deg)"]
+        for i, light in enumerate(lights):
+            title = f"{light.name} ({light.kind}{', key' if i == 0 else ''})##light{light.uid}"
+            if not imgui.tree_node_ex(title, imgui.TreeNodeFlags_.default_open):
+                continue
+            with Rows(f"light{light.uid}", labels) as rows:
+                if rows.open:
+                    self._light_rows(rows, light)
+            imgui.tree_pop()
+
+    def _light_rows(self, rows: Rows, light) -> None:
+        panel = self.core.panel
+        rows.row("intensity", "irradiance (directional) or intensity (point) multiplier on the colour")
+        ch, v = imgui.slider_float(
+            f"##intensity{light.uid}", float(light.intensity), *LIGHT_INTENSITY, "%.3g", imgui.SliderFlags_.logarithmic
+        )
+        if ch:
+            panel.set_light_intensity(light, v)
+        rows.row("color (linear)")
+        rgb = [float(x) for x in np.asarray(light.color, np.float64).reshape(-1)[:3]]
+        flags = imgui.ColorEditFlags_.float | imgui.ColorEditFlags_.hdr
+        ch, v = imgui.color_edit3(f"##color{light.uid}", rgb, flags)
+        if ch:
+            self._try(panel.set_light_color, light, np.clip(v, 0.0, LIGHT_COLOR_MAX))
+        az, el = angles_from_direction(panel.light_direction(light))
+        rows.row("azimuth (deg)", "where the light shines from, about +Y from +Z")
+        ch1, az = imgui.slider_float(f"##azimuth{light.uid}", az, -180.0, 180.0)
+        rows.row("elevation (deg)", "above the horizontal plane")
+        ch2, el = imgui.slider_float(f"##elevation{light.uid}", el, -89.0, 89.0)
         if ch1 or ch2:
-            self._try(panel.set_light_direction, direction_from_angles(az, el))
+            self._try(panel.set_light_direction, direction_from_angles(az, el), light)
 
     def _try(self, fn, *args) -> None:
         try:

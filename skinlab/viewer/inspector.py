@@ -108,15 +108,68 @@ def auto_range(pixels: np.ndarray, mode: str) -> tuple[float, float]:
     return lo, (1.0 / (hi - lo) if hi > lo else 1.0)
 
 
+MAX_ASPECT = 4.0  # a target wider (or taller) than this is shown stretched to it: a 1024x10 one is no strip
+
+
+def shown_aspect(tex_size: tuple[int, int]) -> tuple[float, float]:
+    """(width / height as shown, the stretch of the shorter side: 1 when shown as it is)."""
+    tw, th = tex_size
+    if min(tw, th) <= 0:
+        return 1.0, 1.0
+    a = tw / th
+    shown = min(max(a, 1.0 / MAX_ASPECT), MAX_ASPECT)
+    return shown, max(a / shown, shown / a)
+
+
 def fit_viewport(tex_size: tuple[int, int], win_size: tuple[int, int]) -> tuple[int, int, int, int]:
-    """Largest viewport with the texture's aspect ratio centred in the window (letterbox)."""
+    """Largest viewport with the texture's aspect ratio (at most MAX_ASPECT : 1, see shown_aspect)
+    centred in the window (letterbox)."""
     tw, th = tex_size
     ww, wh = win_size
     if min(tw, th, ww, wh) <= 0:
         return 0, 0, max(ww, 0), max(wh, 0)
-    s = min(ww / tw, wh / th)
-    w, h = max(1, round(tw * s)), max(1, round(th * s))
+    aspect, _ = shown_aspect(tex_size)
+    s = min(ww / aspect, wh)
+    w, h = max(1, round(aspect * s)), max(1, round(s))
     return (ww - w) // 2, (wh - h) // 2, w, h
+
+
+def texel_at(viewport: tuple[int, int, int, int], tex_size: tuple[int, int], x: float, y: float):
+    """(column, row from the top) of the texel shown at window point (x, y from the bottom, as GL's
+    viewport), or None outside the shown target."""
+    vx, vy, vw, vh = viewport
+    u, v = (x - vx) / max(vw, 1), (y - vy) / max(vh, 1)
+    if not (0.0 <= u < 1.0 and 0.0 <= v < 1.0):
+        return None
+    tw, th = tex_size
+    return min(int(u * tw), tw - 1), min(int((1.0 - v) * th), th - 1)
+
+
+def shown_value(values: np.ndarray, view: View, mode: str) -> np.ndarray:
+    """The display colour (0-1 RGB) of raw texel values, as the inspector's shader maps them: a twin
+    of _FS for the colour bar and the read-out."""
+    v = np.asarray(values, np.float64)
+    if mode == "ldr":
+        return np.clip(v[..., :3], 0.0, 1.0)
+    mapped = np.clip((v - view.offset) * view.scale, 0.0, 1.0)
+    if mode == "grey":
+        return np.repeat(mapped[..., :1], 3, axis=-1)
+    if mode == "rg":
+        return np.concatenate([mapped[..., :2], np.zeros(mapped.shape[:-1] + (1,))], axis=-1)
+    from skinlab.scene.optics.color import srgb_encode
+
+    return srgb_encode(mapped[..., :3])
+
+
+def colour_bar(view: View, mode: str, n: int = 9) -> list[tuple[float, tuple[float, float, float]]]:
+    """The values the display maps onto its range, offset to offset + 1/scale, with their display
+    colours: n stops for the colour bar under the inspector's target."""
+    top = view.offset + (1.0 / view.scale if view.scale else 1.0)
+    if mode == "ldr":
+        view, top = View(0.0, 1.0), 1.0
+    stops = np.linspace(view.offset, top, n)
+    cols = shown_value(np.repeat(stops[:, None], 3, axis=1), view, mode)
+    return [(float(v), tuple(float(x) for x in c)) for v, c in zip(stops, cols)]
 
 
 @dataclass
@@ -142,6 +195,14 @@ class Inspector:
             filter=(moderngl.LINEAR, moderngl.LINEAR), repeat_x=False, repeat_y=False, compare_func=""
         )
         self._fbo = None
+        self._pixels: tuple | None = None  # (key, array): the last target read for the read-out
+
+    def texel(self, key, texture, column: int, row: int) -> np.ndarray:
+        """Raw values of one texel (row 0 at the top); the target is read once per ``key`` (its name
+        and the frame number), so hovering costs no read per mouse move."""
+        if self._pixels is None or self._pixels[0] != key:
+            self._pixels = (key, read_texture(texture))
+        return self._pixels[1][row, column]
 
     # -- choosing ----------------------------------------------------------------------------
     def names(self, targets: dict) -> list[str]:

@@ -281,8 +281,15 @@ class PanelModel:
                     return l
         return None
 
-    def set_light_direction(self, direction) -> np.ndarray:
-        light = self.key_light()
+    def lights(self) -> list[LightNode]:
+        """Every light of the scene, the key light first (the panel shows a row of controls each)."""
+        key = self.key_light()
+        rest = [n for n in self.scene.nodes() if isinstance(n, LightNode) and n is not key]
+        return ([key] if key is not None else []) + rest
+
+    def set_light_direction(self, direction, light: LightNode | None = None) -> np.ndarray:
+        """Turn a light (the key light by default) to travel along ``direction``."""
+        light = light or self.key_light()
         if light is None:
             raise ValueError("light direction: the scene has no light")
         d = np.asarray(direction, np.float64).reshape(-1)
@@ -297,8 +304,8 @@ class PanelModel:
         self.version += 1
         return d
 
-    def light_direction(self) -> np.ndarray | None:
-        light = self.key_light()
+    def light_direction(self, light: LightNode | None = None) -> np.ndarray | None:
+        light = light or self.key_light()
         if light is None:
             return None
         if light.kind == "directional":
@@ -306,6 +313,42 @@ class PanelModel:
         p = light.world_position
         n = np.linalg.norm(p)
         return -p / n if n else np.array([0.0, 0.0, -1.0])
+
+    def set_light_intensity(self, light: LightNode, value: float) -> float:
+        """A light's intensity, clamped into LIGHT_INTENSITY (NaN: unchanged)."""
+        v = float(value)
+        if not math.isfinite(v):
+            return light.intensity
+        light.intensity = min(max(v, LIGHT_INTENSITY[0]), LIGHT_INTENSITY[1])
+        self.version += 1
+        return light.intensity
+
+    def set_light_color(self, light: LightNode, rgb) -> np.ndarray:
+        """A light's linear RGB colour, each channel clamped into [0, LIGHT_COLOR_MAX]."""
+        c = np.asarray(rgb, np.float64).reshape(-1)
+        if c.size != 3 or not np.isfinite(c).all():
+            raise ValueError(f"light {light.name!r} color: expected 3 finite numbers, got {rgb!r}")
+        light.color = np.clip(c, 0.0, LIGHT_COLOR_MAX)
+        self.version += 1
+        return light.color
+
+    # -- exposure -----------------------------------------------------------------------------
+    def exposure(self) -> float:
+        return float(self.scene.environment.exposure)
+
+    def set_exposure(self, value: float) -> float:
+        """The scene's exposure (a linear multiplier before tone mapping), clamped into EXPOSURE."""
+        v = float(value)
+        if not math.isfinite(v):
+            return self.exposure()
+        self.scene.environment.exposure = min(max(v, EXPOSURE[0]), EXPOSURE[1])
+        self.version += 1
+        return self.scene.environment.exposure
+
+
+EXPOSURE = (1.0 / 256.0, 256.0)  # the panel's exposure slider (logarithmic): +-8 stops
+LIGHT_INTENSITY = (0.0, 100.0)  # the panel's light intensity slider
+LIGHT_COLOR_MAX = 10.0  # a light's colour channels in the panel (linear, may exceed 1)
 
 
 # -- the current technique's settings (skinlab/render/options.py declarations) --------------------------------

@@ -116,10 +116,11 @@ class ViewerWindow:
         from imgui_bundle import imgui
         from imgui_bundle.python_backends import pyglet_backend
 
-        from .gui import Gui
+        from .gui import Gui, apply_style
 
         self.imgui = imgui
         imgui.create_context()
+        apply_style()
         imgui.get_io().set_ini_filename(None)  # no imgui.ini in the working folder
         self.imgui_impl = pyglet_backend.create_renderer(self.window, attach_callbacks=False)
         self.gui = Gui(self.core)
