@@ -10,6 +10,7 @@ import argparse
 import importlib
 import os
 import sys
+import warnings
 
 from skinlab.commands import COMMAND_MODULES
 
@@ -87,6 +88,15 @@ def main(argv: list[str] | None = None) -> int:
         print(version())
         return 0
     args = build_parser().parse_args(argv)
+    with warnings.catch_warnings():  # restored when main returns (tests call it in-process)
+        if not os.environ.get("SKINLAB_DEBUG"):
+            # numpy's float warnings ("overflow encountered in multiply") are noise around a one-line
+            # error or a result: what matters is checked and said in words (SKINLAB_DEBUG=1 shows them)
+            warnings.filterwarnings("ignore", category=RuntimeWarning)
+        return _run(args)
+
+
+def _run(args) -> int:
     from skinlab.gl.context import ContextError
     from skinlab.gl.shader_source import ShaderError
 
