@@ -150,18 +150,55 @@ def reference_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_ver
     return _content_key(desc, {"export": EXPORT_VERSION, "mitsuba": mitsuba_version, "request": asdict(req)})
 
 
-def load_cached(key: str) -> Reference | None:
+def load_cached(key: str, shape: tuple[int, int, int] | None = None) -> Reference | None:
+    """A whole reference filed under `key` (``<key>.npz`` and ``<key>.json``), or None. An entry that
+    does not read back (truncated, emptied, garbage), whose arrays are not finite float32 images of
+    `shape` (H, W, 4) or whose record lacks what a reference says (its noise floor, seconds, notes)
+    is discarded with a one-line warning and rendered again, never used."""
     d = cache_dir()
     npz, js = d / f"{key}.npz", d / f"{key}.json"
     if not (npz.is_file() and js.is_file()):
         return None
     try:
-        with np.load(npz) as z:
+        with np.load(npz, allow_pickle=False) as z:
             img, a, b = z["image"], z["half_a"], z["half_b"]
         meta = json.loads(js.read_text())
-    except (OSError, ValueError, KeyError):
-        return None  # a damaged entry is rendered again
+    except Exception as exc:  # BadZipFile, EOFError, ValueError, KeyError, UnicodeDecodeError...: damaged
+        return _discard(npz, js, f"it does not read back ({type(exc).__name__})")
+    problem = _whole_problem(img, a, b, meta, shape)
+    if problem:
+        return _discard(npz, js, problem)
     return Reference(img, a, b, key, meta, cached=True)
+
+
+def _whole_problem(img, a, b, meta, shape) -> str | None:
+    """What is wrong with a whole reference's arrays and record, or None."""
+    for name, arr in (("image", img), ("half_a", a), ("half_b", b)):
+        if arr.dtype != np.float32 or arr.ndim != 3 or arr.shape[2] != 4:
+            return f"{name} is {arr.dtype} {arr.shape}, not a float32 (H, W, 4) image"
+        if shape is not None and arr.shape != tuple(shape):
+            return f"{name} is {arr.shape[1]}x{arr.shape[0]}, the request {shape[1]}x{shape[0]}"
+        if not np.isfinite(arr).all():
+            return f"{name} holds NaN or Inf"
+    if a.shape != img.shape or b.shape != img.shape:
+        return "its halves differ in size from its image"
+    if not isinstance(meta, dict):
+        return f"its record is {type(meta).__name__}, not a table"
+    nf = meta.get("noise_floor")
+    if not isinstance(nf, dict) or not all(k in nf for k in ("rel_l1", "rel_l1_block", "pixels")):
+        return "its record has no noise floor"
+    if not isinstance(meta.get("seconds"), int | float) or not isinstance(meta.get("notes"), list):
+        return "its record lacks its seconds or notes"
+    return None
+
+
+def _discard(npz: Path, js: Path, why: str) -> None:
+    import sys
+
+    print(f"warning: {npz}: discarded a cached reference ({why}); it is rendered again", file=sys.stderr)
+    for f in (npz, js):
+        f.unlink(missing_ok=True)
+    return None
 
 
 def series_key(desc: ReferenceDescription, req: ReferenceRequest, mitsuba_version: str) -> str:
@@ -250,7 +287,8 @@ def render_reference(
         scene, req.width, req.height, sun_deg=req.sun_deg, max_depth=req.max_depth, rr_depth=req.rr_depth
     )
     mi = set_variant(req.variant) if render else mitsuba_module()
-    if use_cache and (hit := load_cached(reference_key(desc, req, mi.__version__))) is not None:
+    shape = (req.height, req.width, 4)
+    if use_cache and (hit := load_cached(reference_key(desc, req, mi.__version__), shape)) is not None:
         return hit
     key, store = pass_store(desc, req, mi.__version__, use_cache)
     have = store.load() if use_cache else []
