@@ -33,16 +33,16 @@ def check_output_path(path: str | Path, option: str = "") -> Path:
     prefixes the message."""
     path = Path(path)
     label = f"{option}: " if option else ""
+    try:
+        check_writable(path)  # first: a name too long makes even is_dir() raise
+    except OSError as exc:
+        raise ValueError(f"{label}{path}: {exc.strerror}") from None
     if path.is_dir():
         raise ValueError(f"{label}{path}: is a folder; give a file name such as {path / 'render.png'}")
     try:
         image_format(path)
     except ValueError as exc:
         raise ValueError(f"{label}{exc}") from None
-    try:
-        check_writable(path)
-    except OSError as exc:
-        raise ValueError(f"{label}{path}: {exc.strerror}") from None
     for parent in path.parents:
         if parent.exists():
             if not parent.is_dir():

@@ -2,15 +2,24 @@
 in exit status 2 with exactly one line on stderr that names the file (or option) and the key, no
 traceback, and no output file (nor a temporary one) left behind.
 
-The cases run the real command line in-process (``skinlab.cli.main``); none gets as far as rendering."""
+The cases run the real command line in-process (``skinlab.cli.main``); none gets as far as rendering.
+stderr is captured at the file descriptor, so what C libraries print themselves (libpng's "libpng
+error: ...") counts as a line too. Round two (issue 26: a 759-case probe and a new user) adds numbers
+beyond float range, deep nesting, symbolic link loops, broken node transforms, OBJ index 0, output
+paths, Mitsuba's options and the albedo names; the inputs that must render, not fail (zero normals,
+3,000 nested nodes, an exposure of 1e30, maps beyond half-float range) are in
+test_bad_input_that_renders_is_finite_and_said_once."""
 
 from __future__ import annotations
 
+import base64
+import json
 import os
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from skinlab.cli import main
@@ -31,6 +40,55 @@ LIGHT = MESH + "[[lights]]\n{}\n"
 
 def scene(text: str) -> dict:
     return {"s.toml": text, "tri.obj": TRIANGLE_OBJ}
+
+
+BIG = "1" + "0" * 400  # an integer no float holds
+SSS = '[materials.m]\nsubsurface = 1\n{}\n[[meshes]]\nfile = "tri.obj"\nmaterial = "m"\n'
+GLTF_SCENE = '[[meshes]]\nfile = "d.gltf"\n'
+
+
+def gltf(nodes: list[dict], roots: list[int] | None = None) -> str:
+    """A one-triangle glTF (embedded buffer) with the given nodes (node "mesh": 0 draws the triangle)."""
+    pos = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32).tobytes()
+    buf = pos + np.array([0, 1, 2], np.uint16).tobytes() + b"\0\0"
+    doc = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": roots or [0]}],
+        "nodes": nodes,
+        "buffers": [
+            {"byteLength": len(buf), "uri": "data:application/octet-stream;base64," + base64.b64encode(buf).decode()}
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 36},
+            {"buffer": 0, "byteOffset": 36, "byteLength": 6},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"},
+        ],
+        "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+    }
+    return json.dumps(doc)
+
+
+def gltf_node(**kw) -> dict:
+    return {"s.toml": GLTF_SCENE, "d.gltf": gltf([{"name": "tri_node", "mesh": 0, **kw}])}
+
+
+def symlink_loop(path: Path) -> None:
+    path.symlink_to(path.name + ".other")
+    path.with_name(path.name + ".other").symlink_to(path.name)
+
+
+def png_bytes(cut: int | None = None) -> bytes:
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray((np.arange(64 * 64 * 3) % 251).astype(np.uint8).reshape(64, 64, 3)).save(buf, "PNG")
+    return buf.getvalue()[:cut] if cut else buf.getvalue()
 
 
 # (id, files to write, argv ({tmp} = the case's folder), what stderr must contain)
@@ -174,6 +232,170 @@ CASES = [
     ),
     ("peer-frames", {}, ["bench", "peer", "--frames", "0", "--no-progress"], ["--frames"]),
     ("peer-rounds", {}, ["bench", "peer", "--rounds", "0", "--no-progress"], ["--rounds"]),
+    # -- round two: integers beyond float range, in every numeric key (one root cause: _is_number) --
+    (
+        "int-huge-mm",
+        scene(f"[scene]\nmm_per_unit = {BIG}\n" + MESH),
+        RENDER,
+        ["s.toml", "[scene].mm_per_unit", "401 digits"],
+    ),
+    (
+        "int-huge-exposure",
+        scene(f"[environment]\nexposure = {BIG}\n" + MESH),
+        RENDER,
+        ["[environment].exposure", "digits"],
+    ),
+    ("int-huge-yfov", scene(MESH + f"[camera]\nyfov_deg = {BIG}\n"), RENDER, ["s.toml", "[camera].yfov_deg", "digits"]),
+    ("int-huge-znear", scene(MESH + f"[camera]\nznear = {BIG}\n"), RENDER, ["[camera].znear", "digits"]),
+    ("int-huge-zfar", scene(MESH + f"[camera]\nzfar = {BIG}\n"), RENDER, ["[camera].zfar", "digits"]),
+    ("int-huge-roughness", scene(MAT.format(f"roughness = {BIG}")), RENDER, ["[materials.m].roughness", "digits"]),
+    ("int-huge-metallic", scene(MAT.format(f"metallic = {BIG}")), RENDER, ["[materials.m].metallic", "digits"]),
+    ("int-huge-specular", scene(MAT.format(f"specular = {BIG}")), RENDER, ["[materials.m].specular", "digits"]),
+    (
+        "int-huge-normal-scale",
+        scene(MAT.format(f"normal_scale = {BIG}")),
+        RENDER,
+        ["[materials.m].normal_scale", "digits"],
+    ),
+    ("int-huge-subsurface", scene(MAT.format(f"subsurface = -{BIG}")), RENDER, ["[materials.m].subsurface", "digits"]),
+    (
+        "int-huge-radius",
+        scene(MAT.format(f"subsurface_radius = [1, {BIG}, 1]")),
+        RENDER,
+        ["[materials.m].subsurface_radius", "component 2"],
+    ),
+    (
+        "int-huge-colour",
+        scene(MAT.format(f"base_color = [{BIG}, 0, 0]")),
+        RENDER,
+        ["[materials.m].base_color", "component 1"],
+    ),
+    (
+        "int-huge-override",
+        scene(MESH + f"overrides = {{ metallic = {BIG} }}\n"),
+        RENDER,
+        ["[[meshes]] #1.overrides.metallic"],
+    ),
+    ("int-huge-intensity", scene(LIGHT.format(f"intensity = {BIG}")), RENDER, ["[[lights]] #1.intensity", "digits"]),
+    (
+        "int-huge-light-colour",
+        scene(LIGHT.format(f"color = [1, 1, {BIG}]")),
+        RENDER,
+        ["[[lights]] #1.color", "component 3"],
+    ),
+    ("int-huge-direction", scene(LIGHT.format(f"direction = [0, -{BIG}, 0]")), RENDER, ["[[lights]] #1.direction"]),
+    ("int-huge-scale", scene(MESH + f"scale = {BIG}\n"), RENDER, ["[[meshes]] #1.scale", "digits"]),
+    (
+        "int-huge-translation",
+        scene(MESH + f"translation = [0, {BIG}, 0]\n"),
+        RENDER,
+        ["[[meshes]] #1.translation", "component 2"],
+    ),
+    ("int-huge-camera-position", scene(MESH + f"[camera]\nposition = [{BIG}, 0, 1]\n"), RENDER, ["[camera].position"]),
+    ("int-5000-digits", scene("[scene]\nmm_per_unit = " + "9" * 5000 + "\n" + MESH), RENDER, ["s.toml", "too long"]),
+    # -- nesting ----------------------------------------------------------------------------------
+    (
+        "toml-deep-array",
+        scene("[scene]\nname = " + "[" * 2000 + "]" * 2000 + "\n" + MESH),
+        RENDER,
+        ["s.toml", "nested"],
+    ),
+    (
+        "toml-deep-table",
+        scene(MESH + "overrides = " + "{ a = " * 2000 + "1" + " }" * 2000 + "\n"),
+        RENDER,
+        ["s.toml", "nested"],
+    ),
+    # -- files: symbolic link loops, OBJ index 0, node transforms -------------------------------
+    (
+        "texture-symlink-loop",
+        {**scene(MAT.format("roughness_map = 'r.png'")), "r.png": symlink_loop},
+        RENDER,
+        ["[materials.m].roughness_map", "r.png", "link loop"],
+    ),
+    (
+        "mesh-symlink-loop",
+        {"s.toml": '[[meshes]]\nfile = "m.obj"\n', "m.obj": symlink_loop},
+        RENDER,
+        ["[[meshes]] #1.file", "m.obj", "link loop"],
+    ),
+    (
+        "obj-index-0",
+        {"s.toml": '[[meshes]]\nfile = "b.obj"\n', "b.obj": "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n"},
+        RENDER,
+        ["b.obj", "line 4", "index 0", "start at 1"],
+    ),
+    (
+        "obj-vertex-inf",
+        {"s.toml": '[[meshes]]\nfile = "b.obj"\n', "b.obj": "v 0 0 0\nv inf 0 0\nv 0 1 0\nf 1 2 3\n"},
+        RENDER,
+        ["b.obj", "vertex 1"],
+    ),
+    (
+        "obj-vertex-1e39",
+        {"s.toml": '[[meshes]]\nfile = "b.obj"\n', "b.obj": "v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n"},
+        RENDER,
+        ["b.obj", "vertex 1", "float32"],
+    ),
+    ("gltf-translation-nan", gltf_node(translation=[0, float("nan"), 0]), RENDER, ["d.gltf", "node 'tri_node'", "NaN"]),
+    ("gltf-rotation-nan", gltf_node(rotation=[float("nan"), 0, 0, 1]), RENDER, ["d.gltf", "node 'tri_node'", "NaN"]),
+    ("gltf-zero-scale", gltf_node(scale=[0, 1, 1]), RENDER, ["d.gltf", "node 'tri_node'", "singular"]),
+    (
+        "gltf-singular-matrix",
+        gltf_node(matrix=[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1]),
+        RENDER,
+        ["node 'tri_node'", "singular"],
+    ),
+    ("gltf-scale-1e30", gltf_node(scale=[1e30, 1e30, 1e30]), RENDER, ["d.gltf", "node 'tri_node'", "1e+30"]),
+    (
+        "gltf-parent-zero-scale",
+        {
+            "s.toml": GLTF_SCENE,
+            "d.gltf": gltf([{"name": "group", "scale": [1, 0, 1], "children": [1]}, {"name": "leaf", "mesh": 0}]),
+        },
+        RENDER,
+        ["d.gltf", "node 'group'", "singular", "holds mesh node 'leaf'"],
+    ),
+    ("mesh-scale-1e-300", scene(MESH + "scale = [1, 1, 1e-300]\n"), RENDER, ["s.toml", "[[meshes]] #1.scale", "1e-12"]),
+    (
+        "mm-per-unit-1e-300",
+        scene("[scene]\nmm_per_unit = 1e-300\n" + SSS.format("")),
+        RENDER,
+        ["[scene].mm_per_unit", "1e-12"],
+    ),
+    # -- textures: truncated and header-only PNG (libpng's own lines kept off stderr) -------------
+    (
+        "png-truncated",
+        {**scene(MAT.format("base_color_map = 'c.png'")), "c.png": png_bytes(600)},
+        RENDER,
+        ["[materials.m].base_color_map", "c.png"],
+    ),
+    (
+        "png-header-only",
+        {**scene(MAT.format("base_color_map = 'c.png'")), "c.png": png_bytes(33)},
+        RENDER,
+        ["[materials.m].base_color_map", "c.png"],
+    ),
+    # -- output paths: the message names the user's path, never a temporary one ----------------
+    ("out-name-too-long", scene(MESH), [*RENDER, "--out", "{tmp}/" + "a" * 300 + ".png"], ["--out", "aaaa", "at most"]),
+    ("out-under-proc", scene(MESH), [*RENDER, "--out", "/proc/x.png"], ["--out", "/proc/x.png"]),
+    (
+        "out-dangling-parent",
+        {**scene(MESH), "d": lambda p: p.symlink_to("/nonexistent/skinlab-dir")},
+        [*RENDER, "--out", "{tmp}/d/x.png"],
+        ["--out", "d/x.png", "does not exist"],
+    ),
+    # -- options Mitsuba or a random walk would have failed on ----------------------------------
+    ("reference-max-depth", {}, ["reference", "--out", "{tmp}/r.exr", "--max-depth", "-7"], ["--max-depth", "-7"]),
+    ("reference-seed-huge", {}, ["reference", "--out", "{tmp}/r.exr", "--seed", "9" * 23], ["--seed", "4294967295"]),
+    ("mc-albedo-ambiguous", {}, ["mc", "--albedo", "0.5"], ["--albedo", "--single-albedo", "--surface-albedo"]),
+    (
+        "profile-albedo-ambiguous",
+        {},
+        ["profile", "burley", "--albedo", "0.5", "--mfp", "1"],
+        ["--albedo", "--surface-albedo"],
+    ),
+    ("mc-preset-unknown", {}, ["mc", "--preset", "cheese"], ["cheese"]),
 ]
 
 
@@ -181,7 +403,9 @@ def _write(folder: Path, files: dict) -> None:
     for name, content in files.items():
         p = folder / name
         p.parent.mkdir(parents=True, exist_ok=True)
-        if isinstance(content, bytes):
+        if callable(content):  # a symbolic link (loop)
+            content(p)
+        elif isinstance(content, bytes):
             p.write_bytes(content)
         else:
             p.write_text(content)
@@ -192,7 +416,7 @@ def _tree(folder: Path) -> set[str]:
 
 
 @pytest.mark.parametrize("files, argv, expected", [c[1:] for c in CASES], ids=[c[0] for c in CASES])
-def test_bad_input_is_one_line_exit_2_naming_file_and_key(tmp_path, capsys, monkeypatch, files, argv, expected):
+def test_bad_input_is_one_line_exit_2_naming_file_and_key(tmp_path, capfd, monkeypatch, files, argv, expected):
     monkeypatch.delenv("SKINLAB_DEBUG", raising=False)
     _write(tmp_path, files)
     before = _tree(tmp_path)
@@ -200,7 +424,7 @@ def test_bad_input_is_one_line_exit_2_naming_file_and_key(tmp_path, capsys, monk
         code = main([a.format(tmp=tmp_path) for a in argv])
     except SystemExit as exc:  # argparse: usage errors
         code = exc.code
-    err = capsys.readouterr().err
+    err = capfd.readouterr().err  # the file descriptor's: what C libraries print counts too
     assert code == 2, err
     lines = err.strip().splitlines()
     assert len(lines) == 1, err
@@ -210,9 +434,109 @@ def test_bad_input_is_one_line_exit_2_naming_file_and_key(tmp_path, capsys, monk
     assert _tree(tmp_path) == before, "an output (or temporary) file was left behind"
 
 
+def _exr(value: float):
+    def write(path: Path) -> None:
+        from skinlab.image_output import write_image
+
+        write_image(path, np.full((4, 4, 3), value, np.float32))
+
+    return write
+
+
+TINY = ["--size", "8x8", "--shadow-size", "64", "--tsd-size", "32"]
+# (id, files, argv, the one warning line's pieces (None: no stderr at all), check of the written image)
+RENDERS = [
+    (
+        "obj-normals-zero",
+        {"s.toml": '[[meshes]]\nfile = "b.obj"\n', "b.obj": "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n"},
+        ["render", "{tmp}/s.toml", "--out", "{tmp}/x.exr", *TINY],
+        ["b.obj", "3 of 3 vertex normals", "recomputed"],
+        "finite",
+    ),
+    (
+        "obj-normals-nan",
+        {
+            "s.toml": '[[meshes]]\nfile = "b.obj"\n',
+            "b.obj": "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn nan nan nan\nf 1//1 2//1 3//1\n",
+        },
+        ["render", "{tmp}/s.toml", "--out", "{tmp}/x.exr", *TINY],
+        ["b.obj", "vertex normals", "NaN"],
+        "finite",
+    ),
+    (
+        "gltf-3000-nested-nodes",
+        {
+            "s.toml": GLTF_SCENE,
+            "d.gltf": gltf(
+                [{"name": f"n{i}", "children": [i + 1]} for i in range(3000)] + [{"name": "leaf", "mesh": 0}]
+            ),
+        },
+        ["render", "{tmp}/s.toml", "--out", "{tmp}/x.exr", *TINY],
+        None,
+        "finite",
+    ),
+    (
+        "exposure-1e30",
+        scene(SSS.format("")),
+        ["render", "{tmp}/s.toml", "--out", "{tmp}/x.png", *TINY, "--exposure", "1e30"],
+        None,
+        "white",
+    ),
+    (
+        "exr-roughness-map-1e6",
+        {**scene(SSS.format("roughness_map = 'r.exr'")), "r.exr": _exr(1e6)},
+        ["render", "{tmp}/s.toml", "--out", "{tmp}/x.exr", *TINY],
+        None,
+        "finite",
+    ),
+    (
+        "exr-subsurface-map-1e6",
+        {**scene(SSS.format("subsurface_map = 'r.exr'")), "r.exr": _exr(1e6)},
+        ["render", "{tmp}/s.toml", "--out", "{tmp}/x.exr", *TINY],
+        None,
+        "finite",
+    ),
+    (
+        "out-name-250",
+        scene(MESH),
+        ["render", "{tmp}/s.toml", "--out", "{tmp}/" + "b" * 246 + ".png", *TINY],
+        None,
+        "written",
+    ),
+]
+
+
+@pytest.mark.parametrize("files, argv, warns, check", [c[1:] for c in RENDERS], ids=[c[0] for c in RENDERS])
+def test_bad_input_that_renders_is_finite_and_said_once(tmp_path, capfd, monkeypatch, files, argv, warns, check):
+    """Inputs that must render rather than fail: finite pixels, at most one warning line naming the
+    file and what was repaired, no library noise, and nothing but the output left behind."""
+    from skinlab.image_output import read_image
+
+    monkeypatch.delenv("SKINLAB_DEBUG", raising=False)
+    _write(tmp_path, files)
+    before = _tree(tmp_path)
+    argv = [a.format(tmp=tmp_path) for a in argv]
+    code = main(argv)
+    err = capfd.readouterr().err
+    assert code == 0, err
+    lines = err.strip().splitlines()
+    if warns is None:
+        assert lines == [], err
+    else:
+        assert len(lines) == 1 and lines[0].startswith("warning: "), err
+        for piece in warns:
+            assert piece in lines[0], f"{piece!r} not in {lines[0]!r}"
+    out = Path(argv[argv.index("--out") + 1])
+    assert _tree(tmp_path) - before == {str(out.relative_to(tmp_path))}, "a temporary file was left behind"
+    pixels = read_image(out)
+    assert np.isfinite(pixels).all()
+    if check == "white":  # tone mapping overflowed to NaN (black) before: now everything is at the top
+        assert pixels[..., :3].min() >= 250, pixels[..., :3].min()
+
+
 def test_every_case_is_distinct():
-    ids = [c[0] for c in CASES]
-    assert len(ids) == len(set(ids)) and len(ids) >= 60
+    ids = [c[0] for c in CASES + RENDERS]
+    assert len(ids) == len(set(ids)) and len(ids) >= 120
 
 
 def test_closed_pipe_ends_quietly():
