@@ -89,7 +89,7 @@ SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
         Key("name", "string", "the file's stem", "shown in the viewer's title and output names"),
         Key(
             "mm_per_unit",
-            "number > 0",
+            "number >= 1e-12",
             "1.0",
             "millimetres per scene unit: the physical scale that subsurface_radius (mm) is measured against",
         ),
@@ -159,7 +159,13 @@ SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
         Key("translation", "3 numbers", "[0, 0, 0]", "scene units"),
         Key("rotation", "4 numbers", "[0, 0, 0, 1]", "quaternion x, y, z, w (not with rotation_deg)"),
         Key("rotation_deg", "3 numbers", "[0, 0, 0]", "Euler angles about X, Y, Z in degrees (not with rotation)"),
-        Key("scale", "1 or 3 numbers, non-zero", "1", "scale factor(s)"),
+        Key(
+            "scale",
+            "1 or 3 numbers, magnitude 1e-12 to 1e12",
+            "1",
+            "scale factor(s); with the file's own node transforms a mesh's world transform must scale by 1e-12 "
+            "to 1e12 and move by at most 1e12 (errors name the node)",
+        ),
         Key("visible", "boolean", "true", "false hides the mesh and all its nodes"),
         Key("flip_v", "boolean", "false", "v -> 1 - v: for files whose UV origin is the image's top-left"),
         Key(
