@@ -122,7 +122,7 @@ def _face_pairs(f: np.ndarray) -> np.ndarray:
     return np.stack([face[two], face[two + 1]], axis=1)
 
 
-def _folds(p: np.ndarray, f: np.ndarray, ignore: np.ndarray | None = None) -> np.ndarray:
+def folded_triangles(p: np.ndarray, f: np.ndarray, ignore: np.ndarray | None = None) -> np.ndarray:
     """Triangles meeting a neighbour at more than 90 degrees: a scan's folded-over triangles (pairs
     with a triangle in ``ignore``, a boolean mask, left out)."""
     fn = np.cross(p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]])
@@ -146,7 +146,7 @@ def unfold(
     edges, _ = _undirected_edges(f)
     degree = np.bincount(edges.reshape(-1), minlength=len(p)).astype(np.float64)
     for _ in range(rounds):
-        folded = _folds(p, f, ignore)
+        folded = folded_triangles(p, f, ignore)
         if not len(folded):
             return p, f
         moving = np.unique(f[folded].reshape(-1))
@@ -156,7 +156,7 @@ def unfold(
         p[moving] = total[moving] / np.maximum(degree[moving], 1.0)[:, None]
     if ignore is not None:
         return p, f
-    stuck = np.unique(f[_folds(p, f)].reshape(-1))
+    stuck = np.unique(f[folded_triangles(p, f)].reshape(-1))
     return p, f[~np.isin(f, stuck).any(axis=1)]
 
 
@@ -191,7 +191,7 @@ def close_mesh(positions: np.ndarray, indices: np.ndarray, unfold_rounds: int = 
         # a small hole's fan in a curved place may fold against its rim: smooth it in, else cut it out
         # with its surroundings and fill the larger hole again
         p, f = unfold(p, f, unfold_rounds, ignore=big)
-        stuck = np.unique(f[_folds(p, f, big)].reshape(-1))
+        stuck = np.unique(f[folded_triangles(p, f, big)].reshape(-1))
         if not len(stuck):
             break
         keep = ~np.isin(f, stuck).any(axis=1)

@@ -46,6 +46,7 @@ import math
 import numpy as np
 
 from skinlab.scene.graph import LightNode, MeshNode, Scene
+from skinlab.scene.mesh_topology import edge_report
 from skinlab.scene.optics.constants import MIN_MFP_MM
 from skinlab.scene.optics.rough_dielectric import SMOOTH_ALPHA  # below it a smooth dielectric (rough one degenerates)
 from skinlab.scene.optics.similarity import real_albedo, real_mfp
@@ -321,6 +322,11 @@ def describe(
             if closed:
                 notes.append(f"{node.name}: {closed} hole(s) in the mesh capped so that the medium is closed")
                 uv = None
+            bad = edge_report(mesh).non_manifold
+            if bad:  # three or more triangles on an edge: which side is inside is ambiguous there
+                notes.append(
+                    f"{node.name}: {bad} non-manifold edge(s): the medium's inside is ambiguous there (repair the mesh)"
+                )
             if signed_volume(pos, faces) < 0:  # Mitsuba tells inside from outside by the winding
                 faces = faces[:, ::-1].copy()
             bsdf = boundary_bsdf(values)

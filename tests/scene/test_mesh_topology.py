@@ -8,7 +8,7 @@ import pytest
 from skinlab.render.plan import plan_frame
 from skinlab.render.settings import RenderSettings
 from skinlab.scene.mesh import Mesh
-from skinlab.scene.mesh_topology import _folds, close_mesh, edge_report, open_mesh_warning
+from skinlab.scene.mesh_topology import close_mesh, edge_report, folded_triangles, open_mesh_warning
 from skinlab.scene.scenefile import load_scene
 from tests.tsd_scenes import light_from, quad_mesh, slab_scene
 
@@ -58,7 +58,7 @@ def test_bundled_bunny_is_closed_without_folds_above_its_base():
     mesh = node.mesh
     assert edge_report(mesh).closed, edge_report(mesh)
     p, f = mesh.positions.astype(np.float64), mesh.indices.astype(np.int64)
-    folded = _folds(p, f)
+    folded = folded_triangles(p, f)
     base = p[:, 1].min()
     # only where the filled base meets the sides (a right angle within 7 mm of the bottom) do faces meet
     # at more than 90 degrees; the scan had 92 such folds all over the body
@@ -89,3 +89,15 @@ def test_translucency_on_an_open_mesh_warns_once():
     # no shadow-casting light, no translucency: nothing reads the thickness, nothing to say
     scene = slab_scene(mesh=box)
     assert not [w for w in plan_frame(scene, settings).warnings if "closed" in w]
+
+
+def test_the_truth_notes_non_manifold_edges():
+    """The path tracer caps holes itself (and says so); a non-manifold edge it cannot repair: a note."""
+    from skinlab.truth.export import describe
+
+    fin = Mesh("fin", np.vstack([CUBE_P, [[0.5, -1, 0.5]]]) - 0.5, np.vstack([CUBE_F, [[0, 1, 8]]]))
+    notes = describe(slab_scene(mesh=fin), 8, 8).notes
+    assert any("1 non-manifold edge" in n for n in notes), notes
+    assert not any(
+        "non-manifold" in n for n in describe(slab_scene(mesh=Mesh("cube", CUBE_P - 0.5, CUBE_F)), 8, 8).notes
+    )

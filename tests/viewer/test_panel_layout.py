@@ -33,6 +33,7 @@ def ui():
     imgui.create_context()
     gui_module.apply_style()
     io = imgui.get_io()
+    io.set_ini_filename(None)  # no imgui.ini in the working folder
     io.display_size = imgui.ImVec2(960, 720)
     io.backend_flags |= imgui.BackendFlags_.renderer_has_textures  # no renderer: nothing is drawn
     yield io
