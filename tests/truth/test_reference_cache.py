@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.truth.test_truth_render import sky_slab
+from tests.tsd_scenes import sky_slab
 
 ROOT = Path(__file__).resolve().parents[2]
 SIZE = 6
