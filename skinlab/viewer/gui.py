@@ -170,6 +170,14 @@ class Gui:
             if new is not None:
                 if w.widget.startswith("checkbox"):
                     c, new = imgui.checkbox(label, bool(new))
+                elif w.widget == "combo":
+                    c = False
+                    if imgui.begin_combo(label, str(new)):
+                        for choice in w.choices:
+                            clicked, _ = imgui.selectable(choice, choice == new)
+                            if clicked:
+                                c, new = True, choice
+                        imgui.end_combo()
                 elif w.widget.startswith("slider_int"):
                     c, new = imgui.slider_int(label, int(new), int(w.range[0]), int(w.range[1]))
                 else:

@@ -26,6 +26,7 @@ import numpy as np
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
 from skinlab.render.bounce import bind_bounce, bounce_defines
 from skinlab.render.boundary import bind_boundary
+from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
 from skinlab.render.texture_units import TextureUnits
@@ -37,7 +38,8 @@ from .seams import SeamMap, node_border_strips
 
 STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
-MAX_TAPS = 31  # skinlab/shaders/passes/tsd_blur.frag
+MAX_TAPS = 31  # skinlab/shaders/techniques/tsd/blur.glsl
+DILATE_GROUP = 16  # texels per side of a work group of skinlab/shaders/techniques/tsd/dilate.comp
 
 
 def _texture(ctx, size: int) -> moderngl.Texture:
@@ -223,12 +225,18 @@ def _uv_raster_setup(ctx, fbo, size: int) -> None:
     ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
 
 
-def dilate(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, rings: int) -> None:
+def dilate(
+    renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, rings: int, compute: bool = False
+) -> None:
     """`rings` one-texel dilation steps from `src` into `dst`, ping-ponging with the scratch
-    texture (in place, src is dst, the count is rounded up to an even one)."""
+    texture (in place, src is dst, the count is rounded up to an even one). With `compute` every
+    ring in one dispatch (techniques/tsd/dilate.comp; in place through the scratch texture)."""
     ctx = renderer.ctx
-    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_dilate.frag")
     steps = rings + (rings % 2) if src is dst else max(rings, 1)
+    if compute:
+        dilate_compute(renderer, t, src, dst, steps)
+        return
+    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_dilate.frag")
     for i in range(steps):
         out = dst if (steps - 1 - i) % 2 == 0 else t.scratch
         t.fbo(ctx, out).use()
@@ -237,6 +245,26 @@ def dilate(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Tex
         set_uniform(prog, "u_src", 0)
         renderer.fullscreen(prog)
         src = out
+
+
+def dilate_compute(
+    renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, rings: int, seams: bool = False
+) -> None:
+    """`rings` rings of dilation from `src` into `dst` in one dispatch (techniques/tsd/dilate.comp);
+    with `seams` the texels are read through the node's seam map first (the seam fill)."""
+    ctx = renderer.ctx
+    cs = renderer.programs.compute("techniques/tsd/dilate.comp", {"RINGS": rings, "TSD_SEAMS": seams})
+    out = t.scratch if src is dst else dst
+    units = TextureUnits(ctx)
+    units.bind(cs, "u_src", src)
+    if seams:
+        units.bind(cs, "u_seam", t.seam_map(ctx).texture)
+    bind_images(cs, {"u_dst": out})
+    groups = (t.size + DILATE_GROUP - 1) // DILATE_GROUP
+    cs.run(groups, groups, 1)
+    ctx.memory_barrier()
+    if out is not dst:
+        ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, out))
 
 
 class TsdPass:
@@ -277,7 +305,7 @@ class TsdStretchPass(TsdPass):
         if prm.seams is not None:  # the surface across seams, in the gutter: drawn first, the charts win
             self.r.resources.mesh(prm.seams.mesh()).vao(prog).render(moderngl.TRIANGLES)
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
-        dilate(self.r, t, t.stretch, t.stretch, prm.dilate)
+        dilate(self.r, t, t.stretch, t.stretch, prm.dilate, prm.compute)
         store(self.r).stretch_updates += 1
 
 
@@ -384,12 +412,14 @@ class TsdDilatePass(TsdPass):
         frame.targets[f"tsd_stretch[{name}]"] = t.stretch
 
     def run(self, frame, p) -> None:
-        t = self.node_targets(p)
-        if p.params.seams is not None:  # the gutter across seams, then dilation for the rest
+        t, prm = self.node_targets(p), p.params
+        if prm.compute:  # the seam fill and every ring in one dispatch
+            dilate_compute(self.r, t, t.raw, t.irradiance, max(prm.dilate, 1), prm.seams is not None)
+        elif prm.seams is not None:  # the gutter across seams, then dilation for the rest
             seam_fill(self.r, t, t.raw, t.irradiance)
-            dilate(self.r, t, t.irradiance, t.irradiance, p.params.dilate)
+            dilate(self.r, t, t.irradiance, t.irradiance, prm.dilate)
         else:
-            dilate(self.r, t, t.raw, t.irradiance, p.params.dilate)
+            dilate(self.r, t, t.raw, t.irradiance, prm.dilate)
         self.publish(frame, p)
 
 
@@ -409,10 +439,18 @@ class TsdSeamPass(TsdPass):
         self.publish(frame, p)
 
 
-def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture) -> None:
+def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, compute: bool = False) -> None:
     """`src` into `dst` (another texture), the texels the seam map marks read across the seam
-    (skinlab/shaders/passes/tsd_seam_fill.frag)."""
+    (skinlab/shaders/passes/tsd_seam_fill.frag; `compute`: techniques/tsd/blur.comp's TSD_SEAM_FILL)."""
     ctx = renderer.ctx
+    if compute:
+        cs = renderer.programs.compute("techniques/tsd/blur.comp", {"TSD_SEAM_FILL": 1})
+        src.use(0)
+        t.seam_map(ctx).texture.use(1)
+        set_uniforms(cs, {"u_src": 0, "u_seam": 1})
+        bind_images(cs, {"u_dst": dst})
+        dispatch(cs, (t.size, t.size))
+        return
     prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_seam_fill.frag")
     t.fbo(ctx, dst).use()
     ctx.viewport = (0, 0, t.size, t.size)
@@ -437,22 +475,32 @@ class TsdBlurPass(TsdPass):
         t = self.node_targets(p)
         src = t.irradiance if step.level == 0 else t.level(ctx, step.level - 1)
         dst = t.level(ctx, step.level)
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
+        seams = prm.seams is not None
+        # u then v; with seams the v step goes to the scratch texture and the seam fill from there
+        # into the level (its gutter across the seams, for the next blur and the gather)
+        steps = ((src, dst), (dst, t.scratch)) if seams else ((src, t.scratch), (t.scratch, dst))
+        if prm.compute:
+            prog = self.r.programs.compute("techniques/tsd/blur.comp")
+        else:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         taps_t, taps_w = blur_taps(step.taps)
         set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
         set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)
         set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_sigma_mm": step.sigma_mm, "u_taps": step.taps})
         t.stretch.use(1)
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-        for axis, (a, b) in enumerate(((src, t.scratch), (t.scratch, dst))):
-            t.fbo(ctx, b).use()
-            ctx.viewport = (0, 0, size, size)
+        for axis, (a, b) in enumerate(steps):
             a.use(0)
             set_uniform(prog, "u_axis", axis)
-            self.r.fullscreen(prog)
-        if prm.seams is not None:  # the level's gutter across the seams, for the next blur and the gather
-            seam_fill(self.r, t, dst, t.scratch)
-            ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, t.scratch))
+            if prm.compute:
+                bind_images(prog, {"u_dst": b})
+                dispatch(prog, (size, size))
+            else:
+                t.fbo(ctx, b).use()
+                ctx.viewport = (0, 0, size, size)
+                self.r.fullscreen(prog)
+        if seams:
+            seam_fill(self.r, t, t.scratch, dst, prm.compute)
         self.publish(frame, p)
 
 
