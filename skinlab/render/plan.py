@@ -17,7 +17,7 @@ if TYPE_CHECKING:
     from .settings import RenderSettings
 
 # the path `compute = auto` takes for tone mapping on software GL (measured: docs/architecture.md)
-TONEMAP_ON_SOFTWARE = "compute"
+TONEMAP_ON_SOFTWARE = "fragment"
 
 __all__ = ["FramePlan", "PlannedPass", "ShadowParams", "ForwardParams", "plan_frame"]
 

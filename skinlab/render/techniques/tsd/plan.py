@@ -38,8 +38,8 @@ from .seams import node_seams, seam_band_texels, seams_summary
 DILATE_RINGS = 4  # texels of dilation past chart borders (irradiance and stretch)
 # the path `compute = auto` takes on software GL for the dilations and the blurs (skinlab/render/compute.py;
 # measured: docs/architecture.md "Compute passes")
-DILATE_ON_SOFTWARE = "compute"
-BLUR_ON_SOFTWARE = "compute"
+DILATE_ON_SOFTWARE = "fragment"
+BLUR_ON_SOFTWARE = "fragment"
 
 
 def model_scale(world: np.ndarray) -> float:
@@ -95,6 +95,10 @@ class TsdIrradianceParams(TsdNodeParams):
     translucency: bool = False
     mix: float = 0.5  # pre-/post-scatter texturing: albedo^mix before the blur
     gather: DiffusionKernel | None = None  # the forward pass's gather weights (None: kernel)
+    # shade each texel once from a G-buffer of the rasterised surface (techniques/tsd/surface.glsl), the
+    # same light; else shade while rasterising the mesh (a software rasteriser shades whole blocks of
+    # texels for each small UV triangle)
+    deferred: bool = False
 
 
 @dataclass
@@ -255,6 +259,14 @@ def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tu
     )
 
 
+def deferred_irradiance(device) -> bool:
+    """Whether the irradiance pass shades from its surface G-buffer (TsdIrradianceParams.deferred): on
+    software GL, where it takes about half the time of shading while rasterising the UV layout
+    (docs/tsd.md "Cost"), the same light to fp32 rounding; on a GPU, which shades 2x2 quads, the
+    direct raster (not measured there yet)."""
+    return device is not None and device.software
+
+
 def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
     node, n, k = t.node, t.size, t.kernel
     base = dict(node=node, size=n, material=t.material, kernel=k, dilate=DILATE_RINGS, seams=t.seams)
@@ -297,6 +309,11 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
             res,
             f"material '{t.material.name}' scatters ({t.material['sss_model']}): light entering the surface in UV space"
             + (
+                "; each texel shaded once from the rasterised surface (a G-buffer)"
+                if deferred_irradiance(ctx.device)
+                else ""
+            )
+            + (
                 ", translucency through thin parts (its record's gutter filled "
                 + ("across UV seams and " if t.seams is not None else "")
                 + "one texel past chart borders)"
@@ -310,6 +327,7 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 translucency=translucency,
                 mix=mix,
                 gather=UNIT_KERNEL if exact is not None else k,
+                deferred=deferred_irradiance(ctx.device),
             ),
             inputs=irradiance_inputs(t, ctx, mix, translucency),
             # the light-through record is filled across the seams from the seam map
