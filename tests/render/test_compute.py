@@ -1,6 +1,7 @@
 """Compute shaders for the screen- and texture-space passes (skinlab/render/compute.py): every pass with a
 compute variant gives its fragment pass's image to fp32 rounding (on llvmpipe, bit for bit), the
-compute kernels match the NumPy twins the fragment passes are checked against, the planner picks the
+compute kernels match the NumPy twins the fragment passes are checked against (the disk pass's
+model: tests/render/techniques/test_disk.py, both paths), the planner picks the
 path per pass and says why, and a context without compute shaders falls back to the fragment path."""
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from skinlab.render.techniques.tsd.plan import TsdBlurParams
 from skinlab.scene.graph import MeshNode
 from skinlab.scene.optics import tsd
 from skinlab.scene.optics.tsd import BlurStep
+from tests.render.techniques.test_tsd_seams import _random_seam_case
 from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
 FP32 = 4 * np.finfo(np.float32).eps
@@ -119,17 +121,8 @@ def test_compute_dilation_matches_its_twin(renderer):
 def test_compute_seam_fill_and_blur_match_their_twins(renderer):
     """The blur and the seam fill as compute shaders against diffuse_reference with the seam map and
     seam_fill_reference (the fragment passes' twins), 1e-4."""
-    rng = np.random.default_rng(3)
     n = 40
-    img = np.zeros((n, n, 4), np.float32)
-    real = np.zeros((n, n), bool)
-    real[5:20, 4:30] = real[24:36, 8:34] = True
-    img[real, :3] = rng.uniform(0.1, 2.0, (real.sum(), 3))
-    img[real, 3] = 1.0
-    seam = np.zeros((n, n, 4), np.float32)
-    ext = ~real & (rng.random((n, n)) < 0.6)
-    seam[ext, 0:2] = rng.uniform(0.0, 1.0, (ext.sum(), 2))
-    seam[ext, 3] = 1.0
+    img, seam, _, _ = _random_seam_case(n)
     node = SimpleNamespace(uid=-32, name="seams")
     t = store(renderer).targets(node, n)
     try:
@@ -152,44 +145,6 @@ def test_compute_seam_fill_and_blur_match_their_twins(renderer):
             np.testing.assert_allclose(got, want, rtol=1e-4, atol=1e-5 * np.abs(want).max())
     finally:
         store(renderer).nodes.pop(-32).release()
-
-
-def test_the_disk_compute_pass_matches_its_numpy_model(renderer):
-    """techniques/disk/gather.comp against disk_filter_reference (the fragment pass's model), as the
-    fragment pass is tested (tests/render/techniques/test_disk.py)."""
-    import math
-
-    from skinlab.render.techniques.disk import DiskSettings
-    from skinlab.scene.optics import disk
-
-    n = 48
-    scene = two_media_slab()
-    res = renderer.render(
-        scene, RenderSettings(n, n, shadow_size=512, technique=DiskSettings(samples=16), compute="on")
-    )
-    prm = next(p.params for p in res.plan.passes if p.kind == "disk_sss")
-    assert prm.compute
-    f = renderer.last_frame
-    src = np.frombuffer(f.targets["disk_diffuse"].read(), np.float32).reshape(n, n, 4)
-    gpu = np.frombuffer(f.targets["disk_filtered"].read(), np.float32).reshape(n, n, 4)[..., :3]
-    depth = np.frombuffer(f.targets["depth"].read(), np.float32).reshape(n, n).astype(np.float64)
-    cam = scene.camera
-    zn, zf = cam.znear, cam.zfar
-    view_z = 2 * zn * zf / (zf + zn - (depth * 2 - 1) * (zf - zn))
-    ys, xs = np.mgrid[0:n, 0:n] + 0.5
-    ref = disk.disk_filter_reference(
-        src[..., :3],
-        src[..., 3],
-        view_z,
-        prm.table(),
-        np.array([k.reach_mm for k in prm.kernels]),
-        scene.mm_per_unit,
-        n / (2 * math.tan(cam.yfov / 2)),
-        2 * math.pi * disk.interleaved_gradient_noise(xs, ys),
-    )
-    assert np.abs(ref - src[..., :3]).max() > 0.01  # it filters
-    worst = (np.abs(gpu - ref) / np.maximum(np.abs(ref), 1e-3)).max(axis=2)
-    assert np.mean(worst < 1e-4) > 0.98 and worst.max() < 0.05, (np.mean(worst < 1e-4), worst.max())
 
 
 def test_the_path_is_chosen_per_pass_and_explained(ctx):
