@@ -86,11 +86,11 @@ def dispatch(cs: moderngl.ComputeShader, size: tuple[int, int], barrier: bool = 
         cs.ctx.memory_barrier()
 
 
-def bind_images(cs: moderngl.ComputeShader, images: dict, write: bool = True) -> None:
-    """Bind each texture to the image uniform named by its key, on units 0, 1, ... in order
-    (written, not read: the .comp files declare them ``writeonly``)."""
+def bind_images(cs: moderngl.ComputeShader, images: dict) -> None:
+    """Bind each texture to the image uniform named by its key, on image units 0, 1, ... in order,
+    for writing (the .comp files declare them ``writeonly``; what they read is a sampler)."""
     from skinlab.gl.uniforms import set_uniform
 
     for unit, (name, tex) in enumerate(images.items()):
-        tex.bind_to_image(unit, read=not write, write=write)
+        tex.bind_to_image(unit, read=False, write=True)
         set_uniform(cs, name, unit)
