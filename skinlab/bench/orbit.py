@@ -13,7 +13,10 @@ renderer, interleaved so that a change of machine load hits all three alike:
 
 Frame time is wall time of ``render(readback=False)`` followed by ``glFinish`` (the viewer reads
 nothing back). The medians and the ratios ``orbit_over_plain`` and ``full_over_plain`` are reported
-with the load average, since the machine may be shared.
+with the load average, since the machine may be shared. Beside them, the same from the process's CPU
+time over each frame (``*_cpu_ms``, ``*_over_plain_cpu``: every thread's, so on software GL the
+rasteriser's own work), which a machine loaded by other jobs inflates far less than the wall time;
+and per pass, one frame of each of ``full`` and ``plain`` with glFinish after every pass (wall and CPU).
 """
 
 from __future__ import annotations
@@ -70,6 +73,7 @@ def orbit_scene(name: str, path, size, frames: int, ctx, progress=None) -> dict:
     lo, hi = scene.world_bounds()
     cam = scene.camera
     times: dict[str, list[float]] = {m: [] for m in MODES}
+    cpu: dict[str, list[float]] = {m: [] for m in MODES}
     ran: dict[str, set] = {m: set() for m in MODES}
     try:
         start_eye = cam.world_position
@@ -79,25 +83,28 @@ def orbit_scene(name: str, path, size, frames: int, ctx, progress=None) -> dict:
         for eye, target in orbit_path(cam, (lo + hi) / 2, frames):
             cam.look_at(eye, target)
             for m in MODES:
-                t0 = time.perf_counter()
+                c0, t0 = time.process_time(), time.perf_counter()
                 res = renderers[m].render(scene, settings[m], readback=False)
                 ctx.finish()
                 times[m].append((time.perf_counter() - t0) * 1e3)
+                cpu[m].append((time.process_time() - c0) * 1e3)
                 ran[m].update(res.plan.ran())
             if progress is not None:
                 progress.update(1)
         cam.look_at(start_eye, (lo + hi) / 2)
         # one frame per mode with glFinish after each pass: where the time goes
-        breakdown = {}
+        breakdown, breakdown_cpu = {}, {}
         for m in ("full", "plain"):
             r = renderers[m]
             r.timer.sync = True
             res = r.render(scene, settings[m], readback=False)
             breakdown[m] = {p.name: round(p.cpu_ms, 2) for p in res.timings.passes}
+            breakdown_cpu[m] = {p.name: round(p.process_ms, 2) for p in res.timings.passes}
     finally:
         for r in renderers.values():
             r.release()
     med = {m: statistics.median(v) for m, v in times.items()}
+    med_cpu = {m: statistics.median(v) for m, v in cpu.items()}
     return {
         "scene": name,
         "frames": frames,
@@ -105,8 +112,12 @@ def orbit_scene(name: str, path, size, frames: int, ctx, progress=None) -> dict:
         "orbit_over_plain": med["orbit"] / med["plain"],
         "full_over_plain": med["full"] / med["plain"],
         "orbit_over_plain_orbit": med["orbit"] / med["plain_orbit"],
+        **{f"{m}_cpu_ms": med_cpu[m] for m in MODES},
+        "orbit_over_plain_cpu": med_cpu["orbit"] / med_cpu["plain"],
+        "full_over_plain_cpu": med_cpu["full"] / med_cpu["plain"],
         "passes_run_while_orbiting": sorted(ran["orbit"], key=lambda n: (n != "forward", n)),
         "passes_ms": breakdown,
+        "passes_cpu_ms": breakdown_cpu,
     }
 
 

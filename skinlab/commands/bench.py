@@ -302,6 +302,14 @@ def run_orbit_bench(args) -> int:
             f"    orbit_over_plain {r['orbit_over_plain']:.2f}   full_over_plain {r['full_over_plain']:.2f}   "
             f"orbit_over_plain_orbit {r['orbit_over_plain_orbit']:.2f}"
         )
+        print(
+            f"    process CPU time: orbit {r['orbit_cpu_ms']:.1f}, full {r['full_cpu_ms']:.1f}, plain "
+            f"{r['plain_cpu_ms']:.1f} ms: orbit_over_plain {r['orbit_over_plain_cpu']:.2f}   "
+            f"full_over_plain {r['full_over_plain_cpu']:.2f}"
+        )
+        for m in ("full", "plain"):
+            parts = ", ".join(f"{n} {v:.1f}" for n, v in r["passes_cpu_ms"][m].items())
+            print(f"    {m} frame per pass (process CPU ms): {parts}")
         print(f"    passes run while orbiting: {', '.join(r['passes_run_while_orbiting'])}")
     return 0
 

@@ -38,6 +38,8 @@ def add_technique_options(parser: argparse.ArgumentParser) -> None:
             kw = dict(dest=_dest(t.name, name), default=None, help=o.help(defaults[name]))
             if o.kind == "bool":
                 group.add_argument(*flags, action=argparse.BooleanOptionalAction, **kw)
+            elif o.kind == "choice":
+                group.add_argument(*flags, choices=o.choices, **kw)
             else:
                 group.add_argument(*flags, type=str, metavar="N" if o.kind == "int" else "X", **kw)
 
@@ -60,7 +62,7 @@ def technique_from_args(args) -> TechniqueSettings:
 
 
 def _parse(raw, kind: str, flag: str, o):
-    if kind == "bool" or not isinstance(raw, str):
+    if kind in ("bool", "choice") or not isinstance(raw, str):
         return raw
     try:
         return int(raw) if kind == "int" else float(raw)
@@ -83,6 +85,8 @@ def add_render_options(parser: argparse.ArgumentParser) -> None:
         kw = dict(dest=_render_dest(name), default=None, help=o.help(default))
         if o.kind == "bool":
             parser.add_argument(flag, action=argparse.BooleanOptionalAction, **kw)
+        elif o.kind == "choice":
+            parser.add_argument(flag, choices=o.choices, **kw)
         else:
             parser.add_argument(flag, type=str, metavar="N" if o.kind == "int" else "X", **kw)
 

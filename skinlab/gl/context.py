@@ -13,6 +13,7 @@ import os
 import moderngl
 
 GL_VERSION = 330
+COMPUTE_GL_VERSION = 430  # compute shaders (the subsurface passes' compute path, skinlab/render/compute.py)
 
 _HINTS = {
     "libEGL": "libEGL.so.1 (Debian/Ubuntu: apt-get install libegl1 libegl-mesa0)",
@@ -78,6 +79,22 @@ def create_headless_context(shared: bool = True) -> moderngl.Context:
     if shared:
         _SHARED = ctx
     return ctx
+
+
+def compute_unavailable(ctx: moderngl.Context) -> str | None:
+    """None when `ctx` runs compute shaders (OpenGL 4.3 or newer), else why not, in words. The
+    headless context asks for 3.3 as a minimum and gets the newest core profile the driver has
+    (llvmpipe: 4.5); the viewer's window asks for 3.3 core and may get exactly that."""
+    code = int(getattr(ctx, "version_code", 0) or 0)
+    if code >= COMPUTE_GL_VERSION:
+        return None
+    return f"the GL context is {code // 100}.{code % 100 // 10} (compute shaders need 4.3)"
+
+
+def software_gl(ctx: moderngl.Context) -> bool:
+    """Whether `ctx` rasterises in software (Mesa llvmpipe or softpipe)."""
+    name = ctx.info.get("GL_RENDERER", "").lower()
+    return "llvmpipe" in name or "softpipe" in name
 
 
 def describe(ctx: moderngl.Context) -> str:

@@ -1,4 +1,6 @@
-"""Compiled programs cached by (stage files, defines), with last-good fallback on failure."""
+"""Compiled programs cached by (stage files, defines), with last-good fallback on failure: vertex +
+fragment programs (:meth:`ProgramCache.get`) and compute shaders (:meth:`ProgramCache.compute`, GL 4.3;
+skinlab/render/compute.py decides where they run)."""
 
 from __future__ import annotations
 
@@ -19,6 +21,9 @@ def normalize_defines(defines: Mapping[str, object] | None) -> dict[str, str]:
             continue
         out[k] = "1" if v is True else str(v)
     return out
+
+
+COMPUTE = "<compute>"  # the vertex-stage slot of a compute shader's key
 
 
 def _key(vs: str, fs: str, defines: Mapping[str, object] | None, includes: Mapping[str, str] | None) -> tuple:
@@ -42,8 +47,16 @@ def compile_program(
     includes: Mapping[str, str] | None = None,
 ) -> tuple[moderngl.Program, set[Path]]:
     """Compile one program; on failure raise :class:`ShaderError` naming file and line. ``includes``:
-    include names resolved to other files for this program (ShaderLibrary.expand's aliases)."""
+    include names resolved to other files for this program (ShaderLibrary.expand's aliases). With
+    ``vs`` = COMPUTE, ``fs`` is a compute shader's file and the result a moderngl.ComputeShader."""
     defines = normalize_defines(defines)
+    if vs == COMPUTE:
+        src = library.expand(fs, defines, includes)
+        deps = {p for p in src.paths if p is not None}
+        try:
+            return ctx.compute_shader(src.text), deps
+        except moderngl.Error:
+            raise _diagnose_compute(ctx, src) from None
     srcs: dict[str, ExpandedSource] = {
         "vertex_shader": library.expand(vs, defines, includes),
         "fragment_shader": library.expand(fs, defines, includes),
@@ -86,6 +99,15 @@ def _diagnose(ctx: moderngl.Context, srcs: dict[str, ExpandedSource]) -> ShaderE
     return ShaderError("\n".join(messages), locs)
 
 
+def _diagnose_compute(ctx: moderngl.Context, src: ExpandedSource) -> ShaderError:
+    try:
+        ctx.compute_shader(src.flat).release()
+    except moderngl.Error as exc:
+        msg, where = parse_errors(str(exc), src, "compute")
+        return ShaderError(msg, where)
+    return ShaderError("compute shader failed to compile, but the flat source compiles (driver issue?)")
+
+
 class ProgramCache:
     """Programs keyed by (stage files, defines, include aliases). ``reload`` recompiles programs whose files
     changed and keeps the last good program when the new source fails."""
@@ -111,6 +133,13 @@ class ProgramCache:
             self.compiles += 1
             entry = self.entries[key] = ProgramEntry(prog, deps, None, 1)
         return entry.program
+
+    def compute(
+        self, cs: str, defines: Mapping[str, object] | None = None, includes: Mapping[str, str] | None = None
+    ) -> moderngl.ComputeShader:
+        """The compute shader of file `cs` (a ``#version 430`` file under the shader root) for a variant;
+        reloaded like the programs."""
+        return self.get(COMPUTE, cs, defines, includes)
 
     def dependents(self, changed: set[Path]) -> list[tuple]:
         changed = {Path(p).resolve() for p in changed}

@@ -48,6 +48,11 @@ class ForwardParams:
 
 
 @dataclass
+class TonemapParams:
+    compute: bool = False  # the compute shader (skinlab/render/compute.py), else the fragment shader
+
+
+@dataclass
 class FramePlan:
     passes: list[PlannedPass]
     skipped: list[tuple[str, str]] = field(default_factory=list)  # (what, why not)

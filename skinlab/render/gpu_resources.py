@@ -75,6 +75,8 @@ class GpuResources:
         self.meshes: dict[int, GpuMesh] = {}
         self.textures: dict[tuple[str, str], moderngl.Texture] = {}
         self.uploads = 0
+        self._isotropic: moderngl.Sampler | None = None
+        self._sampled_units: set[int] = set()
 
     def mesh(self, mesh: Mesh) -> GpuMesh:
         g = self.meshes.get(mesh.uid)
@@ -108,13 +110,38 @@ class GpuResources:
             self.uploads += 1
         return tex
 
-    def bind_material(self, prog: moderngl.Program, material, units) -> None:
-        """The material's plain values as uniforms and its maps on units from `units` (TextureUnits)."""
+    def bind_material(self, prog: moderngl.Program, material, units, isotropic: bool = False) -> None:
+        """The material's plain values as uniforms and its maps on units from `units` (TextureUnits).
+        `isotropic`: the maps filtered trilinearly, without the anisotropic filtering the screen-space
+        passes want at grazing angles (a sampler object on their units until :meth:`unbind_samplers`).
+        For passes that rasterise in UV space, where a texel's footprint on the map is a square: a GPU
+        takes one probe there, which is trilinear filtering, while llvmpipe's anisotropic filter (an
+        elliptical average) differs from it, changes with the last bit of the derivatives and costs
+        a third of the texture-space irradiance pass."""
         set_uniforms(prog, material.uniforms())
         for sampler, (path, cs) in material.textures().items():
-            units.bind(prog, sampler, self.texture(path, cs))
+            unit = units.bind(prog, sampler, self.texture(path, cs))
+            if isotropic:
+                self.isotropic_sampler().use(unit)
+                self._sampled_units.add(unit)
+
+    def isotropic_sampler(self) -> moderngl.Sampler:
+        """The maps' filtering (trilinear, repeat) without anisotropy (bind_material's `isotropic`)."""
+        if self._isotropic is None:
+            self._isotropic = self.ctx.sampler(filter=(moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR), anisotropy=1.0)
+        return self._isotropic
+
+    def unbind_samplers(self) -> None:
+        """Back to each texture's own filtering on the units bind_material gave a sampler object."""
+        for unit in self._sampled_units:
+            self._isotropic.clear(unit)
+        self._sampled_units.clear()
 
     def release(self) -> None:
+        if self._isotropic is not None:
+            self.unbind_samplers()
+            self._isotropic.release()
+            self._isotropic = None
         for g in self.meshes.values():
             g.release()
         for t in self.textures.values():

@@ -14,14 +14,19 @@ class Option:
     """What a settings field means and which values it takes."""
 
     doc: str
-    kind: str  # int | float | bool
+    kind: str  # int | float | bool | choice
     range: tuple[float, float] | None = None  # inclusive
     odd: bool = False  # ints only: odd values
     none: str = ""  # when not empty, None is allowed and means this (e.g. "from each blur's width")
     unit: str = ""
     flags: tuple[str, ...] = ()  # extra command-line spellings kept for compatibility
+    choices: tuple[
+        str, ...
+    ] = ()  # kind "choice": the values it takes (the first is not the default unless so declared)
 
     def expected(self, with_none: bool = True) -> str:
+        if self.kind == "choice":
+            return "one of " + ", ".join(self.choices)
         what = {"int": "an integer", "float": "a number", "bool": "true or false"}[self.kind]
         if self.odd:
             what = "an odd integer"
@@ -36,6 +41,10 @@ class Option:
         if value is None and self.none:
             return None
         bad = ValueError(f"{label}: expected {self.expected()}, got {value!r}")
+        if self.kind == "choice":
+            if not isinstance(value, str) or value not in self.choices:
+                raise bad
+            return value
         if self.kind == "bool":
             if not isinstance(value, bool):
                 raise bad
@@ -60,7 +69,7 @@ class Option:
         """One line for --help and the viewer's tooltips: meaning, values, default."""
         unit = f" {self.unit}" if self.unit else ""
         shown = self.none if default is None else f"{default}{unit}"
-        values = "" if self.kind == "bool" else f"; {self.expected(with_none=False)}"
+        values = "" if self.kind in ("bool", "choice") else f"; {self.expected(with_none=False)}"
         return f"{self.doc}{values} (default: {shown})"
 
 

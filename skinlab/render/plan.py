@@ -5,7 +5,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from .bounce import plan_bounce, prefetch_bounce
-from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams, shadow_pass_name
+from .compute import Device, choose_path
+from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams, TonemapParams, shadow_pass_name
 from .registry import get_technique
 from .reuse import light_placement, scene_geometry
 from .technique import PlanContext
@@ -15,14 +16,19 @@ if TYPE_CHECKING:
 
     from .settings import RenderSettings
 
+# the path `compute = auto` takes for tone mapping on software GL (measured: docs/architecture.md)
+TONEMAP_ON_SOFTWARE = "fragment"
+
 __all__ = ["FramePlan", "PlannedPass", "ShadowParams", "ForwardParams", "plan_frame"]
 
 
-def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
+def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Device | None = None) -> FramePlan:
     """Passes for this frame: shadow maps, interreflection (skinlab/render/bounce.py), the technique's
     passes (registry), the forward pass with
     the technique's shading hook, tone mapping. ``state``: the technique's renderer-side state (its
-    caches, e.g. texture-space diffusion's stretch maps); None plans as if nothing were cached."""
+    caches, e.g. texture-space diffusion's stretch maps); None plans as if nothing were cached.
+    ``device``: what the GL context can do (skinlab/render/compute.py: compute shaders); None plans the
+    fragment path everywhere."""
     meshes = scene.mesh_nodes()
     lights = scene.lights()
     n = settings.supersample
@@ -44,7 +50,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
         shadow_lights = []
     technique = get_technique(settings.technique_name)
     prefetch_bounce(scene, settings, meshes, lights)  # rays are cast while the technique plans
-    tp = technique.plan(PlanContext(scene, settings, meshes, lights, shadow_lights[:2], plan, state))
+    tp = technique.plan(PlanContext(scene, settings, meshes, lights, shadow_lights[:2], plan, state, device))
     distance = tp.shadow_distance and bool(shadow_lights)
     geometry = scene_geometry(scene) if shadow_lights else ()
     for slot, l in enumerate(shadow_lights[:2]):
@@ -84,6 +90,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
         )
     )
     plan.passes += tp.after_forward
+    path = choose_path(settings, device, TONEMAP_ON_SOFTWARE)
     plan.passes.append(
         PlannedPass(
             "tonemap",
@@ -91,7 +98,9 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None) -> FramePlan:
             "ldr_color" + ("+hdr_filtered" if n > 1 else ""),
             settings.size,
             (f"box filter of each pixel's {n} x {n} samples (linear radiance), then " if n > 1 else "")
-            + "ACES tone mapping and sRGB encoding for display/PNG",
+            + "ACES tone mapping and sRGB encoding for display/PNG"
+            + path.note,
+            TonemapParams(path.compute),
         )
     )
     return plan

@@ -14,6 +14,7 @@ from skinlab.gl.shader_source import ShaderLibrary
 from skinlab.scene.graph import Scene
 
 from .bounce import BouncePass
+from .compute import Device
 from .frame import Frame
 from .frame_plan import FramePlan
 from .gpu_resources import GpuResources
@@ -43,6 +44,7 @@ class Renderer:
     def __init__(self, ctx: moderngl.Context, library: ShaderLibrary | None = None):
         self.ctx = ctx
         self.programs = ProgramCache(ctx, library)
+        self.device = Device.of(ctx)  # what the planner may use (compute shaders; skinlab/render/compute.py)
         self.resources = GpuResources(ctx)
         self.timer = PassTimer(ctx)
         # the core's passes; a technique's are made on first use (pass_for)
@@ -103,7 +105,7 @@ class Renderer:
     # -- a frame ------------------------------------------------------------------------
     def plan(self, scene: Scene, settings: RenderSettings) -> FramePlan:
         t = get_technique(settings.technique_name)
-        return plan_frame(scene, settings, self.state(*t.state) if t.state is not None else None)
+        return plan_frame(scene, settings, self.state(*t.state) if t.state is not None else None, self.device)
 
     def render(
         self, scene: Scene, settings: RenderSettings | None = None, readback: bool | tuple[str, ...] = True

@@ -6,6 +6,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
+from .compute import COMPUTE_CHOICES
 from .options import Option, TechniqueSettings, option
 from .registry import DEFAULT_TECHNIQUE, get_technique
 
@@ -54,6 +55,16 @@ class RenderSettings:
         "int",
         range=(4, 4096),
         unit="rays per vertex",
+    )
+
+    # compute shaders for the screen- and texture-space passes (skinlab/render/compute.py)
+    compute: str = option(
+        "auto",
+        "compute shaders (GL 4.3) for the subsurface passes, tone mapping and the supersample filter: auto "
+        "(per pass, the path measured faster on this kind of device), on (wherever the GL context offers "
+        "them), off (fragment shaders); images agree to fp32 rounding",
+        "choice",
+        choices=COMPUTE_CHOICES,
     )
 
     def __post_init__(self) -> None:

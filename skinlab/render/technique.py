@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from skinlab.scene.optics.edges import step_edge
 
+from .compute import Device, PassPath, choose_path
 from .frame_plan import FramePlan, PlannedPass
 from .options import TechniqueSettings
 
@@ -98,10 +99,16 @@ class PlanContext:
     shadow_lights: list[LightNode]  # those with a shadow map (at most 2)
     plan: FramePlan  # record skips and warnings here
     state: Any = None  # the technique's renderer-side state; None when planned without a renderer
+    device: Device | None = None  # the GL context's abilities (compute shaders); None: planned without one
 
     @property
     def options(self) -> TechniqueSettings:
         return self.settings.technique
+
+    def path(self, software: str = "compute") -> PassPath:
+        """Compute or fragment shader for a pass with a compute variant (skinlab/render/compute.py
+        choose_path; `software`: the path ``compute = auto`` takes on software GL)."""
+        return choose_path(self.settings, self.device, software)
 
 
 @dataclass

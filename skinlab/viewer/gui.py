@@ -239,6 +239,14 @@ class Gui:
                     imgui.begin_disabled()
                 if w.widget.startswith("checkbox"):
                     c, got = imgui.checkbox(hidden, bool(with_value))
+                elif w.widget == "combo":
+                    c, got = False, with_value
+                    if imgui.begin_combo(hidden, str(with_value)):
+                        for choice in w.choices:
+                            clicked, _ = imgui.selectable(choice, choice == with_value)
+                            if clicked:
+                                c, got = True, choice
+                        imgui.end_combo()
                 elif w.widget.startswith("slider_int"):
                     c, got = imgui.slider_int(hidden, int(with_value), int(w.range[0]), int(w.range[1]))
                 else:

@@ -354,7 +354,7 @@ LIGHT_COLOR_MAX = 10.0  # a light's colour channels in the panel (linear, may ex
 # -- the current technique's settings (skinlab/render/options.py declarations) --------------------------------
 
 # Option.kind -> widget kind; an option that may be None (automatic) gets "<kind>_or_auto"
-TECHNIQUE_WIDGETS = {"bool": "checkbox", "int": "slider_int", "float": "slider_float"}
+TECHNIQUE_WIDGETS = {"bool": "checkbox", "int": "slider_int", "float": "slider_float", "choice": "combo"}
 
 
 def technique_widgets(settings) -> list[Widget]:
@@ -376,15 +376,16 @@ def option_widgets(settings, defaults: dict) -> list[Widget]:
     for name, o in settings.options().items():
         kind = TECHNIQUE_WIDGETS[o.kind] + ("_or_auto" if o.none else "")
         rng = tuple(float(x) for x in o.range) if o.range is not None else None
-        out.append(Widget(name, kind, getattr(settings, name), rng, unit=o.unit, doc=o.help(defaults[name])))
+        out.append(Widget(name, kind, getattr(settings, name), rng, o.choices, unit=o.unit, doc=o.help(defaults[name])))
     return out
 
 
 def technique_value(settings, name: str, value: Any) -> Any:
     """A widget's value made valid for the field: numbers clamped into the declared range, integers
-    rounded (odd counts to the nearest odd one inside the range); None (automatic) and booleans as given."""
+    rounded (odd counts to the nearest odd one inside the range); None (automatic), booleans and
+    choices as given (the settings check them)."""
     o = settings.options()[name]
-    if value is None or o.kind == "bool":
+    if value is None or o.kind in ("bool", "choice"):
         return value
     v = float(value)
     if o.range is not None:

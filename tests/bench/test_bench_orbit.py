@@ -29,6 +29,10 @@ def test_orbit_bench_times_all_modes_and_only_view_dependent_passes_run_while_or
         assert row[f"{m}_ms"] > 0
     assert row["orbit_over_plain"] == pytest.approx(row["orbit_ms"] / row["plain_ms"])
     assert row["full_over_plain"] == pytest.approx(row["full_ms"] / row["plain_ms"])
+    for m in ("orbit", "full", "plain", "plain_orbit"):
+        assert row[f"{m}_cpu_ms"] > 0
+    assert row["full_over_plain_cpu"] == pytest.approx(row["full_cpu_ms"] / row["plain_cpu_ms"])
+    assert set(row["passes_cpu_ms"]["full"]) == set(row["passes_ms"]["full"])
     assert row["passes_run_while_orbiting"] == ["forward", "tonemap"]
     full = row["passes_ms"]["full"]
     assert "shadow[key]" in full and any(n.startswith("tsd_irradiance") for n in full)

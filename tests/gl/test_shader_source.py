@@ -86,3 +86,44 @@ def test_reload_keeps_last_good_program_and_recovers(ctx, root):
     before = cache.compiles
     cache.reload({root / "unrelated.glsl"})
     assert cache.compiles == before
+
+
+CS = """#version 430 core
+layout(local_size_x = 8, local_size_y = 8) in;
+#include "lib/util.glsl"
+layout(rgba32f) writeonly uniform image2D u_dst;
+void main() {
+    imageStore(u_dst, ivec2(gl_GlobalInvocationID.xy), vec4(util_value()));
+}
+"""
+
+
+def test_compute_shaders_include_report_errors_and_reload(ctx, root):
+    """ProgramCache.compute: includes and defines as for programs, an error names the included file
+    and line, a reload keeps the last good shader and then picks up the fix."""
+    import numpy as np
+
+    (root / "p.comp").write_text(CS)
+    cache = ProgramCache(ctx, ShaderLibrary(root=root))
+    cs = cache.compute("p.comp")
+    assert cache.compute("p.comp") is cs and "u_dst" in cs
+    tex = ctx.texture((8, 8), 4, dtype="f4")
+    tex.bind_to_image(0, read=False, write=True)
+    cs.run(1, 1, 1)
+    ctx.memory_barrier()
+    assert np.allclose(np.frombuffer(tex.read(), np.float32), 1.0)
+    util = root / "lib" / "util.glsl"
+    util.write_text(UTIL.replace("return PI * 0.0 + 1.0;", "return undefined_symbol;"))
+    errors = cache.reload({util})
+    assert len(errors) == 1 and f"{root.name}/lib/util.glsl:4:" in str(errors[0]), errors
+    assert "compute shader failed to compile" in str(errors[0])
+    assert cache.compute("p.comp") is cs  # the last good one
+    util.write_text(UTIL.replace("1.0;", "2.0;"))
+    assert cache.reload({util}) == []
+    cache.compute("p.comp").run(1, 1, 1)
+    ctx.memory_barrier()
+    assert np.allclose(np.frombuffer(tex.read(), np.float32), 2.0)
+    tex.release()
+    with pytest.raises(ShaderError, match=r"p2.comp:6: error: `nothing_here. undeclared"):
+        (root / "p2.comp").write_text(CS.replace("vec4(util_value())", "vec4(nothing_here)"))
+        cache.compute("p2.comp")

@@ -61,6 +61,13 @@ def composite(renderer, frame, out_fbo, out_tex, filtered, name: str) -> None:
     filtered.use(1)
     set_uniforms(comp, {"u_color": 0, "u_blurred": 1})
     renderer.fullscreen(comp)
+    publish_composite(frame, out_tex, filtered, name)
+
+
+def publish_composite(frame, out_tex, filtered, name: str) -> None:
+    """The frame's targets after a screen-space pass: `filtered` as `name`, the image before as
+    hdr_color_unblurred and the composite `out_tex` as hdr_color (a compute path that writes the
+    composite itself calls this instead of :func:`composite`)."""
     frame.targets[name] = filtered
     frame.targets["hdr_color_unblurred"] = frame.targets["hdr_color"]
     frame.targets["hdr_color"] = out_tex

@@ -3,13 +3,16 @@
 With ``RenderSettings.supersample`` N > 1 the forward HDR holds N x N samples per output pixel: this
 pass box-filters them (the mean of linear radiance and coverage) into ``hdr_filtered`` at the output
 size, what the ``hdr`` read-back returns, and tone-maps the filtered radiance
-(skinlab/shaders/passes/tonemap_supersample.frag; NumPy twin: skinlab/render/supersample.py)."""
+(skinlab/shaders/passes/tonemap_supersample.frag; NumPy twin: skinlab/render/supersample.py). With
+``TonemapParams.compute`` the same per-pixel code runs as a compute shader (passes/tonemap.comp)."""
 
 from __future__ import annotations
 
 import moderngl
+import numpy as np
 
-from skinlab.gl.uniforms import set_uniforms
+from skinlab.gl.uniforms import set_uniform, set_uniforms
+from skinlab.render.compute import bind_images, dispatch
 
 
 class TonemapPass:
@@ -38,18 +41,27 @@ class TonemapPass:
         ctx = self.r.ctx
         n = frame.settings.supersample
         tex, fbo, hdr = self.targets(p.resolution, n > 1)
-        if n > 1:
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap_supersample.frag", {"SUPERSAMPLE": n})
+        defines = {"SUPERSAMPLE": n} if n > 1 else {}
+        compute = p.params is not None and p.params.compute
+        if compute:
+            prog = self.r.programs.compute("passes/tonemap.comp", defines)
+        elif n > 1:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap_supersample.frag", defines)
         else:
             prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap.frag")
-        fbo.use()
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         frame.targets["hdr_color"].use(0)
         set_uniforms(
             prog,
             {"u_hdr": 0, "u_exposure": frame.scene.environment.exposure, "u_background": frame.settings.background},
         )
-        self.r.fullscreen(prog)
+        if compute:
+            set_uniform(prog, "u_size", np.asarray(p.resolution, np.int32).tobytes())
+            bind_images(prog, {"u_ldr": tex, **({"u_filtered": hdr} if hdr is not None else {})})
+            dispatch(prog, p.resolution)
+        else:
+            fbo.use()
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+            self.r.fullscreen(prog)
         frame.targets["ldr_color"] = tex
         if hdr is not None:
             frame.targets["hdr_filtered"] = hdr

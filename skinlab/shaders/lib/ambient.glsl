@@ -6,7 +6,11 @@
 #include "skinlab/constants.glsl"
 uniform vec3 u_ambient;
 #ifdef BOUNCE
+#ifdef DEFERRED_SURFACE
+vec3 v_bounce;  // read from a G-buffer by the pass (techniques/tsd/surface.glsl), not interpolated
+#else
 in vec3 v_bounce;
+#endif
 #endif
 
 vec3 ambient_radiance(float occlusion) {

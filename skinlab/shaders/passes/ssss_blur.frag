@@ -1,50 +1,7 @@
 #version 330 core
-// Screen-space separable SSS (Jimenez et al. 2009/2015): one 1-D pass of the pixel's profile's kernel
-// along u_dir over the subsurface diffuse target (its alpha: the profile index + 1, 0 where nothing
-// scatters; the kernels are rows of u_table). Offsets are in millimetres on the surface; a pixel at
-// view depth z spans z * u_mm_per_unit / u_pixels_per_unit_at_1 mm. Depth-aware ("follow the
-// surface"): a sample whose depth differs by more than the kernel's range, or that is not
-// scattering material of the same profile, is replaced by the centre sample. Kernel:
-// skinlab/scene/optics/ssss.py.
-#include "skinlab/constants.glsl"
-#define MAX_SSSS_TAPS 63
-#define MAX_SSSS_PROFILES 16
-in vec2 v_uv;
-uniform sampler2D u_src;            // rgb: subsurface diffuse radiance, a: profile index + 1
-uniform sampler2D u_depth;          // the forward pass's depth buffer
-uniform vec2 u_dir;                 // (1/width, 0) or (0, 1/height)
-uniform int u_taps;
-uniform sampler2D u_table;          // (taps x profiles): rgb weight, a offset mm
-uniform float u_range_mm[MAX_SSSS_PROFILES];
-uniform float u_mm_per_unit;
-uniform float u_pixels_per_unit;    // along u_dir, for a surface at view depth 1
-uniform vec2 u_near_far;
+// Screen-space separable SSS: one 1-D pass of each pixel's profile's kernel (techniques/ssss/blur.glsl,
+// shared with the compute path techniques/ssss/blur.comp).
+#include "techniques/ssss/blur.glsl"
 out vec4 f_color;
-
-float view_depth(vec2 uv) {
-    float z = texture(u_depth, uv).r * 2.0 - 1.0;
-    float n = u_near_far.x, f = u_near_far.y;
-    return 2.0 * n * f / (f + n - z * (f - n));
-}
-
-void main() {
-    vec4 c = texture(u_src, v_uv);
-    int prof = int(c.a + 0.5) - 1;
-    if (prof < 0) { f_color = c; return; }
-    float range_mm = u_range_mm[prof];
-    float z = view_depth(v_uv);
-    float px_per_mm = u_pixels_per_unit / (z * u_mm_per_unit);
-    vec3 sum = vec3(0.0);
-    for (int i = 0; i < MAX_SSSS_TAPS; ++i) {
-        if (i >= u_taps) break;
-        vec4 k = texelFetch(u_table, ivec2(i, prof), 0);
-        vec2 uv = v_uv + u_dir * (k.a * px_per_mm);
-        vec4 s = texture(u_src, uv);
-        float dz_mm = abs(view_depth(uv) - z) * u_mm_per_unit;
-        // another profile (or none): the centre. A filtered fetch on a border blends the indices:
-        // within 1 of the pixel's own it is accepted (as the single-profile blur always did)
-        float follow = abs(s.a - c.a) < 1.0 ? clamp(dz_mm / max(range_mm, 1e-6), 0.0, 1.0) : 1.0;
-        sum += k.rgb * mix(s.rgb, c.rgb, follow);
-    }
-    f_color = vec4(sum, c.a);
-}
+// the pixel's centre (as the compute path: the same coordinates to the last bit)
+void main() { f_color = ssss_blur_at(gl_FragCoord.xy / vec2(textureSize(u_src, 0))); }

@@ -1,13 +1,6 @@
 #version 330 core
-// Exposure, ACES tone mapping and sRGB encoding; background where nothing was drawn.
-#include "lib/color.glsl"
-in vec2 v_uv;
-uniform sampler2D u_hdr;
-uniform float u_exposure;
-uniform vec3 u_background;
+// Exposure, ACES tone mapping and sRGB encoding; background where nothing was drawn (lib/tonemap.glsl;
+// the compute path: passes/tonemap.comp).
+#include "lib/tonemap.glsl"
 out vec4 f_color;
-void main() {
-    vec4 hdr = texture(u_hdr, v_uv);
-    vec3 c = mix(u_background, hdr.rgb, clamp(hdr.a, 0.0, 1.0));
-    f_color = vec4(srgb_encode(tonemap_aces(c * u_exposure)), 1.0);
-}
+void main() { f_color = tonemap_pixel(ivec2(gl_FragCoord.xy)); }

@@ -1,35 +1,6 @@
 #version 330 core
-// One separable step of the texture-space diffusion chain: a 1-D Gaussian of u_sigma_mm millimetres
-// along u_axis (0 = u, 1 = v), the step in texels from the stretch map (mm per texel) at this texel.
-// Taps at t_i sigma with weights from skinlab/scene/optics/tsd.py blur_taps(); linear interpolation between
-// the two nearest texels by hand (two fetches), so the NumPy twin (blur_axis_reference) agrees to
-// fp32 rounding. Input and output are premultiplied by coverage (rgb = E a, a = coverage).
-#include "skinlab/constants.glsl"
-#define MAX_TAPS 31
-uniform sampler2D u_src;
-uniform sampler2D u_stretch;
-uniform int u_axis;
-uniform float u_sigma_mm;
-uniform int u_taps;
-uniform float u_tap_t[MAX_TAPS];
-uniform float u_tap_w[MAX_TAPS];
+// One separable step of the texture-space diffusion chain (techniques/tsd/blur.glsl, shared with the
+// compute path techniques/tsd/blur.comp).
+#include "techniques/tsd/blur.glsl"
 out vec4 f_color;
-void main() {
-    ivec2 p = ivec2(gl_FragCoord.xy);
-    ivec2 last = textureSize(u_src, 0) - 1;
-    ivec2 dir = u_axis == 0 ? ivec2(1, 0) : ivec2(0, 1);
-    float mm = max(texelFetch(u_stretch, p, 0)[u_axis], TSD_MIN_MM_PER_TEXEL);
-    float step_texels = min(u_sigma_mm / mm, TSD_MAX_STEP_TEXELS);
-    vec4 sum = vec4(0.0);
-    for (int i = 0; i < MAX_TAPS; ++i) {
-        if (i >= u_taps) break;
-        float x = u_tap_t[i] * step_texels;
-        float fl = floor(x);
-        float f = x - fl;
-        int i0 = int(fl);
-        vec4 a = texelFetch(u_src, clamp(p + dir * i0, ivec2(0), last), 0);
-        vec4 b = texelFetch(u_src, clamp(p + dir * (i0 + 1), ivec2(0), last), 0);
-        sum += u_tap_w[i] * (a + (b - a) * f);
-    }
-    f_color = sum;
-}
+void main() { f_color = tsd_blur_at(ivec2(gl_FragCoord.xy)); }

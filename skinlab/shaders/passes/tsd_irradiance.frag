@@ -11,7 +11,8 @@
 // distance map, times the cosine to the normal: a flat slab's own thickness); lib/sss_translucency.glsl,
 // shared with the forward hooks of the screen-space techniques. It also records that light per texel
 // and shadow slot, unblurred, with its thickness and cosine (f_through0/1, f_through_cos): the gather
-// gives it the exit factor of light that came through.
+// gives it the exit factor of light that came through. Variant DEFERRED_SURFACE: drawn fullscreen
+// over the UV layout, the inputs read from the surface G-buffer (techniques/tsd/surface.glsl).
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/ambient.glsl"
@@ -22,11 +23,15 @@
 #include "lib/surface.glsl"
 #include "lib/material_uv.glsl"
 
+#ifdef DEFERRED_SURFACE
+#include "techniques/tsd/surface.glsl"  // the inputs from the surface G-buffer, one fragment per texel
+#else
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
 in vec4 v_tangent;
 in vec4 v_color;  // the vertex colour (1 where the mesh has none)
+#endif
 
 uniform float u_tsd_mix;
 uniform int u_slot_light[2];              // the light each shadow slot holds (lib/lights.glsl slots)
@@ -76,6 +81,9 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
 }
 
 void main() {
+#ifdef DEFERRED_SURFACE
+    if (!load_surface()) discard;
+#endif
     vec3 ng = normalize(v_normal);
     vec3 n = ng;
 #ifdef HAS_NORMAL_MAP

@@ -231,7 +231,8 @@ def test_viewer_cycles_to_disk(ctx, tmp_path):
         c.close()
 
 
-def test_pass_matches_its_numpy_model_pixel_by_pixel(renderer):
+@pytest.mark.parametrize("compute", ["off", "on"])  # the fragment pass and its compute shader (RenderSettings.compute)
+def test_pass_matches_its_numpy_model_pixel_by_pixel(renderer, compute):
     """The disk pass on a shadow-edge slab with a nearer slab over part of it (rejection in depth)
     against skinlab/scene/optics/disk.py disk_filter_reference on the same forward targets. A sample's
     position may differ in fp32 by ~1e-3 pixel and a sample land on the neighbouring texel, so 98 %
@@ -241,9 +242,11 @@ def test_pass_matches_its_numpy_model_pixel_by_pixel(renderer):
     n = 64
     scene = slab_scene(occluder=True, material=skin("burley"))
     scene.add(MeshNode("near", quad_mesh("near", 0.3, 0.9, -0.6, 0.2, z=0.5), skin("dipole", radius=(3, 2, 1))))
-    res = renderer.render(scene, RenderSettings(n, n, shadow_size=1024, technique=DiskSettings(samples=16)))
+    st = RenderSettings(n, n, shadow_size=1024, technique=DiskSettings(samples=16), compute=compute)
+    res = renderer.render(scene, st)
     f = renderer.last_frame
     prm = next(p.params for p in res.plan.passes if p.kind == "disk_sss")
+    assert prm.compute is (compute == "on")
     src = np.frombuffer(f.targets["disk_diffuse"].read(), np.float32).reshape(n, n, 4)
     gpu = np.frombuffer(f.targets["disk_filtered"].read(), np.float32).reshape(n, n, 4)[..., :3]
     depth = np.frombuffer(f.targets["depth"].read(), np.float32).reshape(n, n).astype(np.float64)

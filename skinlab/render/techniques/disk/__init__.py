@@ -23,6 +23,10 @@ from skinlab.scene.optics.tsd import material_medium
 
 from .passes import DIFFUSE_TARGET, DiskParams, DiskPass
 
+# the path `compute = auto` takes for the gather on software GL (skinlab/render/compute.py; measured:
+# docs/architecture.md "Compute passes")
+GATHER_ON_SOFTWARE = "fragment"
+
 HOOK = "techniques/disk/forward.glsl"
 
 
@@ -106,14 +110,15 @@ class DiskTechnique(Technique):
             return TechniquePlan()
         kernels = [disk_kernel(model, medium, o.samples) for model, medium in keys]
         names = ", ".join(f"'{lab}' ({m})" for lab, (m, _) in zip(labels, keys))
+        path = ctx.path(GATHER_ON_SOFTWARE)
         p = PlannedPass(
             "disk_sss",
             "disk_sss",
             "hdr_color",
             ctx.settings.render_size,
             f"Burley disk SSS (Golubev 2018): {o.samples} samples per pixel"
-            f"{', rotated per pixel' if o.rotate else ''}, depth-aware; {len(keys)} profile(s): {names}",
-            DiskParams(o.samples, o.rotate, kernels, labels),
+            f"{', rotated per pixel' if o.rotate else ''}, depth-aware; {len(keys)} profile(s): {names}" + path.note,
+            DiskParams(o.samples, o.rotate, kernels, labels, path.compute),
         )
         through = plan_translucency(ctx, True, o.translucency)
         return TechniquePlan(DiskForward(nodes, through), after_forward=[p], shadow_distance=through)

@@ -1,5 +1,7 @@
 """The disk pass: importance-sampled Burley disk SSS over the forward pass's subsurface diffuse
-target (skinlab/shaders/passes/disk_sss.frag), then the composite with the rest of the lit image."""
+target (skinlab/shaders/passes/disk_sss.frag, the per-pixel code in techniques/disk/gather.glsl), then the
+composite with the rest of the lit image; with ``DiskParams.compute`` both in one compute dispatch
+(techniques/disk/gather.comp)."""
 
 from __future__ import annotations
 
@@ -9,8 +11,9 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from skinlab.gl.uniforms import set_array, set_uniforms
-from skinlab.render.passes.screen_targets import ScreenTargets, composite
+from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
+from skinlab.render.compute import bind_images, dispatch
+from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
 from skinlab.scene.optics.disk import MAX_DISK_PROFILES
 
 DIFFUSE_TARGET = "disk_diffuse"
@@ -22,6 +25,7 @@ class DiskParams:
     rotate: bool
     kernels: list  # skinlab.scene.optics.disk.DiskKernel per profile index
     labels: list  # the material named for each profile (the plan's explanation)
+    compute: bool = False  # the compute shader (techniques/disk/gather.comp), else the fragment shader
 
     def table(self) -> np.ndarray:
         """(profiles, samples, 4) float32: rgb weight, a radius mm (the shader's u_table)."""
@@ -47,7 +51,10 @@ class DiskPass:
         ffilt, fout = self._gpu.fbos
         cam = frame.scene.camera
         table = self._gpu.table(prm.table())
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/disk_sss.frag")
+        if prm.compute:
+            prog = self.r.programs.compute("techniques/disk/gather.comp")
+        else:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/disk_sss.frag")
         reach = np.array([k.reach_mm for k in prm.kernels], np.float32)
         set_array(prog, "u_reach_mm", reach, MAX_DISK_PROFILES)
         set_uniforms(
@@ -64,10 +71,17 @@ class DiskPass:
                 "u_rotate": 1.0 if prm.rotate else 0.0,
             },
         )
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         frame.targets[DIFFUSE_TARGET].use(0)
         frame.targets["depth"].use(1)
         table.use(2)
+        if prm.compute:  # the gather and the composite in one dispatch
+            frame.targets["hdr_color"].use(3)
+            set_uniform(prog, "u_color", 3)
+            bind_images(prog, {"u_dst": filtered, "u_composite": out})
+            dispatch(prog, (w, h))
+            publish_composite(frame, out, filtered, "disk_filtered")
+            return
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         ffilt.use()
         self.r.fullscreen(prog)
         composite(self.r, frame, fout, out, filtered, "disk_filtered")

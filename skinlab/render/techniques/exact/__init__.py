@@ -34,6 +34,11 @@ class ExactSettings(TechniqueSettings):
     seams: bool = option(True, "light crosses UV seams (seam map; off: blurs stop at chart borders)", "bool")
 
 
+# the path `compute = auto` takes for the convolution on software GL (skinlab/render/compute.py; measured:
+# docs/architecture.md "Compute passes")
+GATHER_ON_SOFTWARE = "fragment"
+
+
 class ExactTechnique(Technique):
     name = "exact"
     description = "brute-force texture-space convolution with the exact profile (the slow image reference)"
@@ -58,7 +63,14 @@ class ExactTechnique(Technique):
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options
         passes, nodes, translucency, local = plan_tsd(
-            ctx, o.size, FIT_GAUSSIANS, None, o.albedo_mix, o.translucency, exact=True, seams=o.seams
+            ctx,
+            o.size,
+            FIT_GAUSSIANS,
+            None,
+            o.albedo_mix,
+            o.translucency,
+            exact=ctx.path(GATHER_ON_SOFTWARE),
+            seams=o.seams,
         )
         return TechniquePlan(
             TsdForward(len(nodes), local, translucency=translucency),

@@ -1,6 +1,7 @@
 """The exact technique's pass: brute-force convolution of the dilated irradiance with the exact
-radial profile (skinlab/shaders/passes/tsd_exact.frag) into level 0, which the texture-space gather then
-reads with weight 1 (plan.UNIT_KERNEL)."""
+radial profile (skinlab/shaders/passes/tsd_exact.frag; the per-texel code techniques/exact/gather.glsl,
+run by techniques/exact/gather.comp with ``TsdExactParams.compute``) into level 0, which the
+texture-space gather then reads with weight 1 (plan.UNIT_KERNEL)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_uniforms
+from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.techniques.tsd.passes import TsdPass, store
 from skinlab.render.techniques.tsd.plan import TsdExactParams
 from skinlab.scene.optics.tsd import exact_profile_lut, material_medium
@@ -57,7 +59,10 @@ class TsdExactPass(TsdPass):
         t = store(self.r).targets(node, size)
         lut, r_max = self.lut(prm.model, material_medium(prm.material.values))
         dst = t.level(ctx, 0)
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_exact.frag")
+        if prm.compute:
+            prog = self.r.programs.compute("techniques/exact/gather.comp")
+        else:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_exact.frag")
         set_uniforms(
             prog,
             {
@@ -74,9 +79,13 @@ class TsdExactPass(TsdPass):
         t.irradiance.use(0)
         t.stretch.use(1)
         lut.use(2)
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-        t.fbo(ctx, dst).use()
-        ctx.viewport = (0, 0, size, size)
-        self.r.fullscreen(prog)
+        if prm.compute:
+            bind_images(prog, {"u_dst": dst})
+            dispatch(prog, (size, size))
+        else:
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
+            t.fbo(ctx, dst).use()
+            ctx.viewport = (0, 0, size, size)
+            self.r.fullscreen(prog)
         t.irradiance.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self.publish(frame, p)

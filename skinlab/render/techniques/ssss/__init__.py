@@ -21,6 +21,9 @@ from .passes import MAX_SSSS_TAPS, SsssBlurParams, SsssBlurPass
 from .plan import SsssPlan, plan_ssss
 
 HOOK = "techniques/ssss/forward.glsl"
+# the path `compute = auto` takes for the blur on software GL (skinlab/render/compute.py; measured:
+# docs/architecture.md "Compute passes")
+BLUR_ON_SOFTWARE = "fragment"
 DIFFUSE_TARGET = "ssss_diffuse"
 
 
@@ -80,14 +83,15 @@ class SsssTechnique(Technique):
         if ssss is None:
             return TechniquePlan()
         names = ", ".join(f"'{k.material.name}' ({k.material['sss_model']})" for k in ssss.kernels)
+        path = ctx.path(BLUR_ON_SOFTWARE)
         blur = PlannedPass(
             "ssss_blur",
             "ssss_blur",
             "hdr_color",
             ctx.settings.render_size,
             f"screen-space separable SSS (Jimenez et al.): {o.taps}-tap kernel per pixel's profile "
-            f"({len(ssss.kernels)}: {names}), horizontal then vertical, depth-aware",
-            SsssBlurParams(ssss, o.gaussians),
+            f"({len(ssss.kernels)}: {names}), horizontal then vertical, depth-aware" + path.note,
+            SsssBlurParams(ssss, o.gaussians, path.compute),
         )
         through = plan_translucency(ctx, True, o.translucency)
         return TechniquePlan(SsssForward(ssss, through), after_forward=[blur], shadow_distance=through)

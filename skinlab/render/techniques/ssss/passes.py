@@ -1,5 +1,7 @@
 """Screen-space separable SSS (Jimenez et al.): blur the forward pass's subsurface diffuse target
-horizontally then vertically with the profile's 1-D kernel (skinlab/scene/optics/ssss.py) and add it back."""
+horizontally then vertically with the profile's 1-D kernel (skinlab/scene/optics/ssss.py) and add it back.
+The per-pixel code is techniques/ssss/blur.glsl, run by passes/ssss_blur.frag or, with
+``SsssBlurParams.compute``, by techniques/ssss/blur.comp (the vertical pass writing the composite too)."""
 
 from __future__ import annotations
 
@@ -10,17 +12,19 @@ import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_array, set_uniforms
-from skinlab.render.passes.screen_targets import ScreenTargets, composite
+from skinlab.render.compute import bind_images, dispatch
+from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
 
 from .plan import MAX_SSSS_PROFILES, SsssPlan
 
-MAX_SSSS_TAPS = 63  # skinlab/shaders/passes/ssss_blur.frag
+MAX_SSSS_TAPS = 63  # skinlab/shaders/techniques/ssss/blur.glsl
 
 
 @dataclass
 class SsssBlurParams:
     ssss: SsssPlan
     gaussians: int = 6  # the Gaussian fit the kernels were sampled from
+    compute: bool = False  # the compute shader (techniques/ssss/blur.comp), else the fragment shader
 
 
 class SsssBlurPass:
@@ -40,7 +44,10 @@ class SsssBlurPass:
         # pixels per scene unit at view depth 1: rows span 2 tan(yfov/2), columns the same times aspect
         ppu_y = h / (2.0 * math.tan(cam.yfov / 2.0))
         ppu_x = ppu_y  # square pixels (aspect = w / h)
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/ssss_blur.frag")
+        if p.params.compute:
+            prog = self.r.programs.compute("techniques/ssss/blur.comp")
+        else:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/ssss_blur.frag")
         n = len(plan.offsets_mm)
         table = self._gpu.table(plan.table())
         ranges = np.array([k.range_mm for k in plan.kernels], np.float32)
@@ -56,13 +63,42 @@ class SsssBlurPass:
                 "u_near_far": (cam.znear, cam.zfar),
             },
         )
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         frame.targets["depth"].use(1)
         table.use(2)
-        for src, fbo, d, ppu in (
-            (frame.targets["ssss_diffuse"], ftmp, (1.0 / w, 0.0), ppu_x),
-            (tmp, fblur, (0.0, 1.0 / h), ppu_y),
-        ):
+        steps = (
+            (frame.targets["ssss_diffuse"], tmp, ftmp, (1.0 / w, 0.0), ppu_x),
+            (tmp, blurred, fblur, (0.0, 1.0 / h), ppu_y),
+        )
+        if p.params.compute:  # horizontal, then vertical with the composite
+            horizontal = steps[0]
+            horizontal[0].use(0)
+            set_uniforms(prog, {"u_dir": horizontal[3], "u_pixels_per_unit": horizontal[4]})
+            bind_images(prog, {"u_dst": tmp})
+            dispatch(prog, (w, h))
+            vertical = self.r.programs.compute("techniques/ssss/blur.comp", {"SSSS_COMPOSITE": 1})
+            set_array(vertical, "u_range_mm", ranges, MAX_SSSS_PROFILES)
+            tmp.use(0)
+            frame.targets["hdr_color"].use(3)
+            set_uniforms(
+                vertical,
+                {
+                    "u_src": 0,
+                    "u_depth": 1,
+                    "u_table": 2,
+                    "u_color": 3,
+                    "u_taps": n,
+                    "u_mm_per_unit": frame.scene.mm_per_unit,
+                    "u_near_far": (cam.znear, cam.zfar),
+                    "u_dir": steps[1][3],
+                    "u_pixels_per_unit": steps[1][4],
+                },
+            )
+            bind_images(vertical, {"u_dst": blurred, "u_composite": out})
+            dispatch(vertical, (w, h))
+            publish_composite(frame, out, blurred, "ssss_blurred")
+            return
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+        for src, _, fbo, d, ppu in steps:
             fbo.use()
             src.use(0)
             set_uniforms(prog, {"u_dir": d, "u_pixels_per_unit": ppu})

@@ -13,7 +13,7 @@ from skinlab.render.scattering import scattering_material
 from skinlab.scene.optics.ssss import ssss_kernel
 from skinlab.scene.optics.tsd import material_medium, profile_fit
 
-MAX_SSSS_PROFILES = 16  # skinlab/shaders/passes/ssss_blur.frag
+MAX_SSSS_PROFILES = 16  # skinlab/shaders/techniques/ssss/blur.glsl
 
 
 @dataclass

@@ -18,6 +18,7 @@ twin of the blur and gather. The gather is the technique's forward hook
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import moderngl
@@ -26,6 +27,7 @@ import numpy as np
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
 from skinlab.render.bounce import bind_bounce, bounce_defines
 from skinlab.render.boundary import bind_boundary
+from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
 from skinlab.render.texture_units import TextureUnits
@@ -37,7 +39,8 @@ from .seams import SeamMap, node_border_strips
 
 STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
-MAX_TAPS = 31  # skinlab/shaders/passes/tsd_blur.frag
+MAX_TAPS = 31  # skinlab/shaders/techniques/tsd/blur.glsl
+DILATE_GROUP = 16  # texels per side of a work group of skinlab/shaders/techniques/tsd/dilate.comp
 
 
 def _texture(ctx, size: int) -> moderngl.Texture:
@@ -76,6 +79,8 @@ class TsdNodeTargets:
     through: list = field(default_factory=list)  # the light-through record, filled (through_record)
     through_raw: list = field(default_factory=list)  # as the irradiance pass wrote it
     strips: tuple = ()  # (source array, depth renderbuffer): where the record's fill runs (strip_mask)
+    surface: list = field(default_factory=list)  # the surface G-buffer (surface_buffer), RGBA32F, nearest
+    masks: dict = field(default_factory=dict)  # coverage masks by what was rasterised (coverage_mask)
 
     def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture, depth=None) -> moderngl.Framebuffer:
         key = (id(tex), *(id(m) for m in more), id(depth))
@@ -123,6 +128,34 @@ class TsdNodeTargets:
             self.through = _record_textures(ctx, self.size)
         return self.through
 
+    def coverage_mask(self, ctx, what: str):
+        """A depth renderbuffer the UV raster of `what` ("stretch", "irradiance") writes (0.5 where a
+        triangle covers the texel, 1 elsewhere: raster_mask), read by the dilation of its result: a
+        fullscreen ring tested against it with "<" shades only the texels no triangle covers, the
+        only ones a ring can change (mask_ready says whether it holds the current raster)."""
+        m = self.masks.get(what)
+        if m is None:
+            m = self.masks[what] = [ctx.depth_renderbuffer((self.size, self.size)), False]
+        return m[0]
+
+    def mask_ready(self, what: str):
+        """`what`'s coverage mask when its raster wrote it, else None (dilate every texel)."""
+        m = self.masks.get(what)
+        return m[0] if m is not None and m[1] else None
+
+    def surface_buffer(self, ctx, bounce: bool) -> list:
+        """The irradiance pass's surface G-buffer (deferred shading, techniques/tsd/surface.glsl): world
+        position and coverage, normal and the tangent's handedness, tangent, the vertex colour, and
+        with `bounce` the interreflection's irradiance, as the UV raster interpolates them. Nearest
+        filtering."""
+        want = 5 if bounce else 4
+        while len(self.surface) < want:
+            t = ctx.texture((self.size, self.size), 4, dtype="f4")
+            t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            t.repeat_x = t.repeat_y = False
+            self.surface.append(t)
+        return self.surface[:want]
+
     def through_raw_record(self, ctx) -> list:
         """The same record as the irradiance pass rasterised it (empty in the gutter)."""
         if not self.through_raw:
@@ -150,6 +183,8 @@ class TsdNodeTargets:
             *self.levels,
             *self.through,
             *self.through_raw,
+            *self.surface,
+            *(m[0] for m in self.masks.values()),
         ]:
             t.release()
         if self.seam is not None:
@@ -223,20 +258,82 @@ def _uv_raster_setup(ctx, fbo, size: int) -> None:
     ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
 
 
-def dilate(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, rings: int) -> None:
+@contextmanager
+def raster_mask(ctx, t: TsdNodeTargets, what: str, fbo):
+    """Around a UV raster into `fbo` (its depth attachment t.coverage_mask(what), cleared to 1): every
+    triangle writes its depth (0.5) whatever is there, so the mask marks the covered texels."""
+    ctx.enable(moderngl.DEPTH_TEST)
+    ctx.depth_func = "1"  # always: the last triangle wins, as without the mask
+    try:
+        yield
+    finally:
+        ctx.depth_func = "<"
+        ctx.disable(moderngl.DEPTH_TEST)
+    t.masks[what][1] = True
+
+
+def dilate(
+    renderer,
+    t: TsdNodeTargets,
+    src: moderngl.Texture,
+    dst: moderngl.Texture,
+    rings: int,
+    compute: bool = False,
+    mask=None,
+) -> None:
     """`rings` one-texel dilation steps from `src` into `dst`, ping-ponging with the scratch
-    texture (in place, src is dst, the count is rounded up to an even one)."""
+    texture (in place, src is dst, the count is rounded up to an even one). With `compute` every
+    ring in one dispatch (techniques/tsd/dilate.comp; in place through the scratch texture). With
+    `mask` (TsdNodeTargets.coverage_mask, the raster `src` came from) each ring shades only the texels
+    no triangle covered, through an early depth test: a covered texel never changes, so the targets
+    start as copies of `src` and the rings give the same texels as shading every one (on llvmpipe a
+    ring over every texel cost about 7 ms at 512 x 512, whatever it changed)."""
     ctx = renderer.ctx
-    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_dilate.frag")
     steps = rings + (rings % 2) if src is dst else max(rings, 1)
-    for i in range(steps):
-        out = dst if (steps - 1 - i) % 2 == 0 else t.scratch
-        t.fbo(ctx, out).use()
-        ctx.viewport = (0, 0, t.size, t.size)
-        src.use(0)
-        set_uniform(prog, "u_src", 0)
-        renderer.fullscreen(prog)
-        src = out
+    if compute:
+        dilate_compute(renderer, t, src, dst, steps)
+        return
+    outs = [dst if (steps - 1 - i) % 2 == 0 else t.scratch for i in range(steps)]
+    if mask is not None:  # what the rings do not shade is src's
+        for out in {id(o): o for o in outs}.values():
+            if out is not src:
+                ctx.copy_framebuffer(t.fbo(ctx, out), t.fbo(ctx, src))
+    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_dilate.frag")
+    if mask is not None:
+        ctx.enable(moderngl.DEPTH_TEST)  # the fullscreen triangle's 0.5 passes "<" only where no triangle was
+        ctx.depth_func = "<"
+    try:
+        for out in outs:
+            fbo = t.fbo(ctx, out, depth=mask)
+            fbo.depth_mask = False
+            fbo.use()
+            ctx.viewport = (0, 0, t.size, t.size)
+            src.use(0)
+            set_uniform(prog, "u_src", 0)
+            renderer.fullscreen(prog)
+            src = out
+    finally:
+        ctx.disable(moderngl.DEPTH_TEST)
+
+
+def dilate_compute(
+    renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, rings: int, seams: bool = False
+) -> None:
+    """`rings` rings of dilation from `src` into `dst` in one dispatch (techniques/tsd/dilate.comp);
+    with `seams` the texels are read through the node's seam map first (the seam fill)."""
+    ctx = renderer.ctx
+    cs = renderer.programs.compute("techniques/tsd/dilate.comp", {"RINGS": rings, "TSD_SEAMS": seams})
+    out = t.scratch if src is dst else dst
+    units = TextureUnits(ctx)
+    units.bind(cs, "u_src", src)
+    if seams:
+        units.bind(cs, "u_seam", t.seam_map(ctx).texture)
+    bind_images(cs, {"u_dst": out})
+    groups = (t.size + DILATE_GROUP - 1) // DILATE_GROUP
+    cs.run(groups, groups, 1)
+    ctx.memory_barrier()
+    if out is not dst:
+        ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, out))
 
 
 class TsdPass:
@@ -264,9 +361,10 @@ class TsdStretchPass(TsdPass):
         prm: TsdNodeParams = p.params
         ctx, node, size = self.r.ctx, prm.node, prm.size
         t = self.node_targets(p)
-        fbo = t.fbo(ctx, t.stretch)
+        mask = t.coverage_mask(ctx, "stretch")
+        fbo = t.fbo(ctx, t.stretch, depth=mask)
         _uv_raster_setup(ctx, fbo, size)
-        fbo.clear(0.0, 0.0, 0.0, 0.0)
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         radius_map = {k: v for k, v in node.material.textures().items() if k == "u_subsurface_radius_map"}
         defines = {"HAS_SUBSURFACE_RADIUS_MAP": "1"} if radius_map else {}
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_stretch.frag", defines)
@@ -274,10 +372,11 @@ class TsdStretchPass(TsdPass):
         units = TextureUnits(ctx)
         for sampler, (path, cs) in radius_map.items():
             units.bind(prog, sampler, self.r.resources.texture(path, cs))
-        if prm.seams is not None:  # the surface across seams, in the gutter: drawn first, the charts win
-            self.r.resources.mesh(prm.seams.mesh()).vao(prog).render(moderngl.TRIANGLES)
-        self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
-        dilate(self.r, t, t.stretch, t.stretch, prm.dilate)
+        with raster_mask(ctx, t, "stretch", fbo):
+            if prm.seams is not None:  # the surface across seams, in the gutter: drawn first, the charts win
+                self.r.resources.mesh(prm.seams.mesh()).vao(prog).render(moderngl.TRIANGLES)
+            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        dilate(self.r, t, t.stretch, t.stretch, prm.dilate, prm.compute, t.mask_ready("stretch"))
         store(self.r).stretch_updates += 1
 
 
@@ -302,19 +401,39 @@ class TsdIrradiancePass(TsdPass):
         prm: TsdIrradianceParams = p.params
         ctx, node, size, mat = self.r.ctx, prm.node, prm.size, prm.material
         t = self.node_targets(p)
+        nmax = frame.settings.max_lights
+        bounce = bounce_defines(frame, node)
+        surface = []
+        if prm.deferred:  # the mesh's vertex outputs rasterised into the G-buffer, then shaded per texel
+            surface = t.surface_buffer(ctx, bool(bounce))
+            gbuf = t.fbo(ctx, *surface, depth=t.coverage_mask(ctx, "irradiance"))
+            _uv_raster_setup(ctx, gbuf, size)
+            gbuf.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            raster = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_surface.frag", bounce)
+            set_uniforms(raster, node_uniforms(node))
+            bind_bounce(frame, node, raster, TextureUnits(ctx))
+            with raster_mask(ctx, t, "irradiance", gbuf):  # the dilation's mask
+                self.r.resources.mesh(node.mesh).vao(raster).render(moderngl.TRIANGLES)
+        elif "irradiance" in t.masks:
+            t.masks["irradiance"][1] = False
         fbo = t.fbo(ctx, t.raw, *(t.through_raw_record(ctx) if prm.translucency else ()))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
-        nmax = frame.settings.max_lights
-        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **bounce_defines(frame, node)}
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **bounce}
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
-        prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
+        if prm.deferred:
+            defines["DEFERRED_SURFACE"] = 1
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_irradiance.frag", defines)
+        else:
+            prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
         units = TextureUnits(ctx)
+        for k, tex in enumerate(surface):
+            units.bind(prog, f"u_surface{k}", tex)
         bind_shadow_maps(self.r, frame, prog, units)
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
-        self.r.resources.bind_material(prog, mat, units)
+        self.r.resources.bind_material(prog, mat, units, isotropic=square_footprint(mat))
         bind_bounce(frame, node, prog, units)
         bind_boundary(prog, mat)
         if "u_slot_light" in prog:  # the light each filled shadow slot holds (its lights are shaded per slot)
@@ -324,11 +443,22 @@ class TsdIrradiancePass(TsdPass):
             prog["u_slot_light"].write(slot_light[: max(prog["u_slot_light"].array_length, 1)].tobytes())
         if prm.translucency:
             bind_translucency(prog, frame, units, self.r.dummy_texture())
-        self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        if prm.deferred:
+            self.r.fullscreen(prog)
+        else:
+            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        self.r.resources.unbind_samplers()
         if prm.translucency:  # the record's gutter by the chart borders: across the seams, else dilated
             slots = min(len(prm.shadow_lights), SHADOW_SLOTS)
             through_fill(self.r, t, prm.seams is not None, node_border_strips(node.mesh, size), slots)
         self.publish(frame, p)
+
+
+def square_footprint(material) -> bool:
+    """Whether a UV texel's footprint on the material's maps is a square: always, unless its texture
+    transform scales u and v differently (the maps are then filtered anisotropically, as elsewhere)."""
+    sx, sy = (abs(float(x)) for x in material.values.get("uv_scale", (1.0, 1.0)))
+    return sx == sy
 
 
 def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | None = None, slots: int = 2) -> None:
@@ -384,12 +514,14 @@ class TsdDilatePass(TsdPass):
         frame.targets[f"tsd_stretch[{name}]"] = t.stretch
 
     def run(self, frame, p) -> None:
-        t = self.node_targets(p)
-        if p.params.seams is not None:  # the gutter across seams, then dilation for the rest
+        t, prm = self.node_targets(p), p.params
+        if prm.compute:  # the seam fill and every ring in one dispatch
+            dilate_compute(self.r, t, t.raw, t.irradiance, max(prm.dilate, 1), prm.seams is not None)
+        elif prm.seams is not None:  # the gutter across seams, then dilation for the rest
             seam_fill(self.r, t, t.raw, t.irradiance)
-            dilate(self.r, t, t.irradiance, t.irradiance, p.params.dilate)
+            dilate(self.r, t, t.irradiance, t.irradiance, prm.dilate, mask=t.mask_ready("irradiance"))
         else:
-            dilate(self.r, t, t.raw, t.irradiance, p.params.dilate)
+            dilate(self.r, t, t.raw, t.irradiance, prm.dilate, mask=t.mask_ready("irradiance"))
         self.publish(frame, p)
 
 
@@ -409,10 +541,18 @@ class TsdSeamPass(TsdPass):
         self.publish(frame, p)
 
 
-def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture) -> None:
+def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, compute: bool = False) -> None:
     """`src` into `dst` (another texture), the texels the seam map marks read across the seam
-    (skinlab/shaders/passes/tsd_seam_fill.frag)."""
+    (skinlab/shaders/passes/tsd_seam_fill.frag; `compute`: techniques/tsd/blur.comp's TSD_SEAM_FILL)."""
     ctx = renderer.ctx
+    if compute:
+        cs = renderer.programs.compute("techniques/tsd/blur.comp", {"TSD_SEAM_FILL": 1})
+        src.use(0)
+        t.seam_map(ctx).texture.use(1)
+        set_uniforms(cs, {"u_src": 0, "u_seam": 1})
+        bind_images(cs, {"u_dst": dst})
+        dispatch(cs, (t.size, t.size))
+        return
     prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_seam_fill.frag")
     t.fbo(ctx, dst).use()
     ctx.viewport = (0, 0, t.size, t.size)
@@ -437,22 +577,32 @@ class TsdBlurPass(TsdPass):
         t = self.node_targets(p)
         src = t.irradiance if step.level == 0 else t.level(ctx, step.level - 1)
         dst = t.level(ctx, step.level)
-        prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
+        seams = prm.seams is not None
+        # u then v; with seams the v step goes to the scratch texture and the seam fill from there
+        # into the level (its gutter across the seams, for the next blur and the gather)
+        steps = ((src, dst), (dst, t.scratch)) if seams else ((src, t.scratch), (t.scratch, dst))
+        if prm.compute:
+            prog = self.r.programs.compute("techniques/tsd/blur.comp")
+        else:
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
+            ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         taps_t, taps_w = blur_taps(step.taps)
         set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
         set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)
         set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_sigma_mm": step.sigma_mm, "u_taps": step.taps})
         t.stretch.use(1)
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
-        for axis, (a, b) in enumerate(((src, t.scratch), (t.scratch, dst))):
-            t.fbo(ctx, b).use()
-            ctx.viewport = (0, 0, size, size)
+        for axis, (a, b) in enumerate(steps):
             a.use(0)
             set_uniform(prog, "u_axis", axis)
-            self.r.fullscreen(prog)
-        if prm.seams is not None:  # the level's gutter across the seams, for the next blur and the gather
-            seam_fill(self.r, t, dst, t.scratch)
-            ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, t.scratch))
+            if prm.compute:
+                bind_images(prog, {"u_dst": b})
+                dispatch(prog, (size, size))
+            else:
+                t.fbo(ctx, b).use()
+                ctx.viewport = (0, 0, size, size)
+                self.r.fullscreen(prog)
+        if seams:
+            seam_fill(self.r, t, t.scratch, dst, prm.compute)
         self.publish(frame, p)
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from skinlab.render.compute import PassPath
 from skinlab.render.frame_plan import PlannedPass, shadow_pass_name
 from skinlab.render.reuse import light_state, material_state, node_geometry
 from skinlab.render.scattering import scattering_material
@@ -37,6 +38,10 @@ from skinlab.scene.uv_checks import analyse_uvs
 from .seams import node_seams, seam_band_texels, seams_summary
 
 DILATE_RINGS = 4  # texels of dilation past chart borders (irradiance and stretch)
+# the path `compute = auto` takes on software GL for the dilations and the blurs (skinlab/render/compute.py;
+# measured: docs/architecture.md "Compute passes")
+DILATE_ON_SOFTWARE = "fragment"
+BLUR_ON_SOFTWARE = "fragment"
 
 # A mesh's texture space is sized from its surface and its size on screen: this many texels per
 # screen pixel, along a line, where the mesh comes nearest the camera (the whole surface counted, the
@@ -192,6 +197,7 @@ class TsdNodeParams:
     kernel: DiffusionKernel  # the Gaussian chain (and the translucency's Gaussians)
     dilate: int = DILATE_RINGS
     seams: object = None  # SeamExtension: light crosses UV seams (seams.py); None: not used
+    compute: bool = False  # the pass's compute shader (skinlab/render/compute.py), where it has one
 
 
 @dataclass
@@ -201,6 +207,10 @@ class TsdIrradianceParams(TsdNodeParams):
     translucency: bool = False
     mix: float = 0.5  # pre-/post-scatter texturing: albedo^mix before the blur
     gather: DiffusionKernel | None = None  # the forward pass's gather weights (None: kernel)
+    # shade each texel once from a G-buffer of the rasterised surface (techniques/tsd/surface.glsl), the
+    # same light; else shade while rasterising the mesh (a software rasteriser shades whole blocks of
+    # texels for each small UV triangle)
+    deferred: bool = False
 
 
 @dataclass
@@ -293,14 +303,15 @@ def plan_tsd(
     taps: int | None,
     mix: float,
     translucency: bool,
-    exact: bool = False,
+    exact: PassPath | None = None,
     seams: bool = True,
     fit_size: bool = False,
 ):
     """The texture-space passes of every scattering mesh (stretch, the seam map where the mesh has
-    UV seams and `seams` is on, irradiance, dilation, then the Gaussian blurs, or with `exact` the
-    brute-force convolution) and whether translucency runs; (passes, node plans, translucency,
-    local: uid -> material of the meshes scattered locally)."""
+    UV seams and `seams` is on, irradiance, dilation, then the Gaussian blurs, or with `exact` - the
+    path of technique exact's pass, skinlab/render/compute.py - the brute-force convolution) and
+    whether translucency runs; (passes, node plans, translucency, local: uid -> material of the
+    meshes scattered locally)."""
     plan = ctx.plan
     local: dict = {}
     nodes = [
@@ -378,6 +389,14 @@ def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tu
     )
 
 
+def deferred_irradiance(device) -> bool:
+    """Whether the irradiance pass shades from its surface G-buffer (TsdIrradianceParams.deferred): on
+    software GL, where it takes about half the time of shading while rasterising the UV layout
+    (docs/tsd.md "Cost"), the same light to fp32 rounding; on a GPU, which shades 2x2 quads, the
+    direct raster (not measured there yet)."""
+    return device is not None and device.software
+
+
 def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
     node, n, k = t.node, t.size, t.kernel
     base = dict(node=node, size=n, material=t.material, kernel=k, dilate=DILATE_RINGS, seams=t.seams)
@@ -386,15 +405,17 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
     seam_key = (t.seam_band, t.seams.band_uv) if t.seams is not None else None
     seam_pass = f"tsd_seams[{node.name}]"
     seam_after = (seam_pass,) if t.seams is not None else ()
+    dilation = ctx.path(DILATE_ON_SOFTWARE)
     out = [
         PlannedPass(
             stretch,
             "tsd_stretch",
             "tsd_stretch",
             res,
-            f"mm per texel of '{node.mesh.name}' (depends on the geometry and the scene scale)",
-            TsdNodeParams(**base),
-            inputs=(stretch_inputs(node, ctx.scene), DILATE_RINGS, seam_key),
+            f"mm per texel of '{node.mesh.name}' (depends on the geometry and the scene scale); its dilation"
+            + dilation.note,
+            TsdNodeParams(**base, compute=dilation.compute),
+            inputs=(stretch_inputs(node, ctx.scene), DILATE_RINGS, seam_key, dilation.compute),
         )
     ]
     if t.seams is not None:
@@ -419,6 +440,11 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
             f"material '{t.material.name}' scatters ({t.material['sss_model']}): light entering the surface in UV space"
             + (f"; {t.size_note}" if t.size_note else "")
             + (
+                "; each texel shaded once from the rasterised surface (a G-buffer)"
+                if deferred_irradiance(ctx.device)
+                else ""
+            )
+            + (
                 ", translucency through thin parts (its record's gutter filled "
                 + ("across UV seams and " if t.seams is not None else "")
                 + "one texel past chart borders)"
@@ -431,7 +457,8 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 shadow_lights=ctx.shadow_lights,
                 translucency=translucency,
                 mix=mix,
-                gather=UNIT_KERNEL if exact else k,
+                gather=UNIT_KERNEL if exact is not None else k,
+                deferred=deferred_irradiance(ctx.device),
             ),
             inputs=irradiance_inputs(t, ctx, mix, translucency),
             # the light-through record is filled across the seams from the seam map
@@ -445,13 +472,14 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
             "tsd_irradiance",
             res,
             ("fill the gutter across UV seams from the seam map, then push" if t.seams is not None else "push")
-            + f" irradiance {DILATE_RINGS} texels past UV chart borders",
-            TsdNodeParams(**base),
-            inputs=(DILATE_RINGS, seam_key),
+            + f" irradiance {DILATE_RINGS} texels past UV chart borders"
+            + dilation.note,
+            TsdNodeParams(**base, compute=dilation.compute),
+            inputs=(DILATE_RINGS, seam_key, dilation.compute),
             after=(irradiance, *seam_after),
         )
     )
-    if exact:
+    if exact is not None:
         out.append(
             PlannedPass(
                 f"tsd_exact[{node.name}]",
@@ -459,14 +487,15 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 "tsd_level0",
                 res,
                 f"brute-force convolution with the exact {t.material['sss_model']} profile (image reference; slow "
-                "on purpose)",
-                TsdExactParams(**base, model=t.material["sss_model"]),
-                inputs=(t.material["sss_model"], material_state(t.material)),
+                "on purpose)" + exact.note,
+                TsdExactParams(**base, model=t.material["sss_model"], compute=exact.compute),
+                inputs=(t.material["sss_model"], material_state(t.material), exact.compute),
                 after=(dilated, stretch),
             )
         )
         return out
     previous = dilated
+    blur = ctx.path(BLUR_ON_SOFTWARE)
     for s in k.steps:
         w = ", ".join(f"{x:.3f}" for x in s.weight)
         name = f"tsd_blur[{node.name}]{s.level}"
@@ -477,9 +506,9 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 f"tsd_level{s.level}",
                 res,
                 f"Gaussian v={s.variance_mm2:.4g} mm2 (step sigma {s.sigma_mm:.3g} mm, {s.taps} taps), "
-                f"weight RGB ({w})" + ("; gutter filled across UV seams" if t.seams is not None else ""),
-                TsdBlurParams(**base, step=s),
-                inputs=(s.level, s.sigma_mm, s.taps, seam_key),
+                f"weight RGB ({w})" + ("; gutter filled across UV seams" if t.seams is not None else "") + blur.note,
+                TsdBlurParams(**base, step=s, compute=blur.compute),
+                inputs=(s.level, s.sigma_mm, s.taps, seam_key, blur.compute),
                 after=(previous, stretch, *seam_after),
             )
         )
