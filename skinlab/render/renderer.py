@@ -14,6 +14,7 @@ from skinlab.gl.shader_source import ShaderLibrary
 from skinlab.scene.graph import Scene
 
 from .bounce import BouncePass
+from .environment import EnvironmentPass, SkyOcclusionPass
 from .frame import Frame
 from .frame_plan import FramePlan
 from .gpu_resources import GpuResources
@@ -49,6 +50,8 @@ class Renderer:
         self.passes: dict[str, RenderPass] = {
             "shadow": ShadowPass(self),
             "bounce": BouncePass(self),
+            "environment": EnvironmentPass(self),
+            "sky_occlusion": SkyOcclusionPass(self),
             "forward": ForwardPass(self),
             "tonemap": TonemapPass(self),
         }

@@ -55,6 +55,13 @@ class RenderSettings:
         range=(4, 4096),
         unit="rays per vertex",
     )
+    # environment maps (skinlab/render/environment.py): what the scene hides of the map's light
+    sky_occlusion: bool = option(
+        True,
+        "environment map: each surface receives the map's light less what the scene hides of it (from the "
+        "interreflection's rays per vertex); false: every surface sees the whole map",
+        "bool",
+    )
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "shadow_size"):

@@ -114,7 +114,9 @@ class Gui:
             self._inspector_section()
             self._scene_section()
             self._material_section()
+            self._selected_light_section()
             self._light_section()
+            self._environment_section()
         imgui.end()
 
     def _render_section(self) -> None:
@@ -306,6 +308,61 @@ class Gui:
         ch2, el = imgui.slider_float("elevation (deg)", el, -89.0, 89.0)
         if ch1 or ch2:
             self._try(panel.set_light_direction, direction_from_angles(az, el))
+
+    def _selected_light_section(self) -> None:
+        """The light selected in the scene tree: colour, intensity, shadow and its kind's shape
+        (panel.light_widgets)."""
+        panel = self.core.panel
+        light = panel.light
+        if light is None or not imgui.collapsing_header("Light", imgui.TreeNodeFlags_.default_open):
+            return
+        imgui.text(f"'{light.name}' ({light.kind})")
+        for w in panel.light_widgets():
+            label = f"{widget_label(w)}##light"
+            if w.widget == "checkbox":
+                ch, v = imgui.checkbox(label, bool(w.value))
+            elif w.widget == "color_edit3":
+                ch, v = imgui.color_edit3(label, [float(x) for x in w.value], imgui.ColorEditFlags_.float)
+            else:
+                ch, v = imgui.slider_float(label, float(w.value), w.range[0], w.range[1])
+            if imgui.is_item_hovered() and w.doc:
+                imgui.set_tooltip(w.doc)
+            if ch:
+                self._try(panel.edit_light, w.param, v)
+
+    def _environment_section(self) -> None:
+        """The environment map: a bundled one or a file, its rotation, intensity and background."""
+        panel = self.core.panel
+        if not imgui.collapsing_header("Environment map", imgui.TreeNodeFlags_.default_open):
+            return
+        cur = panel.environment_name()
+        if imgui.begin_combo("map##env", cur if len(cur) < 40 else "..." + cur[-37:]):
+            for c in panel.environment_choices():
+                clicked, _ = imgui.selectable(c, c == cur)
+                if clicked:
+                    self._try(panel.set_environment, c)
+            imgui.end_combo()
+        text = self._text.get("env:file", "")
+        ch, text = imgui.input_text("file (.exr/.hdr)##env", text, imgui.InputTextFlags_.enter_returns_true)
+        self._text["env:file"] = text
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("an equirectangular linear HDR map, 2:1 (relative to the scene's folder); Enter loads it")
+        if ch and text.strip():
+            self._try(panel.set_environment, text)
+        env = self.core.scene.environment
+        if env.map is None:
+            return
+        ch, v = imgui.slider_float("rotation (deg)##env", float(env.rotation_deg), -180.0, 180.0)
+        if ch:
+            self._try(panel.set_environment_value, "rotation_deg", v)
+        ch, v = imgui.slider_float(
+            "intensity##env", float(env.intensity), 0.0, 8.0, "%.3f", imgui.SliderFlags_.logarithmic
+        )
+        if ch:
+            self._try(panel.set_environment_value, "intensity", v)
+        ch, v = imgui.checkbox("show background##env", bool(env.show_background))
+        if ch:
+            self._try(panel.set_environment_value, "show_background", v)
 
     def _try(self, fn, *args) -> None:
         try:

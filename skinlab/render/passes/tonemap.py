@@ -38,10 +38,14 @@ class TonemapPass:
         ctx = self.r.ctx
         n = frame.settings.supersample
         tex, fbo, hdr = self.targets(p.resolution, n > 1)
+        env = frame.data.get("environment")
+        drawn = {"BACKGROUND_DRAWN": 1} if env is not None and env["background"] is not None else {}
         if n > 1:
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap_supersample.frag", {"SUPERSAMPLE": n})
+            prog = self.r.programs.get(
+                "passes/fullscreen.vert", "passes/tonemap_supersample.frag", {"SUPERSAMPLE": n, **drawn}
+            )
         else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap.frag")
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap.frag", drawn or None)
         fbo.use()
         ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         frame.targets["hdr_color"].use(0)

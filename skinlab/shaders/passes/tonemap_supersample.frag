@@ -18,7 +18,11 @@ void main() {
         for (int i = 0; i < SUPERSAMPLE; ++i) {
             vec4 s = texelFetch(u_hdr, base + ivec2(i, j), 0);
             sum += s;
+#ifdef BACKGROUND_DRAWN
+            shown += s.rgb;  // the environment map is drawn where no mesh is (alpha 0)
+#else
             shown += mix(u_background, s.rgb, clamp(s.a, 0.0, 1.0));
+#endif
         }
     }
     float inv = 1.0 / float(SUPERSAMPLE * SUPERSAMPLE);

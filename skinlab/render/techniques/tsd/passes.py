@@ -24,8 +24,9 @@ import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
-from skinlab.render.bounce import bind_bounce, bounce_defines
+from skinlab.render.ambient import ambient_defines, bind_ambient
 from skinlab.render.boundary import bind_boundary
+from skinlab.render.environment import bind_env_bands
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
 from skinlab.render.texture_units import TextureUnits
@@ -306,7 +307,7 @@ class TsdIrradiancePass(TsdPass):
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights
-        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **bounce_defines(frame, node)}
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **ambient_defines(frame, node)}
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
@@ -315,8 +316,9 @@ class TsdIrradiancePass(TsdPass):
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units)
-        bind_bounce(frame, node, prog, units)
+        bind_ambient(frame, node, prog, units)
         bind_boundary(prog, mat)
+        bind_env_bands(prog, mat)
         if "u_slot_light" in prog:  # the light each filled shadow slot holds (its lights are shaded per slot)
             slot_light = np.full(2, -1, np.int32)
             for s, light in enumerate(prm.shadow_lights[:2]):
