@@ -275,7 +275,8 @@ def _light(e: dict) -> dict | None:
         col, p = point_power(e["intensity"])
         return {"name": name, "type": "POINT", "matrix": _look_along([0.0, 0.0, 1.0], e["position"]),
                 "color": col, "strength": p, "angle": 0.0}  # fmt: skip
-    return None
+    # spot and area lights and environment maps (issue 22) have no Blender mapping yet
+    raise ValueError(f"Blender peers: a {e['kind']} emitter ({name}) has no Blender equivalent here yet")
 
 
 def subsurface_inputs(interior: dict, values: dict) -> tuple[dict, dict, list[str]]:

@@ -1,7 +1,8 @@
 """`skinlab bench orbit`: what a frame costs while a person orbits the camera (the viewer's most
 common action), with reuse across frames, without it, and the plain frame, in one run.
 
-Per scene (the head and the bunny by default), the camera circles the scene's centre at its own
+Per scene (the head, the bunny and the head under the studio HDR map by default), the camera circles
+the scene's centre at its own
 distance and height; after warm-up frames, every step of the path renders three frames, one per
 renderer, interleaved so that a change of machine load hits all three alike:
 
@@ -32,7 +33,7 @@ from skinlab.render.settings import RenderSettings
 from skinlab.resources import scenes_root
 
 ASSETS = scenes_root()
-SCENES = {"head": None, "bunny": ASSETS / "bunny-skimmilk.toml"}
+SCENES = {"head": None, "bunny": ASSETS / "bunny-skimmilk.toml", "head-studio": ASSETS / "head-studio.toml"}
 MODES = ("orbit", "full", "plain", "plain_orbit")
 WARMUP = 2
 
@@ -121,7 +122,9 @@ def orbit_scene(name: str, path, size, frames: int, ctx, progress=None) -> dict:
     }
 
 
-def orbit_bench(size=(640, 640), frames: int = 24, scenes=("head", "bunny"), progress: bool = True) -> dict:
+def orbit_bench(
+    size=(640, 640), frames: int = 24, scenes=("head", "bunny", "head-studio"), progress: bool = True
+) -> dict:
     from tqdm import tqdm
 
     from skinlab.gl.context import create_headless_context, describe

@@ -53,6 +53,17 @@ def register(sub) -> None:
         "(positive: the camera moves to its right; default 0)",
     )
     p.add_argument(
+        "--environment",
+        metavar="MAP",
+        default=None,
+        help="light the scene with an HDR environment map: a bundled one by name (studio, city, courtyard, "
+        "interior) or an .exr/.hdr file (replaces the scene's [environment] map; a scene without one "
+        "loses its uniform ambient, as with a map in the scene file)",
+    )
+    p.add_argument("--environment-rotation", type=float, default=None, metavar="DEG", help="turn the map about +Y")
+    p.add_argument("--environment-intensity", type=float, default=None, metavar="X", help="scale the map's radiance")
+    p.add_argument("--background", action="store_true", help="draw the environment map behind the scene")
+    p.add_argument(
         "--sss",
         choices=SSS_MODELS,
         default=None,
@@ -136,6 +147,39 @@ def settings_from_args(args, w: int, h: int) -> RenderSettings:
     )
 
 
+def environment_from_args(args, scene) -> None:
+    """--environment, --environment-rotation, --environment-intensity, --background on the scene."""
+    import math
+
+    from skinlab.scene.envmap import load_pixels, resolve_map
+
+    env = scene.environment
+    if args.environment is not None:
+        path = resolve_map(args.environment, Path.cwd())
+        load_pixels(path)
+        if env.map is None:
+            env.ambient = env.ambient * 0.0
+        env.map = path
+    given = [f for f in ("environment_rotation", "environment_intensity") if getattr(args, f) is not None]
+    if (given or args.background) and env.map is None:
+        flag = "--" + (given[0] if given else "background").replace("_", "-")
+        raise ValueError(f"{flag}: the scene has no environment map (give --environment MAP)")
+    if args.environment_rotation is not None:
+        if not math.isfinite(args.environment_rotation):
+            raise ValueError(
+                f"--environment-rotation: expected a finite angle in degrees, got {args.environment_rotation}"
+            )
+        env.rotation_deg = args.environment_rotation
+    if args.environment_intensity is not None:
+        if not (math.isfinite(args.environment_intensity) and args.environment_intensity >= 0):
+            raise ValueError(
+                f"--environment-intensity: expected a finite number >= 0, got {args.environment_intensity}"
+            )
+        env.intensity = args.environment_intensity
+    if args.background:
+        env.show_background = True
+
+
 def run(args) -> int:
     w, h = parse_size(args.size)
     settings = settings_from_args(args, w, h)
@@ -150,6 +194,7 @@ def run(args) -> int:
             scene.environment.exposure = args.exposure
         if args.camera_orbit:
             scene.orbit_camera(args.camera_orbit)
+        environment_from_args(args, scene)
 
     scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare, args.reuse, edits)
     for warning in result.plan.warnings:

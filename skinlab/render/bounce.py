@@ -30,8 +30,9 @@ import numpy as np
 
 from skinlab.cache import in_background
 from skinlab.gl.uniforms import set_uniform, set_uniforms
-from skinlab.scene.interreflection import BounceTransfer, build_transfer
+from skinlab.scene.interreflection import MAX_RAYS, MIN_RAYS, BounceTransfer, build_transfer
 
+from .environment import bind_environment, environment_defines, environment_state
 from .frame_plan import PlannedPass, shadow_pass_name
 from .gpu_resources import VERTEX_ATTRS, VERTEX_FORMAT, node_uniforms
 from .lights import bind_shadow_maps, light_defines, set_light_uniforms
@@ -49,10 +50,7 @@ if TYPE_CHECKING:
 VERTEX_TEXTURE_WIDTH = 1024  # vertex-space targets: vertex i at texel (i % width, i / width)
 RECORD_TEXTURE_WIDTH = 4096  # ray records: ray r (= vertex x rays + k) at texel (r % width, r / width)
 DATA_KEY = "bounce"  # frame.data: {"offsets": node uid -> first vertex}
-# rays per frame's geometry: the records take 24 bytes a ray (48 MB here) and Embree casts about a
-# million a second on 2 cores; past it each vertex casts fewer rays, down to MIN_RAYS, then none
-MAX_RAYS = 2_000_000
-MIN_RAYS = 4
+# the ray budget per frame's geometry (skinlab/scene/interreflection.py: MAX_RAYS, MIN_RAYS)
 
 
 @dataclass
@@ -80,8 +78,8 @@ def bounce_rays(
         return None, "interreflection off (bounces = 0)"
     if not meshes:
         return None, ""
-    if not lights and not np.any(np.asarray(scene.environment.ambient) > 0):
-        return None, "no light to bounce (no lights, no ambient)"
+    if not lights and not np.any(np.asarray(scene.environment.ambient) > 0) and scene.environment.map is None:
+        return None, "no light to bounce (no lights, no ambient, no environment map)"
     vertices = sum(len(n.mesh.positions) for n in meshes)
     return min(settings.bounce_rays, MAX_RAYS // max(vertices, 1)), ""
 
@@ -131,7 +129,7 @@ def plan_bounce(
         transfer.key,
         tuple(light_state(l) for l in lights),
         tuple(material_state(n.material) for n in meshes),
-        np.asarray(scene.environment.ambient, np.float64).tobytes(),
+        environment_state(scene),
         scene.mm_per_unit,
     )
     shadows = tuple(shadow_pass_name(l) for l in shadow_lights)
@@ -267,12 +265,13 @@ class BouncePass:
         nmax = frame.settings.max_lights
         for node in prm.nodes:
             mat = node.material
-            defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax)}
+            defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **environment_defines(frame, node)}
             prog = self.r.programs.get("passes/bounce_exitance.vert", "passes/bounce_exitance.frag", defines)
             units = TextureUnits(ctx)
             bind_shadow_maps(self.r, frame, prog, units)
             set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
             self.r.resources.bind_material(prog, mat, units)
+            bind_environment(frame, node, prog, units)
             lod = 0.0
             maps = mat.textures()
             if "u_base_color_map" in maps:

@@ -25,6 +25,10 @@ class PlannedPass:
     # settings and scale. None: the pass runs every frame (it depends on the camera).
     inputs: Any = None
     after: tuple[str, ...] = ()  # names of this plan's passes whose results it reads
+    # a kept pass of a technique that reads ambient light (bounce, environment map): the core adds the
+    # passes making that light to its `after`; False for one that depends on geometry alone (a
+    # stretch map), so that turning an environment map does not re-run it
+    reads_light: bool = True
     reused_since: int | None = None  # set by the renderer: not run, its result is frame N's
 
 

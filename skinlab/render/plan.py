@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from .bounce import plan_bounce, prefetch_bounce
 from .compute import Device, choose_path
+from .environment import plan_environment, plan_sky, prefetch_sky
 from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams, TonemapParams, shadow_pass_name
+from .lights import soft_shadow
 from .registry import get_technique
 from .reuse import light_placement, scene_geometry
 from .technique import PlanContext
@@ -22,6 +25,13 @@ TONEMAP_ON_SOFTWARE = "fragment"
 __all__ = ["FramePlan", "PlannedPass", "ShadowParams", "ForwardParams", "plan_frame"]
 
 
+def soft_size(light: LightNode) -> str:
+    """A light's size as the plan says it."""
+    if light.kind == "directional":
+        return f"angular radius {math.degrees(light.angular_radius):.2g} deg"
+    return f"radius {light.size:.3g} scene units"
+
+
 def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Device | None = None) -> FramePlan:
     """Passes for this frame: shadow maps, interreflection (skinlab/render/bounce.py), the technique's
     passes (registry), the forward pass with
@@ -30,9 +40,11 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
     ``device``: what the GL context can do (skinlab/render/compute.py: compute shaders); None plans the
     fragment path everywhere."""
     meshes = scene.mesh_nodes()
-    lights = scene.lights()
     n = settings.supersample
     plan = FramePlan([], warnings=list(getattr(scene, "warnings", ())))  # the scene's own first (loading)
+    # the environment map's passes and its bright sources as lights, after the scene's own
+    environment, env_lights = plan_environment(scene, settings, meshes, plan)
+    lights = scene.lights() + env_lights
     if len(lights) > settings.max_lights:
         plan.skipped.append(
             (
@@ -50,30 +62,43 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
         shadow_lights = []
     technique = get_technique(settings.technique_name)
     prefetch_bounce(scene, settings, meshes, lights)  # rays are cast while the technique plans
+    prefetch_sky(scene, settings, meshes)  # (the same records, for what the scene hides of the map)
     tp = technique.plan(PlanContext(scene, settings, meshes, lights, shadow_lights[:2], plan, state, device))
+    sky = plan_sky(scene, settings, meshes, plan, environment)
+    if sky is not None:
+        environment.append(sky)
     distance = tp.shadow_distance and bool(shadow_lights)
     geometry = scene_geometry(scene) if shadow_lights else ()
+    plan.passes += environment
     for slot, l in enumerate(shadow_lights[:2]):
+        soft = soft_shadow(l)  # a light with a size: soft shadows from the distance map too
+        dist = distance or soft
+        why = [w for w, on in (("translucency", distance), ("soft shadows", soft)) if on]
         plan.passes.append(
             PlannedPass(
                 shadow_pass_name(l),
                 "shadow",
-                f"shadow_map{slot}" + (f"+shadow_distance{slot}" if distance else ""),
+                f"shadow_map{slot}" + (f"+shadow_distance{slot}" if dist else ""),
                 (settings.shadow_size, settings.shadow_size),
                 f"{l.kind} light '{l.name}' casts shadows on {len(meshes)} visible mesh(es)"
-                + ("; distance map for translucency" if distance else ""),
-                ShadowParams(l, slot, distance),
-                inputs=(slot, distance, light_placement(l), geometry),
+                + (f"; distance map for {' and '.join(why)}" if dist else "")
+                + (f" ({soft_size(l)})" if soft else ""),
+                ShadowParams(l, slot, dist),
+                inputs=(slot, dist, light_placement(l), geometry),
             )
         )
     for l in shadow_lights[2:]:
         plan.skipped.append((f"shadow[{l.name}]", "at most 2 shadow-casting lights"))
     bounce = plan_bounce(scene, settings, meshes, lights, shadow_lights[:2], plan)
+    for p in bounce:  # the environment's light bounces too
+        p.after = (*p.after, *(e.name for e in environment))
     plan.passes += bounce
-    if bounce:  # bounce light is ambient light: every pass of the technique that is kept across frames reads it
-        for p in tp.before_forward:
-            if p.inputs is not None:
-                p.after = (*p.after, bounce[-1].name)
+    # bounce and environment light are ambient light: every pass of the technique that is kept
+    # across frames reads them (its inputs hold the environment's rotation and intensity)
+    ambient = [e.name for e in environment] + ([bounce[-1].name] if bounce else [])
+    for p in tp.before_forward:
+        if p.inputs is not None and ambient and p.reads_light:
+            p.after = (*p.after, *ambient)
     plan.passes += tp.before_forward
     hook = tp.forward
     plan.passes.append(

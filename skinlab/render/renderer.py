@@ -15,6 +15,7 @@ from skinlab.scene.graph import Scene
 
 from .bounce import BouncePass
 from .compute import Device
+from .environment import EnvironmentPass, SkyOcclusionPass
 from .frame import Frame
 from .frame_plan import FramePlan
 from .gpu_resources import GpuResources
@@ -51,6 +52,8 @@ class Renderer:
         self.passes: dict[str, RenderPass] = {
             "shadow": ShadowPass(self),
             "bounce": BouncePass(self),
+            "environment": EnvironmentPass(self),
+            "sky_occlusion": SkyOcclusionPass(self),
             "forward": ForwardPass(self),
             "tonemap": TonemapPass(self),
         }

@@ -46,10 +46,14 @@ def scene_geometry(scene: Scene) -> tuple:
 
 
 def light_placement(light: LightNode) -> tuple:
-    """Where a light is: its kind and position or direction (what a shadow map depends on)."""
+    """Where a light is and its shape: its kind, position or direction, a spot's cone, an area light's
+    size and orientation (what a shadow map and its softness depend on)."""
     if light.kind == "directional":
-        return ("directional", light.direction.tobytes())
-    return (light.kind, light.world_position.tobytes())
+        return ("directional", light.direction.tobytes(), float(light.angular_radius))
+    if light.kind == "point":
+        return (light.kind, light.world_position.tobytes())
+    shape = (light.inner_deg, light.outer_deg) if light.kind == "spot" else (light.width, light.height, light.radius)
+    return (light.kind, light.world_position.tobytes(), light.world_matrix[:3, :3].tobytes(), shape)
 
 
 def light_state(light: LightNode) -> tuple:

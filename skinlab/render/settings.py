@@ -56,6 +56,13 @@ class RenderSettings:
         range=(4, 4096),
         unit="rays per vertex",
     )
+    # environment maps (skinlab/render/environment.py): what the scene hides of the map's light
+    sky_occlusion: bool = option(
+        True,
+        "environment map: each surface receives the map's light less what the scene hides of it (from the "
+        "interreflection's rays per vertex); false: every surface sees the whole map",
+        "bool",
+    )
 
     # compute shaders for the screen- and texture-space passes (skinlab/render/compute.py)
     compute: str = option(

@@ -195,9 +195,20 @@ class _Writer:
 
     def light(self, light: LightNode) -> None:
         lights = self.g.extensions.setdefault("KHR_lights_punctual", {"lights": []})["lights"]
-        kind = "directional" if light.kind == "directional" else "point"
+        if light.is_area:  # KHR_lights_punctual has no area lights
+            self.warnings.append(
+                f"light {light.name!r}: a {light.kind} area light is written as a point light with its colour and "
+                "intensity (KHR_lights_punctual has no area lights; the brightness will differ)"
+            )
+        kind = light.kind if light.kind in ("directional", "spot") else "point"
         colour = np.asarray(light.color, float).tolist()
-        lights.append({"name": light.name, "type": kind, "color": colour, "intensity": float(light.intensity)})
+        entry = {"name": light.name, "type": kind, "color": colour, "intensity": float(light.intensity)}
+        if kind == "spot":
+            entry["spot"] = {
+                "innerConeAngle": math.radians(light.inner_deg),
+                "outerConeAngle": math.radians(light.outer_deg),
+            }
+        lights.append(entry)
         self.used.add("KHR_lights_punctual")
         n = self.p.Node(name=light.name, matrix=_matrix(light.world_matrix))
         n.extensions = {"KHR_lights_punctual": {"light": len(lights) - 1}}

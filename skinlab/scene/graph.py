@@ -9,6 +9,7 @@ from __future__ import annotations
 import itertools
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -142,7 +143,16 @@ class MeshNode(Node):
 
 
 class LightNode(Node):
-    KINDS = ("directional", "point")
+    """A light. ``directional``: travels along the node's -Z axis (``direction``); ``point``: at the
+    node's position, intensity falling off with the inverse square of the distance in metres;
+    ``spot``: a point light shining along -Z, full within ``inner_deg`` of its axis, fading linearly
+    in angle to nothing at ``outer_deg`` (half-angles; Mitsuba's spot); ``rect``: a one-sided
+    rectangle ``width`` x ``height`` (scene units) in the node's XY plane, emitting toward -Z;
+    ``sphere``: a sphere of ``radius`` (scene units). color x intensity is the irradiance
+    (directional), the intensity (point, spot) or the emitted radiance (rect, sphere)."""
+
+    KINDS = ("directional", "point", "spot", "rect", "sphere")
+    AREA_KINDS = ("rect", "sphere")
 
     def __init__(
         self,
@@ -153,6 +163,7 @@ class LightNode(Node):
         cast_shadow: bool = False,
         **kw,
     ):
+        shape = {k: kw.pop(k) for k in ("inner_deg", "outer_deg", "width", "height", "radius") if k in kw}
         super().__init__(name, **kw)
         if kind not in self.KINDS:
             raise ValueError(f"light {name!r}: type must be one of {self.KINDS}, got {kind!r}")
@@ -162,6 +173,28 @@ class LightNode(Node):
         self.color = np.asarray(color, np.float64)
         self.intensity = float(intensity)
         self.cast_shadow = bool(cast_shadow)
+        # a directional light's angular radius (radians; > 0: soft shadows, e.g. a source of an
+        # environment map, skinlab/scene/envmap.py)
+        self.angular_radius = 0.0
+        self.inner_deg, self.outer_deg = 30.0, 45.0  # spot
+        self.width = self.height = 1.0  # rect
+        self.radius = 0.5  # sphere
+        for k, v in shape.items():
+            setattr(self, k, v)
+        self.check_shape()
+
+    def check_shape(self) -> None:
+        """ValueError naming the light when its cone or size is out of range."""
+        if self.kind == "spot":
+            i, o = self.inner_deg, self.outer_deg
+            if not (np.isfinite(i) and np.isfinite(o) and 0.0 <= i <= o and 0.0 < o <= 90.0):
+                raise ValueError(
+                    f"light {self.name!r}: a spot needs 0 <= inner_deg <= outer_deg, 0 < outer_deg <= 90, got {i}, {o}"
+                )
+        for k in {"rect": ("width", "height"), "sphere": ("radius",)}.get(self.kind, ()):
+            v = getattr(self, k)
+            if not (np.isfinite(v) and v > 0):
+                raise ValueError(f"light {self.name!r}: {k} must be a finite number > 0 (scene units), got {v}")
 
     @property
     def direction(self) -> np.ndarray:
@@ -172,6 +205,28 @@ class LightNode(Node):
     @property
     def radiance(self) -> np.ndarray:
         return self.color * self.intensity
+
+    @property
+    def is_area(self) -> bool:
+        return self.kind in self.AREA_KINDS
+
+    def half_extents(self) -> tuple[np.ndarray, np.ndarray]:
+        """A rect's half-width and half-height vectors in the world (its node's X and Y axes)."""
+        m = self.world_matrix[:3, :3]
+        x, y = m[:, 0] / np.linalg.norm(m[:, 0]), m[:, 1] / np.linalg.norm(m[:, 1])
+        return x * (self.width / 2), y * (self.height / 2)
+
+    @property
+    def size(self) -> float:
+        """The light's extent that softens its shadows: a directional light's angular radius (radians),
+        an area light's radius (a sphere's, a rect's half-diagonal; scene units), else 0."""
+        if self.kind == "directional":
+            return float(self.angular_radius)
+        if self.kind == "sphere":
+            return float(self.radius)
+        if self.kind == "rect":
+            return float(np.hypot(self.width, self.height) / 2)
+        return 0.0
 
 
 class CameraNode(Node):
@@ -199,8 +254,16 @@ class CameraNode(Node):
 
 @dataclass
 class Environment:
+    """Light from all around the scene: a uniform ambient radiance and an optional HDR environment
+    map (skinlab/scene/envmap.py: equirectangular, Mitsuba's axes), turned about +Y by rotation_deg
+    and scaled by intensity; show_background draws the map behind the scene."""
+
     ambient: np.ndarray = field(default_factory=lambda: np.array([0.03, 0.03, 0.035]))
     exposure: float = 1.0
+    map: Path | None = None  # an .exr or .hdr file
+    rotation_deg: float = 0.0
+    intensity: float = 1.0
+    show_background: bool = False
 
 
 class Scene:

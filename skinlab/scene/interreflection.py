@@ -43,6 +43,11 @@ if TYPE_CHECKING:
 
 GOLDEN = 0.6180339887498949  # the golden ratio's fractional part: the second coordinate's sequence
 RAY_OFFSET = 1e-5  # ray origins leave the surface by this fraction of the scene's bounding diagonal
+# rays per frame's geometry: the records take 24 bytes a ray (48 MB at the budget) and Embree casts about
+# a million a second on 2 cores; past it each vertex casts fewer rays, down to MIN_RAYS, then none
+# (skinlab/render/bounce.py plans with it, and so does the environment's sky occlusion)
+MAX_RAYS = 2_000_000
+MIN_RAYS = 4
 
 
 @dataclass
@@ -65,6 +70,11 @@ class BounceTransfer:
     ring_offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))  # (V + 1,)
     ring_vertices: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     ring_weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
+    # what the scene hides of the sky (environment light, skinlab/render/environment.py): per vertex
+    # the 9 spherical-harmonic coefficients (skinlab/scene/optics/sh.py) of pi/K sum Y(w_k) over its
+    # rays that met any surface, front or back: the irradiance a vertex loses of a radiance L(w) is
+    # sum_lm L_lm sky_blocked[i, lm] (one-ring averaged like the bounce light)
+    sky_blocked: np.ndarray = field(default_factory=lambda: np.zeros((0, 9), np.float32))
 
     @property
     def total_vertices(self) -> int:
@@ -75,6 +85,11 @@ class BounceTransfer:
         """True when some ray met the front of a surface (else there is nothing to gather); from the
         hit fractions, not the records (the plan asks every frame)."""
         return any(f > 0.0 for f in self.hit_fraction.values())
+
+    @property
+    def any_blocked(self) -> bool:
+        """True when some ray met any surface (some vertex sees less than its whole sky)."""
+        return bool(len(self.sky_blocked)) and bool((self.sky_blocked[:, 0] > 0.0).any())
 
 
 def cosine_directions(normals: np.ndarray, rays: int, seed: int = 0) -> np.ndarray:
@@ -122,7 +137,7 @@ def geometry_key(nodes: list[MeshNode], rays: int, seed: int) -> str:
     return h.hexdigest()
 
 
-_CACHE = Memo(8)  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights
+_CACHE = Memo(8)  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights, sky
 
 
 def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> BounceTransfer:
@@ -143,7 +158,7 @@ def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> Boun
             "interreflection", key, lambda: _cast(nodes, rays, seed, total), "interreflection rays", code=__name__
         ),
     )
-    vertices, weights, fractions, r_off, r_vert, r_w = hit
+    vertices, weights, fractions, r_off, r_vert, r_w, sky = hit
     return BounceTransfer(
         rays,
         offsets,
@@ -155,6 +170,7 @@ def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> Boun
         r_off,
         r_vert,
         r_w,
+        sky,
     )
 
 
@@ -203,7 +219,8 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
 
     if total == 0:
         z = np.zeros(0, np.int64)
-        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), [], np.zeros(1, np.int64), z, z
+        sky = np.zeros((0, 9), np.float32)
+        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), [], np.zeros(1, np.int64), z, z, sky
 
     pos, nrm, faces = [], [], []
     start = 0
@@ -231,6 +248,8 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
     tri, ray, loc = mesh.ray.intersects_id(origins, dirs, multiple_hits=False, return_locations=True)
     vertices = np.zeros((nw * rays, 3), np.int64)
     weights = np.zeros((nw * rays, 3), np.float32)
+    blocked = np.zeros(nw * rays, bool)
+    blocked[ray] = True  # met a surface, front or back: no sky that way
     if len(tri):
         front = np.einsum("ij,ij->i", mesh.face_normals[tri], dirs[ray]) < 0.0
         tri, ray, loc = tri[front], ray[front], loc[front]
@@ -251,7 +270,23 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
         k = len(node.mesh.positions)
         fractions.append(float(hit_rays[start : start + k].mean()))
         start += k
-    return vertices, weights, fractions, *one_rings(p_all, f_all, first, inverse)
+    rings = one_rings(p_all, f_all, first, inverse)
+    return vertices, weights, fractions, *rings, sky_blocked(dirs, blocked, rays, inverse, no_normal, rings)
+
+
+def sky_blocked(dirs, blocked, rays: int, inverse, no_normal, rings) -> np.ndarray:
+    """(V, 9) the SH coefficients of what each vertex's blocked rays hide of the sky (BounceTransfer)."""
+    from .optics.sh import sh9_basis
+
+    nw = len(dirs) // rays
+    per = (sh9_basis(dirs) * blocked[:, None]).reshape(nw, rays, 9).sum(1) * (np.pi / rays)
+    per = per[inverse]
+    per[no_normal] = 0.0
+    offsets, ring_vertices, ring_weights = rings
+    owner = np.repeat(np.arange(len(per)), np.diff(offsets))
+    out = np.zeros_like(per)
+    np.add.at(out, owner, ring_weights.astype(np.float64)[:, None] * per[ring_vertices])
+    return out.astype(np.float32)
 
 
 def gather(transfer: BounceTransfer, exitance: np.ndarray) -> np.ndarray:

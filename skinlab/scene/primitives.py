@@ -1,4 +1,4 @@
-"""Simple meshes made in code: a box with one UV chart per face (the reference slabs)."""
+"""Simple meshes made in code: a box with one UV chart per face (the reference slabs), an icosphere."""
 
 from __future__ import annotations
 
@@ -62,3 +62,26 @@ def write_obj(mesh: Mesh, path) -> None:
     from pathlib import Path
 
     Path(path).write_text("\n".join(lines) + "\n")
+
+
+def sphere_mesh(radius: float = 1.0, subdivisions: int = 3, name: str = "sphere") -> Mesh:
+    """An icosphere centred on the origin (smooth normals, a latitude-longitude UV per vertex, so the
+    charts meet along one seam of split vertices' neighbours: enough for tests, not for textures)."""
+    import trimesh
+
+    if not (np.isfinite(radius) and radius > 0):
+        raise ValueError(f"sphere radius: expected a positive number, got {radius}")
+    ico = trimesh.creation.icosphere(subdivisions=int(subdivisions), radius=float(radius))
+    p = np.asarray(ico.vertices, np.float64)
+    n = p / np.linalg.norm(p, axis=1, keepdims=True)
+    uv = np.stack(
+        [np.arctan2(n[:, 0], -n[:, 2]) / (2 * np.pi) + 0.5, 1.0 - np.arccos(np.clip(n[:, 1], -1, 1)) / np.pi], 1
+    )
+    return Mesh(
+        name,
+        p.astype(np.float32),
+        np.asarray(ico.faces, np.uint32),
+        normals=n.astype(np.float32),
+        uvs=uv.astype(np.float32),
+        source="sphere_mesh",
+    )

@@ -1,7 +1,8 @@
 """A scene written back as a scene file (TOML, docs/scenes.md): what the viewer saves after edits
 (``ViewerCore.save_scene``, Ctrl+S) and what ``skinlab.api`` users can call (:func:`save_scene`).
 
-Written: ``[scene]`` (name, mm_per_unit), ``[environment]`` (ambient, exposure), ``[camera]`` (where it is
+Written: ``[scene]`` (name, mm_per_unit), ``[environment]`` (ambient, exposure; the map, its rotation,
+intensity and background), ``[camera]`` (where it is
 now), every material the meshes use as a ``[materials.NAME]`` table of its values that differ from the
 defaults (maps as absolute paths), one ``[[meshes]]`` entry per mesh file with its transform and each
 mesh node's material and visibility under ``[meshes.nodes.NAME]``, and the lights. Loading the file gives
@@ -78,7 +79,18 @@ def scene_toml(scene: Scene) -> str:
     lines = [f"# written by Skinlab from {scene.source or 'a scene built in Python'}", ""]
     lines += _table("[scene]", {"name": scene.name, "mm_per_unit": scene.mm_per_unit})
     env = scene.environment
-    lines += _table("[environment]", {"ambient": np.asarray(env.ambient).tolist(), "exposure": env.exposure})
+    env_values = {"ambient": np.asarray(env.ambient).tolist(), "exposure": env.exposure}
+    if env.map is not None:  # a bundled map by name, another by its absolute path
+        from .envmap import bundled_maps
+
+        bundled = {str(p): n for n, p in bundled_maps().items()}
+        env_values |= {
+            "map": bundled.get(str(env.map), str(Path(env.map).resolve())),
+            "rotation_deg": float(env.rotation_deg),
+            "intensity": float(env.intensity),
+            "show_background": bool(env.show_background),
+        }
+    lines += _table("[environment]", env_values)
     cam = scene.camera
     if cam is not None:
         w = cam.world_matrix
@@ -133,10 +145,12 @@ def scene_toml(scene: Scene) -> str:
         if not isinstance(light, LightNode):
             continue
         entry = {"name": light.name, "type": light.kind}
-        if light.kind == "directional":
-            entry["direction"] = light.direction.tolist()
-        else:
+        if light.kind != "directional":
             entry["position"] = light.world_position.tolist()
+        if light.kind in ("directional", "spot", "rect"):
+            entry["direction"] = light.direction.tolist()
+        shape = {"spot": ("inner_deg", "outer_deg"), "rect": ("width", "height"), "sphere": ("radius",)}
+        entry |= {k: float(getattr(light, k)) for k in shape.get(light.kind, ())}
         entry |= {"color": np.asarray(light.color).tolist(), "intensity": light.intensity}
         entry["cast_shadow"] = light.cast_shadow
         lines += _table("[[lights]]", entry)

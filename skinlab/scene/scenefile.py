@@ -9,6 +9,8 @@ mm_per_unit = 45.0            # physical scale: scattering distances are in mill
 [environment]
 ambient = [0.03, 0.03, 0.035]
 exposure = 1.0
+# map = "studio"               # an HDR environment map: a bundled one by name, or an .exr/.hdr file
+# rotation_deg = 90            # turns the map about +Y; intensity = 1.0; show_background = true
 
 [camera]
 position = [0, 1, 30]
@@ -36,7 +38,7 @@ overrides = { roughness = 0.05 }
 
 [[lights]]
 name = "key"
-type = "directional"           # or "point" (use position)
+type = "directional"           # or "point", "spot", "rect", "sphere" (docs/scenes.md)
 direction = [-0.5, -0.3, -1]   # the way the light travels
 color = [1, 0.97, 0.92]
 intensity = 3.0
@@ -95,8 +97,35 @@ SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
         ),
     ),
     "[environment]": (
-        Key("ambient", "3 numbers >= 0", "[0.03, 0.03, 0.035]", "uniform ambient radiance, linear RGB"),
+        Key(
+            "ambient",
+            "3 numbers >= 0",
+            "[0.03, 0.03, 0.035]; 0 with a map",
+            "uniform ambient radiance, linear RGB (unshadowed; added to the map's light)",
+        ),
         Key("exposure", "number > 0", "1.0", "linear multiplier on radiance before tone mapping (PNG only)"),
+        Key(
+            "map",
+            "string",
+            "none",
+            "an HDR environment map lighting the scene: an equirectangular (2:1) linear .exr or .hdr, relative "
+            "to the scene file, or a bundled map by name (studio, city, courtyard, interior; skinlab/assets/hdri/). "
+            "Mitsuba's axes: +Y up, the image's centre toward +Z; bright small sources become directional "
+            "lights with shadows (docs/environment.md)",
+        ),
+        Key(
+            "rotation_deg",
+            "number",
+            "0",
+            "turns the map about +Y, counter-clockwise seen from above (degrees; needs map)",
+        ),
+        Key("intensity", "number >= 0", "1.0", "multiplier on the map's radiance (needs map)"),
+        Key(
+            "show_background",
+            "boolean",
+            "false",
+            "draw the map behind the scene (the image's alpha stays the meshes' coverage; needs map)",
+        ),
     ),
     "[camera]": (
         Key("position", "3 numbers", "[0, 0, 10]", "eye position, scene units"),
@@ -182,12 +211,40 @@ SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
     ),
     "[[lights]]": (
         Key("name", "string", "lightN", "the viewer's key light is the one named 'key'"),
-        Key("type", "string", '"directional"', '"directional" (uses direction) or "point" (uses position)'),
-        Key("direction", "3 numbers, non-zero", "[0, 0, -1]", "the way a directional light travels"),
-        Key("position", "3 numbers", "(required for point)", "a point light's position, scene units"),
+        Key(
+            "type",
+            "string",
+            '"directional"',
+            '"directional" (uses direction), "point" (position), "spot" (position, direction, inner_deg, '
+            'outer_deg), "rect" (position, direction, width, height) or "sphere" (position, radius)',
+        ),
+        Key("direction", "3 numbers, non-zero", "[0, 0, -1]", "the way a directional, spot or rect light shines"),
+        Key("position", "3 numbers", "(required but for directional)", "the light's position (centre), scene units"),
         Key("color", "1 or 3 numbers >= 0", "[1, 1, 1]", "linear RGB"),
-        Key("intensity", "number >= 0", "1.0", "irradiance (directional) or intensity (point) multiplier on color"),
+        Key(
+            "intensity",
+            "number >= 0",
+            "1.0",
+            "multiplier on color: irradiance (directional), intensity (point, spot: falls off with the inverse "
+            "square of the distance in metres) or emitted radiance (rect, sphere)",
+        ),
         Key("cast_shadow", "boolean", "false", "render a shadow map (at most 2 lights; needed for translucency)"),
+        Key("inner_deg", "number in [0, outer_deg]", "30", "spot: half-angle of the full beam, degrees"),
+        Key(
+            "outer_deg",
+            "number in (0, 90]",
+            "45",
+            "spot: half-angle past which it is dark; between the two the light fades linearly in angle",
+        ),
+        Key(
+            "width",
+            "number > 0",
+            "1",
+            "rect: extent across (horizontal when the light does not point straight up or down), scene units; "
+            "one-sided, shining along direction",
+        ),
+        Key("height", "number > 0", "1", "rect: extent along its other side, scene units"),
+        Key("radius", "number > 0", "0.5", "sphere: radius, scene units"),
     ),
     # what the scene tests, for the accuracy ledger (skinlab/scene/measure.py, docs/ledger.md "Edges and profiles")
     "[measure]": (
@@ -444,6 +501,31 @@ def _check_textures(where: str, material: Material) -> None:
             raise SceneFileError(f"{where}.{p.name}: {exc}") from None
 
 
+def _environment_map(env: dict, base: Path, scene: Scene) -> None:
+    """[environment] map and its settings: the file found and checked (skinlab/scene/envmap.py)."""
+    from .envmap import EnvironmentMapError, load_pixels, resolve_map
+
+    if "map" not in env:
+        for key in ("rotation_deg", "intensity", "show_background"):
+            if key in env:
+                raise SceneFileError(f"[environment].{key}: needs an environment map ([environment] map)")
+        return
+    try:
+        path = resolve_map(_str("[environment].map", env["map"]), base)
+        load_pixels(path)
+    except EnvironmentMapError as exc:
+        raise SceneFileError(f"[environment].map: {exc}") from None
+    e = scene.environment
+    e.map = path
+    e.ambient = np.zeros(3)  # with a map the uniform ambient is off unless given
+    if "rotation_deg" in env:
+        e.rotation_deg = _num("[environment].rotation_deg", env["rotation_deg"])
+    if "intensity" in env:
+        e.intensity = _num("[environment].intensity", env["intensity"], 0.0)
+    if "show_background" in env:
+        e.show_background = _bool("[environment].show_background", env["show_background"])
+
+
 def resolve_scene_path(path: str | Path | None) -> Path:
     """A file that exists, else a bundled scene of that name; FileNotFoundError naming both tries."""
     if not path:
@@ -508,10 +590,11 @@ def _build(path: Path, data: dict) -> Scene:
 
     env = _table("[environment]", data.get("environment", {}))
     _known("[environment]", env, _keys("[environment]"))
-    if "ambient" in env:
-        scene.environment.ambient = _vec("[environment].ambient", env["ambient"], lo=0.0)
     if "exposure" in env:
         scene.environment.exposure = _num("[environment].exposure", env["exposure"], 0.0, lo_open=True)
+    _environment_map(env, base, scene)
+    if "ambient" in env:
+        scene.environment.ambient = _vec("[environment].ambient", env["ambient"], lo=0.0)
 
     materials: dict[str, Material] = {}
     for name, values in _table("[materials]", data.get("materials", {})).items():
@@ -605,32 +688,7 @@ def _build(path: Path, data: dict) -> Scene:
         _check_world_transforms(where, top)
 
     for i, entry in enumerate(_tables("[lights]", data.get("lights", []))):
-        where = f"[[lights]] #{i + 1}"
-        _known(where, entry, _keys("[[lights]]"))
-        kind = _str(f"{where}.type", entry.get("type", "directional"))
-        if kind not in LightNode.KINDS:
-            raise SceneFileError(f"{where}.type: expected one of {', '.join(LightNode.KINDS)}, got {kind!r}")
-        light = LightNode(
-            _str(f"{where}.name", entry.get("name", f"light{i + 1}")),
-            kind,
-            _vec(f"{where}.color", entry.get("color", 1.0), lo=0.0),
-            _num(f"{where}.intensity", entry.get("intensity", 1.0), 0.0),
-            _bool(f"{where}.cast_shadow", entry.get("cast_shadow", False)),
-        )
-        if kind == "directional":
-            if "position" in entry:
-                raise SceneFileError(f"{where}.position: a directional light has no position (use direction)")
-            d = _vec(f"{where}.direction", entry.get("direction", [0, 0, -1]))
-            if np.linalg.norm(d) == 0:
-                raise SceneFileError(f"{where}.direction: must be non-zero")
-            light.rotation = tf.look_at_rotation(np.zeros(3), d)
-        else:
-            if "position" not in entry:
-                raise SceneFileError(f"{where}: a point light needs 'position'")
-            if "direction" in entry:
-                raise SceneFileError(f"{where}.direction: a point light shines every way (remove direction)")
-            light.translation = _vec(f"{where}.position", entry["position"])
-        scene.add(light)
+        scene.add(_light(f"[[lights]] #{i + 1}", entry, i))
 
     if "camera" in data:
         cam = _table("[camera]", data["camera"])
@@ -675,6 +733,57 @@ def _check_world_transforms(where: str, top: Node) -> None:
                 f"{where}: mesh node {node.name!r}: with this entry's translation, rotation and scale its world "
                 f"transform {problem}; {TRANSFORM_RANGE}"
             )
+
+
+# the keys each light type takes besides name, type, color, intensity and cast_shadow
+_LIGHT_KEYS = {
+    "directional": ("direction",),
+    "point": ("position",),
+    "spot": ("position", "direction", "inner_deg", "outer_deg"),
+    "rect": ("position", "direction", "width", "height"),
+    "sphere": ("position", "radius"),
+}
+
+
+def _light(where: str, entry: dict, i: int) -> LightNode:
+    _known(where, entry, _keys("[[lights]]"))
+    kind = _str(f"{where}.type", entry.get("type", "directional"))
+    if kind not in LightNode.KINDS:
+        raise SceneFileError(f"{where}.type: expected one of {', '.join(LightNode.KINDS)}, got {kind!r}")
+    own = _LIGHT_KEYS[kind]
+    for key in ("direction", "position", "inner_deg", "outer_deg", "width", "height", "radius"):
+        if key in entry and key not in own:
+            hint = {
+                "position": " (use direction)",
+                "direction": " (it shines every way: remove direction)" if kind in ("point", "sphere") else "",
+            }.get(key, "")
+            raise SceneFileError(f"{where}.{key}: a {kind} light has no {key}{hint}")
+    shape = {}
+    for key, lo, hi in (("inner_deg", 0.0, 90.0), ("outer_deg", 0.0, 90.0), ("width", 0.0, None), ("height", 0.0, None),
+                        ("radius", 0.0, None)):  # fmt: skip
+        if key in entry:
+            shape[key] = _num(f"{where}.{key}", entry[key], lo, hi, lo_open=key != "inner_deg")
+    try:
+        light = LightNode(
+            _str(f"{where}.name", entry.get("name", f"light{i + 1}")),
+            kind,
+            _vec(f"{where}.color", entry.get("color", 1.0), lo=0.0),
+            _num(f"{where}.intensity", entry.get("intensity", 1.0), 0.0),
+            _bool(f"{where}.cast_shadow", entry.get("cast_shadow", False)),
+            **shape,
+        )
+    except ValueError as exc:
+        raise SceneFileError(f"{where}: {exc}") from None
+    if "position" in own:
+        if "position" not in entry:
+            raise SceneFileError(f"{where}: a {kind} light needs 'position'")
+        light.translation = _vec(f"{where}.position", entry["position"])
+    if "direction" in own:
+        d = _vec(f"{where}.direction", entry.get("direction", [0, 0, -1]))
+        if np.linalg.norm(d) == 0:
+            raise SceneFileError(f"{where}.direction: must be non-zero")
+        light.rotation = tf.look_at_rotation(np.zeros(3), d)
+    return light
 
 
 def _file_material(where: str, own, mm_per_unit: float) -> Material:

@@ -49,6 +49,8 @@ class ReferenceDescription:
     # the reference frame: x_ref = (x_world - frame_origin) * frame_scale (millimetres, centred)
     frame_origin: np.ndarray = field(default_factory=lambda: np.zeros(3))
     frame_scale: float = 1.0
+    # the environment map's pixels (H, W, 3) float32, row 0 at the top, for an "envmap" emitter
+    environment: np.ndarray | None = None
 
     def content(self) -> dict:
         """Everything that determines the image, as JSON-able data plus arrays (for the cache key)."""
@@ -75,6 +77,8 @@ class ReferenceDescription:
                 out.append(s.texture)
             if s.opacity is not None:
                 out.append(s.opacity)
+        if self.environment is not None:
+            out.append(self.environment)
         return out
 
     def to_mitsuba(self, spp: int, seed: int = 0) -> dict:
@@ -100,7 +104,7 @@ class ReferenceDescription:
             },
         }
         for i, e in enumerate(self.emitters):
-            scene[f"emitter{i}"] = _mitsuba_emitter(mi, e)
+            scene[f"emitter{i}"] = mitsuba_emitter(mi, e, self.environment)
         for i, s in enumerate(self.shapes):
             scene[f"shape{i}"] = _mitsuba_mesh(mi, s)
         return scene
@@ -109,11 +113,46 @@ class ReferenceDescription:
 # -- Mitsuba objects ------------------------------------------------------------------------------------
 
 
-def _mitsuba_emitter(mi, e: dict) -> dict:
+def mitsuba_emitter(mi, e: dict, environment: np.ndarray | None = None) -> dict:
+    if e["kind"] == "envmap":
+        # the same axes as Skinlab's (skinlab/scene/envmap.py); rotation_deg about +Y as the frame turns it
+        if environment is None:
+            raise ReferenceError("an envmap emitter needs the description's environment pixels")
+        return {
+            "type": "envmap",
+            "bitmap": mi.Bitmap(np.ascontiguousarray(environment, np.float32)),
+            "scale": float(e["scale"]),
+            "to_world": mi.ScalarTransform4f().rotate([0.0, 1.0, 0.0], float(e["rotation_deg"])),
+        }
     if e["kind"] == "directional":
         return {"type": "directional", "direction": e["direction"], "irradiance": _rgb(e["irradiance"])}
     if e["kind"] == "point":
         return {"type": "point", "position": e["position"], "intensity": _rgb(e["intensity"])}
+    if e["kind"] == "spot":
+        p, d = np.asarray(e["position"]), np.asarray(e["direction"])
+        return {
+            "type": "spot",
+            "to_world": mi.ScalarTransform4f().look_at(origin=p.tolist(), target=(p + d).tolist(), up=_any_up(d)),
+            "intensity": _rgb(e["intensity"]),
+            "cutoff_angle": float(e["cutoff_deg"]),
+            "beam_width": float(e["beam_deg"]),
+        }
+    black = {"type": "diffuse", "reflectance": _rgb([0.0, 0.0, 0.0])}
+    if e["kind"] == "sphere":
+        return {
+            "type": "sphere",
+            "center": list(e["centre"]),
+            "radius": float(e["radius"]),
+            "bsdf": black,
+            "emitter": {"type": "area", "radiance": _rgb(e["radiance"])},
+        }
+    if e["kind"] == "rect":
+        return {
+            "type": "rectangle",
+            "to_world": mi.ScalarTransform4f(rect_to_world(e).tolist()),
+            "bsdf": black,
+            "emitter": {"type": "area", "radiance": _rgb(e["radiance"])},
+        }
     if e["kind"] == "constant":
         return {"type": "constant", "radiance": _rgb(e["radiance"])}
     if e["kind"] == "sun_disk":
@@ -123,6 +162,17 @@ def _mitsuba_emitter(mi, e: dict) -> dict:
         to_world = to_world @ mi.ScalarTransform4f().scale([e["radius"]] * 3)
         return {"type": "disk", "to_world": to_world, "emitter": {"type": "area", "radiance": _rgb(e["radiance"])}}
     raise ReferenceError(f"emitter kind {e['kind']!r} unknown")
+
+
+def rect_to_world(e: dict) -> np.ndarray:
+    """(4, 4) the transform of Mitsuba's rectangle ([-1, 1]^2 in z = 0, emitting toward +z) onto a rect
+    light: columns the half-width and half-height vectors and the way it shines (right-handed), the centre."""
+    ex, ey, n = (np.asarray(e[k], np.float64) for k in ("ex", "ey", "normal"))
+    if np.dot(np.cross(ex, ey), n) < 0:
+        ey = -ey
+    m = np.eye(4)
+    m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = ex, ey, n / np.linalg.norm(n), e["centre"]
+    return m
 
 
 def _any_up(n: np.ndarray) -> list[float]:
@@ -189,6 +239,8 @@ def save(desc: ReferenceDescription, path: Path) -> None:
         ],
     }
     arrays = {"header": np.frombuffer(json.dumps(header, default=float).encode(), np.uint8)}
+    if desc.environment is not None:
+        arrays["environment"] = desc.environment
     for i, s in enumerate(desc.shapes):
         for a in _ARRAYS:
             v = getattr(s, a)
@@ -205,6 +257,7 @@ def load(path: Path) -> ReferenceDescription:
         for i, s in enumerate(header["shapes"]):
             arr = {a: (z[f"shape{i}_{a}"] if f"shape{i}_{a}" in z else None) for a in _ARRAYS}
             shapes.append(ShapeDesc(s["name"], s["material"], bsdf=s["bsdf"], interior=s["interior"], **arr))
+        environment = z["environment"] if "environment" in z else None
     return ReferenceDescription(
         header["width"],
         header["height"],
@@ -218,6 +271,7 @@ def load(path: Path) -> ReferenceDescription:
         header["notes"],
         np.asarray(header["frame_origin"]),
         header["frame_scale"],
+        environment,
     )
 
 

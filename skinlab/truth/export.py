@@ -32,6 +32,14 @@ What the reference models (docs/ground-truth.md):
   alpha_cutoff for "mask", as the frame discards: skinlab/render/alpha.py);
 * ambient light as a constant environment of that radiance (Skinlab's ambient term is unshadowed,
   the environment is not);
+* an environment map as Mitsuba's ``envmap`` of the same pixels (its bright sources included: the
+  frame lights those as directional lights, the path tracer samples them from the map), turned about
+  +Y by the same rotation (both use Mitsuba's axes, skinlab/scene/envmap.py) and scaled by the
+  intensity; Mitsuba centres row j at theta = pi j / (H - 1), Skinlab at pi (j + 1/2) / H: the two
+  differ by at most half a texel, at the poles;
+* spot lights as Mitsuba's ``spot`` (the same intensity as a point light, ``cutoff_angle`` the outer
+  half-angle, ``beam_width`` the inner: both fade linearly in angle between), area lights as shapes
+  (``rectangle``, ``sphere``) with an ``area`` emitter of the same radiance and a black BSDF;
 * optionally (``sun_deg`` > 0) each directional light as a distant disk of that angular diameter
   with the same irradiance, which BSDF sampling can hit (see ``docs/ground-truth.md``: delta lights
   behind a dielectric boundary).
@@ -42,6 +50,7 @@ Every way the reference differs from the realtime frame is listed in ``notes``.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
@@ -282,6 +291,36 @@ def _emitter(
             "intensity": (rad / metres**2).tolist(),
             "light": light.name,
         }
+    pos = ((np.asarray(light.world_position, np.float64) - origin) * scale).tolist()
+    if light.kind == "spot":
+        return {
+            "kind": "spot",
+            "position": pos,
+            "direction": light.direction.tolist(),
+            "intensity": (rad / 1e-6).tolist(),  # as a point light's: distances in mm
+            "cutoff_deg": float(light.outer_deg),
+            "beam_deg": float(light.inner_deg),
+            "light": light.name,
+        }
+    if light.kind == "sphere":
+        return {
+            "kind": "sphere",
+            "centre": pos,
+            "radius": light.radius * scale,
+            "radiance": rad.tolist(),
+            "light": light.name,
+        }
+    if light.kind == "rect":
+        ex, ey = light.half_extents()
+        return {
+            "kind": "rect",
+            "centre": pos,
+            "ex": (ex * scale).tolist(),
+            "ey": (ey * scale).tolist(),
+            "normal": light.direction.tolist(),
+            "radiance": rad.tolist(),
+            "light": light.name,
+        }
     raise ReferenceError(f"light {light.name!r}: type {light.kind!r} has no reference equivalent")
 
 
@@ -370,6 +409,12 @@ def describe(
         raise ReferenceError(f"scene {scene.name!r}: no visible mesh")
     radius = float(np.linalg.norm(np.asarray(hi) - np.asarray(lo)) / 2) * scale
     emitters = [_emitter(l, origin, scale, sun_deg, radius, np.zeros(3)) for l in scene.lights()]
+    if any(l.is_area for l in scene.lights()):
+        names = ", ".join(l.name for l in scene.lights() if l.is_area)
+        notes.append(
+            f"area lights ({names}) are shapes here (black, hidden from the camera) that also block light behind "
+            "them; in the frame they block nothing"
+        )
     if any(not l.cast_shadow for l in scene.lights()):
         names = ", ".join(l.name for l in scene.lights() if not l.cast_shadow)
         notes.append(f"lights without cast_shadow ({names}) are unshadowed in the realtime frame, shadowed here")
@@ -377,6 +422,7 @@ def describe(
     if (amb > 0).any():
         emitters.append({"kind": "constant", "radiance": amb.tolist()})
         notes.append("ambient: a constant environment here (shadowed, seen through the medium); unshadowed in Skinlab")
+    environment = _environment_emitter(scene, emitters, notes)
     if not emitters:
         raise ReferenceError(f"scene {scene.name!r}: no light (and no ambient): the reference would be black")
     cam = scene.camera
@@ -403,4 +449,36 @@ def describe(
         notes=notes,
         frame_origin=origin,
         frame_scale=scale,
+        environment=environment,
     )
+
+
+def _environment_emitter(scene: Scene, emitters: list, notes: list) -> np.ndarray | None:
+    """The scene's environment map as an ``envmap`` emitter (appended); its pixels, or None."""
+    from skinlab.scene.envmap import check_settings, load_pixels, map_key
+
+    env = scene.environment
+    if env.map is None:
+        return None
+    check_settings("[environment]", env.rotation_deg, env.intensity)
+    pixels, negative = load_pixels(env.map)
+    if env.intensity == 0 or not (pixels > 0).any():
+        notes.append(f"environment map {Path(env.map).name}: black (or at intensity 0): no light from it")
+        return None
+    emitters.append(
+        {
+            "kind": "envmap",
+            "map": Path(env.map).name,
+            "key": map_key(env.map),
+            "rotation_deg": float(env.rotation_deg),
+            "scale": float(env.intensity),
+        }
+    )
+    notes.append(
+        "environment map: the map as Mitsuba's envmap, its bright sources sampled from it; the frame lights them "
+        "as directional lights with soft shadow maps and the rest by an irradiance map (diffuse) and prefiltered "
+        "levels (specular)"
+    )
+    if negative:
+        notes.append(f"environment map: {negative} negative texel(s) read as 0 in both renderers")
+    return pixels

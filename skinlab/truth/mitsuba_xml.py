@@ -131,6 +131,44 @@ def _emitter(e: dict, indent: str) -> list[str]:
             f"{i2}</emitter>",
             f"{indent}</shape>",
         ]
+    j = ", ".join
+    if e["kind"] == "envmap":  # the pixels are written beside the XML (write_mitsuba_xml)
+        return [
+            f'{indent}<emitter type="envmap">',
+            f'{i2}<string name="filename" value="{e["file"]}"/>',
+            f'{i2}<float name="scale" value="{_float(e["scale"])}"/>',
+            f'{i2}<transform name="to_world"><rotate y="1" angle="{_float(e["rotation_deg"])}"/></transform>',
+            f"{indent}</emitter>",
+        ]
+    if e["kind"] == "spot":
+        p, d = np.asarray(e["position"]), np.asarray(e["direction"])
+        up = [0.0, 0.0, 1.0] if abs(d[1]) > 0.9 else [0.0, 1.0, 0.0]
+        return [
+            f'{indent}<emitter type="spot">',
+            f'{i2}<transform name="to_world"><lookat origin="{j(map(_float, p))}" target="{j(map(_float, p + d))}" '
+            f'up="{j(map(_float, up))}"/></transform>',
+            rgb("intensity", e["intensity"]),
+            f'{i2}<float name="cutoff_angle" value="{_float(e["cutoff_deg"])}"/>',
+            f'{i2}<float name="beam_width" value="{_float(e["beam_deg"])}"/>',
+            f"{indent}</emitter>",
+        ]
+    if e["kind"] in ("sphere", "rect"):
+        from .description import rect_to_world
+
+        head = [f'{indent}<shape type="{"sphere" if e["kind"] == "sphere" else "rectangle"}">']
+        if e["kind"] == "sphere":
+            head += [f'{i2}<point name="center" value="{j(map(_float, e["centre"]))}"/>',
+                     f'{i2}<float name="radius" value="{_float(e["radius"])}"/>']  # fmt: skip
+        else:
+            head += _matrix(rect_to_world(e), i2)
+        return [
+            *head,
+            f'{i2}<bsdf type="diffuse"><rgb name="reflectance" value="0, 0, 0"/></bsdf>',
+            f'{i2}<emitter type="area">',
+            f'{i2}    <rgb name="radiance" value="{j(map(_float, e["radiance"]))}"/>',
+            f"{i2}</emitter>",
+            f"{indent}</shape>",
+        ]
     raise ValueError(f"Mitsuba XML: emitter kind {e['kind']!r} unknown")
 
 
@@ -178,6 +216,12 @@ def write_mitsuba_xml(desc: ReferenceDescription, folder: str | Path, spp: int =
         "    </sensor>",
     ]
     for e in desc.emitters:
+        if e["kind"] == "envmap":  # its pixels beside the XML, as an EXR Mitsuba reads
+            from skinlab.scene.envmap import write_map
+
+            (folder / "textures").mkdir(exist_ok=True)
+            write_map(folder / "textures" / "envmap.exr", desc.environment)
+            e = {**e, "file": "textures/envmap.exr"}
         lines += _emitter(e, "    ")
     for i, s in enumerate(desc.shapes):
         stem = f"{i:03d}-{''.join(c if c.isalnum() or c in '-_' else '_' for c in s.name)}"

@@ -23,6 +23,7 @@ from .panel import (
     LIGHT_INTENSITY,
     angles_from_direction,
     direction_from_angles,
+    light_widgets,
     render_widgets,
     sss_override_note,
     technique_value,
@@ -166,6 +167,7 @@ class Gui:
             self._scene_section()
             self._material_section()
             self._lights_section()
+            self._environment_section()
         imgui.end()
 
     def _render_section(self) -> None:
@@ -435,8 +437,9 @@ class Gui:
         lights = panel.lights()
         if not lights or not imgui.collapsing_header("Lights", imgui.TreeNodeFlags_.default_open):
             return
-        labels = ["intensity", "color (linear)", "azimuth (deg)", "elevation (deg)"]
         for i, light in enumerate(lights):
+            extra = [widget_label(w) for w in light_widgets(light) if w.param not in ("color", "intensity")]
+            labels = ["intensity", "color (linear)", "azimuth (deg)", "elevation (deg)", *extra]
             title = f"{light.name} ({light.kind}{', key' if i == 0 else ''})##light{light.uid}"
             if not imgui.tree_node_ex(title, imgui.TreeNodeFlags_.default_open):
                 continue
@@ -466,6 +469,50 @@ class Gui:
         ch2, el = imgui.slider_float(f"##elevation{light.uid}", el, -89.0, 89.0)
         if ch1 or ch2:
             self._try(panel.set_light_direction, direction_from_angles(az, el), light)
+        for w in light_widgets(light):  # its shadow and what its kind has (panel.light_widgets)
+            if w.param in ("color", "intensity"):
+                continue
+            rows.row(widget_label(w), w.doc)
+            if w.widget == "checkbox":
+                ch, v = imgui.checkbox(f"##{w.param}{light.uid}", bool(w.value))
+            else:
+                ch, v = imgui.slider_float(f"##{w.param}{light.uid}", float(w.value), w.range[0], w.range[1])
+            if ch:
+                self._try(panel.edit_light, w.param, v, light)
+
+    def _environment_section(self) -> None:
+        """The environment map: a bundled one or a file, its rotation, intensity and background."""
+        panel = self.core.panel
+        if not imgui.collapsing_header("Environment map", imgui.TreeNodeFlags_.default_open):
+            return
+        cur = panel.environment_name()
+        if imgui.begin_combo("map##env", cur if len(cur) < 40 else "..." + cur[-37:]):
+            for c in panel.environment_choices():
+                clicked, _ = imgui.selectable(c, c == cur)
+                if clicked:
+                    self._try(panel.set_environment, c)
+            imgui.end_combo()
+        text = self._text.get("env:file", "")
+        ch, text = imgui.input_text("file (.exr/.hdr)##env", text, imgui.InputTextFlags_.enter_returns_true)
+        self._text["env:file"] = text
+        if imgui.is_item_hovered():
+            imgui.set_tooltip("an equirectangular linear HDR map, 2:1 (relative to the scene's folder); Enter loads it")
+        if ch and text.strip():
+            self._try(panel.set_environment, text)
+        env = self.core.scene.environment
+        if env.map is None:
+            return
+        ch, v = imgui.slider_float("rotation (deg)##env", float(env.rotation_deg), -180.0, 180.0)
+        if ch:
+            self._try(panel.set_environment_value, "rotation_deg", v)
+        ch, v = imgui.slider_float(
+            "intensity##env", float(env.intensity), 0.0, 8.0, "%.3f", imgui.SliderFlags_.logarithmic
+        )
+        if ch:
+            self._try(panel.set_environment_value, "intensity", v)
+        ch, v = imgui.checkbox("show background##env", bool(env.show_background))
+        if ch:
+            self._try(panel.set_environment_value, "show_background", v)
 
     def _try(self, fn, *args) -> None:
         try:

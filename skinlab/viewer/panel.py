@@ -159,6 +159,7 @@ class PanelModel:
     version: int = 0
     error: str | None = None  # last rejected edit, shown in the panel
     applied_presets: dict[int, str] = field(default_factory=dict)  # id(material) -> preset name
+    _ambient_before_map: np.ndarray | None = None  # the scene's ambient while the viewer's map replaces it
 
     def __post_init__(self) -> None:
         self.set_scene(self.scene)
@@ -169,6 +170,7 @@ class PanelModel:
         old = self.selected.name if self.selected is not None else None
         self.scene = scene
         self.applied_presets = {}
+        self._ambient_before_map = None
         self.selected = None
         meshes = scene.mesh_nodes(visible_only=False)
         if old is not None:
@@ -298,9 +300,11 @@ class PanelModel:
         d = d / np.linalg.norm(d)
         if light.kind == "directional":
             light.rotation = tf.look_at_rotation(np.zeros(3), d)
-        else:  # a point light: move it to the same distance from the origin, opposite the direction
+        else:  # a local light: move it to the same distance from the origin, opposite the direction
             r = float(np.linalg.norm(light.translation)) or 1.0
             light.translation = -d * r
+            if light.kind in ("spot", "rect"):  # and turn it to shine at the origin
+                light.rotation = tf.look_at_rotation(np.zeros(3), d)
         self.version += 1
         return d
 
@@ -345,10 +349,167 @@ class PanelModel:
         self.version += 1
         return self.scene.environment.exposure
 
+    # -- the selected light -------------------------------------------------------------------
+    @property
+    def light(self) -> LightNode | None:
+        return self.selected if isinstance(self.selected, LightNode) else None
+
+    def light_widgets(self) -> list[Widget]:
+        light = self.light
+        return light_widgets(light) if light is not None else []
+
+    def edit_light(self, name: str, value: Any, light: LightNode | None = None) -> Any:
+        """Set one of a light's values (the selected light's by default; light_widgets), clamped into
+        its range; a spot's inner half-angle never exceeds its outer one. Errors name the light and the
+        value."""
+        light = light or self.light
+        if light is None:
+            raise ValueError(f"edit {name}: the selected node {getattr(self.selected, 'name', None)!r} is not a light")
+        known = {w.param: w for w in light_widgets(light)}
+        if name not in known:
+            raise ValueError(f"light {light.name!r}: no value {name!r} (it has {', '.join(known)})")
+        w = known[name]
+        try:
+            if w.widget == "checkbox":
+                v = bool(value)
+            elif w.widget == "color_edit3":
+                v = np.clip(np.asarray(value, np.float64).reshape(3), 0.0, None)
+                if not np.isfinite(v).all():
+                    raise ValueError(f"{name}: expected 3 finite numbers, got {value!r}")
+            else:
+                v = float(value)
+                if not math.isfinite(v):
+                    raise ValueError(f"{name}: expected a finite number, got {value!r}")
+                v = min(max(v, w.range[0]), w.range[1])
+                if name == "angular_radius_deg":
+                    name, v = "angular_radius", math.radians(v)
+            old = getattr(light, name)
+            setattr(light, name, v)
+            if light.kind == "spot" and light.inner_deg > light.outer_deg:
+                if name == "inner_deg":
+                    light.outer_deg = light.inner_deg
+                else:
+                    light.inner_deg = light.outer_deg
+            try:
+                light.check_shape()
+            except ValueError:
+                setattr(light, name, old)
+                raise
+        except ValueError as exc:
+            self.error = f"light {light.name!r}: {exc}" if light.name not in str(exc) else str(exc)
+            raise ValueError(self.error) from None
+        self.error = None
+        self.version += 1
+        return getattr(light, name)
+
+    # -- the environment map ---------------------------------------------------------------------
+    def environment_choices(self) -> list[str]:
+        """What the map picker offers: none, the bundled maps, and the scene's own map file."""
+        from skinlab.scene.envmap import bundled_maps
+
+        names = [ENV_NONE, *bundled_maps()]
+        current = self.environment_name()
+        return names if current in names else [*names, current]
+
+    def environment_name(self) -> str:
+        from skinlab.scene.envmap import bundled_maps
+
+        m = self.scene.environment.map
+        if m is None:
+            return ENV_NONE
+        bundled = {str(p): n for n, p in bundled_maps().items()}
+        return bundled.get(str(m), str(m))
+
+    def set_environment(self, choice: str) -> None:
+        """Light the scene with a bundled map (by name), a map file (a path, relative to the scene's
+        folder), or none. A scene that had no map loses its uniform ambient while it has one (as a
+        scene file with a map does) and gets it back with none."""
+        from skinlab.scene.envmap import EnvironmentMapError, load_pixels, resolve_map
+
+        env = self.scene.environment
+        try:
+            if choice in ("", ENV_NONE):
+                if env.map is not None and self._ambient_before_map is not None:
+                    env.ambient = self._ambient_before_map
+                    self._ambient_before_map = None
+                env.map = None
+            else:
+                source = getattr(self.scene, "source", None)
+                path = resolve_map(choice.strip(), Path(source).parent if source else None)
+                load_pixels(path)  # refuse a bad map here, with its one line
+                if env.map is None:
+                    self._ambient_before_map = np.array(env.ambient)
+                    env.ambient = np.zeros(3)
+                env.map = path
+        except EnvironmentMapError as exc:
+            self.error = str(exc)
+            raise ValueError(self.error) from None
+        self.error = None
+        self.version += 1
+
+    def set_environment_value(self, name: str, value: Any) -> Any:
+        """rotation_deg (wrapped to [-180, 180]), intensity (clamped to [0, 100]) or show_background."""
+        env = self.scene.environment
+        if name == "show_background":
+            env.show_background = bool(value)
+        elif name in ("rotation_deg", "intensity"):
+            v = float(value)
+            if not math.isfinite(v):
+                self.error = f"environment {name}: expected a finite number, got {value!r}"
+                raise ValueError(self.error)
+            setattr(env, name, (v + 180.0) % 360.0 - 180.0 if name == "rotation_deg" else min(max(v, 0.0), 100.0))
+        else:
+            raise ValueError(f"environment: no value {name!r} (rotation_deg, intensity, show_background)")
+        self.error = None
+        self.version += 1
+        return getattr(env, name)
+
 
 EXPOSURE = (1.0 / 256.0, 256.0)  # the panel's exposure slider (logarithmic): +-8 stops
 LIGHT_INTENSITY = (0.0, 100.0)  # the panel's light intensity slider
 LIGHT_COLOR_MAX = 10.0  # a light's colour channels in the panel (linear, may exceed 1)
+
+ENV_NONE = "(none)"
+
+
+def light_widgets(light: LightNode) -> list[Widget]:
+    """The panel's widgets for a light: its colour, intensity and shadow, and what its kind has (a
+    spot's cone, an area light's size, a directional light's angular radius: soft shadows)."""
+    top = max(10.0, 2.0 * light.intensity)
+    out = [
+        Widget("color", "color_edit3", tuple(float(x) for x in light.color), doc="linear RGB"),
+        Widget("intensity", "slider_float", light.intensity, (0.0, top), doc=INTENSITY_DOC[light.kind]),
+        Widget("cast_shadow", "checkbox", light.cast_shadow, doc="a shadow map (at most 2 lights)"),
+    ]
+    if light.kind == "spot":
+        out += [
+            Widget("inner_deg", "slider_float", light.inner_deg, (0.0, 90.0), unit="deg", doc="full beam half-angle"),
+            Widget("outer_deg", "slider_float", light.outer_deg, (0.1, 90.0), unit="deg", doc="dark past this"),
+        ]
+    elif light.kind in ("rect", "sphere"):
+        scale = 4.0 * max(light.width, light.height, light.radius)
+        names = ("width", "height") if light.kind == "rect" else ("radius",)
+        out += [
+            Widget(n, "slider_float", getattr(light, n), (1e-3 * scale, scale), unit="scene units", doc="soft shadows")
+            for n in names
+        ]
+    elif light.kind == "directional":
+        out.append(
+            Widget(
+                "angular_radius_deg", "slider_float", math.degrees(light.angular_radius), (0.0, 10.0), unit="deg",
+                doc="the light's angular radius: soft shadows (0: a point at infinity)",
+            )
+        )  # fmt: skip
+    return out
+
+
+INTENSITY_DOC = {
+    "directional": "irradiance multiplier on colour",
+    "point": "intensity multiplier (inverse square of the distance in metres)",
+    "spot": "intensity multiplier (inverse square of the distance in metres)",
+    "rect": "emitted radiance multiplier",
+    "sphere": "emitted radiance multiplier",
+}
 
 
 # -- the current technique's settings (skinlab/render/options.py declarations) --------------------------------

@@ -60,3 +60,11 @@ def test_peer_bench_reports_the_plain_frame_per_pass_and_the_prepass_in_one_run(
     assert res["ratio_no_prepass_over_pyrender"] == pytest.approx(res["skinlab_no_prepass_ms"] / res["pyrender_ms"])
     assert set(res["skinlab_passes_ms"]) == {"forward", "tonemap", "readback"}  # the peer scene casts no shadow
     assert len(res["loadavg"]) == 3
+
+
+def test_orbit_bench_has_an_environment_scene_whose_map_is_kept_while_orbiting():
+    res = orbit_bench((24, 24), frames=1, scenes=("head-studio",), progress=False)
+    (row,) = res["scenes"]
+    assert row["passes_run_while_orbiting"] == ["forward", "tonemap"]
+    full = row["passes_ms"]["full"]
+    assert {"environment", "sky_occlusion", "shadow[studio:source1]"} <= set(full)

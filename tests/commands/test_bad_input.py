@@ -91,6 +91,28 @@ def png_bytes(cut: int | None = None) -> bytes:
     return buf.getvalue()[:cut] if cut else buf.getvalue()
 
 
+def exr(h: int, w: int, fill: float = 0.5, first: float | None = None) -> bytes:
+    """An EXR of h x w texels of `fill` (the first texel `first`), as bytes."""
+    import tempfile
+
+    import numpy as np
+
+    from skinlab.scene.envmap import write_map
+
+    px = np.full((h, w, 3), fill, np.float32)
+    if first is not None:
+        px[0, 0, 0] = first
+    with tempfile.TemporaryDirectory() as d:
+        return write_map(Path(d) / "m.exr", px).read_bytes()
+
+
+ENV = "[environment]\n{}\n" + MESH
+
+
+def env_scene(keys: str, maps: dict | None = None) -> dict:
+    return {**scene(ENV.format(keys)), **(maps or {})}
+
+
 # (id, files to write, argv ({tmp} = the case's folder), what stderr must contain)
 RENDER = ["render", "{tmp}/s.toml", "--out", "{tmp}/out/x.png", "--size", "8x8"]
 CASES = [
@@ -119,7 +141,7 @@ CASES = [
     ("exposure-negative", scene("[environment]\nexposure = -1\n" + MESH), RENDER, ["[environment].exposure"]),
     ("light-colour-negative", scene(LIGHT.format("color = [1, -1, 1]")), RENDER, ["s.toml", "[[lights]] #1.color"]),
     ("light-intensity-string", scene(LIGHT.format("intensity = 'x'")), RENDER, ["[[lights]] #1.intensity"]),
-    ("light-type", scene(LIGHT.format("type = 'spot'")), RENDER, ["s.toml", "[[lights]] #1.type", "point"]),
+    ("light-type", scene(LIGHT.format("type = 'laser'")), RENDER, ["s.toml", "[[lights]] #1.type", "point"]),
     ("light-shadow-string", scene(LIGHT.format("cast_shadow = 'yes'")), RENDER, ["[[lights]] #1.cast_shadow"]),
     ("light-name-number", scene(LIGHT.format("name = 5")), RENDER, ["[[lights]] #1.name"]),
     ("light-intensity-huge", scene(LIGHT.format("intensity = 1e300")), RENDER, ["[[lights]] #1.intensity", "1e+12"]),
@@ -138,6 +160,49 @@ CASES = [
     ("not-utf8", {"s.toml": b"[scene]\nname = '\xff\xfe'\n"}, RENDER, ["s.toml", "UTF-8"]),
     ("not-toml", {"s.toml": "[scene\n"}, RENDER, ["s.toml", "not valid TOML"]),
     ("scene-folder", {"d/x": ""}, ["render", "{tmp}/d", "--out", "{tmp}/x.png"], ["d", "folder"]),
+    # -- environment maps ([environment] map; skinlab/scene/envmap.py) ----------------------------
+    (
+        "env-map-missing",
+        env_scene("map = 'nope.exr'"),
+        RENDER,
+        ["s.toml", "[environment].map", "nope.exr", "not found"],
+    ),
+    ("env-map-number", env_scene("map = 5"), RENDER, ["s.toml", "[environment].map", "string"]),
+    ("env-map-png", env_scene("map = 'm.png'", {"m.png": "x"}), RENDER, ["[environment].map", "m.png", ".exr or .hdr"]),
+    ("env-map-garbage", env_scene("map = 'g.exr'", {"g.exr": b"garbage"}), RENDER, ["[environment].map", "g.exr"]),
+    ("env-map-1x1", env_scene("map = 'm.exr'", {"m.exr": exr(1, 1)}), RENDER, ["[environment].map", "m.exr", "1x1"]),
+    ("env-map-tiny", env_scene("map = 'm.exr'", {"m.exr": exr(2, 4)}), RENDER, ["m.exr", "4x2", "at least 8x4"]),
+    ("env-map-square", env_scene("map = 'm.exr'", {"m.exr": exr(16, 16)}), RENDER, ["m.exr", "twice as wide"]),
+    ("env-map-nan", env_scene("map = 'm.exr'", {"m.exr": exr(8, 16, first=float("nan"))}), RENDER, ["m.exr", "NaN"]),
+    ("env-map-inf", env_scene("map = 'm.exr'", {"m.exr": exr(8, 16, first=float("inf"))}), RENDER, ["m.exr", "Inf"]),
+    (
+        "env-intensity-negative",
+        env_scene("map = 'm.exr'\nintensity = -1", {"m.exr": exr(8, 16)}),
+        RENDER,
+        ["s.toml", "[environment].intensity", "[0.0"],
+    ),
+    (
+        "env-rotation-string",
+        env_scene("map = 'm.exr'\nrotation_deg = 'east'", {"m.exr": exr(8, 16)}),
+        RENDER,
+        ["[environment].rotation_deg"],
+    ),
+    (
+        "env-background-number",
+        env_scene("map = 'm.exr'\nshow_background = 1", {"m.exr": exr(8, 16)}),
+        RENDER,
+        ["[environment].show_background", "true or false"],
+    ),
+    ("env-rotation-without-map", env_scene("rotation_deg = 90"), RENDER, ["[environment].rotation_deg", "needs"]),
+    ("env-unknown-key", env_scene("mapp = 'm.exr'"), RENDER, ["[environment]", "mapp"]),
+    ("env-option-missing", scene(MESH), [*RENDER, "--environment", "nope"], ["nope", "not found", "studio"]),
+    (
+        "env-option-intensity",
+        scene(MESH),
+        [*RENDER, "--environment", "studio", "--environment-intensity", "-2"],
+        ["--environment-intensity", ">= 0"],
+    ),
+    ("env-option-rotation-alone", scene(MESH), [*RENDER, "--environment-rotation", "30"], ["--environment-rotation"]),
     # -- meshes --------------------------------------------------------------------------------
     (
         "ply-face-past-end",
@@ -506,6 +571,18 @@ RENDERS = [
 ]
 
 
+# documented results, not errors: an all-black map is no light (the plan says so), negative texels
+# read as 0 (the plan says how many)
+DOCUMENTED = [
+    ("env-map-black", env_scene("map = 'm.exr'", {"m.exr": exr(8, 16, 0.0)}), "map 'm' is black: no light from it"),
+    (
+        "env-map-negative",
+        env_scene("map = 'm.exr'", {"m.exr": exr(8, 16, first=-2.0)}),
+        "1 negative texel(s) read as 0",
+    ),
+]
+
+
 @pytest.mark.parametrize("files, argv, warns, check", [c[1:] for c in RENDERS], ids=[c[0] for c in RENDERS])
 def test_bad_input_that_renders_is_finite_and_said_once(tmp_path, capfd, monkeypatch, files, argv, warns, check):
     """Inputs that must render rather than fail: finite pixels, at most one warning line naming the
@@ -532,6 +609,16 @@ def test_bad_input_that_renders_is_finite_and_said_once(tmp_path, capfd, monkeyp
     assert np.isfinite(pixels).all()
     if check == "white":  # tone mapping overflowed to NaN (black) before: now everything is at the top
         assert pixels[..., :3].min() >= 250, pixels[..., :3].min()
+
+
+@pytest.mark.parametrize("files, said", [c[1:] for c in DOCUMENTED], ids=[c[0] for c in DOCUMENTED])
+def test_documented_results_render_and_say_so(tmp_path, capsys, files, said):
+    _write(tmp_path, files)
+    code = main(["render", f"{tmp_path}/s.toml", "--out", f"{tmp_path}/x.png", "--size", "8x8", "--explain"])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    assert said in out.out + out.err
+    assert (tmp_path / "x.png").is_file()
 
 
 def test_every_case_is_distinct():

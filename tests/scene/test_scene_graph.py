@@ -47,7 +47,7 @@ def test_quaternion_round_trip_and_look_at():
 
 def test_nodes_reject_bad_values_with_their_names():
     with pytest.raises(ValueError, match="light 'k': type must be"):
-        LightNode("k", kind="spot")
+        LightNode("k", kind="laser")
     with pytest.raises(ValueError, match="camera 'c': yfov"):
         CameraNode("c", yfov=0)
     with pytest.raises(ValueError, match="mm_per_unit"):

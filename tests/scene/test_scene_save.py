@@ -46,3 +46,31 @@ def test_a_glb_with_its_own_materials_round_trips(tmp_path):
     back = load_scene(save_scene(scene, tmp_path / "two.toml"))
     assert materials(back) == materials(scene)
     assert back.find("b").visible is False and back.find("a").material["base_color"] == (1.0, 0.0, 0.0)
+
+
+def test_environment_map_and_spot_and_area_lights_round_trip(tmp_path):
+    from skinlab.scene import transform as tf
+    from skinlab.scene.envmap import bundled_maps
+    from skinlab.scene.graph import LightNode
+
+    scene = load_scene("head-studio")
+    scene.environment.rotation_deg = -75.0
+    scene.environment.intensity = 0.6
+    for kind, kw in (("spot", {"inner_deg": 12.0, "outer_deg": 33.0}), ("rect", {"width": 2.0, "height": 0.5}),
+                     ("sphere", {"radius": 0.3})):  # fmt: skip
+        light = LightNode(kind, kind, intensity=2.0, **kw)
+        light.translation = (1.0, 2.0, 8.0)
+        light.rotation = tf.look_at_rotation((0, 0, 0), (-0.1, -0.2, -1.0))
+        scene.add(light)
+    back = load_scene(save_scene(scene, tmp_path / "lit.toml"))
+    env = back.environment
+    assert env.map == bundled_maps()["studio"] and (env.rotation_deg, env.intensity) == (-75.0, 0.6)
+    assert env.show_background and not env.ambient.any()
+    for kind in ("spot", "rect", "sphere"):
+        a, b = scene.find(kind), back.find(kind)
+        assert b.kind == kind and np.allclose(a.world_position, b.world_position)
+        assert (a.inner_deg, a.outer_deg, a.width, a.height, a.radius) == pytest.approx(
+            (b.inner_deg, b.outer_deg, b.width, b.height, b.radius)
+        )
+        if kind != "sphere":
+            assert np.allclose(a.direction, b.direction)

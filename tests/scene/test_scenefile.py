@@ -81,3 +81,23 @@ def test_unknown_node_name_lists_the_file_nodes(tmp_path):
     text = text.replace("[[lights]]", "").replace('type = "point"\nposition = [0.3, 0.3, 0.3]\nintensity = 2.0\n', "")
     with pytest.raises(SceneFileError, match="has no node named 'Ear'"):
         load_scene(write(tmp_path, text))
+
+
+def test_environment_map_keys(tmp_path):
+    from skinlab.scene.envmap import bundled_maps
+
+    (tmp_path / "tri.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    text = '[environment]\nmap = "studio"\nrotation_deg = 45\nintensity = 0.5\nshow_background = true\n'
+    (tmp_path / "s.toml").write_text(text + '[[meshes]]\nfile = "tri.obj"\n')
+    env = load_scene(tmp_path / "s.toml").environment
+    assert env.map == bundled_maps()["studio"]
+    assert (env.rotation_deg, env.intensity, env.show_background) == (45.0, 0.5, True)
+    assert np.array_equal(env.ambient, np.zeros(3))  # with a map the uniform ambient is off unless given
+    (tmp_path / "s.toml").write_text('[environment]\nmap = "studio"\nambient = 0.1\n[[meshes]]\nfile = "tri.obj"\n')
+    assert np.allclose(load_scene(tmp_path / "s.toml").environment.ambient, 0.1)
+    # a path relative to the scene file
+    import shutil
+
+    shutil.copy(bundled_maps()["city"], tmp_path / "c.exr")
+    (tmp_path / "s.toml").write_text('[environment]\nmap = "c.exr"\n[[meshes]]\nfile = "tri.obj"\n')
+    assert load_scene(tmp_path / "s.toml").environment.map == (tmp_path / "c.exr").resolve()

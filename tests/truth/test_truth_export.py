@@ -186,8 +186,8 @@ def ex_camera():
 
 def test_unrepresentable_scenes_name_the_problem():
     s = _box_scene()
-    s.find("sun").kind = "spot"  # a light type the reference cannot draw
-    with pytest.raises(ex.ReferenceError, match="light 'sun'.*spot"):
+    s.find("sun").kind = "laser"  # a light type the reference cannot draw
+    with pytest.raises(ex.ReferenceError, match="light 'sun'.*laser"):
         ex.describe(s, 8, 8)
     dark = Scene("dark", 1.0)
     dark.add(MeshNode("box", box_mesh((1, 1, 1)), skin()))
@@ -264,3 +264,52 @@ def test_frame_is_centred_on_the_scattering_meshes():
     s.find("box").material = plate
     lo, hi = s.world_bounds()
     assert np.allclose(ex.describe(s, 8, 8).frame_origin, (lo + hi) / 2) and (lo + hi)[0] / 2 == 20.5
+
+
+def test_environment_map_exports_as_mitsubas_envmap_with_the_same_rotation(tmp_path):
+    """The map's own pixels (its sources included), its rotation about +Y and intensity as scale;
+    the frame's source lights are not exported again; save/load carries the pixels; the key sees them."""
+    from skinlab.scene.envmap import write_map
+    from skinlab.truth import description
+    from skinlab.truth.reference import reference_key
+
+    px = np.full((16, 32, 3), 0.5, np.float32)
+    px[4, 8] = 9000.0
+    s = _box_scene()
+    for l in list(s.lights()):
+        l.visible = False
+    s.environment.map = write_map(tmp_path / "sun.exr", px)
+    s.environment.rotation_deg = 35.0
+    s.environment.intensity = 1.5
+    d = ex.describe(s, 8, 8)
+    (em,) = d.emitters
+    assert em["kind"] == "envmap" and em["rotation_deg"] == 35.0 and em["scale"] == 1.5 and em["map"] == "sun.exr"
+    assert np.array_equal(d.environment, px)
+    assert any("envmap" in n for n in d.notes)
+    path = tmp_path / "d.npz"
+    description.save(d, path)
+    back = description.load(path)
+    assert np.array_equal(back.environment, px) and back.emitters == d.emitters
+    req = ReferenceRequest(8, 8, spp=16, passes=2)
+    other = ex.describe(s, 8, 8)
+    px2 = px.copy()
+    px2[4, 9] = 1.0
+    other.environment = px2
+    assert reference_key(d, req, "3.x") != reference_key(other, req, "3.x")
+    # a black map (or intensity 0) is no light: with nothing else the reference refuses the scene
+    s.environment.map = write_map(tmp_path / "black.exr", np.zeros((16, 32, 3), np.float32))
+    with pytest.raises(ex.ReferenceError, match="no light"):
+        ex.describe(s, 8, 8)
+
+
+def test_envmap_emitter_dict_turns_about_y(tmp_path):
+    mi = pytest.importorskip("mitsuba")
+    from skinlab.truth.description import mitsuba_emitter
+    from skinlab.truth.reference import set_variant
+
+    set_variant("scalar_rgb")
+    px = np.ones((8, 16, 3), np.float32)
+    e = mitsuba_emitter(mi, {"kind": "envmap", "rotation_deg": 90.0, "scale": 2.0}, px)
+    assert e["type"] == "envmap" and e["scale"] == 2.0
+    m = np.array(e["to_world"].matrix, np.float64)
+    assert np.allclose(m[:3, :3] @ [1.0, 0, 0], [0, 0, -1.0], atol=1e-6)  # as skinlab.scene.envmap.rotation_y

@@ -765,3 +765,81 @@ def test_the_viewer_saves_the_edited_scene_as_toml(ctx, tmp_path):
         assert np.allclose(back.camera.world_matrix, c.scene.camera.world_matrix, atol=1e-9)
     finally:
         c.close()
+
+
+# -- lights and the environment map in the panel ----------------------------------------------------
+
+
+def test_panel_light_widgets_per_kind_and_clamped_edits():
+    from skinlab.scene.graph import LightNode, Scene
+    from skinlab.viewer.panel import light_widgets
+
+    s = Scene("s")
+    spot = s.add(LightNode("spot", "spot", inner_deg=20.0, outer_deg=30.0))
+    rect = s.add(LightNode("rect", "rect", width=2.0, height=1.0))
+    sun = s.add(LightNode("sun", "directional"))
+    names = lambda l: [w.param for w in light_widgets(l)]  # noqa: E731
+    assert names(spot) == ["color", "intensity", "cast_shadow", "inner_deg", "outer_deg"]
+    assert names(rect)[3:] == ["width", "height"] and names(sun)[3:] == ["angular_radius_deg"]
+    panel = PanelModel(s)
+    panel.selected = spot
+    v0 = panel.version
+    assert panel.edit_light("inner_deg", 50.0) == 50.0 and spot.outer_deg == 50.0  # the cone stays valid
+    assert panel.edit_light("outer_deg", 200.0) == 90.0  # clamped into its range
+    assert panel.version > v0
+    panel.selected = sun
+    panel.edit_light("angular_radius_deg", 2.0)
+    assert math.isclose(sun.angular_radius, math.radians(2.0))
+    with pytest.raises(ValueError, match="'sun'.*radius"):
+        panel.edit_light("radius", 1.0)
+    panel.selected = rect
+    panel.edit_light("width", 0.0)  # clamped to the slider's smallest size, never 0
+    assert rect.width > 0
+    # a spot or rect key light aims at the origin from where the key-light sliders put it
+    rect.name = "key"
+    panel.set_light_direction(direction_from_angles(20.0, 30.0))
+    assert np.allclose(rect.direction, -rect.world_position / np.linalg.norm(rect.world_position))
+
+
+def test_panel_environment_map_pick_rotate_intensity_background(tmp_path):
+    from skinlab.scene.envmap import bundled_maps, write_map
+    from skinlab.scene.scenefile import load_scene
+    from skinlab.viewer.panel import ENV_NONE
+
+    panel = PanelModel(load_scene())
+    env = panel.scene.environment
+    ambient = env.ambient.copy()
+    assert panel.environment_name() == ENV_NONE
+    assert {"studio", "city"} <= set(panel.environment_choices())
+    panel.set_environment("studio")
+    assert env.map == bundled_maps()["studio"] and not env.ambient.any()
+    assert panel.set_environment_value("rotation_deg", 270.0) == -90.0
+    assert panel.set_environment_value("intensity", -3.0) == 0.0
+    assert panel.set_environment_value("show_background", True) is True
+    good = write_map(tmp_path / "mine.exr", np.ones((8, 16, 3), np.float32))
+    panel.set_environment(str(good))
+    assert panel.environment_name() == str(good) and str(good) in panel.environment_choices()
+    bad = write_map(tmp_path / "square.exr", np.ones((8, 8, 3), np.float32))
+    with pytest.raises(ValueError, match="square.exr.*twice as wide"):
+        panel.set_environment(str(bad))
+    assert env.map == good and "square.exr" in panel.error  # the last good map stays
+    panel.set_environment(ENV_NONE)
+    assert env.map is None and np.allclose(env.ambient, ambient)
+
+
+def test_core_renders_a_turning_environment_map_reusing_what_does_not_depend_on_it(core):
+    c, _ = core
+    c.set_technique_option("size", 256)  # wide enough for the skin's blurs: a texture-space irradiance pass
+    c.panel.set_environment("courtyard")  # no sources: no shadow map of its own
+    assert c.render()
+    assert "environment" in c.result.plan.names()
+    c.panel.set_environment_value("rotation_deg", 45.0)
+    assert c.render()
+    ran, reused = set(c.result.plan.ran()), set(c.result.plan.reused())
+    assert {"environment", "shadow[key]"} <= reused and not any(n.startswith("tsd_stretch") for n in ran)
+    assert any(n.startswith("tsd_irradiance") for n in ran), c.result.plan.explain()
+    c.panel.set_environment(ENV_NONE_NAME)
+    assert c.render() and "environment" not in c.result.plan.names()
+
+
+ENV_NONE_NAME = "(none)"

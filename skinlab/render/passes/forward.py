@@ -13,14 +13,17 @@ the same depth, the one drawn last shows instead of the one drawn first)."""
 from __future__ import annotations
 
 import moderngl
+import numpy as np
 
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.alpha import bind_mask, blended, draw_order, mask_defines
-from skinlab.render.bounce import bind_bounce, bounce_defines
+from skinlab.render.ambient import ambient_defines, bind_ambient
 from skinlab.render.boundary import bind_boundary
+from skinlab.render.environment import DATA_KEY as ENV_DATA
+from skinlab.render.environment import bind_env_bands, env_uniforms
 from skinlab.render.frame_plan import ForwardParams
 from skinlab.render.gpu_resources import node_uniforms
-from skinlab.render.lights import bind_shadow_maps, light_defines, set_light_uniforms
+from skinlab.render.lights import area_defines, bind_shadow_maps, light_defines, set_light_uniforms
 from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK, NodeShading
 from skinlab.render.texture_units import TextureUnits
 
@@ -30,6 +33,7 @@ class ForwardPass:
         self.r = renderer
         self._targets = None
         self._depth_fbo = None  # the depth target alone, for the depth pre-pass
+        self._bg_fbo = None  # (colour target, framebuffer of it and the depth): the environment behind
 
     def targets(self, size, outputs: tuple[str, ...] = ()):
         """(colour, depth, framebuffer, extra colour targets): one more float target per name in
@@ -59,6 +63,9 @@ class ForwardPass:
             for x in (self._depth_fbo, fbo, color, depth, *extra):
                 x.release()
             self._targets = self._depth_fbo = None
+        if self._bg_fbo is not None:
+            self._bg_fbo[1].release()
+            self._bg_fbo = None
 
     def run(self, frame, p) -> None:
         ctx = self.r.ctx
@@ -84,10 +91,37 @@ class ForwardPass:
         finally:
             if prepass:
                 ctx.depth_func, fbo.depth_mask = "<", True
+        self.background(frame, color, depth, per_frame)
         frame.targets["hdr_color"] = color
         frame.targets["depth"] = depth
         for name, tex in zip(hook.outputs, extra):
             frame.targets[name] = tex
+
+    def background(self, frame, color, depth, per_frame) -> None:
+        """The environment map where no mesh was drawn (``[environment] show_background``): the colour
+        target alone (a technique's extra targets keep their clear value), depth test '<=', no writes."""
+        data = frame.data.get(ENV_DATA)
+        if data is None or data["background"] is None:
+            return
+        ctx = self.r.ctx
+        if self._bg_fbo is None or self._bg_fbo[0] is not color:
+            if self._bg_fbo is not None:
+                self._bg_fbo[1].release()
+            self._bg_fbo = (color, ctx.framebuffer([color], depth))
+        fbo = self._bg_fbo[1]
+        fbo.use()
+        ctx.depth_func, fbo.depth_mask = "<=", False
+        try:
+            prog = self.r.programs.get("passes/background.vert", "passes/background.frag")
+            units = TextureUnits(ctx)
+            set_uniforms(
+                prog, {**env_uniforms(frame.scene, data["prepared"]), "u_camera_pos": per_frame["u_camera_pos"]}
+            )
+            set_uniforms(prog, {"u_inv_view_proj": np.linalg.inv(per_frame["u_view_proj"])})
+            units.bind(prog, "u_env_background", data["background"])
+            self.r.fullscreen(prog)
+        finally:
+            ctx.depth_func, fbo.depth_mask = "<", True
 
     def depth_prepass(self, frame, per_frame) -> None:
         self._depth_fbo.use()
@@ -126,7 +160,8 @@ class ForwardPass:
         defines = {
             **sh.material.defines(),
             **light_defines(prm.shadow_lights, nmax),
-            **bounce_defines(frame, node),
+            **area_defines(prm.lights),
+            **ambient_defines(frame, node),
             **sh.defines,
         }
         prog = self.r.programs.get(
@@ -137,10 +172,11 @@ class ForwardPass:
         bind_shadow_maps(self.r, frame, prog, units)
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, node_uniforms(node))
-        bind_bounce(frame, node, prog, units)
+        bind_ambient(frame, node, prog, units)
         self.r.resources.bind_material(prog, sh.material, units)
         scatters = sh.hook != PLAIN_HOOK and sh.subsurface
         bind_boundary(prog, sh.material if scatters else None)
+        bind_env_bands(prog, sh.material if scatters else None)
         if sh.bind is not None:
             sh.bind(prog, units)
         self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)

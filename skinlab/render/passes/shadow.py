@@ -4,12 +4,15 @@ small as the box allows; a point light's perspective map is fitted to the boundi
 
 from __future__ import annotations
 
+import math
+
 import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.alpha import bind_mask, blended, mask_defines
 from skinlab.render.frame_plan import ShadowParams
+from skinlab.render.lights import SOFT_KEY, soft_shadow
 from skinlab.render.texture_units import TextureUnits
 from skinlab.scene import transform as tf
 from skinlab.scene.graph import LightNode
@@ -57,6 +60,31 @@ def light_view_proj(light: LightNode, lo: np.ndarray, hi: np.ndarray) -> np.ndar
 def light_eye(light: LightNode) -> np.ndarray:
     """The light's position (w = 1) or the direction its light travels (w = 0)."""
     return np.append(light.direction, 0.0) if light.kind == "directional" else np.append(light.world_position, 1.0)
+
+
+def soft_parameters(light: LightNode, m: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """lib/shadow_soft.glsl's `soft` for a light with a size and its texture-space shadow matrix `m`:
+    (size: tan of a directional light's angular radius or a local light's radius, 0 directional / 1
+    local, uv per scene unit across the light's view (at unit distance for a local light), the
+    scene's diameter)."""
+    centre = (lo + hi) / 2
+    diameter = max(float(np.linalg.norm(hi - lo)), 1e-6)
+    local = light.kind != "directional"
+    d = light.direction if not local else centre - light.world_position
+    d = d / np.linalg.norm(d)
+    side = np.cross(d, [0.0, 1.0, 0.0] if abs(d[1]) < 0.9 else [1.0, 0.0, 0.0])
+    side /= np.linalg.norm(side)
+    eps = 1e-3 * diameter
+
+    def uv(x):
+        q = m @ np.append(x, 1.0)
+        return q[:2] / q[3]
+
+    k = float(np.linalg.norm(uv(centre + side * eps) - uv(centre)) / eps)
+    if local:
+        k *= float(np.linalg.norm(centre - light.world_position))
+    size = math.tan(light.size) if not local else light.size
+    return np.array([size, float(local), k, diameter])
 
 
 class ShadowPass:
@@ -107,7 +135,11 @@ class ShadowPass:
         frame.shadow_eyes[slot] = light_eye(light)
         if dist is not None:
             frame.targets[f"shadow_distance{slot}"] = dist
-        frame.shadow_matrices[slot] = CLIP_TO_TEXTURE @ light_view_proj(light, *frame.scene.world_bounds())
+        lo, hi = frame.scene.world_bounds()
+        m = CLIP_TO_TEXTURE @ light_view_proj(light, lo, hi)
+        frame.shadow_matrices[slot] = m
+        if soft_shadow(light):
+            frame.data.setdefault(SOFT_KEY, {})[slot] = soft_parameters(light, m, lo, hi)
 
     def run(self, frame, p) -> None:
         ctx = self.r.ctx

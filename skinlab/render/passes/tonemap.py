@@ -41,14 +41,16 @@ class TonemapPass:
         ctx = self.r.ctx
         n = frame.settings.supersample
         tex, fbo, hdr = self.targets(p.resolution, n > 1)
-        defines = {"SUPERSAMPLE": n} if n > 1 else {}
+        env = frame.data.get("environment")
+        drawn = {"BACKGROUND_DRAWN": 1} if env is not None and env["background"] is not None else {}
+        defines = {**({"SUPERSAMPLE": n} if n > 1 else {}), **drawn}
         compute = p.params is not None and p.params.compute
         if compute:
             prog = self.r.programs.compute("passes/tonemap.comp", defines)
         elif n > 1:
             prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap_supersample.frag", defines)
         else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap.frag")
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tonemap.frag", defines or None)
         frame.targets["hdr_color"].use(0)
         set_uniforms(
             prog,

@@ -212,6 +212,63 @@ def single_ambient_albedo(a: float, eta: float, mu) -> np.ndarray:
     return float(a) * tu * integral / (2.0 * eta * eta)
 
 
+def single_ambient_band(a: float, eta: float, mu, band: int) -> np.ndarray:
+    """The single scattering of band `band` (0, 1, 2) of a sky's spherical harmonics toward cosine mu:
+    Jensen's term with an isotropic phase function depends on the incident direction only through its
+    cosine m with the normal, so by the Funk-Hecke theorem a sky of radiance sum L_lm Y_lm scatters
+    sum_l lambda_l(mu) sum_m L_lm Y_lm(n) toward the viewer, lambda_l(mu) = a (1 - F(mu)) / (2 eta^2)
+    int_0^1 (1 - F(m)) m P_l(m) / (mu_t(m) + mu_t(mu)) dm (P_l Legendre's polynomial; band 0 is
+    single_ambient_albedo, the uniform sky's)."""
+    if band == 0:
+        return single_ambient_albedo(a, eta, mu)
+    mu = np.clip(np.asarray(mu, np.float64), 0.0, 1.0)
+    eta = float(clamp_eta(eta))
+    m, w = _gl()
+    legendre = {1: m, 2: 0.5 * (3.0 * m * m - 1.0)}[band]
+
+    def t_and_ct(c):
+        ct = np.sqrt(np.maximum((eta - 1.0) * (eta + 1.0) + c * c, 0.0)) / eta
+        if eta == 1.0:
+            return np.ones_like(c), ct
+        return 1.0 - fresnel_dielectric(c, eta), ct
+
+    tm, ctm = t_and_ct(m)
+    tu, ctu = t_and_ct(mu)
+    integral = np.sum(w * tm * m * legendre / np.maximum(ctm + ctu[..., None], 1e-12), axis=-1)
+    return float(a) * tu * integral / (2.0 * eta * eta)
+
+
+def single_band_tables(alpha, colour, eta) -> np.ndarray:
+    """(3 bands, ANGULAR_NODES, 3 channels) lambda_l(mu) / A_colour (single_ambient_band) at the
+    angular nodes, per unit base colour as the other tables."""
+    mu = angular_nodes()
+    out = np.zeros((3, ANGULAR_NODES, 3))
+    for c in range(3):
+        a, col = float(np.ravel(alpha)[c]), float(np.ravel(colour)[c])
+        if col <= 0.0 or a <= 0.0:
+            continue
+        for band in range(3):
+            out[band, :, c] = single_ambient_band(a, eta, mu, band) / col
+    return out
+
+
+def entry_band_tables(alpha, colour, eta, ggx_alpha: float = 0.0) -> np.ndarray:
+    """(3 bands, 3 channels) what band l of a sky's SH radiance brings into the multiple scattering,
+    per unit base colour: the entering light of a sky sum L_lm Y_lm is sum_l eps_l sum_m L_lm Y_lm(n)
+    with eps_l = 2 pi int_0^1 A_ms(m) m P_l(m) dm / A_colour (Funk-Hecke; eps_0 = pi A_ms_d / A_colour,
+    the uniform sky's: pi x the entry_diffuse of BoundaryTables)."""
+    m, w = _gl()
+    out = np.zeros((3, 3))
+    for c in range(3):
+        a, col = float(np.ravel(alpha)[c]), float(np.ravel(colour)[c])
+        if col <= 0.0 or a <= 0.0:
+            continue
+        f = ms_albedo(a, eta, m, ggx_alpha) * m
+        for band, p in enumerate((np.ones_like(m), m, 0.5 * (3 * m * m - 1))):
+            out[band, c] = 2.0 * np.pi * np.sum(w * f * p) / col
+    return out
+
+
 def hemispherical(f) -> float:
     """2 int_0^1 f(mu) mu dmu."""
     m, w = _gl()

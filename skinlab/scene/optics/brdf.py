@@ -45,10 +45,12 @@ def smith_g2(NoL, NoV, a):
 
 
 def fresnel_schlick(f0, VoH):
-    """f0 has a trailing RGB axis; VoH broadcasts against the rest."""
+    """Schlick's Fresnel from f0 toward F90 = min(50 f0, 1) at grazing (Karis 2013: below 2 % no real
+    interface, so an index-matched boundary, f0 = 0, reflects nothing). f0 has a trailing RGB axis;
+    VoH broadcasts against the rest."""
     f0 = _f(f0)
     w = pow5(1.0 - np.clip(_f(VoH), 0.0, 1.0))
-    return f0 + (1.0 - f0) * w[..., None]
+    return f0 + (np.clip(50.0 * f0, 0.0, 1.0) - f0) * w[..., None]
 
 
 def burley_diffuse(NoL, NoV, LoH, roughness):

@@ -185,3 +185,16 @@ GLSL_CONSTANTS.update(
 # skinlab/scene/optics/oblique.py).
 LUMA_R, LUMA_G, LUMA_B = 0.2126, 0.7152, 0.0722
 GLSL_CONSTANTS.update({"LUMA_R": LUMA_R, "LUMA_G": LUMA_G, "LUMA_B": LUMA_B})
+
+# ---------------------------------------------------------------------------------------------
+# Environment lighting (issue 22; skinlab/scene/optics/sh.py, skinlab/scene/envmap.py,
+# skinlab/shaders/lib/environment.glsl). Real spherical harmonics to order 2 (Sloan 2008, appendix
+# A2) and the clamped cosine's zonal coefficients (Ramamoorthi & Hanrahan 2001, eq. 8).
+SH_C0 = 0.28209479177387814  # 1 / (2 sqrt(pi))
+SH_C1 = 0.4886025119029199  # sqrt(3 / (4 pi))
+SH_C2 = 1.0925484305920792  # sqrt(15 / (4 pi))
+SH_C3 = 0.31539156525252005  # sqrt(5 / (16 pi))
+SH_C4 = 0.5462742152960396  # sqrt(15 / (16 pi))
+SH_A = (PI, 2.0 * PI / 3.0, PI / 4.0)
+GLSL_CONSTANTS.update({"SH_C0": SH_C0, "SH_C1": SH_C1, "SH_C2": SH_C2, "SH_C3": SH_C3, "SH_C4": SH_C4})
+GLSL_CONSTANTS.update({f"SH_A{band}": a for band, a in enumerate(SH_A)})

@@ -1,6 +1,6 @@
-"""NumPy twin of skinlab/shaders/lib/shadow.glsl for a depth-compare sampler with NEAREST filtering,
-clamp-to-edge addressing and compare function '<=' (the result of each tap is exactly 0 or 1,
-so the twin is exact). The renderer samples with LINEAR compare filtering, whose bilinear weights
+"""NumPy twins of skinlab/shaders/lib/shadow.glsl (and lib/shadow_soft.glsl, below) for a depth-compare
+sampler with NEAREST filtering, clamp-to-edge addressing and compare function '<=' (the result of each
+tap is exactly 0 or 1, so the twin is exact). The renderer samples with LINEAR compare filtering, whose bilinear weights
 are implementation precision (llvmpipe uses 8-bit weights); those are not part of the twin."""
 
 from __future__ import annotations
@@ -32,3 +32,61 @@ def shadow_pcf(depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarr
             j = np.clip(np.floor(v * h).astype(np.int64), 0, h - 1)
             total += (ref <= depth_map[j, i]).astype(np.float64)
     return np.where(outside, 1.0, total / 9.0)
+
+
+SOFT_SEARCH_TAPS = 8  # blocker search taps (lib/shadow_soft.glsl)
+SOFT_TAPS = 12  # filter taps
+SOFT_SEARCH_TEXELS = 96.0  # the blocker search spans at most this radius (texels)
+GOLDEN_ANGLE = 2.399963229728653
+
+
+def vogel_tap(k: int, n: int = SOFT_TAPS) -> np.ndarray:
+    """Tap k of n on a Vogel (golden-angle) disk of radius 1 (lib/shadow_soft.glsl vogel_tap)."""
+    r = np.sqrt((k + 0.5) / n)
+    a = k * GOLDEN_ANGLE
+    return np.array([r * np.cos(a), r * np.sin(a)])
+
+
+def _nearest(img: np.ndarray, u, v) -> np.ndarray:
+    h, w = img.shape
+    i = np.clip(np.floor(np.asarray(u) * w).astype(np.int64), 0, w - 1)
+    j = np.clip(np.floor(np.asarray(v) * h).astype(np.int64), 0, h - 1)
+    return img[j, i]
+
+
+def shadow_soft(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL) -> np.ndarray:
+    """Twin of lib/shadow_soft.glsl shadow_soft with NEAREST filtering of both maps (each compare
+    tap exactly 0 or 1): maps (H, W) with row 0 at v = 0; soft and eye (4,); world (N, 3)."""
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    soft, eye = np.asarray(soft, np.float64), np.asarray(eye, np.float64)
+    p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
+    c = p[:, :3] / p[:, 3:4]
+    outside = (c < 0).any(1) | (c > 1).any(1)
+    d_r = world @ eye[:3] if eye[3] == 0.0 else np.linalg.norm(world - eye[:3], axis=1)
+    local = soft[1] > 0.5
+    k = soft[2] / np.maximum(d_r, 1e-20) if local else np.full(len(world), soft[2])
+    texel = 1.0 / depth_map.shape[1]
+    if local:
+        nearest = np.maximum(d_r - soft[3], 0.05 * d_r)
+        widest = 2.0 * soft[0] * (d_r - nearest) / nearest
+    else:
+        widest = np.full(len(world), 2.0 * soft[0] * soft[3])
+    search = np.clip(0.5 * widest * k, texel, SOFT_SEARCH_TEXELS * texel)
+    bias = 2.0 * texel / k
+    total = np.zeros(len(world))
+    count = np.zeros(len(world))
+    for t in range(SOFT_SEARCH_TAPS):
+        o = vogel_tap(t, SOFT_SEARCH_TAPS)
+        d = _nearest(dist_map, c[:, 0] + o[0] * search, c[:, 1] + o[1] * search)
+        hit = d < d_r - bias
+        total += np.where(hit, d, 0.0)
+        count += hit
+    d_b = np.where(count > 0, total / np.maximum(count, 1), d_r)  # no blocker: lit (below)
+    w = 2.0 * soft[0] * (d_r - d_b) / np.maximum(d_b, 1e-20) if local else 2.0 * soft[0] * (d_r - d_b)
+    radius = np.maximum(0.5 * w * k, 1.5 * texel)
+    ref = c[:, 2] - shadow_bias(NoL)
+    lit = np.zeros(len(world))
+    for t in range(SOFT_TAPS):
+        o = vogel_tap(t)
+        lit += (ref <= _nearest(depth_map, c[:, 0] + o[0] * radius, c[:, 1] + o[1] * radius)).astype(np.float64)
+    return np.where(outside | (count == 0), 1.0, lit / SOFT_TAPS)

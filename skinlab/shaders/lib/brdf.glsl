@@ -31,8 +31,12 @@ float smith_g2(float NoL, float NoV, float a) {
     return 1.0 / (1.0 + smith_lambda(NoL, a) + smith_lambda(NoV, a));
 }
 
+// Schlick's Fresnel toward F90 = min(50 F0, 1) at grazing (Karis 2013: a reflectance below 2 % is no
+// real interface): an index-matched boundary (specular 0, F0 = 0) reflects nothing at any angle, as
+// the true Fresnel at index 1 (and the path-traced truth's null boundary); every real dielectric
+// (F0 >= 0.02, specular >= 0.25) and every metal keeps Schlick's whole edge.
 vec3 fresnel_schlick(vec3 f0, float VoH) {
-    return f0 + (vec3(1.0) - f0) * pow5(1.0 - clamp(VoH, 0.0, 1.0));
+    return f0 + (clamp(50.0 * f0, 0.0, 1.0) - f0) * pow5(1.0 - clamp(VoH, 0.0, 1.0));
 }
 
 // Burley diffuse factor (multiply by base colour): includes 1/pi and the retro-reflection.

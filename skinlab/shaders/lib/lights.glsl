@@ -1,17 +1,32 @@
 // Scene lights shared by every pass that lights a surface (forward / gather, irradiance):
-// up to MAX_LIGHTS directional or point lights, two shadow-map slots. Python side:
-// skinlab/render/lights.py set_light_uniforms(). Point lights fall off with the inverse square of the
-// distance in metres (lib/lighting.glsl inverse_square).
+// up to MAX_LIGHTS lights, two shadow-map slots. Python side: skinlab/render/lights.py
+// set_light_uniforms(); NumPy twin of light_incidence: skinlab/scene/optics/lighting.py.
+// Directional lights bring their irradiance; point and spot lights fall off with the inverse square of
+// the distance in metres (lib/lighting.glsl inverse_square), a spot also linearly in angle from its
+// inner to its outer half-angle (Mitsuba's spot); area lights (a sphere, a one-sided rectangle) of
+// radiance L bring their exact irradiance while the whole light is above the surface's horizon, as a
+// light from one direction l (the direction of their vector irradiance: lib/area_lights.glsl).
 #include "lib/lighting.glsl"
 #include "lib/shadow.glsl"
+#include "lib/area_lights.glsl"
+#if defined(SHADOW_SOFT0) || defined(SHADOW_SOFT1)
+#include "lib/shadow_soft.glsl"
+uniform sampler2D u_shadow_distance0;  // a soft slot's distance map (skinlab/render/lights.py)
+uniform sampler2D u_shadow_distance1;
+uniform vec4 u_shadow_soft[2];         // lib/shadow_soft.glsl shadow_soft's `soft`, per slot
+uniform vec4 u_shadow_eye[2];          // each slot's light position (w = 1) or direction (w = 0)
+#endif
 
 #ifndef MAX_LIGHTS
 #define MAX_LIGHTS 4
 #endif
 
 uniform int u_num_lights;
-uniform vec4 u_light_vec[MAX_LIGHTS];        // w = 0: direction to the light; w = 1: position
+uniform vec4 u_light_vec[MAX_LIGHTS];        // w = 0: direction to the light; w = 1: position (centre)
 uniform vec3 u_light_radiance[MAX_LIGHTS];   // colour * intensity
+uniform vec4 u_light_axis[MAX_LIGHTS];       // xyz: the way it shines; w: 0 plain, 1 spot, 2 rect, 3 sphere
+uniform vec4 u_light_shape[MAX_LIGHTS];      // spot: (outer, 1 / (outer - inner)); sphere: (radius);
+                                             // rect: (half-width vector, half-height), world units
 uniform int u_light_shadow[MAX_LIGHTS];      // shadow slot, or -1
 uniform sampler2DShadow u_shadow0;
 uniform sampler2DShadow u_shadow1;
@@ -21,13 +36,27 @@ uniform float u_mm_per_unit;
 // Direction to light i (l) and the irradiance it brings to a surface facing it (e) at world.
 void light_incidence(int i, vec3 world, vec3 n, out vec3 l, out vec3 e) {
     e = u_light_radiance[i];
+    float kind = u_light_axis[i].w;
     if (u_light_vec[i].w == 0.0) {
         l = u_light_vec[i].xyz;
-    } else {
+    } else if (kind < 1.5) {  // point or spot
         vec3 d = u_light_vec[i].xyz - world;
         float dist = length(d);
         l = dist > 0.0 ? d / dist : n;
         e *= inverse_square(dist * u_mm_per_unit);
+        if (kind > 0.5) e *= spot_falloff(u_light_axis[i].xyz, l, u_light_shape[i].x, u_light_shape[i].y);
+    } else if (kind < 2.5) {  // rect
+        vec4 s = u_light_shape[i];
+        vec3 ey = normalize(cross(u_light_axis[i].xyz, s.xyz)) * s.w;
+        vec3 f = rect_vector_irradiance(u_light_vec[i].xyz, s.xyz, ey, u_light_axis[i].xyz, world);
+        float len = length(f);
+        l = len > 0.0 ? f / len : n;
+        e *= len;
+    } else {  // sphere
+        vec3 d = u_light_vec[i].xyz - world;
+        float dist = length(d);
+        l = dist > 0.0 ? d / dist : n;
+        e *= sphere_irradiance(u_light_shape[i].x, dist);
     }
 }
 
@@ -43,10 +72,36 @@ void light_incidence(int i, vec3 world, vec3 n, out vec3 l, out vec3 e) {
 float light_visibility(int i, vec3 world, float NoL_geom) {
 #if SHADOW_SLOTS > 0
     int slot = u_light_shadow[i];
+#ifdef SHADOW_SOFT0  // a light with a size: soft shadows (lib/shadow_soft.glsl)
+    if (slot == 0) return shadow_soft(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom);
+#else
     if (slot == 0) return shadow_pcf(u_shadow0, u_shadow_matrix[0], world, NoL_geom);
+#endif
 #if SHADOW_SLOTS > 1
+#ifdef SHADOW_SOFT1
+    if (slot == 1) return shadow_soft(u_shadow1, u_shadow_distance1, u_shadow_matrix[1], u_shadow_soft[1], u_shadow_eye[1], world, NoL_geom);
+#else
     if (slot == 1) return shadow_pcf(u_shadow1, u_shadow_matrix[1], world, NoL_geom);
 #endif
 #endif
+#endif
     return 1.0;
+}
+
+// The direction (ls) and GGX alpha of light i's specular at world toward v (n the shading normal):
+// an area light's representative point (lib/area_lights.glsl), widened alpha and its energy factor;
+// for the other kinds l, a and 1.
+vec3 light_specular_direction(int i, vec3 world, vec3 n, vec3 v, vec3 l, float a, out float a_spec, out float energy) {
+    a_spec = a;
+    energy = 1.0;
+    float kind = u_light_axis[i].w;
+    if (u_light_vec[i].w == 0.0 || kind < 1.5) return l;
+    vec3 r = reflect(-v, n);
+    vec3 c = u_light_vec[i].xyz;
+    vec4 s = u_light_shape[i];
+    if (kind < 2.5) {
+        vec3 ey = normalize(cross(u_light_axis[i].xyz, s.xyz)) * s.w;
+        return rect_specular_point(c, s.xyz, ey, world, r, a, a_spec, energy);
+    }
+    return sphere_specular_point(c, s.x, world, r, a, a_spec, energy);
 }

@@ -7,6 +7,7 @@
 // pass), entering with the rest, so a screen-space blur spreads it as texture-space diffusion's does.
 #include "lib/sss_boundary.glsl"
 #include "lib/ambient.glsl"
+#include "lib/ambient_entering.glsl"
 #ifdef SSS_TRANSLUCENCY
 #include "lib/sss_translucency.glsl"
 #endif
@@ -19,7 +20,7 @@ void sss_add_light(vec3 e, float vis, float NoL) {
 
 // The radiance leaving the medium toward the viewer for subsurface weight sss_w (ambient included).
 vec3 sss_local_radiance(vec3 base, float NoV, float occlusion, float sss_w) {
-    vec3 entering = sss_in + PI * ambient_radiance(occlusion) * u_sss_entry_diffuse;
+    vec3 entering = sss_in + ambient_entering(occlusion);
     vec3 leaving = entering * sss_exit(abs(NoV));
 #ifdef SSS_TRANSLUCENCY
     // light through thin parts leaves with its own angular distribution (lib/sss_boundary.glsl sss_slab_exit)

@@ -1,13 +1,17 @@
 #version 330 core
 // Interreflection, one order (skinlab/render/bounce.py; NumPy twin skinlab/scene/interreflection.py): the
 // radiant exitance of a mesh vertex, M = sender albedo x (the lights with their shadows + the sky
-// + the previous order's bounce light). The colour map is read at the mip level whose texel spans
+// + the environment map, variant ENV_MAP + the previous order's bounce light). The colour map is read at the mip level whose texel spans
 // about one vertex's share of the UV area (a vertex stands for the surface around it).
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/bounce.glsl"
 #include "skinlab/material.glsl"
 #include "lib/material_uv.glsl"
+
+#ifdef ENV_MAP
+#include "lib/sky_occlusion.glsl"
+#endif
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -33,6 +37,9 @@ void main() {
     base *= textureLod(u_base_color_map, material_uv(v_uv), u_albedo_lod).rgb;
 #endif
     vec3 e = PI * u_ambient;
+#ifdef ENV_MAP
+    e += env_diffuse_irradiance(n);  // the environment map, less what the scene hides of it here
+#endif
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, li;

@@ -5,6 +5,7 @@
 in vec3 in_position;
 in vec3 in_normal;
 in vec2 in_uv;
+#include "lib/sky_vertex.glsl"
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
 uniform int u_vertex_offset;   // this mesh's first vertex in the target
@@ -20,4 +21,5 @@ void main() {
     vec2 texel = vec2(i % u_target_size.x, i / u_target_size.x) + 0.5;
     gl_Position = vec4(texel / vec2(u_target_size) * 2.0 - 1.0, 0.0, 1.0);
     gl_PointSize = 1.0;
+    sky_vertex();
 }

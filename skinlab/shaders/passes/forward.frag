@@ -11,7 +11,9 @@
 // lib/sss_boundary.glsl) is added per light, and for ambient light, for a mesh whose technique
 // scatters (u_sss_single > 0): it leaves within about a mean free path of where it entered, so no
 // technique blurs it. Ambient light is the sky and, with variant BOUNCE, the light the scene's
-// surfaces throw onto this one (interreflection, lib/ambient.glsl).
+// surfaces throw onto this one (interreflection, lib/ambient.glsl); with variant ENV_MAP the
+// environment map's diffuse light (lib/ambient.glsl, every hook's entering light too) and its
+// specular light by the split sum (lib/sky_occlusion.glsl env_specular).
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
@@ -20,6 +22,9 @@
 #include "lib/surface.glsl"
 #include "lib/material_uv.glsl"
 #include "skinlab/material.glsl"
+#ifdef ENV_MAP
+#include "lib/env_single.glsl"
+#endif
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -68,6 +73,7 @@ void main() {
 #ifdef HAS_OCCLUSION_MAP
     occlusion = occlusion_at_strength(texture(u_occlusion_map, muv).r, u_occlusion_strength);
 #endif
+    ambient_set_normal(n);               // the environment map's diffuse light at this normal
     float plain = sss_plain_weight();    // weight of the surface's own Burley diffuse
     vec3 f0 = principled_f0(base, metal, u_specular);
     float a = ggx_alpha(rough);
@@ -96,8 +102,18 @@ void main() {
 #ifdef DIFFUSE_TRANSMISSION
         diffuse *= 1.0 - u_diffuse_transmission;  // what is not sent through
 #endif
+#ifdef AREA_LIGHTS
+        // an area light's specular from its representative point, with a widened lobe (lib/lights.glsl)
+        float a_s, energy;
+        vec3 ls = light_specular_direction(i, v_world, n, v, l, a, a_s, energy);
+        vec3 hs = half_vector(n, v, ls);
+        float NoLs = max(dot(n, ls), 0.0);
+        vec3 spec = specular_ggx(NoLs, NoV, dot(n, hs), dot(ls, hs), a_s, f0) * energy;
+        color += e * vis * (diffuse * NoL + spec * NoLs);
+#else
         vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
         color += e * vis * (diffuse + spec) * NoL;
+#endif
         if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
         // the technique's diffusion: shadowed where it entered (oblique entry, lib/sss_oblique.glsl)
         vec3 z0 = u_sss_mfp * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
@@ -109,8 +125,16 @@ void main() {
 #ifdef DIFFUSE_TRANSMISSION
     kept = 1.0 - u_diffuse_transmission;  // the sky behind shows through as much as the front one is sent away
 #endif
+#ifdef ENV_MAP
+    color += ambient * (base * ((1.0 - metal) * plain * kept)) + ambient_uniform(occlusion) * f0
+           + env_specular(n, v, rough, f0, occlusion);
+    // the uniform sky's and the bounce light's single scattering, and the map's by its SH bands
+    if (single) color += single_w * (ambient_uniform(occlusion) * sss_single_ambient(NoV)
+                                     + env_single(n, NoV) * (occlusion * env_visible_share(n)));
+#else
     color += ambient * (base * ((1.0 - metal) * plain * kept) + f0);
     if (single) color += ambient * single_w * sss_single_ambient(NoV);  // its single scattering
+#endif
     color += sss_radiance(sss_albedo, NoV, occlusion, v_uv);
     vec3 emission = u_emissive;
 #ifdef HAS_EMISSIVE_MAP

@@ -17,6 +17,7 @@
 #include "lib/lights.glsl"
 #include "lib/ambient.glsl"
 #include "lib/sss_boundary.glsl"
+#include "lib/ambient_entering.glsl"
 #include "lib/sss_oblique.glsl"
 #include "skinlab/material.glsl"
 #include "lib/sss_maps.glsl"
@@ -97,6 +98,7 @@ void main() {
 #ifdef HAS_OCCLUSION_MAP
     occlusion = occlusion_at_strength(texture(u_occlusion_map, material_uv(v_uv)).r, u_occlusion_strength);
 #endif
+    ambient_set_normal(n);  // the environment map's diffuse light at this normal (lib/ambient.glsl)
     vec3 e_in = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {   // the lights without a shadow map
         if (i >= u_num_lights) break;
@@ -112,7 +114,7 @@ void main() {
 #if SHADOW_SLOTS > 1
     e_in += shadowed_light(1, n, ng);
 #endif
-    e_in += PI * ambient_radiance(occlusion) * u_sss_entry_diffuse;  // the sky and bounce light
+    e_in += ambient_entering(occlusion);  // the sky and bounce light
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 #ifdef TSD_TRANSLUCENCY
     f_through0 = through_rec[0];

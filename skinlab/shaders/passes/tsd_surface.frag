@@ -1,7 +1,8 @@
 #version 330 core
 // Texture-space diffusion's surface G-buffer, the writing side: the mesh rasterised at its UVs
 // (passes/tsd_uv.vert), each texel's interpolated vertex outputs written as they are, for the
-// irradiance pass's variant DEFERRED_SURFACE to shade each texel once (techniques/tsd/surface.glsl).
+// irradiance pass's variant DEFERRED_SURFACE to shade each texel once (techniques/tsd/surface.glsl);
+// with SKY_OCCLUSION the vertex's sky coefficients too (lib/sky_vertex.glsl).
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
@@ -10,19 +11,36 @@ in vec4 v_color;
 #ifdef BOUNCE
 in vec3 v_bounce;
 #endif
+#ifdef SKY_OCCLUSION
+in vec4 v_sky03;
+in vec4 v_sky47;
+in float v_sky8;
+#endif
 layout(location = 0) out vec4 f_surface0;
 layout(location = 1) out vec4 f_surface1;
 layout(location = 2) out vec4 f_surface2;
 layout(location = 3) out vec4 f_surface3;
-#ifdef BOUNCE
+#if defined(BOUNCE) || defined(SKY_OCCLUSION)
 layout(location = 4) out vec4 f_surface4;
+#endif
+#ifdef SKY_OCCLUSION
+layout(location = 5) out vec4 f_surface5;
+layout(location = 6) out vec4 f_surface6;
 #endif
 void main() {
     f_surface0 = vec4(v_world, 1.0);
     f_surface1 = vec4(v_normal, v_tangent.w);
-    f_surface2 = vec4(v_tangent.xyz, 0.0);
     f_surface3 = v_color;
 #ifdef BOUNCE
     f_surface4 = vec4(v_bounce, 0.0);
+#elif defined(SKY_OCCLUSION)
+    f_surface4 = vec4(0.0);
+#endif
+#ifdef SKY_OCCLUSION
+    f_surface2 = vec4(v_tangent.xyz, v_sky8);
+    f_surface5 = v_sky03;
+    f_surface6 = v_sky47;
+#else
+    f_surface2 = vec4(v_tangent.xyz, 0.0);
 #endif
 }

@@ -25,9 +25,10 @@ import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
-from skinlab.render.bounce import bind_bounce, bounce_defines
+from skinlab.render.ambient import ambient_defines, bind_ambient
 from skinlab.render.boundary import bind_boundary
 from skinlab.render.compute import bind_images, dispatch
+from skinlab.render.environment import bind_env_bands
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
 from skinlab.render.texture_units import TextureUnits
@@ -143,12 +144,13 @@ class TsdNodeTargets:
         m = self.masks.get(what)
         return m[0] if m is not None and m[1] else None
 
-    def surface_buffer(self, ctx, bounce: bool) -> list:
+    def surface_buffer(self, ctx, bounce: bool, sky: bool = False) -> list:
         """The irradiance pass's surface G-buffer (deferred shading, techniques/tsd/surface.glsl): world
-        position and coverage, normal and the tangent's handedness, tangent, the vertex colour, and
-        with `bounce` the interreflection's irradiance, as the UV raster interpolates them. Nearest
-        filtering."""
-        want = 5 if bounce else 4
+        position and coverage, normal and the tangent's handedness, tangent (its a: the ninth sky
+        coefficient), the vertex colour, with `bounce` the interreflection's irradiance, and with `sky`
+        the sky occlusion's first eight coefficients (two more; the bounce slot is kept so the layout
+        is fixed), as the UV raster interpolates them. Nearest filtering."""
+        want = 7 if sky else 5 if bounce else 4
         while len(self.surface) < want:
             t = ctx.texture((self.size, self.size), 4, dtype="f4")
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -402,16 +404,18 @@ class TsdIrradiancePass(TsdPass):
         ctx, node, size, mat = self.r.ctx, prm.node, prm.size, prm.material
         t = self.node_targets(p)
         nmax = frame.settings.max_lights
-        bounce = bounce_defines(frame, node)
+        ambient = ambient_defines(frame, node)
+        # what the surface G-buffer carries besides the geometry: the vertex's bounce light and sky occlusion
+        carried = {k: v for k, v in ambient.items() if k in ("BOUNCE", "SKY_OCCLUSION")}
         surface = []
         if prm.deferred:  # the mesh's vertex outputs rasterised into the G-buffer, then shaded per texel
-            surface = t.surface_buffer(ctx, bool(bounce))
+            surface = t.surface_buffer(ctx, "BOUNCE" in carried, "SKY_OCCLUSION" in carried)
             gbuf = t.fbo(ctx, *surface, depth=t.coverage_mask(ctx, "irradiance"))
             _uv_raster_setup(ctx, gbuf, size)
             gbuf.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            raster = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_surface.frag", bounce)
+            raster = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_surface.frag", carried)
             set_uniforms(raster, node_uniforms(node))
-            bind_bounce(frame, node, raster, TextureUnits(ctx))
+            bind_ambient(frame, node, raster, TextureUnits(ctx))
             with raster_mask(ctx, t, "irradiance", gbuf):  # the dilation's mask
                 self.r.resources.mesh(node.mesh).vao(raster).render(moderngl.TRIANGLES)
         elif "irradiance" in t.masks:
@@ -419,7 +423,7 @@ class TsdIrradiancePass(TsdPass):
         fbo = t.fbo(ctx, t.raw, *(t.through_raw_record(ctx) if prm.translucency else ()))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
-        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **bounce}
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **ambient}
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         if prm.deferred:
@@ -434,8 +438,9 @@ class TsdIrradiancePass(TsdPass):
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units, isotropic=square_footprint(mat))
-        bind_bounce(frame, node, prog, units)
+        bind_ambient(frame, node, prog, units)
         bind_boundary(prog, mat)
+        bind_env_bands(prog, mat)
         if "u_slot_light" in prog:  # the light each filled shadow slot holds (its lights are shaded per slot)
             slot_light = np.full(2, -1, np.int32)
             for s, light in enumerate(prm.shadow_lights[:2]):

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skinlab.render.compute import PassPath
+from skinlab.render.environment import environment_state
 from skinlab.render.frame_plan import PlannedPass, shadow_pass_name
 from skinlab.render.reuse import light_state, material_state, node_geometry
 from skinlab.render.scattering import scattering_material
@@ -381,7 +382,7 @@ def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tu
         material_state(t.material),
         tuple(light_state(l) for l in ctx.lights),
         tuple(l.uid for l in ctx.shadow_lights),
-        np.asarray(ctx.scene.environment.ambient, np.float64).tobytes(),
+        environment_state(ctx.scene),
         float(ctx.scene.mm_per_unit),
         float(mix),
         trans,
@@ -416,6 +417,7 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
             + dilation.note,
             TsdNodeParams(**base, compute=dilation.compute),
             inputs=(stretch_inputs(node, ctx.scene), DILATE_RINGS, seam_key, dilation.compute),
+            reads_light=False,
         )
     ]
     if t.seams is not None:
@@ -429,6 +431,7 @@ def _node_passes(t, ctx, mix, translucency, exact) -> list[PlannedPass]:
                 "cached); the irradiance's gutter and every blurred level's are filled from across the seams",
                 TsdNodeParams(**base),
                 inputs=(node.mesh.uid, node.mesh.version, seam_key),
+                reads_light=False,
             )
         )
     out.append(

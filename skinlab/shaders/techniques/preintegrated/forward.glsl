@@ -12,6 +12,7 @@
 // skinlab/render/technique.py.
 #include "lib/sss_boundary.glsl"
 #include "lib/ambient.glsl"
+#include "lib/ambient_entering.glsl"
 #ifdef SSS_TRANSLUCENCY
 #include "lib/sss_translucency.glsl"
 #endif
@@ -72,6 +73,6 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
         through_exit += te;
 #endif
     }
-    entering += PI * ambient_radiance(occlusion) * u_sss_entry_diffuse;
+    entering += ambient_entering(occlusion);
     return base * (entering * sss_exit(abs(NoV)) + through_exit) * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI);
 }

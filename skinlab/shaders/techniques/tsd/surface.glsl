@@ -1,8 +1,8 @@
 // Texture-space diffusion's surface G-buffer, the reading side (variant DEFERRED_SURFACE of
 // passes/tsd_irradiance.frag, drawn as one fullscreen triangle over the UV layout): the vertex
 // outputs of passes/tsd_uv.vert at each texel, as passes/tsd_surface.frag rasterised them, become the
-// globals the irradiance code reads (v_world, v_normal, v_uv, v_tangent, v_color, and v_bounce for
-// lib/ambient.glsl). A vertex output added to tsd_uv.vert must be carried here too (the fullscreen
+// globals the irradiance code reads (v_world, v_normal, v_uv, v_tangent, v_color, v_bounce for
+// lib/ambient.glsl and v_sky03/47/8 for lib/sky_occlusion.glsl). A vertex output added to tsd_uv.vert must be carried here too (the fullscreen
 // pass would not link without it). The same values, so the same light, as rasterising the mesh with the shading in
 // the fragment shader, but each texel shaded once: a software rasteriser shades whole blocks of
 // pixels for every small UV triangle that touches them (about 2.4x the covered texels on the head).
@@ -14,6 +14,10 @@ uniform sampler2D u_surface2;  // tangent (as interpolated)
 uniform sampler2D u_surface3;  // the vertex colour
 #ifdef BOUNCE
 uniform sampler2D u_surface4;  // the interreflection's irradiance (lib/bounce_vertex.glsl)
+#endif
+#ifdef SKY_OCCLUSION
+uniform sampler2D u_surface5;  // the sky occlusion's coefficients 0-3 (lib/sky_vertex.glsl)
+uniform sampler2D u_surface6;  // and 4-7; the 9th in u_surface2's a
 #endif
 vec3 v_world;
 vec3 v_normal;
@@ -30,10 +34,16 @@ bool load_surface() {
     vec4 s1 = texelFetch(u_surface1, p, 0);
     v_world = s0.xyz;
     v_normal = s1.xyz;
-    v_tangent = vec4(texelFetch(u_surface2, p, 0).xyz, s1.a);
+    vec4 s2 = texelFetch(u_surface2, p, 0);
+    v_tangent = vec4(s2.xyz, s1.a);
     v_color = texelFetch(u_surface3, p, 0);
 #ifdef BOUNCE
     v_bounce = texelFetch(u_surface4, p, 0).rgb;
+#endif
+#ifdef SKY_OCCLUSION
+    v_sky03 = texelFetch(u_surface5, p, 0);
+    v_sky47 = texelFetch(u_surface6, p, 0);
+    v_sky8 = s2.a;
 #endif
     return true;
 }

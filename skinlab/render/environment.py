@@ -1,0 +1,398 @@
+"""Environment light in the frame: an HDR map (``[environment] map``; skinlab/scene/envmap.py) lights
+every surface, for every technique, through the shared ambient code (skinlab/shaders/lib/ambient.glsl).
+
+Planned by the core (skinlab/render/plan.py, :func:`plan_environment`):
+
+* ``environment``: the map prepared on the CPU (its bright sources taken out as directional lights,
+  the rest as an irradiance map for every normal, 9 SH coefficients and prefiltered GGX levels;
+  cached by the file's content, on disk under ``$SKINLAB_CACHE_DIR/environment`` when it took more
+  than 50 ms) and uploaded: the levels as
+  one texture's mip chain, the irradiance map, the split-sum BRDF table, and the map itself when it is
+  drawn behind the scene. A uniform map is one radiance (no prefilter, one level); a black map plans nothing.
+* ``sky_occlusion``: what each vertex's rays meet (the interreflection's ray records,
+  skinlab/scene/interreflection.py ``sky_blocked``) as 9 SH coefficients per vertex, so a surface
+  receives the map's light less what the scene hides of it; skipped when no ray meets anything.
+* the map's sources as directional lights with shadow maps (``skinlab.scene.envmap.environment_lights``),
+  after the scene's own lights.
+
+The passes that shade ambient light (forward, texture-space irradiance, the interreflection's
+exitance) compile with ``ENV_MAP`` (and ``SKY_OCCLUSION``) from :func:`environment_defines` and bind
+the per-frame uniforms with :func:`bind_environment`: the SH coefficients turned to world axes and
+scaled by the intensity, the rotation for the specular lookups. Turning the map or changing its
+intensity re-uploads nothing: only the passes whose inputs hold the light run again.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import TYPE_CHECKING
+
+import moderngl
+import numpy as np
+
+from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
+from skinlab.scene import envmap
+from skinlab.scene.optics import sh, split_sum
+
+from .frame_plan import PlannedPass
+
+if TYPE_CHECKING:
+    from skinlab.scene.graph import MeshNode, Scene
+    from skinlab.scene.interreflection import BounceTransfer
+
+    from .frame import Frame
+    from .frame_plan import FramePlan
+    from .settings import RenderSettings
+    from .texture_units import TextureUnits
+
+ENV_PASS = "environment"
+SKY_PASS = "sky_occlusion"
+DATA_KEY = "environment"  # frame.data: the prepared map and its textures
+SKY_KEY = "sky_occlusion"  # frame.data: {"offsets": node uid -> first vertex}
+SKY_WIDTH = 1024  # vertices per row of the sky-occlusion texture (3 texels each)
+
+
+@dataclass
+class EnvironmentParams:
+    prepared: envmap.PreparedMap
+    path: object  # the map file (the background reads its pixels)
+    background: bool
+
+
+@dataclass
+class SkyParams:
+    transfer: BounceTransfer
+
+
+def plan_environment(
+    scene: Scene, settings: RenderSettings, meshes: list[MeshNode], plan: FramePlan
+) -> tuple[list[PlannedPass], list]:
+    """The environment's passes and the map's sources as lights (none without a map)."""
+    env = scene.environment
+    if env.map is None:
+        return [], []
+    envmap.check_settings("[environment]", env.rotation_deg, env.intensity)
+    prepared = envmap.prepare(env.map)
+    if prepared.black:
+        plan.skipped.append((ENV_PASS, f"map '{prepared.name}' is black: no light from it"))
+        return [], []
+    if env.intensity == 0 and not env.show_background:
+        plan.skipped.append((ENV_PASS, f"map '{prepared.name}' at intensity 0: no light from it"))
+        return [], []
+    how = {"memory": "prepared earlier", "disk": "prepared earlier, read from the cache"}.get(
+        prepared.cached, f"prepared in {prepared.seconds:.2f} s"
+    )
+    if prepared.uniform:
+        what = "uniform map: one radiance, no prefilter"
+    else:
+        what = f"{len(prepared.levels)} prefiltered GGX levels (split sum), 9 SH coefficients"
+        if prepared.sources:
+            what += f", {len(prepared.sources)} bright source(s) lit as directional lights with shadows"
+    passes = [
+        PlannedPass(
+            ENV_PASS,
+            "environment",
+            "env_radiance+env_brdf" + ("+env_background" if env.show_background else ""),
+            (prepared.levels[0].shape[1], prepared.levels[0].shape[0]),
+            f"map '{prepared.name}' {prepared.width}x{prepared.height} ({how}): {what}"
+            + (f"; {prepared.negative_texels} negative texel(s) read as 0" if prepared.negative_texels else "")
+            + ("; drawn behind the scene" if env.show_background else ""),
+            EnvironmentParams(prepared, env.map, bool(env.show_background)),
+            inputs=(prepared.key, bool(env.show_background)),
+        )
+    ]
+    return passes, envmap.environment_lights(scene)
+
+
+def sky_rays(settings: RenderSettings, meshes: list[MeshNode]) -> int:
+    """Rays per vertex the sky occlusion casts (the interreflection's, within its budget)."""
+    from skinlab.scene.interreflection import MAX_RAYS
+
+    vertices = sum(len(n.mesh.positions) for n in meshes)
+    return min(settings.bounce_rays, MAX_RAYS // max(vertices, 1))
+
+
+def prefetch_sky(scene: Scene, settings: RenderSettings, meshes: list[MeshNode]) -> None:
+    """Start casting the sky occlusion's rays on a worker thread (the interreflection's records, shared
+    with it: skinlab/cache.py in_background), so that they are cast while the technique plans."""
+    from skinlab.cache import in_background
+    from skinlab.scene.interreflection import MIN_RAYS, build_transfer
+
+    if scene.environment.map is not None and settings.sky_occlusion and meshes:
+        rays = sky_rays(settings, meshes)
+        if rays >= MIN_RAYS:
+            in_background(build_transfer, list(meshes), rays)
+
+
+def plan_sky(
+    scene: Scene, settings: RenderSettings, meshes: list[MeshNode], plan: FramePlan, environment: list
+) -> PlannedPass | None:
+    """The sky-occlusion pass of a frame with an environment map (`environment`: its planned passes)."""
+    from skinlab.scene.interreflection import MAX_RAYS, MIN_RAYS, build_transfer
+
+    if not environment:
+        return None
+    if not settings.sky_occlusion:
+        plan.skipped.append((SKY_PASS, "sky occlusion off (sky_occlusion = false)"))
+        return None
+    if not meshes:
+        return None
+    vertices = sum(len(n.mesh.positions) for n in meshes)
+    rays = sky_rays(settings, meshes)
+    if rays < MIN_RAYS:
+        plan.skipped.append((SKY_PASS, f"{vertices} vertices: over the ray budget ({MAX_RAYS:,} rays)"))
+        return None
+    transfer = build_transfer(meshes, rays)
+    if not transfer.any_blocked:
+        plan.skipped.append((SKY_PASS, "nothing hides the sky: every ray from every vertex leaves the scene"))
+        return None
+    return PlannedPass(
+        SKY_PASS,
+        "sky_occlusion",
+        "sky_blocked",
+        (3 * SKY_WIDTH, max(1, math.ceil(transfer.total_vertices / SKY_WIDTH))),
+        f"what the scene hides of the sky: {transfer.total_vertices} vertices x {transfer.rays} rays "
+        "(the interreflection's), 9 SH coefficients each",
+        SkyParams(transfer),
+        inputs=(transfer.key,),
+    )
+
+
+def environment_state(scene: Scene) -> tuple:
+    """What light from all around depends on (a pass's reuse inputs): the ambient radiance and the
+    map's content, rotation and intensity."""
+    env = scene.environment
+    amb = np.asarray(env.ambient, np.float64).tobytes()
+    if env.map is None:
+        return (amb,)
+    return (amb, envmap.map_key(env.map), float(env.rotation_deg), float(env.intensity))
+
+
+# -- the GPU side ------------------------------------------------------------------------------------
+
+_TABLE: np.ndarray | None = None
+
+
+def brdf_table() -> np.ndarray:
+    """The split-sum table (computed once per process: about 50 ms)."""
+    global _TABLE
+    if _TABLE is None:
+        _TABLE = split_sum.brdf_table().astype(np.float32)
+    return _TABLE
+
+
+def upload_levels(ctx: moderngl.Context, levels: list[np.ndarray]) -> moderngl.Texture:
+    """The prefiltered levels as one RGB float texture's mip chain (trilinear, repeat across u)."""
+    base = levels[0]
+    tex = ctx.texture((base.shape[1], base.shape[0]), 3, np.ascontiguousarray(base, np.float32).tobytes(), dtype="f4")
+    if len(levels) > 1:
+        tex.build_mipmaps(0, len(levels) - 1)
+        for k, lv in enumerate(levels[1:], start=1):
+            tex.write(np.ascontiguousarray(lv, np.float32).tobytes(), level=k)
+        tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    else:
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    tex.repeat_x, tex.repeat_y = True, False
+    return tex
+
+
+def upload_table(ctx: moderngl.Context, table: np.ndarray) -> moderngl.Texture:
+    """The split-sum table as an RG float texture (bilinear, clamped)."""
+    tex = ctx.texture(
+        (table.shape[1], table.shape[0]), 2, np.ascontiguousarray(table, np.float32).tobytes(), dtype="f4"
+    )
+    tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    tex.repeat_x = tex.repeat_y = False
+    return tex
+
+
+class EnvironmentPass:
+    """Uploads the prepared map (plan_environment); its textures are kept per map."""
+
+    def __init__(self, renderer):
+        self.r = renderer
+        self.held: dict | None = None  # key, radiance, brdf, background (or None)
+
+    def _textures(self, prm: EnvironmentParams) -> dict:
+        prepared = prm.prepared
+        held = self.held
+        if held is not None and held["key"] == prepared.key and (held["background"] is not None) >= prm.background:
+            return held
+        self.release()
+        ctx = self.r.ctx
+        tex = upload_levels(ctx, prepared.levels)
+        brdf = upload_table(ctx, brdf_table())
+        irr = upload_levels(ctx, [prepared.irradiance])
+        bg = None
+        if prm.background:
+            pixels, _ = envmap.load_pixels(prm.path)
+            bg = ctx.texture((pixels.shape[1], pixels.shape[0]), 3, pixels.tobytes(), dtype="f4")
+            bg.filter = (moderngl.LINEAR, moderngl.LINEAR)
+            bg.repeat_x, bg.repeat_y = True, False
+        self.held = {"key": prepared.key, "radiance": tex, "brdf": brdf, "irradiance": irr, "background": bg}
+        return self.held
+
+    def release(self) -> None:
+        if self.held is not None:
+            for name in ("radiance", "brdf", "irradiance", "background"):
+                if self.held[name] is not None:
+                    self.held[name].release()
+            self.held = None
+
+    def outputs(self, frame, p) -> tuple:
+        held = self._textures(p.params)
+        return tuple(
+            t for t in (held["radiance"], held["brdf"], held["irradiance"], held["background"]) if t is not None
+        )
+
+    def publish(self, frame: Frame, p) -> None:
+        prm: EnvironmentParams = p.params
+        held = self._textures(prm)
+        frame.data[DATA_KEY] = {
+            "prepared": prm.prepared,
+            "radiance": held["radiance"],
+            "brdf": held["brdf"],
+            "irradiance": held["irradiance"],
+            "background": held["background"] if prm.background else None,
+        }
+
+    def run(self, frame: Frame, p) -> None:
+        self.publish(frame, p)  # the textures are made (uploaded) on first use
+
+
+class SkyOcclusionPass:
+    """Uploads each vertex's blocked-sky coefficients (plan_sky) to a vertex-space texture."""
+
+    def __init__(self, renderer):
+        self.r = renderer
+        self.held: tuple | None = None  # (transfer key, texture)
+
+    def _texture(self, transfer: BounceTransfer) -> moderngl.Texture:
+        if self.held is not None and self.held[0] == transfer.key:
+            return self.held[1]
+        self.release()
+        n = transfer.total_vertices
+        rows = max(1, math.ceil(n / SKY_WIDTH))
+        data = np.zeros((rows * SKY_WIDTH, 12), np.float32)
+        data[:n, :9] = transfer.sky_blocked
+        tex = self.r.ctx.texture((3 * SKY_WIDTH, rows), 4, data.tobytes(), dtype="f4")
+        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.held = (transfer.key, tex)
+        return tex
+
+    def release(self) -> None:
+        if self.held is not None:
+            self.held[1].release()
+            self.held = None
+
+    def outputs(self, frame, p) -> tuple:
+        return (self._texture(p.params.transfer),)
+
+    def publish(self, frame: Frame, p) -> None:
+        tr = p.params.transfer
+        frame.targets["sky_blocked"] = self._texture(tr)
+        frame.data[SKY_KEY] = {"offsets": dict(tr.offsets)}
+
+    def run(self, frame: Frame, p) -> None:
+        self.publish(frame, p)
+
+
+# -- the receiving side: every pass that shades ambient light --------------------------------------
+
+
+def environment_defines(frame: Frame, node: MeshNode | None = None) -> dict:
+    """``ENV_MAP`` when this frame has an environment map, ``SKY_OCCLUSION`` when `node` has sky
+    occlusion data (lib/ambient.glsl, lib/sky_vertex.glsl)."""
+    if DATA_KEY not in frame.data:
+        return {}
+    sky = frame.data.get(SKY_KEY)
+    occluded = sky is not None and node is not None and node.uid in sky["offsets"]
+    return {"ENV_MAP": 1, **({"SKY_OCCLUSION": 1} if occluded else {})}
+
+
+def env_uniforms(scene: Scene, prepared: envmap.PreparedMap) -> dict:
+    """The per-frame uniforms of lib/environment.glsl (the rotation and intensity applied here)."""
+    env = scene.environment
+    return {
+        "u_env_sh": envmap.world_sh(prepared, env.rotation_deg, env.intensity),
+        "u_env_to_map": envmap.rotation_y(env.rotation_deg).T,
+        "u_env_intensity": float(env.intensity),
+        "u_env_max_lod": float(len(prepared.levels) - 1),
+    }
+
+
+def bind_environment(frame: Frame, node: MeshNode | None, prog, units: TextureUnits) -> None:
+    """The map's uniforms and textures for a program compiled with :func:`environment_defines`."""
+    data = frame.data.get(DATA_KEY)
+    if data is None:
+        return
+    values = env_uniforms(frame.scene, data["prepared"])
+    set_array(prog, "u_env_sh", values.pop("u_env_sh"), 9)
+    set_uniforms(prog, values)
+    units.bind(prog, "u_env_radiance", data["radiance"])
+    units.bind(prog, "u_env_brdf", data["brdf"])
+    units.bind(prog, "u_env_irradiance", data["irradiance"])
+    sky = frame.data.get(SKY_KEY)
+    if sky is not None and node is not None and node.uid in sky["offsets"]:
+        units.bind(prog, "u_sky_blocked", frame.targets["sky_blocked"])
+        set_uniform(prog, "u_sky_offset", sky["offsets"][node.uid])
+
+
+@lru_cache(maxsize=256)
+def _band_tables(alpha: tuple, colour: tuple, eta: float, ggx_alpha: float) -> tuple[np.ndarray, np.ndarray]:
+    from skinlab.scene.optics.boundary import entry_band_tables, single_band_tables
+
+    a, c = np.array(alpha), np.array(colour)
+    return single_band_tables(a, c, eta), entry_band_tables(a, c, eta, ggx_alpha)
+
+
+def bind_env_bands(prog, material) -> None:
+    """The SH-band tables of lib/env_single.glsl (single scattering) and lib/ambient_entering.glsl (the
+    light entering the multiple scattering) for a mesh shaded as scattering; zeros for the others."""
+    names = ("u_sss_single_band1", "u_sss_single_band2", "u_sss_entry_bands")
+    if not any(n in prog or f"{n}[0]" in prog for n in names):
+        return
+    from skinlab.render.boundary import boundary_ggx_alpha
+    from skinlab.scene.optics.boundary import ANGULAR_NODES, SMOOTH_ALPHA
+    from skinlab.scene.optics.tsd import material_medium, subsurface_albedo
+
+    if material is None or not material.has_subsurface:
+        single, entry = np.zeros((3, ANGULAR_NODES, 3)), np.zeros((3, 3))
+    else:  # the same medium and colour as the boundary's tables (skinlab/render/boundary.py material_boundary)
+        m = material_medium(material.values)
+        alpha = tuple(round(float(x), 9) for x in np.clip(m.alpha_arr, 0.0, 1.0))
+        colour = tuple(round(float(x), 9) for x in np.clip(np.ravel(subsurface_albedo(material.values)), 0.0, 1.0))
+        ga = boundary_ggx_alpha(material)
+        single, entry = _band_tables(alpha, colour, round(float(m.eta), 6), round(ga if ga >= SMOOTH_ALPHA else 0.0, 9))
+    set_array(prog, "u_sss_single_band1", single[1], ANGULAR_NODES)
+    set_array(prog, "u_sss_single_band2", single[2], ANGULAR_NODES)
+    set_array(prog, "u_sss_entry_bands", entry, 3)
+
+
+def env_band_ratio(world_sh: np.ndarray, n, bands, uniform, limit: float = 4.0) -> np.ndarray:
+    """NumPy twin of lib/environment.glsl env_band_ratio: (..., 3) what a zonal kernel of band factors
+    `bands` (3, ..., 3) gathers from the radiance coefficients (9, 3) at normals n, per unit of the SH
+    irradiance there, clamped to [0, limit x uniform]; `uniform` where the SH irradiance vanishes."""
+    y = sh.sh9_basis(n)
+    c = np.asarray(world_sh, np.float64)
+    s = [y[..., :1] * c[0], y[..., 1:4] @ c[1:4], y[..., 4:9] @ c[4:9]]
+    got = sum(np.asarray(bands[k]) * s[k] for k in range(3))
+    irr = sum(sh.SH_A[k] * s[k] for k in range(3))
+    uniform = np.broadcast_to(np.asarray(uniform, np.float64), irr.shape)
+    ok = irr > 1e-6 * np.maximum(s[0], 1e-20)
+    return np.where(ok, np.clip(got / np.where(ok, irr, 1.0), 0.0, limit * uniform), uniform)
+
+
+def env_diffuse(world_sh: np.ndarray, n, blocked=None, irradiance=None) -> np.ndarray:
+    """NumPy twin of lib/sky_occlusion.glsl env_diffuse_irradiance at world normals n (..., 3): the
+    unoccluded irradiance `irradiance` (..., 3) (the irradiance map's lookup; default: the SH
+    irradiance of the radiance coefficients world_sh (9, 3)) times 1 - the share the blocked
+    coefficients b (..., 9) hide, sum L_lm b_lm / E_sh(n), clamped to [0, 1]."""
+    e_sh = sh.irradiance(world_sh, n)
+    e = e_sh if irradiance is None else np.asarray(irradiance, np.float64)
+    if blocked is None:
+        return e
+    hidden = np.asarray(blocked, np.float64) @ np.asarray(world_sh, np.float64)
+    return e * (1.0 - np.clip(hidden / np.maximum(e_sh, 1e-20), 0.0, 1.0))

@@ -1,0 +1,306 @@
+"""GLSL environment lighting (skinlab/shaders/lib/environment.glsl, lib/sky_occlusion.glsl) against its
+NumPy twins (skinlab/scene/optics/sh.py, split_sum.py, skinlab/render/environment.py env_diffuse), hard
+cases included: the poles, the u seam, n.v = 0 and 1, roughness 0 and 1, visibility 0 and 1."""
+
+import numpy as np
+import pytest
+
+from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.gl.uniforms import set_array, set_uniforms
+from skinlab.render.environment import env_diffuse, upload_levels, upload_table
+from skinlab.scene.optics import sh, split_sum
+
+F32 = np.float32
+
+
+def unit(rng, n):
+    d = rng.normal(size=(n, 3))
+    return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+def hard_directions(rng):
+    d = unit(rng, 300)
+    d[:8] = [[0, 1, 0], [0, -1, 0], [1, 0, 0], [-1, 0, 0], [0, 0, 1], [0, 0, -1], [1e-7, 1, 0], [0, 0.6, -0.8]]
+    d[8] = [-1e-6, 0.3, -0.95]  # just left of the u seam (u -> 1)
+    d[9] = [1e-6, 0.3, -0.95]  # just right of it (u -> 0)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    return d.astype(F32).astype(np.float64)
+
+
+def sh_setup(coeffs):
+    return lambda prog: set_array(prog, "u_env_sh", coeffs, 9)
+
+
+def test_sh_irradiance_matches_numpy(glsl):
+    rng = np.random.default_rng(3)
+    coeffs = rng.normal(size=(9, 3))
+    coeffs[0] = [3.0, 2.0, 1.0]
+    n = hard_directions(rng)
+    gpu = glsl.evaluate("lib/environment.glsl", "env_sh_irradiance(n)", {"n": n}, 3, setup=sh_setup(coeffs))
+    assert_close_fp32(gpu, sh.irradiance(coeffs, n), rtol=1e-4, atol=1e-5, what="env_sh_irradiance")
+
+
+def test_sh_irradiance_of_a_uniform_sky_is_pi_L():
+    # radiance 1 everywhere: only L00 = 4 pi Y00; irradiance pi on every normal
+    coeffs = np.zeros((9, 1))
+    coeffs[0] = 4 * np.pi * sh.SH_C0
+    n = unit(np.random.default_rng(0), 50)
+    assert np.allclose(sh.irradiance(coeffs, n), np.pi)
+
+
+def test_sh_projection_and_irradiance_of_a_linear_sky_are_exact():
+    # L(w) = 1 + w.z (band-limited): E(n) = pi + (2 pi / 3) n.z exactly, projected from a fine map
+    w, h = 256, 128
+    d = split_sum.texel_directions(w, h).reshape(-1, 3)
+    omega = split_sum.texel_solid_angles(w, h).ravel()
+    coeffs = sh.project(1.0 + d[:, 2:3], d, omega)
+    n = unit(np.random.default_rng(1), 40)
+    assert np.allclose(sh.irradiance(coeffs, n)[:, 0], np.pi + 2 * np.pi / 3 * n[:, 2], atol=2e-3)
+    assert abs(omega.sum() - 4 * np.pi) < 1e-9
+
+
+def test_sh_rotation_turns_the_light_with_the_map():
+    rng = np.random.default_rng(2)
+    coeffs = rng.normal(size=(9, 2))
+    a = np.radians(37.0)
+    r = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+    m = sh.rotation(r)
+    d = unit(rng, 30)
+    # the turned light toward R d is the original toward d
+    assert np.allclose(sh.radiance(m @ coeffs, d @ r.T), sh.radiance(coeffs, d), atol=1e-9)
+    assert np.allclose(sh.rotation(np.eye(3)), np.eye(9), atol=1e-12)
+
+
+def test_hidden_share_and_occluded_diffuse_match_numpy(glsl):
+    rng = np.random.default_rng(4)
+    coeffs = rng.normal(size=(9, 3)) * 0.3
+    coeffs[0] = [4.0, 3.0, 2.0]
+    n = hard_directions(rng)
+    b = rng.normal(size=(len(n), 9)) * 0.2
+    b[:, 0] = rng.uniform(0, np.pi * sh.SH_C0, len(n))
+    b[0] = 0.0  # nothing blocked
+    b[1] = [np.pi * sh.SH_C0 * 2, *([0.0] * 8)]  # more than everything: all hidden
+    b = b.astype(F32).astype(np.float64)
+    inputs = {"n": n, "b03": b[:, :4], "b47": b[:, 4:8], "b8": b[:, 8]}
+    gpu = glsl.evaluate(
+        "lib/sky_occlusion.glsl", "env_hidden_share(n, b03, b47, b8)", inputs, 3, setup=sh_setup(coeffs)
+    )
+    e_sh = sh.irradiance(coeffs, n)
+    ref = np.clip((b @ coeffs) / np.maximum(e_sh, 1e-20), 0.0, 1.0)
+    assert_close_fp32(gpu, ref, rtol=2e-4, atol=2e-5, what="hidden share")
+    assert np.allclose(ref[0], 0.0) and np.allclose(ref[1], 1.0)
+    # the twin of the whole: the unoccluded irradiance times what is left
+    irr = rng.uniform(0.5, 2.0, (len(n), 3))
+    assert np.allclose(env_diffuse(coeffs, n, b, irr), irr * (1 - ref))
+    assert np.allclose(env_diffuse(coeffs, n), e_sh)
+
+
+def test_irradiance_map_reads_as_numpy_does_and_is_the_exact_convolution(glsl, ctx):
+    rng = np.random.default_rng(8)
+    w, h = 64, 32
+    d = split_sum.texel_directions(w, h)
+    c = rng.normal(size=(9, 3)) * 0.08
+    c[0] = [2.0, 1.5, 1.0]
+    img = np.maximum(sh.radiance(c, d), 0.0)
+    irr = split_sum.irradiance_map(img, 32, source_width=64)
+    # a band-limited, non-negative sky: the map is its SH irradiance (the convolution is exact)
+    nd = split_sum.texel_directions(32, 16)
+    assert (sh.radiance(c, d) > 0).all()
+    assert np.allclose(irr, sh.irradiance(c, nd), rtol=5e-3)
+    tex = upload_levels(ctx, [irr])
+    try:
+        n = hard_directions(rng)
+
+        def setup(prog):
+            set_uniforms(prog, {"u_env_to_map": np.eye(3), "u_env_intensity": 1.5})
+            bind(prog, "u_env_irradiance", tex)
+
+        gpu = glsl.evaluate("lib/environment.glsl", "env_map_irradiance(n)", {"n": n}, 3, setup=setup)
+        u, v = split_sum.equirect_uv(n)
+        assert_close_fp32(gpu, 1.5 * split_sum.bilinear(irr, u, v), rtol=4e-3, atol=1e-3, what="env_map_irradiance")
+    finally:
+        tex.release()
+
+
+def test_equirect_uv_matches_numpy_at_poles_and_seam(glsl):
+    d = hard_directions(np.random.default_rng(5))
+    gpu = glsl.evaluate("lib/environment.glsl", "equirect_uv(d)", {"d": d}, 2)
+    u, v = split_sum.equirect_uv(d)
+    # u wraps: compare on the circle
+    du = np.abs(gpu[:, 0] - u)
+    du = np.minimum(du, 1 - du)
+    # llvmpipe's atan is good to about 1e-5 (a 25th of a texel of a 4096-wide map)
+    assert du.max() < 1e-5, du.max()
+    assert_close_fp32(gpu[:, 1], v, rtol=1e-5, atol=1e-5, what="equirect v")
+    assert gpu[8, 0] > 0.99 and gpu[9, 0] < 0.01  # the two sides of the seam
+    # Mitsuba's axes: +Z is the image's centre column, +X a quarter to the right, +Y the top row
+    uu, vv = split_sum.equirect_uv(np.array([[0, 0, 1.0], [1.0, 0, 0], [0, 1.0, 0]]))
+    assert np.allclose(uu[:2], [0.5, 0.25]) and np.isclose(vv[2], 0.0)
+
+
+def test_texel_directions_invert_equirect_uv():
+    d = split_sum.texel_directions(16, 8)
+    u, v = split_sum.equirect_uv(d)
+    assert np.allclose(u, (np.arange(16) + 0.5)[None, :] / 16)
+    assert np.allclose(v, (np.arange(8) + 0.5)[:, None] / 8)
+
+
+def bind(prog, sampler, tex, unit=12):
+    """A sampler the included file declares itself, on a unit the evaluator's inputs leave free."""
+    tex.use(unit)
+    prog[sampler].value = unit
+
+
+def smooth_levels(rng, width=64, n=4):
+    """A mip chain of smooth positive data (neighbouring texels differ by at most a few percent, so
+    the GPU's fixed-point filter weights stay within the tolerance)."""
+    out = []
+    for k in range(n):
+        w = width >> k
+        d = split_sum.texel_directions(w, w // 2)
+        c = rng.normal(size=(9, 3)) * 0.2
+        c[0] = [2.0, 1.5, 1.0]
+        out.append(np.maximum(sh.radiance(c, d), 0.05).astype(F32))
+    return out
+
+
+def test_env_radiance_reads_levels_as_numpy_does(glsl, ctx):
+    rng = np.random.default_rng(6)
+    levels = smooth_levels(rng)
+    tex = upload_levels(ctx, levels)
+    try:
+        d = hard_directions(rng)
+        rough = rng.uniform(0, 1, len(d))
+        rough[:10] = [0, 1, 0.5, 0.2, 0.0, 1.0, 0.33, 0.66, 0.99, 0.01]
+        rot = np.radians(25.0)
+        r = np.array([[np.cos(rot), 0, np.sin(rot)], [0, 1, 0], [-np.sin(rot), 0, np.cos(rot)]])
+
+        def setup(prog):
+            set_uniforms(prog, {"u_env_to_map": r.T, "u_env_intensity": 2.0, "u_env_max_lod": float(len(levels) - 1)})
+            bind(prog, "u_env_radiance", tex)
+
+        gpu = glsl.evaluate("lib/environment.glsl", "env_radiance(d, r)", {"d": d, "r": rough}, 3, setup=setup)
+        ref = 2.0 * split_sum.sample_levels(levels, d @ r, rough * (len(levels) - 1))
+        # the GPU filters with fixed-point weights (llvmpipe: 8 bits): 1/256 of a texel step
+        assert_close_fp32(gpu, ref, rtol=4e-3, atol=1e-3, what="env_radiance")
+    finally:
+        tex.release()
+
+
+def test_env_brdf_reads_the_table_as_numpy_does(glsl, ctx):
+    table = split_sum.brdf_table(16, 64).astype(F32)
+    tex = upload_table(ctx, table)
+    try:
+        nv, r = (a.ravel() for a in np.meshgrid([0.0, 1e-4, 0.1, 0.37, 0.5, 0.9, 1.0], [0.0, 0.05, 0.3, 0.5, 1.0]))
+        gpu = glsl.evaluate(
+            "lib/environment.glsl", "env_brdf(nv, r)", {"nv": nv, "r": r}, 2, setup=lambda p: bind(p, "u_env_brdf", tex)
+        )
+        assert_close_fp32(gpu, split_sum.table_lookup(table, nv, r), rtol=4e-3, atol=1e-3, what="env_brdf")
+    finally:
+        tex.release()
+
+
+def test_split_sum_table_against_brute_force_integration():
+    from skinlab.scene.optics.brdf import ggx_alpha, specular_ggx
+
+    table = split_sum.brdf_table()
+    for rough, mu in ((1.0, 1.0), (0.5, 0.5), (0.2, 0.9), (0.0, 1.0)):
+        n = 400
+        th = (np.arange(n) + 0.5) / n * np.pi / 2
+        ph = (np.arange(2 * n) + 0.5) / (2 * n) * 2 * np.pi
+        t, p = np.meshgrid(th, ph, indexing="ij")
+        l = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+        v = np.array([np.sqrt(1 - mu * mu), 0, mu])
+        h = l + v
+        h /= np.linalg.norm(h, axis=-1, keepdims=True)
+        dw = np.sin(t) * (np.pi / 2 / n) * (np.pi / n)
+        for f0 in (0.04, 1.0):
+            f = specular_ggx(l[..., 2], mu, h[..., 2], (l * h).sum(-1), ggx_alpha(rough), np.full(3, f0))[..., 0]
+            exact = (f * l[..., 2] * dw).sum()
+            a, b = split_sum.table_lookup(table, mu, rough)
+            if rough > 0:  # roughness 0 is a delta the grid cannot integrate: A = 1, B = 0 exactly
+                assert abs(f0 * a + b - exact) < 0.01 * exact + 2e-3, (rough, mu, f0, f0 * a + b, exact)
+    assert np.allclose(split_sum.table_lookup(table, 1.0, 0.0), [1.0, 0.0], atol=1e-6)
+
+
+def test_specular_occlusion_matches_numpy(glsl):
+    nv, vis, r = (
+        a.ravel() for a in np.meshgrid([0.0, 0.01, 0.3, 0.7, 1.0, -0.1], [0.0, 0.2, 0.5, 1.0], [0.0, 0.4, 1.0])
+    )
+    gpu = glsl.evaluate("lib/environment.glsl", "env_specular_occlusion(nv, vis, r)", {"nv": nv, "vis": vis, "r": r})
+    ref = split_sum.specular_occlusion(nv, vis, r)
+    assert_close_fp32(gpu[:, 0], ref, rtol=1e-4, atol=2e-6, what="specular occlusion")
+    assert np.allclose(ref[vis == 1.0], 1.0) and np.allclose(ref[vis == 0.0], 0.0)
+
+
+def test_prefilter_keeps_the_map_energy_and_levels_blur():
+    rng = np.random.default_rng(7)
+    img = np.maximum(rng.normal(1.0, 0.5, (64, 128, 3)), 0).astype(F32)
+    img[20, 40] = 50.0  # one bright texel
+    levels = split_sum.prefilter(img, levels=4, width=64, samples=32)
+    mean = []
+    for lv in levels:
+        om = split_sum.texel_solid_angles(lv.shape[1], lv.shape[0])
+        mean.append((lv.mean(-1) * om).sum() / (4 * np.pi))
+    om = split_sum.texel_solid_angles(128, 64)
+    src = (img.mean(-1) * om).sum() / (4 * np.pi)
+    assert np.allclose(mean, src, rtol=0.02), (mean, src)
+    assert levels[-1].std() < levels[1].std() < levels[0].std()  # rougher levels are smoother
+    assert [lv.shape for lv in levels] == [(32, 64, 3), (16, 32, 3), (8, 16, 3), (4, 8, 3)]
+
+
+def test_band_ratio_matches_numpy(glsl):
+    from skinlab.render.environment import env_band_ratio
+
+    rng = np.random.default_rng(9)
+    coeffs = rng.normal(size=(9, 3)) * 0.4
+    coeffs[0] = [3.0, 2.0, 1.0]
+    coeffs[:, 2] *= 1e-9  # a dark channel: where the SH irradiance vanishes the uniform ratio
+    n = hard_directions(rng)
+    l0, l1, l2 = (rng.uniform(0.05, 0.3, (len(n), 3)) for _ in range(3))
+    uni = rng.uniform(0.02, 0.1, (len(n), 3))
+    prelude = "vec3 br(vec3 n, vec3 a, vec3 b, vec3 c, vec3 u) { return env_band_ratio(n, a, b, c, u); }"
+    gpu = glsl.evaluate(
+        "lib/environment.glsl", "br(n, a, b, c, u)", {"n": n, "a": l0, "b": l1, "c": l2, "u": uni}, 3,
+        prelude=prelude, setup=sh_setup(coeffs),
+    )  # fmt: skip
+    ref = env_band_ratio(coeffs, n, [l0, l1, l2], uni)
+    assert_close_fp32(gpu, ref, rtol=2e-3, atol=1e-6, what="env_band_ratio")
+    assert (ref <= 4 * uni + 1e-12).all() and (ref >= 0).all()
+
+
+def test_band_factors_integrate_single_scattering_and_entry_exactly():
+    """Funk-Hecke: under a band-limited sky L = sum L_lm Y_lm, Jensen's single scattering (isotropic
+    phase) toward cosine mu is sum_l lambda_l(mu) sum_m L_lm Y_lm(n), and the light entering the
+    multiple scattering sum_l eps_l sum_m L_lm Y_lm(n): against brute-force integration over the
+    hemisphere, at index 1 and 1.3."""
+    from skinlab.scene.optics import boundary as bd
+
+    rng = np.random.default_rng(10)
+    c = rng.normal(size=(9, 1)) * 0.2
+    c[0] = 2.0
+    n = np.array([0.0, 0.0, 1.0])
+    t = (np.arange(200) + 0.5) / 200 * np.pi / 2
+    p = (np.arange(64) + 0.5) / 64 * 2 * np.pi
+    tt, pp = np.meshgrid(t, p, indexing="ij")
+    w = np.stack([np.sin(tt) * np.cos(pp), np.sin(tt) * np.sin(pp), np.cos(tt)], -1)
+    dw = np.sin(tt) * (np.pi / 2 / 200) * (2 * np.pi / 64)
+    L = sh.radiance(c, w)[..., 0]
+    m = w[..., 2]
+    y = sh.sh9_basis(n)
+    s = [y[0] * c[0, 0], y[1:4] @ c[1:4, 0], y[4:9] @ c[4:9, 0]]
+    for eta in (1.0, 1.3):
+        a, mu = 0.7, 0.6
+        # the single-scattering kernel of single_ambient_albedo, per unit incident radiance and dw
+        e = float(bd.clamp_eta(eta))
+        ct = lambda x, e=e: np.sqrt(np.maximum((e - 1) * (e + 1) + x * x, 0)) / e  # noqa: E731
+        tr = (lambda x: np.ones_like(x)) if e == 1.0 else (lambda x, e=e: 1 - bd.fresnel_dielectric(x, e))  # noqa: E731
+        k = a * tr(np.array(mu)) * tr(m) * m / (4 * np.pi * e * e * (ct(m) + ct(np.array(mu))))
+        brute = (L * k * dw).sum()
+        bands = sum(bd.single_ambient_band(a, eta, np.array([mu]), b)[0] * s[b] for b in range(3))
+        assert bands == pytest.approx(brute, rel=2e-3), (eta, bands, brute)
+        entry = bd.entry_band_tables(np.full(3, a), np.ones(3), eta)
+        brute = (L * bd.ms_albedo(a, eta, m) * m * dw).sum()
+        assert sum(entry[b, 0] * s[b] for b in range(3)) == pytest.approx(brute, rel=2e-3)
+        # band 0 is the uniform sky's
+        assert entry[0, 0] == pytest.approx(np.pi * bd.hemispherical(lambda x, a=a, eta=eta: bd.ms_albedo(a, eta, x)))
