@@ -5,7 +5,8 @@ the plain frame (skinlab/bench/orbit.py).
 `skinlab bench reload`: latency from saving a shader file to the first frame rendered with it
 (skinlab/bench/reload.py).
 `skinlab bench accuracy`: the accuracy/time ledger of the SSS techniques (skinlab/bench/accuracy.py).
-`skinlab bench startup`: how long `skinlab render` takes to answer: fresh, cold and warm starts (skinlab/bench/startup.py).
+`skinlab bench startup`: how long `skinlab render` takes to answer: fresh, cold and warm starts
+(skinlab/bench/startup.py).
 This module only parses options and prints; the benchmarks live in skinlab/bench/."""
 
 from __future__ import annotations
@@ -189,7 +190,9 @@ def register(sub) -> None:
     )
     st.add_argument("scene", nargs="?", default=None, help="a bundled scene name or a scene/mesh file (default head)")
     st.add_argument("--size", default="64x64", help="frame size WIDTHxHEIGHT in pixels (default 64x64)")
-    st.add_argument("--rounds", type=int, default=3, help="rounds of fresh, cold and warm starts (default 3); medians are shown")
+    st.add_argument(
+        "--rounds", type=int, default=3, help="rounds of fresh, cold and warm starts (default 3); medians are shown"
+    )
     st.add_argument("--json", action="store_true", help="print the result as JSON")
     st.set_defaults(func=run_startup_bench)
 

@@ -50,20 +50,26 @@ class _NotFound(ShaderError):
 def _code_outside_comments(line: str, in_comment: bool) -> tuple[str, bool]:
     """The line's text outside // and /* */ comments, and whether a /* */ comment is still open at
     its end (``in_comment``: one was open at its start)."""
-    code, i = [], 0
-    while i < len(line):
+    if not in_comment and "/" not in line:  # most lines: nothing to strip
+        return line, False
+    code, i, n = [], 0, len(line)
+    while i < n:
         if in_comment:
             end = line.find("*/", i)
             if end < 0:
                 return "".join(code), True
             in_comment, i = False, end + 2
-        elif line.startswith("//", i):
+            continue
+        j = line.find("/", i)
+        while 0 <= j < n - 1 and line[j + 1] not in "/*":  # a division, not a comment
+            j = line.find("/", j + 1)
+        if j < 0 or j >= n - 1:
+            code.append(line[i:])
             break
-        elif line.startswith("/*", i):
-            in_comment, i = True, i + 2
-        else:
-            code.append(line[i])
-            i += 1
+        code.append(line[i:j])
+        if line[j + 1] == "/":
+            break
+        in_comment, i = True, j + 2
     return "".join(code), in_comment
 
 

@@ -57,22 +57,22 @@ def _line_of(root: Path, rel: str, piece: str) -> int:
 
 def test_missing_include_names_the_including_line(library):
     root, cache = library
-    errors = _edit(root, cache, "passes/tonemap.frag", '#include "lib/color.glsl"', '#include "lib/colour.glsl"')
+    errors = _edit(root, cache, "passes/tonemap.frag", '#include "lib/tonemap.glsl"', '#include "lib/tonemapp.glsl"')
     assert len(errors) == 1
-    line = _line_of(root, "passes/tonemap.frag", "colour.glsl")
-    assert str(errors[0]).startswith(f"shaders/passes/tonemap.frag:{line}: shader file 'lib/colour.glsl' not found")
+    line = _line_of(root, "passes/tonemap.frag", "tonemapp.glsl")
+    assert str(errors[0]).startswith(f"shaders/passes/tonemap.frag:{line}: shader file 'lib/tonemapp.glsl' not found")
     _assert_located(errors[0], root)
 
 
 def test_mangled_include_is_a_compile_error_not_a_key_error(library):
     root, cache = library
     rel = "passes/tonemap.frag"
-    errors = _edit(root, cache, rel, '#include "lib/color.glsl"', '#include "lib/color.glsl#include "lib/x.glsl"')
+    errors = _edit(root, cache, rel, '#include "lib/tonemap.glsl"', '#include "lib/tonemap.glsl#include "lib/x.glsl"')
     assert len(errors) == 1 and "malformed #include" in str(errors[0])
     assert errors[0].locations == [("shaders/passes/tonemap.frag", _line_of(root, rel, "lib/x.glsl"))]
     # the edit of the issue: the include's closing quote eaten by a second include
     (root / rel).write_text(
-        (root / rel).read_text().replace('"lib/color.glsl#include "lib/x.glsl"', '"lib/a.glsl#include "')
+        (root / rel).read_text().replace('"lib/tonemap.glsl#include "lib/x.glsl"', '"lib/a.glsl#include "')
     )
     errors = cache.reload({root / rel})
     assert len(errors) == 1

@@ -127,3 +127,42 @@ def test_compute_shaders_include_report_errors_and_reload(ctx, root):
     with pytest.raises(ShaderError, match=r"p2.comp:6: error: `nothing_here. undeclared"):
         (root / "p2.comp").write_text(CS.replace("vec4(util_value())", "vec4(nothing_here)"))
         cache.compute("p2.comp")
+
+
+def _strip_comments_by_char(line: str, in_comment: bool) -> tuple[str, bool]:
+    """A character-by-character reading of // and /* */ comments: the reference for the fast one."""
+    code, i = [], 0
+    while i < len(line):
+        if in_comment:
+            end = line.find("*/", i)
+            if end < 0:
+                return "".join(code), True
+            in_comment, i = False, end + 2
+        elif line.startswith("//", i):
+            break
+        elif line.startswith("/*", i):
+            in_comment, i = True, i + 2
+        else:
+            code.append(line[i])
+            i += 1
+    return "".join(code), in_comment
+
+
+def test_comment_stripping_matches_a_character_by_character_reading():
+    """The include scanner's comment stripping (it runs on every line of every expanded stage) gives
+    what reading the line a character at a time gives: divisions kept, // and /* */ removed, a /*
+    comment carried into the next line."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    from skinlab.gl.shader_source import _code_outside_comments
+
+    @settings(max_examples=3000, deadline=None)
+    @given(st.text(alphabet="ab/* x", max_size=16), st.booleans())
+    def check(line, in_comment):
+        assert _code_outside_comments(line, in_comment) == _strip_comments_by_char(line, in_comment)
+
+    check()
+    assert _code_outside_comments("a / b // c", False) == ("a / b ", False)
+    assert _code_outside_comments("x /* y", False) == ("x ", True)
+    assert _code_outside_comments("y */ z", True) == (" z", False)
