@@ -47,7 +47,7 @@ class _NotFound(ShaderError):
     """An included file that does not exist (the include site adds its file and line)."""
 
 
-def _code_outside_comments(line: str, in_comment: bool) -> tuple[str, bool]:
+def code_outside_comments(line: str, in_comment: bool) -> tuple[str, bool]:
     """The line's text outside // and /* */ comments, and whether a /* */ comment is still open at
     its end (``in_comment``: one was open at its start)."""
     if not in_comment and "/" not in line:  # most lines: nothing to strip
@@ -180,7 +180,7 @@ class ShaderLibrary:
             out.append(f"#line {first + 1} {idx}")
             in_comment = False  # inside a /* */ comment at the start of the line
             for i in range(first, len(lines)):
-                code, after = _code_outside_comments(lines[i], in_comment)
+                code, after = code_outside_comments(lines[i], in_comment)
                 m = _INCLUDE.match(lines[i]) if not in_comment else None
                 in_comment = after
                 if m:

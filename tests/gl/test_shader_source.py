@@ -155,14 +155,14 @@ def test_comment_stripping_matches_a_character_by_character_reading():
     from hypothesis import given, settings
     from hypothesis import strategies as st
 
-    from skinlab.gl.shader_source import _code_outside_comments
+    from skinlab.gl.shader_source import code_outside_comments
 
     @settings(max_examples=3000, deadline=None)
     @given(st.text(alphabet="ab/* x", max_size=16), st.booleans())
     def check(line, in_comment):
-        assert _code_outside_comments(line, in_comment) == _strip_comments_by_char(line, in_comment)
+        assert code_outside_comments(line, in_comment) == _strip_comments_by_char(line, in_comment)
 
     check()
-    assert _code_outside_comments("a / b // c", False) == ("a / b ", False)
-    assert _code_outside_comments("x /* y", False) == ("x ", True)
-    assert _code_outside_comments("y */ z", True) == (" z", False)
+    assert code_outside_comments("a / b // c", False) == ("a / b ", False)
+    assert code_outside_comments("x /* y", False) == ("x ", True)
+    assert code_outside_comments("y */ z", True) == (" z", False)
