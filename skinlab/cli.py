@@ -48,12 +48,16 @@ class _VersionAction(argparse.Action):
         parser.exit()
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The command line's parser; with ``command`` (a subcommand's name) only that subcommand's module
+    is imported and registered (what `main` does when the command line names one: a command does not
+    pay for importing every other)."""
     parser = OneLineParser(prog="skinlab", description="Realtime subsurface-scattering workbench")
     parser.add_argument("--version", action=_VersionAction, help="print the version and exit")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=OneLineParser)
     sub.required = True
-    for name in COMMAND_MODULES:
+    only = f"skinlab.commands.{command}"
+    for name in [only] if only in COMMAND_MODULES else COMMAND_MODULES:
         try:
             mod = importlib.import_module(name)
         except ModuleNotFoundError as exc:
@@ -87,7 +91,8 @@ def main(argv: list[str] | None = None) -> int:
     if (sys.argv[1:] if argv is None else argv) == ["--version"]:  # answers before any command module loads
         print(version())
         return 0
-    args = build_parser().parse_args(argv)
+    words = sys.argv[1:] if argv is None else argv
+    args = build_parser(words[0] if words and not words[0].startswith("-") else None).parse_args(argv)
     with warnings.catch_warnings():  # restored when main returns (tests call it in-process)
         if not os.environ.get("SKINLAB_DEBUG"):
             # numpy's float warnings ("overflow encountered in multiply") are noise around a one-line

@@ -42,7 +42,7 @@ PHASES = ("imports", "scene", "gl", "plan", "first frame", "frame", "write")
 CHILD = """import time
 t0 = time.perf_counter()
 import json, skinlab.cli
-skinlab.cli.build_parser()
+skinlab.cli.build_parser("render")
 t1 = time.perf_counter()
 from skinlab.bench.startup import child
 print(json.dumps(child({scene!r}, {size!r}, {out!r}, t0, t1)))

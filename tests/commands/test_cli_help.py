@@ -51,3 +51,20 @@ def test_accuracy_help_defaults_come_from_the_sweeps():
     size = {n: base_setting("exact", SWEEPS[n]).value("size") for n in ("full", "quick")}
     assert f"default {size['full']}; --quick {size['quick']}" in helps["exact_size"]
     assert f"default {SWEEPS['full'].photons}; --quick {SWEEPS['quick'].photons}" in helps["photons"]
+
+
+def test_a_named_command_imports_only_its_own_module():
+    """`skinlab render ...` builds the parser of `render` alone: no other command's module (and what
+    it imports) is loaded; its --help reads as in the full parser; an unknown name gets the full list."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys; from skinlab.cli import build_parser; build_parser('scenes'); "
+        "print(sorted(m for m in sys.modules if m.startswith('skinlab.commands.')))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert eval(out) == ["skinlab.commands.scenes"], out
+    one = dict(_subparsers(build_parser("render")))[("render",)].format_help()
+    assert one == dict(_subparsers(build_parser()))[("render",)].format_help()
+    assert len(dict(_subparsers(build_parser("no-such-command")))) > 5
