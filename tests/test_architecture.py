@@ -126,15 +126,49 @@ def test_every_registered_pass_and_settings_class_keeps_the_interfaces():
     import inspect
 
     from skinlab.render.options import TechniqueSettings
+    from skinlab.render.technique import RenderPass, TechniqueState
 
     for t in registry.techniques():
         assert t.description and "\n" not in t.description, t.name
         assert issubclass(t.settings_type, TechniqueSettings) and t.settings_type.technique == t.name
         t.settings_type()  # the defaults are valid
+        if t.state is not None:
+            assert issubclass(t.state[1], TechniqueState), t.name
         for kind, cls in t.passes.items():
-            # the RenderPass protocol (skinlab/render/technique.py): made with the renderer, run per planned pass
+            # the RenderPass base (skinlab/render/technique.py): made with the renderer, run per planned pass
+            assert issubclass(cls, RenderPass), (t.name, kind)
             assert list(inspect.signature(cls.run).parameters) == ["self", "frame", "p"], (t.name, kind)
             assert list(inspect.signature(cls.__init__).parameters) == ["self", "renderer"], (t.name, kind)
+
+
+def test_render_pass_defaults_are_no_ops(ctx):
+    """RenderPass's optional parts: a pass naming no outputs (never reused), publishing and releasing
+    nothing; run must be written."""
+    from skinlab.render.renderer import Renderer
+    from skinlab.render.technique import RenderPass
+
+    r = Renderer(ctx)
+    p = RenderPass(r)
+    assert p.r is r and p.outputs(None, None) == () and p.publish(None, None) is None and p.release() is None
+    with pytest.raises(NotImplementedError, match="RenderPass.run"):
+        p.run(None, None)
+    r.release()
+
+
+def test_settings_for_a_name_import_that_technique_alone():
+    """RenderSettings resolves a technique's name without the registry: only that package is imported
+    (and the packages it builds on)."""
+    import subprocess
+
+    code = (
+        "import sys\n"
+        "from skinlab.render.settings import RenderSettings\n"
+        "st = RenderSettings(16, 16, technique='ssss')\n"
+        "pkgs = {m.split('.')[3] for m in sys.modules if m.startswith('skinlab.render.techniques.')}\n"
+        "print(st.technique_name, sorted(pkgs), 'skinlab.render.registry' in sys.modules)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["ssss", "['ssss']", "False"], out
 
 
 def test_release_frees_every_pass_and_state_and_the_renderer_stays_usable(ctx):
@@ -181,25 +215,20 @@ def test_core_modules_never_name_a_technique():
 
 
 def module_name(path: Path) -> str:
-    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    parts = list((path.relative_to(ROOT) if path.is_relative_to(ROOT) else Path(path.name)).with_suffix("").parts)
     if parts[-1] == "__init__":
         parts = parts[:-1]
     return ".".join(parts)
 
 
 def imports_of(path: Path, modules: set[str]) -> set[str]:
-    """Modules of the project imported anywhere in the file (functions too), except under TYPE_CHECKING."""
+    """Modules of the project imported anywhere in the file: functions too, and those imported for type
+    annotations only (under TYPE_CHECKING), so that the types form no cycle either."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
     me = module_name(path)
     pkg = me if path.name == "__init__.py" else me.rsplit(".", 1)[0]
-    skip = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.If) and "TYPE_CHECKING" in ast.unparse(node.test):
-            skip |= {id(n) for b in node.body for n in ast.walk(b)}
     out = set()
     for node in ast.walk(tree):
-        if id(node) in skip:
-            continue
         if isinstance(node, ast.Import):
             names = [a.name for a in node.names]
         elif isinstance(node, ast.ImportFrom):
@@ -261,8 +290,12 @@ def test_no_import_cycles():
     assert cycles(graph) == []
 
 
-def test_the_cycle_check_finds_a_cycle():
+def test_the_cycle_check_finds_a_cycle(tmp_path):
     assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+    # an import made for annotations only is an edge too
+    mod = tmp_path / "m.py"
+    mod.write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from skinlab.render import frame\n")
+    assert imports_of(mod, {"skinlab.render.frame"}) == {"skinlab.render.frame"}
 
 
 def test_library_modules_never_import_the_cli_layer():

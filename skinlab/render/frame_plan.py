@@ -9,8 +9,6 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from skinlab.scene.graph import LightNode
 
-    from .technique import ForwardHook
-
 
 @dataclass
 class PlannedPass:
@@ -42,13 +40,6 @@ class ShadowParams:
     light: LightNode
     slot: int  # shadow map slot 0 or 1
     distance: bool  # also a light-space distance map (a technique's translucency)
-
-
-@dataclass
-class ForwardParams:
-    lights: list[LightNode]
-    shadow_lights: list[LightNode]
-    hook: ForwardHook  # the technique's shading of each mesh
 
 
 @dataclass

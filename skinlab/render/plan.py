@@ -8,11 +8,11 @@ from typing import TYPE_CHECKING
 from .bounce import plan_bounce, prefetch_bounce
 from .compute import Device, choose_path
 from .environment import plan_environment, plan_sky, prefetch_sky
-from .frame_plan import ForwardParams, FramePlan, PlannedPass, ShadowParams, TonemapParams, shadow_pass_name
+from .frame_plan import FramePlan, PlannedPass, ShadowParams, TonemapParams, shadow_pass_name
 from .lights import soft_shadow
 from .registry import get_technique
 from .reuse import light_placement, scene_geometry
-from .technique import PlanContext
+from .technique import ForwardParams, PlanContext
 
 if TYPE_CHECKING:
     from skinlab.scene.graph import LightNode, Scene

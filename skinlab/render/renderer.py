@@ -27,7 +27,7 @@ from .registry import get_technique, pass_class
 from .reuse import ReuseRecord, pass_key
 from .settings import RenderSettings
 from .supersample import nearest_depth
-from .technique import RenderPass
+from .technique import RenderPass, TechniqueState
 from .timing import FrameTimings, PassTimer
 
 
@@ -57,11 +57,11 @@ class Renderer:
             "forward": ForwardPass(self),
             "tonemap": TonemapPass(self),
         }
-        self.states: dict[str, object] = {}  # techniques' GPU state kept across frames, by key
+        self.states: dict[str, TechniqueState] = {}  # techniques' GPU state kept across frames, by key
         self._fs_vbo = ctx.buffer(np.array([-1, -1, 3, -1, -1, 3], dtype="f4").tobytes())
         self._fs_vaos: dict[int, moderngl.VertexArray] = {}
-        self._dummy_shadow = None
-        self._dummy_texture = None
+        self._dummy_shadow: moderngl.Texture | None = None
+        self._dummy_texture: moderngl.Texture | None = None
         self.last_frame: Frame | None = None  # the latest frame's targets (viewer's pass inspector)
         # reuse across frames (skinlab/render/reuse.py): a pass whose inputs are unchanged since it last
         # ran is not run again; False runs every pass every frame (benchmarks of the full frame)
@@ -137,9 +137,7 @@ class Renderer:
             raise ValueError(f"scene {scene.name!r} has no camera")
         plan = self.plan(scene, settings)
         for st in self.states.values():  # a technique's state keeps what this frame uses
-            begin = getattr(st, "begin_frame", None)
-            if begin is not None:
-                begin(plan)
+            st.begin_frame(plan)
         frame = Frame(
             scene,
             settings,
@@ -171,7 +169,7 @@ class Renderer:
         for p in plan.passes:
             impl = self.pass_for(p.kind)
             key = keys[p.name] = pass_key(p, keys, self.programs.generation)
-            outputs = impl.outputs(frame, p) if key is not None and hasattr(impl, "outputs") else ()
+            outputs = impl.outputs(frame, p) if key is not None else ()
             if self.reuse and outputs:
                 since = record.since(outputs, key)
                 if since is not None:
@@ -205,20 +203,18 @@ class Renderer:
             return hdr, ldr, None
         zbuf = np.frombuffer(frame.targets["depth"].read(), np.float32).reshape(h * n, w * n)[::-1]
         zbuf = nearest_depth(zbuf, n)
-        cam = frame.scene.camera
-        n, f = cam.znear, cam.zfar
+        cam = frame.scene.active_camera()
+        near, far = cam.znear, cam.zfar
         zn = zbuf.astype(np.float64) * 2.0 - 1.0
         with np.errstate(divide="ignore", invalid="ignore"):
-            lin = 2.0 * n * f / (f + n - zn * (f - n))
+            lin = 2.0 * near * far / (far + near - zn * (far - near))
         depth = np.where(zbuf >= 1.0, np.inf, lin).astype(np.float32)
         return hdr, ldr, depth
 
     def release(self) -> None:
         """Release every GPU object the renderer made; it stays usable (all are made again on demand)."""
         for p in self.passes.values():
-            release = getattr(p, "release", None)
-            if release is not None:
-                release()
+            p.release()
         for vao in self._fs_vaos.values():
             vao.release()
         self._fs_vaos.clear()

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from .compute import COMPUTE_CHOICES
-from .options import Option, TechniqueSettings, option
-from .registry import DEFAULT_TECHNIQUE, get_technique
+from .options import Option, TechniqueSettings, option, technique_settings
+from .techniques import DEFAULT_TECHNIQUE
 
 
 @dataclass
@@ -24,7 +24,8 @@ class RenderSettings:
     max_lights: int = 4
     # None: each material's own sss_model; else one of skinlab.scene.materials.SSS_MODELS for every material
     sss_model: str | None = None
-    # how subsurface scattering is rendered: a registered technique (skinlab/render/registry.py)
+    # how subsurface scattering is rendered: a registered technique's settings (skinlab/render/registry.py),
+    # or its name for its defaults (a settings object after construction: `technique_options`)
     technique: TechniqueSettings | str = DEFAULT_TECHNIQUE
     # draw depth first, then shade each visible pixel once (skinlab/render/passes/forward.py)
     depth_prepass: bool = True
@@ -94,7 +95,7 @@ class RenderSettings:
                     f"render setting sss_model: expected one of {', '.join(SSS_MODELS)}, got {self.sss_model!r}"
                 )
         if isinstance(self.technique, str):
-            self.technique = get_technique(self.technique).settings_type()
+            self.technique = technique_settings(self.technique)()
         elif not isinstance(self.technique, TechniqueSettings):
             raise ValueError(
                 "render setting technique: expected a technique name or its settings, got " + repr(self.technique)
@@ -104,7 +105,7 @@ class RenderSettings:
     def for_technique(cls, technique: str, width: int = 640, height: int = 640, **kw: Any) -> RenderSettings:
         """Settings for a technique by name; keywords are RenderSettings fields or the technique's
         own settings (``for_technique("tsd", 64, 64, shadow_size=256, size=128)``)."""
-        st = get_technique(technique).settings_type
+        st = technique_settings(technique)
         own = {f.name for f in dataclasses.fields(cls)}
         opts = {k: v for k, v in kw.items() if k not in own}
         unknown = set(opts) - set(st.options())
@@ -123,8 +124,14 @@ class RenderSettings:
         return {f.name: f.metadata["option"] for f in dataclasses.fields(cls) if "option" in f.metadata}
 
     @property
+    def technique_options(self) -> TechniqueSettings:
+        """The technique's settings (``technique`` after construction, typed as such)."""
+        assert isinstance(self.technique, TechniqueSettings)
+        return self.technique
+
+    @property
     def technique_name(self) -> str:
-        return self.technique.technique
+        return self.technique_options.technique
 
     @property
     def size(self) -> tuple[int, int]:

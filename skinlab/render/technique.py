@@ -8,8 +8,8 @@ A technique (skinlab/render/techniques/<name>/, registered in skinlab/render/reg
   ``RenderSettings.technique``;
 - :meth:`Technique.plan`: its passes for the visible meshes (PlannedPass lists with reasons, skips in
   the frame plan) and how the forward pass shades each mesh (a :class:`ForwardHook`);
-- ``passes``: its pass classes by kind (each a :class:`RenderPass`), made once per renderer;
-- ``state``: GPU state it keeps across frames (per renderer), if any;
+- ``passes``: its pass classes by kind (each derived from :class:`RenderPass`), made once per renderer;
+- ``state``: GPU state it keeps across frames (per renderer; a :class:`TechniqueState`), if any;
 - for the accuracy ledger (skinlab/bench/): :meth:`Technique.edge_response` and its :class:`LedgerStyle`.
 
 The forward pass (skinlab/render/passes/forward.py) shades every mesh with skinlab/shaders/passes/forward.frag;
@@ -27,9 +27,9 @@ colour (the colour rule, docs/scenes.md), not the plain part's base colour.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar, cast
 
 from skinlab.scene.optics.edges import step_edge
 
@@ -40,26 +40,71 @@ from .options import TechniqueSettings
 if TYPE_CHECKING:
     import moderngl
 
+    from skinlab.gl.programs import ProgramCache
     from skinlab.scene.graph import LightNode, MeshNode, Scene
 
     from .frame import Frame
+    from .gpu_resources import GpuResources
     from .settings import RenderSettings
     from .texture_units import TextureUnits
 
 PLAIN_HOOK = "techniques/none/forward.glsl"  # no subsurface term: Burley diffuse only
 HOOK_INCLUDE = "skinlab/sss_hook.glsl"  # the include name forward.frag uses for the hook
 
+S = TypeVar("S", bound=TechniqueSettings)
 
-class RenderPass(Protocol):
+
+class PassHost(Protocol):
+    """What a pass uses of the renderer that made it (skinlab/render/renderer.py ``Renderer``)."""
+
+    ctx: moderngl.Context
+    programs: ProgramCache
+    resources: GpuResources
+
+    def fullscreen(self, prog: moderngl.Program) -> None: ...
+
+    def dummy_texture(self) -> moderngl.Texture: ...
+
+    def dummy_shadow_map(self) -> moderngl.Texture: ...
+
+    def state(self, key: str, factory: Callable[[moderngl.Context], Any]) -> Any: ...
+
+
+class RenderPass:
     """A pass kind's implementation: made once per renderer, run for each planned pass of its kind.
-    A pass holding GPU objects of its own also has ``release()``, called by Renderer.release. A pass
-    that can be reused across frames (its PlannedPass has ``inputs``; skinlab/render/reuse.py) also has
-    ``outputs(frame, planned)`` (the textures holding its result) and ``publish(frame, planned)``
-    (hands them to the frame as ``run`` does)."""
 
-    def __init__(self, renderer) -> None: ...
+    The optional parts have no-op defaults: ``release()`` frees the pass's own GPU objects (called by
+    Renderer.release); a pass that can be reused across frames (its PlannedPass has ``inputs``;
+    skinlab/render/reuse.py) returns from ``outputs(frame, planned)`` the textures holding its result
+    (the default, none, runs it every frame) and has ``publish(frame, planned)`` hand them to the frame
+    as ``run`` does."""
 
-    def run(self, frame: Frame, planned: PlannedPass) -> None: ...
+    def __init__(self, renderer: PassHost) -> None:
+        self.r = renderer
+
+    def run(self, frame: Frame, p: PlannedPass) -> None:
+        raise NotImplementedError(f"{type(self).__name__}.run")
+
+    def outputs(self, frame: Frame, p: PlannedPass) -> tuple[moderngl.Texture, ...]:
+        return ()
+
+    def publish(self, frame: Frame, p: PlannedPass) -> None:
+        return None
+
+    def release(self) -> None:
+        return None
+
+
+class TechniqueState:
+    """GPU state a technique keeps across frames (``Technique.state``; one per renderer): told each
+    frame plan before the passes run (``begin_frame``: release what the plan no longer needs) and
+    released with the renderer."""
+
+    def begin_frame(self, plan: FramePlan) -> None:
+        return None
+
+    def release(self) -> None:
+        return None
 
 
 @dataclass
@@ -89,7 +134,16 @@ class ForwardHook:
 
 
 @dataclass
-class PlanContext:
+class ForwardParams:
+    """The forward pass's parameters (skinlab/render/passes/forward.py)."""
+
+    lights: list[LightNode]
+    shadow_lights: list[LightNode]
+    hook: ForwardHook  # the technique's shading of each mesh
+
+
+@dataclass
+class PlanContext(Generic[S]):
     """What a technique plans from."""
 
     scene: Scene
@@ -102,8 +156,9 @@ class PlanContext:
     device: Device | None = None  # the GL context's abilities (compute shaders); None: planned without one
 
     @property
-    def options(self) -> TechniqueSettings:
-        return self.settings.technique
+    def options(self) -> S:
+        """The technique's settings (``settings.technique``, of the planning technique's type)."""
+        return cast(S, self.settings.technique_options)
 
     def path(self, software: str = "compute") -> PassPath:
         """Compute or fragment shader for a pass with a compute variant (skinlab/render/compute.py
@@ -153,21 +208,23 @@ class LedgerStyle:
     levels: str = ""  # a pass kind whose count the ledger reports as `blur_levels` (0: the frame blurs nothing)
 
 
-class Technique:
-    """Base class of a technique package's ``TECHNIQUE``; see the module docstring."""
+class Technique(Generic[S]):
+    """Base class of a technique package's ``TECHNIQUE``; see the module docstring. ``S`` is its
+    settings class (``settings_type``)."""
 
     name: str = ""
     description: str = ""
-    settings_type: type[TechniqueSettings] = TechniqueSettings
-    passes: dict[str, type] = {}
-    state: tuple[str, Callable[[Any], Any]] | None = None  # (key shared by techniques, factory(ctx))
+    settings_type: type[S]
+    passes: Mapping[str, type[RenderPass]] = {}
+    # (key shared by techniques, factory(ctx)): its GPU state kept across frames
+    state: tuple[str, Callable[[moderngl.Context], TechniqueState]] | None = None
     ledger: LedgerStyle = LedgerStyle("o", "grey")
     scatters: bool = True  # False: the technique renders no material as scattering (its model is "none")
     # not empty: why a frame may take long (an image reference); the viewer's T key skips the technique
     # and its panel marks it with this, so a slow GPU is not stalled by one key press
     slow: str = ""
 
-    def plan(self, ctx: PlanContext) -> TechniquePlan:
+    def plan(self, ctx: PlanContext[S]) -> TechniquePlan:
         return TechniquePlan()
 
     def edge_response(self, model: str, medium, plan: FramePlan):

@@ -170,13 +170,13 @@ def test_a_registered_technique_declares_its_view_independent_passes(ctx):
     from skinlab.render.frame_plan import PlannedPass
     from skinlab.render.options import TechniqueSettings
     from skinlab.render.reuse import material_state
-    from skinlab.render.technique import Technique, TechniquePlan
+    from skinlab.render.technique import RenderPass, Technique, TechniquePlan
 
     runs = []
 
-    class ToyBakePass:
+    class ToyBakePass(RenderPass):
         def __init__(self, renderer):
-            self.r = renderer
+            super().__init__(renderer)
             self.tex = renderer.ctx.texture((4, 4), 4, dtype="f4")
 
         def outputs(self, frame, p):

@@ -89,7 +89,7 @@ def plan_profiles(ctx: PlanContext):
     return nodes, keys, labels
 
 
-class DiskTechnique(Technique):
+class DiskTechnique(Technique[DiskSettings]):
     name = "disk"
     description = "importance-sampled Burley disk SSS in screen space (Golubev 2018; HDRP, EEVEE Next)"
     settings_type = DiskSettings

@@ -14,6 +14,7 @@ import numpy as np
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
 from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
+from skinlab.render.technique import RenderPass
 from skinlab.scene.optics.disk import MAX_DISK_PROFILES
 
 DIFFUSE_TARGET = "disk_diffuse"
@@ -36,9 +37,9 @@ class DiskParams:
         return t
 
 
-class DiskPass:
+class DiskPass(RenderPass):
     def __init__(self, renderer):
-        self.r = renderer
+        super().__init__(renderer)
         self._gpu = ScreenTargets(renderer.ctx, 2)  # filtered, composite
 
     def release(self) -> None:

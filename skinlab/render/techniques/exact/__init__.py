@@ -39,7 +39,7 @@ class ExactSettings(TechniqueSettings):
 GATHER_ON_SOFTWARE = "fragment"
 
 
-class ExactTechnique(Technique):
+class ExactTechnique(Technique[ExactSettings]):
     name = "exact"
     description = "brute-force texture-space convolution with the exact profile (the slow image reference)"
     slow = "the brute-force reference: a frame may take seconds"

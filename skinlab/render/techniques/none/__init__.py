@@ -14,7 +14,7 @@ class NoneSettings(TechniqueSettings):
     technique = "none"
 
 
-class NoneTechnique(Technique):
+class NoneTechnique(Technique[NoneSettings]):
     name = "none"
     description = "no subsurface scattering: plain Burley diffuse (the lower bound)"
     settings_type = NoneSettings

@@ -16,7 +16,14 @@ import numpy as np
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.options import TechniqueSettings, option
 from skinlab.render.scattering import scattering_material
-from skinlab.render.technique import ForwardHook, LedgerStyle, PlanContext, Technique, TechniquePlan
+from skinlab.render.technique import (
+    ForwardHook,
+    LedgerStyle,
+    PlanContext,
+    Technique,
+    TechniquePlan,
+    TechniqueState,
+)
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from skinlab.scene.optics.preintegrated import LUT_CURV, LUT_NOL, preintegrated_lut
 from skinlab.scene.optics.tsd import material_medium, profile_fit
@@ -37,7 +44,7 @@ class PreintegratedSettings(TechniqueSettings):
     translucency: bool = option(True, OPTION_DOC, "bool")
 
 
-class LutTextures:
+class LutTextures(TechniqueState):
     """The lookup tables as textures, one per (model, medium), kept across frames (at most 32)."""
 
     def __init__(self, ctx: moderngl.Context):
@@ -113,7 +120,7 @@ class PreintegratedForward(ForwardHook):
         return translucent_shading(mat, HOOK, frame, through, bind)
 
 
-class PreintegratedTechnique(Technique):
+class PreintegratedTechnique(Technique[PreintegratedSettings]):
     name = "preintegrated"
     description = "pre-integrated skin (Penner & Borshukov 2011): a N.L x curvature lookup, no extra pass"
     settings_type = PreintegratedSettings

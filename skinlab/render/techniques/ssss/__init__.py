@@ -64,7 +64,7 @@ class SsssForward(ForwardHook):
         return translucent_shading(node.material, HOOK, frame, through, bind, subsurface=index > 0)
 
 
-class SsssTechnique(Technique):
+class SsssTechnique(Technique[SsssSettings]):
     name = "ssss"
     description = "screen-space separable SSS (Jimenez et al.): a post-process blur of the diffuse light"
     settings_type = SsssSettings

@@ -14,6 +14,7 @@ import numpy as np
 from skinlab.gl.uniforms import set_array, set_uniforms
 from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
+from skinlab.render.technique import RenderPass
 
 from .plan import MAX_SSSS_PROFILES, SsssPlan
 
@@ -27,9 +28,9 @@ class SsssBlurParams:
     compute: bool = False  # the compute shader (techniques/ssss/blur.comp), else the fragment shader
 
 
-class SsssBlurPass:
+class SsssBlurPass(RenderPass):
     def __init__(self, renderer):
-        self.r = renderer
+        super().__init__(renderer)
         self._gpu = ScreenTargets(renderer.ctx, 3)  # tmp, blurred, composite
 
     def release(self) -> None:

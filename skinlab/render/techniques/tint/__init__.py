@@ -44,7 +44,7 @@ class TintForward(ForwardHook):
         return NodeShading(mat, HOOK, bind=lambda prog, units: set_uniform(prog, "u_sss_tint", tint))
 
 
-class TintTechnique(Technique):
+class TintTechnique(Technique[TintSettings]):
     name = "tint"
     description = (
         "a baseline to compare the others against, not a look: each pixel's subsurface light times the "

@@ -70,7 +70,7 @@ class TsdSettings(TechniqueSettings):
     seams: bool = option(True, "light crosses UV seams (seam map; off: blurs stop at chart borders)", "bool")
 
 
-class TsdTechnique(Technique):
+class TsdTechnique(Technique[TsdSettings]):
     name = "tsd"
     description = "texture-space diffusion with the Gaussian fit (d'Eon & Luebke 2007; the default)"
     settings_type = TsdSettings

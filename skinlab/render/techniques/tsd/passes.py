@@ -31,6 +31,7 @@ from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.environment import bind_env_bands
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
+from skinlab.render.technique import RenderPass, TechniqueState
 from skinlab.render.texture_units import TextureUnits
 from skinlab.render.translucency import bind_translucency
 from skinlab.scene.optics.tsd import DiffusionKernel, blur_taps
@@ -207,7 +208,7 @@ class TsdFrameNode:
     through_slots: int = 0  # the shadow slots whose light through it recorded (TsdNodeTargets.through_record)
 
 
-class TsdStore:
+class TsdStore(TechniqueState):
     """Per-node TSD textures, kept across frames (the renderer reuses the results of passes whose
     inputs did not change). The renderer keeps one per renderer (Renderer.state) and calls
     begin_frame with each frame plan."""
@@ -338,11 +339,8 @@ def dilate_compute(
         ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, out))
 
 
-class TsdPass:
+class TsdPass(RenderPass):
     """A texture-space pass of one mesh node; ``output`` names the node texture holding its result."""
-
-    def __init__(self, renderer):
-        self.r = renderer
 
     def node_targets(self, p) -> TsdNodeTargets:
         return store(self.r).targets(p.params.node, p.params.size)
