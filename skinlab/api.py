@@ -89,7 +89,7 @@ class Skinlab:
             if exposure is not None:
                 scene.environment.exposure = float(exposure)
             if camera_orbit:
-                saved_camera = scene.camera.local_matrix.copy()
+                saved_camera = scene.active_camera().local_matrix.copy()
                 scene.orbit_camera(camera_orbit)
             if warm_up:
                 self.renderer.render(scene, st, readback=False)
@@ -97,7 +97,7 @@ class Skinlab:
         finally:
             scene.environment.exposure = saved_exposure
             if saved_camera is not None:
-                scene.camera.set_matrix(saved_camera)
+                scene.active_camera().set_matrix(saved_camera)
 
     def close(self) -> None:
         self.renderer.release()

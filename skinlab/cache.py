@@ -202,7 +202,9 @@ def _write(path: Path, value: Any) -> None:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, "wb") as f:
-            np.savez(f, __layout__=np.asarray(layout), __digest__=np.asarray(_digest(arrays, layout)), **arrays)
+            digest = _digest(arrays, layout)
+            named: dict[str, Any] = {"__layout__": np.asarray(layout), "__digest__": np.asarray(digest), **arrays}
+            np.savez(f, **named)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

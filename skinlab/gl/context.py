@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ctypes.util
 import os
+from typing import Any
 
 import moderngl
 
@@ -64,9 +65,11 @@ def create_headless_context(shared: bool = True) -> moderngl.Context:
             + ". `make setup` installs them where apt-get is available."
         )
     idx = egl_device_index()
-    kwargs = {"device_index": idx} if idx else {}
+    kwargs: dict[str, Any] = {"device_index": idx} if idx else {}
     try:
-        ctx = moderngl.create_context(standalone=True, backend="egl", require=GL_VERSION, **kwargs)
+        # (moderngl's stub types each of **settings as a dict)
+        create: Any = moderngl.create_context
+        ctx = create(standalone=True, backend="egl", require=GL_VERSION, **kwargs)
     except Exception as exc:  # glcontext raises plain Exceptions with terse text
         text = str(exc).strip() or exc.__class__.__name__
         hint = ""

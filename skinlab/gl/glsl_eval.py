@@ -106,8 +106,7 @@ class GLSLEvaluator:
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 tex.use(unit)
                 textures.append(tex)
-                if f"u_{k}" in prog:
-                    prog[f"u_{k}"].value = unit
+                set_uniform(prog, f"u_{k}", unit)
             for unit, (k, (_, tex)) in enumerate(samplers.items(), start=len(arrays)):
                 tex.use(unit)
                 set_uniform(prog, k, unit)

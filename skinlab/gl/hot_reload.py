@@ -12,6 +12,7 @@ from __future__ import annotations
 import threading
 import time
 from pathlib import Path
+from typing import Any
 
 from .programs import ProgramCache
 from .shader_source import ShaderError
@@ -29,7 +30,7 @@ class ShaderWatcher:
         self.settle_s = settle_s
         self._pending: dict[Path, float] = {}
         self._lock = threading.Lock()
-        self._observer = None
+        self._observer: Any = None  # a watchdog Observer, once started
         self.errors: list[ShaderError] = []  # errors of the last reload that failed
         self.reloads = 0
         self._mtimes = self._scan()
@@ -37,7 +38,7 @@ class ShaderWatcher:
             self._start_observer()
 
     # -- change detection -------------------------------------------------------------
-    def _scan(self) -> dict[Path, float]:
+    def _scan(self) -> dict[Path, int]:
         out = {}
         for p in self.root.rglob("*"):
             if p.suffix in SHADER_SUFFIXES and p.is_file():

@@ -32,7 +32,7 @@ def _key(vs: str, fs: str, defines: Mapping[str, object] | None, includes: Mappi
 
 @dataclass
 class ProgramEntry:
-    program: moderngl.Program | None
+    program: moderngl.Program
     deps: set[Path] = field(default_factory=set)
     error: str | None = None  # last failed compile, if the current program is older
     generation: int = 0  # bumps on every successful (re)compile
@@ -63,10 +63,15 @@ def compile_program(
     }
     deps = {p for s in srcs.values() for p in s.paths if p is not None}
     try:
-        prog = ctx.program(**{k: s.text for k, s in srcs.items()})
+        prog = _program(ctx, {k: s.text for k, s in srcs.items()})
     except moderngl.Error:
         raise _diagnose(ctx, srcs) from None
     return prog, deps
+
+
+def _program(ctx: moderngl.Context, stages: Mapping[str, str]) -> moderngl.Program:
+    """ctx.program with the stages by keyword (vertex_shader=..., fragment_shader=...)."""
+    return ctx.program(vertex_shader=stages["vertex_shader"], fragment_shader=stages["fragment_shader"])
 
 
 def _diagnose(ctx: moderngl.Context, srcs: dict[str, ExpandedSource]) -> ShaderError:
@@ -75,11 +80,12 @@ def _diagnose(ctx: moderngl.Context, srcs: dict[str, ExpandedSource]) -> ShaderE
         "vertex_shader": "#version 330 core\nvoid main(){ gl_Position = vec4(0.0); }\n",
         "fragment_shader": "#version 330 core\nout vec4 o;\nvoid main(){ o = vec4(0.0); }\n",
     }
-    messages, locs = [], []
+    messages: list[str] = []
+    locs: list[tuple[str, int]] = []
     for stage, src in srcs.items():
         other = {k: v for k, v in trivial.items() if k != stage}
         try:
-            ctx.program(**{stage: src.flat}, **other).release()
+            _program(ctx, {stage: src.flat, **other}).release()
         except moderngl.Error as exc:
             log = str(exc)
             if stage.split("_")[0] not in log and "link" in log.lower() and not locs:
@@ -92,7 +98,7 @@ def _diagnose(ctx: moderngl.Context, srcs: dict[str, ExpandedSource]) -> ShaderE
             locs.extend(where)
     if not messages:
         try:
-            ctx.program(**{k: s.flat for k, s in srcs.items()}).release()
+            _program(ctx, {k: s.flat for k, s in srcs.items()}).release()
             messages.append("program failed to compile, but the flat source compiles (driver issue?)")
         except moderngl.Error as exc:
             messages.append("program failed to link:\n" + str(exc).strip())
@@ -159,8 +165,7 @@ class ProgramCache:
                 errors.append(exc)
                 continue
             self.compiles += 1
-            if entry.program is not None:
-                entry.program.release()
+            entry.program.release()
             entry.program, entry.deps, entry.error = prog, deps, None
             entry.generation += 1
             self.generation += 1
@@ -168,6 +173,5 @@ class ProgramCache:
 
     def release(self) -> None:
         for e in self.entries.values():
-            if e.program is not None:
-                e.program.release()
+            e.program.release()
         self.entries.clear()

@@ -4,7 +4,7 @@ compiler drops unused uniforms, which is not an error)."""
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, cast
 
 import moderngl
 import numpy as np
@@ -13,7 +13,7 @@ import numpy as np
 def set_uniform(prog: moderngl.Program, name: str, value: Any) -> bool:
     if name not in prog:
         return False
-    u = prog[name]
+    u = cast(moderngl.Uniform, prog[name])
     if isinstance(value, np.ndarray) and value.ndim == 2 and value.shape in ((4, 4), (3, 3)):
         u.write(np.ascontiguousarray(value.T, dtype=np.float32).tobytes())  # GL is column-major
         return True
@@ -45,4 +45,4 @@ def set_array(prog: moderngl.Program, name: str, rows: np.ndarray, length: int) 
     width = rows.shape[1] if rows.ndim == 2 else 1
     buf = np.zeros((length, width) if width > 1 else (length,), np.float32)
     buf[: len(rows)] = rows
-    prog[name].write(buf.tobytes())
+    cast(moderngl.Uniform, prog[name]).write(buf.tobytes())

@@ -37,6 +37,7 @@ from .frame_plan import PlannedPass, shadow_pass_name
 from .gpu_resources import VERTEX_ATTRS, VERTEX_FORMAT, node_uniforms
 from .lights import bind_shadow_maps, light_defines, set_light_uniforms
 from .reuse import light_state, material_state
+from .technique import RenderPass
 from .texture_units import TextureUnits
 
 if TYPE_CHECKING:
@@ -162,11 +163,11 @@ def uv_footprint(mesh: Mesh) -> float:
     return math.sqrt(area / len(mesh.positions))
 
 
-class BouncePass:
+class BouncePass(RenderPass):
     """Runs each planned ``bounce[N]`` (module docstring)."""
 
     def __init__(self, renderer):
-        self.r = renderer
+        super().__init__(renderer)
         self.targets: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer]] = {}  # order -> irradiance
         self.exitance: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
         self.gathered: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None  # before the one-ring average

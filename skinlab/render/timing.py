@@ -36,8 +36,9 @@ class FrameTimings:
 
     @property
     def frame_ms(self) -> float:
-        if not self.software_gl and self.passes and all(p.gpu_ms is not None for p in self.passes):
-            return sum(p.gpu_ms for p in self.passes)
+        gpu = [p.gpu_ms for p in self.passes if p.gpu_ms is not None]
+        if not self.software_gl and self.passes and len(gpu) == len(self.passes):
+            return sum(gpu)
         return sum(p.cpu_ms for p in self.passes)
 
     def table(self) -> str:
@@ -49,11 +50,8 @@ class FrameTimings:
             gpu = f"{p.gpu_ms:9.2f}" if p.gpu_ms is not None else f"{'n/a':>9}"
             lines.append(f"  {p.name:<{width}}  {p.cpu_ms:9.2f}  {gpu}")
         lines.append(f"  {'-' * width}  {'-' * 9}  {'-' * 9}")
-        gpu_total = (
-            f"{sum(p.gpu_ms for p in self.passes):9.2f}"
-            if self.passes and all(p.gpu_ms is not None for p in self.passes)
-            else f"{'n/a':>9}"
-        )
+        measured = [p.gpu_ms for p in self.passes if p.gpu_ms is not None]
+        gpu_total = f"{sum(measured):9.2f}" if self.passes and len(measured) == len(self.passes) else f"{'n/a':>9}"
         lines.append(f"  {'frame (total)':<{width}}  {sum(p.cpu_ms for p in self.passes):9.2f}  {gpu_total}")
         return "\n".join(lines)
 

@@ -369,6 +369,7 @@ class GltfFile:
                 f"{where}: thin-walled scattering (no KHR_materials_volume thickness) read as diffuse transmission"
             )
             return None
+        assert vol is not None  # thick
         values["subsurface"] = dt_factor if dt is not None else 1.0
         values["subsurface_color"] = tuple(float(x) for x in colour)
         values["subsurface_scatter_anisotropy"] = g
@@ -467,8 +468,8 @@ def volume_radius_mm(volume: dict, mm_per_unit: float) -> tuple[float, float, fl
 
     rho = van_de_hulst_albedo(np.asarray(volume["multiscatter"], np.float64), volume["g"])
     reduced = volume_sigma_t(volume) * (1.0 - rho * float(volume["g"]))
-    r = 4.0 * math.pi * mm_per_unit / np.maximum(reduced, 1e-300)
-    return tuple(float(x) for x in np.clip(r, 0.0, 1000.0))
+    r = np.clip(4.0 * math.pi * mm_per_unit / np.maximum(reduced, 1e-300), 0.0, 1000.0)
+    return float(r[0]), float(r[1]), float(r[2])
 
 
 def _dict(v) -> dict:

@@ -10,10 +10,14 @@ import itertools
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import transform as tf
+
+if TYPE_CHECKING:
+    from .measure import MeasureSpec
 
 
 class Node:
@@ -277,9 +281,15 @@ class Scene:
         self.root = Node("root")
         self.camera: CameraNode | None = None
         self.environment = Environment()
-        self.source = None  # path of the scene file, if any
-        self.measure = None  # what the scene tests (skinlab/scene/measure.py MeasureSpec; a file's [measure])
+        self.source: Path | None = None  # path of the scene file, if any
+        self.measure: MeasureSpec | None = None  # what the scene tests (a file's [measure])
         self.warnings: list[str] = []  # what loading met and could not honour (listed by every frame plan)
+
+    def active_camera(self) -> CameraNode:
+        """The camera, or ValueError naming the scene."""
+        if self.camera is None:
+            raise ValueError(f"scene {self.name!r} has no camera")
+        return self.camera
 
     def add(self, node: Node, parent: Node | None = None) -> Node:
         (parent or self.root).add(node)

@@ -190,7 +190,8 @@ def _nodes(path: Path, loaded, trimesh) -> tuple[list[LoadedNode], list[str]]:
                 if child in seen:
                     continue
                 seen.add(child)
-                matrix, geom_name = graph.get(frame_to=child, frame_from=parent)
+                matrix, found = graph.get(frame_to=child, frame_from=parent)
+                geom_name = None if found is None else str(found)
                 _check_node_matrix(path, str(child), np.asarray(matrix))
                 mesh, material = None, None
                 if geom_name is not None and geom_name in loaded.geometry:

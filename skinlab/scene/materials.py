@@ -37,6 +37,13 @@ class Param:
     unit: str = ""
 
     @property
+    def limits(self) -> tuple[float, float]:
+        """The range of a numeric parameter (declared for every one)."""
+        if self.range is None:
+            raise TypeError(f"material parameter {self.name}: a {self.kind} has no range")
+        return self.range
+
+    @property
     def uniform(self) -> str:
         return f"u_{self.name}"
 
@@ -51,7 +58,7 @@ class Param:
                 return np.array([float(value)])
             except (TypeError, ValueError, OverflowError):  # OverflowError: an int beyond float range
                 raise ValueError(
-                    f"{label}: expected a number in [{self.range[0]}, {self.range[1]}], got {value!r}"
+                    f"{label}: expected a number in [{self.limits[0]}, {self.limits[1]}], got {value!r}"
                 ) from None
         n = 2 if self.kind == "vec2" else 3
         try:
@@ -82,7 +89,7 @@ class Param:
                 raise ValueError(f"{label}: expected one of {', '.join(self.choices)}; got {value!r}")
             return value
         arr = self._numbers(value, label)
-        lo, hi = self.range
+        lo, hi = self.limits
         if not np.isfinite(arr).all() or (arr < lo).any() or (arr > hi).any():
             unit = f" {self.unit}" if self.unit else ""
             raise ValueError(f"{label}: value {value!r} outside the valid range [{lo}, {hi}]{unit}")
@@ -95,7 +102,7 @@ class Param:
             return self.validate(value)
         arr = self._numbers(value, self.name)
         arr = np.where(np.isnan(arr), np.asarray(self._numbers(self.default, self.name)), arr)
-        return self._canonical(np.clip(arr, *self.range))
+        return self._canonical(np.clip(arr, *self.limits))
 
 
 # One meaning per parameter, stated here once: the panel's tooltips, the docs (docs/scenes.md, generated

@@ -19,7 +19,7 @@ class Mesh:
     name: str
     positions: np.ndarray  # (N, 3) float32
     indices: np.ndarray  # (M, 3) uint32
-    normals: np.ndarray | None = None  # (N, 3) float32
+    normals: np.ndarray = None  # type: ignore[assignment]  # (N, 3) float32; None: made from the faces
     uvs: np.ndarray | None = None  # (N, 2) float32, OpenGL convention (v up)
     tangents: np.ndarray | None = None  # (N, 4) float32, w = handedness
     source: str = ""
@@ -81,6 +81,14 @@ class Mesh:
                 raise ValueError(f"mesh {self.name!r}: tangents need UVs")
             self.tangents = compute_tangents(self.positions, self.normals, self.uvs, self.indices)
         return self.tangents
+
+    def uv_array(self, what: str) -> np.ndarray:
+        """The UVs, or ValueError naming the mesh and that `what` needs them."""
+        if self.uvs is None:
+            raise ValueError(
+                f"mesh {self.name!r} ({self.source or 'no file'}) has no UV coordinates, and {what} needs them"
+            )
+        return self.uvs
 
     def ensure_uvs(self, reason: str = "a technique needs UVs", generate: bool = True) -> None:
         """Generate a UV atlas with xatlas if the mesh has none (or raise naming the mesh)."""

@@ -78,8 +78,8 @@ def skinlab_radius(mfp_mm, values: dict) -> tuple[float, float, float]:
     g = float(values.get("subsurface_scatter_anisotropy", 0.0))
     reduced = invert_surface_albedo(subsurface_albedo(values), eta_from_specular(values["specular"]))
     real = real_albedo(reduced, g)
-    r = 4.0 * math.pi * np.asarray(mfp_mm, np.float64) / np.maximum(1.0 - real * g, 1e-12)
-    return tuple(float(x) for x in np.clip(r, 0.0, 1000.0))
+    r = np.clip(4.0 * math.pi * np.asarray(mfp_mm, np.float64) / np.maximum(1.0 - real * g, 1e-12), 0.0, 1000.0)
+    return float(r[0]), float(r[1]), float(r[2])
 
 
 def _length(where: str, v) -> float:

@@ -28,17 +28,17 @@ def box_mesh(size, name: str = "box") -> Mesh:
             p[ua] = cu * half[ua]
             p[va] = cv * half[va]
             corners.append(p)
-        corners = np.array(corners)
-        if np.dot(np.cross(corners[1] - corners[0], corners[2] - corners[0]), n) < 0:
-            corners = corners[[0, 3, 2, 1]]
+        quad = np.array(corners)
+        if np.dot(np.cross(quad[1] - quad[0], quad[2] - quad[0]), n) < 0:
+            quad = quad[[0, 3, 2, 1]]
         # UVs from the face's own axes, uniform scale into the cell
         e = np.array([size[ua], size[va]])
-        local = np.stack([corners[:, ua], corners[:, va]], axis=1) / e.max() + 0.5 * e / e.max()
+        local = np.stack([quad[:, ua], quad[:, va]], axis=1) / e.max() + 0.5 * e / e.max()
         cell = np.array([k % 3, k // 3], np.float64)
         m = 1.0 / 16
         uvk = (cell + m + local * (1 - 2 * m)) / np.array([3.0, 2.0])
         base = 4 * k
-        pos.append(corners)
+        pos.append(quad)
         nrm.append(np.tile(n, (4, 1)))
         uv.append(uvk)
         tri += [[base, base + 1, base + 2], [base, base + 2, base + 3]]
@@ -56,7 +56,7 @@ def write_obj(mesh: Mesh, path) -> None:
     """Wavefront OBJ with positions, UVs and normals per vertex (one index for all three)."""
     lines = [f"# {mesh.name}: written by skinlab.scene.primitives.write_obj", f"o {mesh.name}"]
     lines += [f"v {x:.6g} {y:.6g} {z:.6g}" for x, y, z in mesh.positions]
-    lines += [f"vt {u:.6g} {v:.6g}" for u, v in mesh.uvs]
+    lines += [f"vt {u:.6g} {v:.6g}" for u, v in mesh.uv_array("an OBJ file")]
     lines += [f"vn {x:.6g} {y:.6g} {z:.6g}" for x, y, z in mesh.normals]
     lines += ["f " + " ".join(f"{i + 1}/{i + 1}/{i + 1}" for i in t) for t in mesh.indices]
     from pathlib import Path

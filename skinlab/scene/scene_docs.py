@@ -191,7 +191,7 @@ def _fmt_range(p: Param) -> str:
         return ", ".join(f'"{c}"' for c in p.choices)
     if p.kind == "texture":
         return "sRGB image" if p.colorspace == "srgb" else "linear image"
-    lo, hi = p.range
+    lo, hi = p.limits
     return f"[{lo:g}, {hi:g}]"
 
 

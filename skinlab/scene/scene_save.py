@@ -131,16 +131,16 @@ def scene_toml(scene: Scene) -> str:
             if info.get(flag):
                 entry[flag] = True
         lines += _table("[[meshes]]", entry)
-        for node in top.walk():
-            if node is top:
+        for sub in top.walk():
+            if sub is top:
                 continue
             cfg: dict = {}
-            if isinstance(node, MeshNode):
-                cfg["material"] = names[id(node.material)]
-            if not node.visible:
+            if isinstance(sub, MeshNode):
+                cfg["material"] = names[id(sub.material)]
+            if not sub.visible:
                 cfg["visible"] = False
             if cfg:
-                lines += _table(f"[meshes.nodes.{_key(node.name)}]", cfg)
+                lines += _table(f"[meshes.nodes.{_key(sub.name)}]", cfg)
     for light in scene.nodes():
         if not isinstance(light, LightNode):
             continue

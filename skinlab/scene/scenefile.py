@@ -609,7 +609,7 @@ def _build(path: Path, data: dict) -> Scene:
         if name is None and own is not None:
             key = (str(mfile), own.index)
             if key not in file_materials:
-                file_materials[key] = _file_material(f"{where} ({Path(mfile).name})", own, mm)
+                file_materials[key] = _file_material(f"{where} ({Path(str(mfile)).name})", own, mm)
             mat = file_materials[key]
         elif name is None:
             mat = Material("default")
@@ -678,7 +678,7 @@ def _build(path: Path, data: dict) -> Scene:
                         ln.material if "material" not in cfg and "material" not in entry else None,
                         mpath,
                     )
-                node = MeshNode(ln.name, ln.mesh, mat)
+                node: Node = MeshNode(ln.name, ln.mesh, mat)
             else:
                 node = Node(ln.name)
             node.set_matrix(ln.matrix)

@@ -32,8 +32,8 @@ def matrix_to_quat(m) -> np.ndarray:
         q[i] = 0.25 * s
         q[j] = (m[j, i] + m[i, j]) / s
         q[k] = (m[k, i] + m[i, k]) / s
-    q = np.array(q)
-    return q / np.linalg.norm(q)
+    quat = np.array(q)
+    return quat / np.linalg.norm(quat)
 
 
 def euler_deg_to_quat(angles) -> np.ndarray:

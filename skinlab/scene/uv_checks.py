@@ -156,7 +156,7 @@ def analyse_uvs(
     if uv.shape != (len(p), 2):
         raise ValueError(f"mesh {mesh.name!r}: uvs must be ({len(p)}, 2), got {uv.shape}")
     tuv = uv[f]  # (T, 3, 2)
-    finite = np.isfinite(tuv).all(axis=(1, 2))
+    finite = np.asarray(np.isfinite(tuv).all(axis=(1, 2)))
     tuv = np.where(finite[:, None, None], tuv, 0.0)  # keep the arithmetic NaN-free
     d1, d2 = tuv[:, 1] - tuv[:, 0], tuv[:, 2] - tuv[:, 0]
     det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
@@ -207,7 +207,7 @@ def _weighted_percentiles(values: np.ndarray, weights: np.ndarray) -> dict:
     keep = weights > 0
     values, weights = values[keep], weights[keep]
     total = weights.sum()
-    cols = []
+    cols: list[tuple[np.ndarray, np.ndarray] | None] = []
     for c in range(values.shape[1] if values.ndim == 2 else 2):
         if not len(values) or not total > 0:
             cols.append(None)

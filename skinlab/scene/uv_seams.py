@@ -106,7 +106,7 @@ def charts(mesh: Mesh, pid: np.ndarray | None = None) -> np.ndarray:
 
     f = mesh.indices.astype(np.int64)
     pid = weld(mesh.positions) if pid is None else pid
-    key = np.concatenate([pid[:, None].astype(np.float64), mesh.uvs.astype(np.float64)], 1)
+    key = np.concatenate([pid[:, None].astype(np.float64), mesh.uv_array("chart finding").astype(np.float64)], 1)
     _, uvid = np.unique(key, axis=0, return_inverse=True)
     t, _, lo, hi = _edge_table(f, uvid.ravel())
     order = np.lexsort((hi, lo))
@@ -122,7 +122,7 @@ def border_edges(mesh: Mesh, pid: np.ndarray | None = None) -> tuple[np.ndarray,
     triangle shares in UV (a seam, or the mesh's own boundary)."""
     f = mesh.indices.astype(np.int64)
     pid = weld(mesh.positions) if pid is None else pid
-    key = np.concatenate([pid[:, None].astype(np.float64), mesh.uvs.astype(np.float64)], 1)
+    key = np.concatenate([pid[:, None].astype(np.float64), mesh.uv_array("chart finding").astype(np.float64)], 1)
     _, uvid = np.unique(key, axis=0, return_inverse=True)
     t, k, lo, hi = _edge_table(f, uvid.ravel())
     _, inv, count = np.unique(np.stack([lo, hi], 1), axis=0, return_inverse=True, return_counts=True)
@@ -134,7 +134,7 @@ def _border_frames(mesh: Mesh, pid: np.ndarray | None = None):
     """Each chart border edge (degenerate ones left out) in UV: its ends a0, a1, its unit direction and
     its unit normal pointing away from its triangle, each (K, 2)."""
     f = mesh.indices.astype(np.int64)
-    uv = mesh.uvs.astype(np.float64)
+    uv = mesh.uv_array("chart finding").astype(np.float64)
     t, k = border_edges(mesh, pid)
     a0, a1, a2 = uv[f[t, k]], uv[f[t, (k + 1) % 3]], uv[f[t, (k + 2) % 3]]
     e = a1 - a0
@@ -188,7 +188,7 @@ def seam_edges(mesh: Mesh):
     first = np.flatnonzero(start)
     two = first[count == 2]  # manifold edges: exactly two triangles
     ta, tb, ka, kb = t[two], t[two + 1], k[two], k[two + 1]
-    uv = mesh.uvs.astype(np.float64)
+    uv = mesh.uv_array("seam finding").astype(np.float64)
 
     def corner_uv(tt, kk, p):
         v0, v1 = f[tt, kk], f[tt, (kk + 1) % 3]

@@ -21,19 +21,21 @@ from skinlab.render.ambient import ambient_defines, bind_ambient
 from skinlab.render.boundary import bind_boundary
 from skinlab.render.environment import DATA_KEY as ENV_DATA
 from skinlab.render.environment import bind_env_bands, env_uniforms
-from skinlab.render.frame_plan import ForwardParams
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import area_defines, bind_shadow_maps, light_defines, set_light_uniforms
-from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK, NodeShading
+from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK, ForwardParams, NodeShading, RenderPass
 from skinlab.render.texture_units import TextureUnits
 
 
-class ForwardPass:
+class ForwardPass(RenderPass):
     def __init__(self, renderer):
-        self.r = renderer
+        super().__init__(renderer)
+        # (colour, depth, framebuffer, extra colour targets)
+        self._targets: tuple[moderngl.Texture, moderngl.Texture, moderngl.Framebuffer, list[moderngl.Texture]] | None
         self._targets = None
-        self._depth_fbo = None  # the depth target alone, for the depth pre-pass
-        self._bg_fbo = None  # (colour target, framebuffer of it and the depth): the environment behind
+        self._depth_fbo: moderngl.Framebuffer | None = None  # the depth target alone, for the depth pre-pass
+        # (colour target, framebuffer of it and the depth): the environment behind
+        self._bg_fbo: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
 
     def targets(self, size, outputs: tuple[str, ...] = ()):
         """(colour, depth, framebuffer, extra colour targets): one more float target per name in
@@ -41,8 +43,9 @@ class ForwardPass:
         t = self._targets
         if t is None or t[0].size != tuple(size) or len(t[3]) != len(outputs):
             if t is not None:
-                for x in (t[2], t[1], t[0], *t[3]):
-                    x.release()
+                t[2].release()
+                for tex in (t[1], t[0], *t[3]):
+                    tex.release()
             ctx = self.r.ctx
             color = ctx.texture(size, 4, dtype="f4")
             depth = ctx.depth_texture(size)
@@ -60,8 +63,11 @@ class ForwardPass:
     def release(self) -> None:
         if self._targets is not None:
             color, depth, fbo, extra = self._targets
-            for x in (self._depth_fbo, fbo, color, depth, *extra):
-                x.release()
+            if self._depth_fbo is not None:
+                self._depth_fbo.release()
+            fbo.release()
+            for tex in (color, depth, *extra):
+                tex.release()
             self._targets = self._depth_fbo = None
         if self._bg_fbo is not None:
             self._bg_fbo[1].release()
@@ -124,6 +130,7 @@ class ForwardPass:
             ctx.depth_func, fbo.depth_mask = "<", True
 
     def depth_prepass(self, frame, per_frame) -> None:
+        assert self._depth_fbo is not None  # made with the targets
         self._depth_fbo.use()
         for node in frame.scene.mesh_nodes():
             if blended(node.material):
@@ -139,6 +146,7 @@ class ForwardPass:
         """Every visible mesh: the opaque and masked ones first, then those with alpha_mode "blend" far
         to near, premultiplied over what is behind them without writing depth (skinlab/render/alpha.py)."""
         ctx = self.r.ctx
+        assert self._targets is not None  # made by run
         fbo = self._targets[2]
         depth_mask = fbo.depth_mask
         blending = False

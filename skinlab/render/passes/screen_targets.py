@@ -15,7 +15,7 @@ class ScreenTargets:
         self.ctx, self.count = ctx, count
         self.textures: tuple = ()
         self.fbos: list = []
-        self._table = None
+        self._table: moderngl.Texture | None = None
 
     def at(self, size) -> tuple:
         """`count` RGBA float32 textures of `size` (clamped at the border), remade on a new size."""

@@ -13,6 +13,7 @@ from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.alpha import bind_mask, blended, mask_defines
 from skinlab.render.frame_plan import ShadowParams
 from skinlab.render.lights import SOFT_KEY, soft_shadow
+from skinlab.render.technique import RenderPass
 from skinlab.render.texture_units import TextureUnits
 from skinlab.scene import transform as tf
 from skinlab.scene.graph import LightNode
@@ -87,10 +88,11 @@ def soft_parameters(light: LightNode, m: np.ndarray, lo: np.ndarray, hi: np.ndar
     return np.array([size, float(local), k, diameter])
 
 
-class ShadowPass:
+class ShadowPass(RenderPass):
     def __init__(self, renderer):
-        self.r = renderer
-        self.maps: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer]] = {}
+        super().__init__(renderer)
+        # slot -> (depth texture, framebuffer, distance texture or None)
+        self.maps: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer, moderngl.Texture | None]] = {}
 
     def target(self, slot: int, size: int, distance: bool = False):
         """(depth texture, framebuffer, distance texture or None) for a slot."""

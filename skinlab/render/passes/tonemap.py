@@ -13,11 +13,12 @@ import numpy as np
 
 from skinlab.gl.uniforms import set_uniform, set_uniforms
 from skinlab.render.compute import bind_images, dispatch
+from skinlab.render.technique import RenderPass
 
 
-class TonemapPass:
+class TonemapPass(RenderPass):
     def __init__(self, renderer):
-        self.r = renderer
+        super().__init__(renderer)
         self._target = None  # (ldr, framebuffer, filtered hdr or None)
 
     def release(self) -> None:

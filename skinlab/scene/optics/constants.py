@@ -111,8 +111,8 @@ def _fm_reference(eta: float, which: int) -> float:
         return sum(ck * eta**k for k, ck in enumerate(c))
     if eta < 1.0:
         return sum(ck * eta**k for k, ck in enumerate(FM2_LT1))
-    c = FM2_GE1
-    return c[0] + c[1] / eta + c[2] / eta**2 + c[3] / eta**3 + sum(c[4 + k] * eta ** (k + 1) for k in range(5))
+    g = FM2_GE1
+    return g[0] + g[1] / eta + g[2] / eta**2 + g[3] / eta**3 + sum(g[4 + k] * eta ** (k + 1) for k in range(5))
 
 
 def _chebyshev_fit(fn, lo: float, hi: float, n: int = 14) -> tuple[float, ...]:

@@ -29,6 +29,7 @@ SeedSequence(seed).spawn(...)[k], independent of the number of worker processes.
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
@@ -228,6 +229,7 @@ def simulate(
     s1 = np.zeros(len(edges) - 1)
     s2 = np.zeros_like(s1)
     t1 = t2 = capped = u1 = u2 = 0.0
+    results: Iterable[tuple]
     if workers > 1 and len(jobs) > 1:
         with ProcessPoolExecutor(workers) as ex:
             results = list(ex.map(_run_batch, jobs))

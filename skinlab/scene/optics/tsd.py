@@ -201,7 +201,8 @@ def design_kernel(
     unless `taps` fixes the count."""
     skipped = []
     ident = fit.identity.astype(np.float64).copy()
-    kept_v, kept_w = [], []
+    kept_v: list[float] = []
+    kept_w: list[np.ndarray] = []
     p50 = max(float(mm_per_texel_p50), TSD_MIN_MM_PER_TEXEL)
     p10 = max(float(mm_per_texel_p10), TSD_MIN_MM_PER_TEXEL)
     for k, v in enumerate(fit.variances_mm2):
@@ -224,14 +225,14 @@ def design_kernel(
             continue
         kept_v.append(float(v))
         kept_w.append(w)
-    kept_w = np.array(kept_w).reshape(-1, 3)
+    weights = np.array(kept_w).reshape(-1, 3)
     # renormalise what is left (dropped negligible weights) so the kernel still sums to 1
-    tot = ident + kept_w.sum(axis=0)
+    tot = ident + weights.sum(axis=0)
     scale = np.where(tot > 0, 1.0 / np.where(tot > 0, tot, 1.0), 0.0)
     ident = np.where(tot > 0, ident * scale, 1.0)
-    kept_w = kept_w * scale[None, :]
+    weights = weights * scale[None, :]
     steps, prev = [], 0.0
-    for i, (v, w) in enumerate(zip(kept_v, kept_w)):
+    for i, (v, w) in enumerate(zip(kept_v, weights)):
         sigma = math.sqrt(max(v - prev, 0.0))
         steps.append(BlurStep(i, v, sigma, int(taps) if taps else tap_count(sigma / p10), tuple(float(x) for x in w)))
         prev = v
