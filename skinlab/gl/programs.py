@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import cast
 
 import moderngl
 
@@ -32,7 +33,7 @@ def _key(vs: str, fs: str, defines: Mapping[str, object] | None, includes: Mappi
 
 @dataclass
 class ProgramEntry:
-    program: moderngl.Program
+    program: moderngl.Program | moderngl.ComputeShader
     deps: set[Path] = field(default_factory=set)
     error: str | None = None  # last failed compile, if the current program is older
     generation: int = 0  # bumps on every successful (re)compile
@@ -45,7 +46,7 @@ def compile_program(
     fs: str,
     defines: Mapping[str, object] | None = None,
     includes: Mapping[str, str] | None = None,
-) -> tuple[moderngl.Program, set[Path]]:
+) -> tuple[moderngl.Program | moderngl.ComputeShader, set[Path]]:
     """Compile one program; on failure raise :class:`ShaderError` naming file and line. ``includes``:
     include names resolved to other files for this program (ShaderLibrary.expand's aliases). With
     ``vs`` = COMPUTE, ``fs`` is a compute shader's file and the result a moderngl.ComputeShader."""
@@ -138,14 +139,14 @@ class ProgramCache:
             prog, deps = compile_program(self.ctx, self.library, vs, fs, defines, includes)
             self.compiles += 1
             entry = self.entries[key] = ProgramEntry(prog, deps, None, 1)
-        return entry.program
+        return cast(moderngl.Program, entry.program)  # a compute shader's entry: `compute`
 
     def compute(
         self, cs: str, defines: Mapping[str, object] | None = None, includes: Mapping[str, str] | None = None
     ) -> moderngl.ComputeShader:
         """The compute shader of file `cs` (a ``#version 430`` file under the shader root) for a variant;
         reloaded like the programs."""
-        return self.get(COMPUTE, cs, defines, includes)
+        return cast(moderngl.ComputeShader, self.get(COMPUTE, cs, defines, includes))
 
     def dependents(self, changed: set[Path]) -> list[tuple]:
         changed = {Path(p).resolve() for p in changed}

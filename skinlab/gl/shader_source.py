@@ -52,7 +52,8 @@ def code_outside_comments(line: str, in_comment: bool) -> tuple[str, bool]:
     its end (``in_comment``: one was open at its start)."""
     if not in_comment and "/" not in line:  # most lines: nothing to strip
         return line, False
-    code, i, n = [], 0, len(line)
+    code: list[str] = []
+    i, n = 0, len(line)
     while i < n:
         if in_comment:
             end = line.find("*/", i)

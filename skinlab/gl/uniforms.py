@@ -9,8 +9,11 @@ from typing import Any, cast
 import moderngl
 import numpy as np
 
+# what a uniform is written into: a program, or a compute shader (skinlab/render/compute.py)
+Shader = moderngl.Program | moderngl.ComputeShader
 
-def set_uniform(prog: moderngl.Program, name: str, value: Any) -> bool:
+
+def set_uniform(prog: Shader, name: str, value: Any) -> bool:
     if name not in prog:
         return False
     u = cast(moderngl.Uniform, prog[name])
@@ -30,12 +33,12 @@ def set_uniform(prog: moderngl.Program, name: str, value: Any) -> bool:
     return True
 
 
-def set_uniforms(prog: moderngl.Program, values: Mapping[str, Any]) -> None:
+def set_uniforms(prog: Shader, values: Mapping[str, Any]) -> None:
     for k, v in values.items():
         set_uniform(prog, k, v)
 
 
-def set_array(prog: moderngl.Program, name: str, rows: np.ndarray, length: int) -> None:
+def set_array(prog: Shader, name: str, rows: np.ndarray, length: int) -> None:
     """Fill a uniform array (``vec3 name[length]`` etc.) from rows, zero-padded. The compiler may keep
     only the leading elements a variant uses; only those are written."""
     if name not in prog:

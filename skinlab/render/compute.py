@@ -20,12 +20,16 @@ viewer's window asks for GL 3.3 core) runs the fragment path, and the plan says 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import moderngl
 
-if TYPE_CHECKING:
-    from .settings import RenderSettings
+
+class ComputeSetting(Protocol):
+    """What :func:`choose_path` reads of the settings (``RenderSettings.compute``; the settings
+    import this module for COMPUTE_CHOICES, so it names no settings class)."""
+
+    compute: str
 
 COMPUTE_CHOICES = ("auto", "on", "off")
 LOCAL_SIZE = 8  # work groups of 8 x 8 invocations (local_size_x/y in every .comp)
@@ -60,7 +64,7 @@ class PassPath:
         return f"; {'compute' if self.compute else 'fragment'} shader ({self.why})"
 
 
-def choose_path(settings: RenderSettings, device: Device | None, software: str = "compute") -> PassPath:
+def choose_path(settings: ComputeSetting, device: Device | None, software: str = "compute") -> PassPath:
     """The path of a pass with a compute variant. `software`: the path ``auto`` takes on software GL
     ("compute" or "fragment", from the pass's measurement there)."""
     device = device or NO_DEVICE

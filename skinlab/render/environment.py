@@ -37,8 +37,11 @@ from skinlab.scene import envmap
 from skinlab.scene.optics import sh, split_sum
 
 from .frame_plan import PlannedPass
+from .technique import RenderPass
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from skinlab.scene.graph import MeshNode, Scene
     from skinlab.scene.interreflection import BounceTransfer
 
@@ -57,7 +60,7 @@ SKY_WIDTH = 1024  # vertices per row of the sky-occlusion texture (3 texels each
 @dataclass
 class EnvironmentParams:
     prepared: envmap.PreparedMap
-    path: object  # the map file (the background reads its pixels)
+    path: str | Path  # the map file (the background reads its pixels)
     background: bool
 
 
@@ -208,11 +211,11 @@ def upload_table(ctx: moderngl.Context, table: np.ndarray) -> moderngl.Texture:
     return tex
 
 
-class EnvironmentPass:
+class EnvironmentPass(RenderPass):
     """Uploads the prepared map (plan_environment); its textures are kept per map."""
 
     def __init__(self, renderer):
-        self.r = renderer
+        super().__init__(renderer)
         self.held: dict | None = None  # key, radiance, brdf, background (or None)
 
     def _textures(self, prm: EnvironmentParams) -> dict:
@@ -224,6 +227,7 @@ class EnvironmentPass:
         ctx = self.r.ctx
         tex = upload_levels(ctx, prepared.levels)
         brdf = upload_table(ctx, brdf_table())
+        assert prepared.irradiance is not None  # envmap.prepare makes it
         irr = upload_levels(ctx, [prepared.irradiance])
         bg = None
         if prm.background:
@@ -262,11 +266,11 @@ class EnvironmentPass:
         self.publish(frame, p)  # the textures are made (uploaded) on first use
 
 
-class SkyOcclusionPass:
+class SkyOcclusionPass(RenderPass):
     """Uploads each vertex's blocked-sky coefficients (plan_sky) to a vertex-space texture."""
 
     def __init__(self, renderer):
-        self.r = renderer
+        super().__init__(renderer)
         self.held: tuple | None = None  # (transfer key, texture)
 
     def _texture(self, transfer: BounceTransfer) -> moderngl.Texture:

@@ -133,8 +133,9 @@ class GpuResources:
 
     def unbind_samplers(self) -> None:
         """Back to each texture's own filtering on the units bind_material gave a sampler object."""
-        for unit in self._sampled_units:
-            self._isotropic.clear(unit)
+        if self._isotropic is not None:  # units are given it only once it is made
+            for unit in self._sampled_units:
+                self._isotropic.clear(unit)
         self._sampled_units.clear()
 
     def release(self) -> None:

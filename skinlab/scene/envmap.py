@@ -40,6 +40,7 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -300,7 +301,8 @@ def cache_root() -> Path | None:
 def _save(prepared: PreparedMap, path: Path) -> None:
     from skinlab.atomic_write import atomic_path
 
-    arrays = {f"level{k}": lv for k, lv in enumerate(prepared.levels)}
+    assert prepared.irradiance is not None  # prepare() makes it
+    arrays: dict[str, Any] = {f"level{k}": lv for k, lv in enumerate(prepared.levels)}
     src = prepared.sources
     arrays["source_dir"] = np.array([s.direction for s in src]).reshape(-1, 3)
     arrays["source_e"] = np.array([s.irradiance for s in src]).reshape(-1, 3)

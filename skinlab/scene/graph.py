@@ -129,6 +129,7 @@ class Node:
                 local = n.local_matrix
                 n._world = local if n.parent is None else n.parent._world @ local
                 n.world_updates += 1
+        assert self._world is not None  # made above
         return self._world
 
     @property

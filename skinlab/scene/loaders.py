@@ -113,8 +113,8 @@ def check_node_scales(path: Path, nodes: list[LoadedNode]) -> None:
         if ln.mesh is None or transform_problem(world[ln.name]) is None:
             continue
         chain = [ln.name]
-        while parent_of[chain[-1]] is not None:
-            chain.append(parent_of[chain[-1]])
+        while (up := parent_of[chain[-1]]) is not None:
+            chain.append(up)
         culprit = next((n for n in reversed(chain) if transform_problem(local[n])), None)
         what = transform_problem(world[ln.name] if culprit is None else local[culprit])
         raise ValueError(

@@ -194,8 +194,8 @@ def close_mesh(positions: np.ndarray, indices: np.ndarray, unfold_rounds: int = 
         stuck = np.unique(f[folded_triangles(p, f, big)].reshape(-1))
         if not len(stuck):
             break
-        keep = ~np.isin(f, stuck).any(axis=1)
-        f, big = f[keep], big[keep]
+        kept = ~np.isin(f, stuck).any(axis=1)
+        f, big = f[kept], big[kept]
     _, counts = _undirected_edges(f)
     if (counts != 2).any():
         raise ValueError(f"close_mesh: {int((counts != 2).sum())} edges are still open or non-manifold")
@@ -235,12 +235,12 @@ def _boundary_loops(f: np.ndarray) -> list[list[int]]:
 def _fill_holes(p: np.ndarray, f: np.ndarray, big: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Every hole filled by a fan around its centroid; ``big`` (a mask of the triangles of fans of
     holes of BIG_HOLE edges or more) extended to the new triangles."""
-    new_p, new_f, big = [p], [f], [big]
+    new_p, new_f, new_big = [p], [f], [big]
     n = len(p)
     for loop in _boundary_loops(f):
         centre = p[loop].mean(axis=0)
         new_p.append(centre[None])
         new_f.append(np.array([[loop[i], loop[(i + 1) % len(loop)], n] for i in range(len(loop))], np.int64))
-        big.append(np.full(len(loop), len(loop) >= BIG_HOLE))
+        new_big.append(np.full(len(loop), len(loop) >= BIG_HOLE))
         n += 1
-    return np.concatenate(new_p), np.concatenate(new_f), np.concatenate(big)
+    return np.concatenate(new_p), np.concatenate(new_f), np.concatenate(new_big)

@@ -8,6 +8,8 @@ size, what the ``hdr`` read-back returns, and tone-maps the filtered radiance
 
 from __future__ import annotations
 
+from typing import cast
+
 import moderngl
 import numpy as np
 
@@ -46,6 +48,7 @@ class TonemapPass(RenderPass):
         drawn = {"BACKGROUND_DRAWN": 1} if env is not None and env["background"] is not None else {}
         defines = {**({"SUPERSAMPLE": n} if n > 1 else {}), **drawn}
         compute = p.params is not None and p.params.compute
+        prog: moderngl.Program | moderngl.ComputeShader
         if compute:
             prog = self.r.programs.compute("passes/tonemap.comp", defines)
         elif n > 1:
@@ -59,12 +62,13 @@ class TonemapPass(RenderPass):
         )
         if compute:
             set_uniform(prog, "u_size", np.asarray(p.resolution, np.int32).tobytes())
-            bind_images(prog, {"u_ldr": tex, **({"u_filtered": hdr} if hdr is not None else {})})
-            dispatch(prog, p.resolution)
+            cs = cast(moderngl.ComputeShader, prog)
+            bind_images(cs, {"u_ldr": tex, **({"u_filtered": hdr} if hdr is not None else {})})
+            dispatch(cs, p.resolution)
         else:
             fbo.use()
             ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
-            self.r.fullscreen(prog)
+            self.r.fullscreen(cast(moderngl.Program, prog))
         frame.targets["ldr_color"] = tex
         if hdr is not None:
             frame.targets["hdr_filtered"] = hdr
