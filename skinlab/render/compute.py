@@ -31,6 +31,7 @@ class ComputeSetting(Protocol):
 
     compute: str
 
+
 COMPUTE_CHOICES = ("auto", "on", "off")
 LOCAL_SIZE = 8  # work groups of 8 x 8 invocations (local_size_x/y in every .comp)
 

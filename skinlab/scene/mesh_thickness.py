@@ -20,6 +20,7 @@ import numpy as np
 from skinlab.cache import content_key, stored
 
 from .mesh import mesh_key
+from .mesh_topology import edge_report
 
 _CACHE: dict = {}
 _SEED_RAYS = 256  # vertices tested against every triangle first (a thin part is usually found here)
@@ -69,18 +70,9 @@ class _Rays:
 
 
 def is_closed(mesh) -> bool:
-    """Whether the mesh, its vertices welded by position, is closed: every edge shared by exactly two
-    triangles. Cached per mesh identity and version."""
-    key = ("closed", mesh.uid, mesh.version)
-    hit = _CACHE.get(key)
-    if hit is None:
-        _, weld = np.unique(np.asarray(mesh.positions, np.float32), axis=0, return_inverse=True)
-        tri = weld.reshape(-1)[np.asarray(mesh.indices, np.int64)]
-        edges = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
-        edges = edges[edges[:, 0] != edges[:, 1]]
-        _, counts = np.unique(edges, axis=0, return_counts=True)
-        hit = _CACHE[key] = bool(len(counts) and (counts == 2).all())
-    return hit
+    """Whether the mesh, its vertices welded by position (skinlab/scene/mesh_topology.py, one answer
+    with the truth's and the warnings'), is closed: every edge shared by exactly two triangles."""
+    return edge_report(mesh).closed  # kept per mesh identity and version
 
 
 def thinner_than(mesh, limit: float) -> bool:

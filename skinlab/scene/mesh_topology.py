@@ -7,6 +7,14 @@ A closed mesh matters where light is followed inside the medium: the path-traced
 medium needs an inside) and the thickness a technique reads for light through thin parts; at a hole
 the light leaks out and the surface shows dark specks. Open meshes are warned about where such a
 frame or reference is made (``skinlab/render/scattering.py``, ``skinlab/truth/export.py``).
+
+The one meaning of "the same vertex" for topology (:func:`weld`): vertices at the same float32
+position (-0.0 and 0.0 one) are one, as an atlas generator or a hard edge splits them; nothing closer
+than that is merged. The UV seams (``skinlab/scene/uv_seams.py``), the truth's hole capping
+(``skinlab/truth/export.py``) and the thickness's closed test (``skinlab/scene/mesh_thickness.py``) all
+weld with it, so "is this mesh closed?" has one answer; :func:`welded_mesh` keeps it per mesh version.
+(``skinlab/scene/interreflection.py`` merges copies of one position *and* normal, a vertex's shading
+copies, on purpose.)
 """
 
 from __future__ import annotations
@@ -27,7 +35,7 @@ class EdgeReport:
 
     @property
     def closed(self) -> bool:
-        return self.open == 0 and self.non_manifold == 0
+        return self.open == 0 and self.non_manifold == 0 and self.edges > 0  # no edges: every triangle a point
 
     @property
     def sheet(self) -> bool:
@@ -41,25 +49,58 @@ class EdgeReport:
             for n, what in ((self.open, "open"), (self.non_manifold, "non-manifold"))
             if n
         ]
-        return " and ".join(parts) if parts else "closed"
+        return " and ".join(parts) if parts else "closed" if self.edges else "no edges: every triangle welds to a point"
 
 
 def _undirected_edges(indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The distinct edges (a < b) of a triangle list and how many triangles use each."""
+    """The distinct edges (a < b) of a triangle list and how many triangles use each; a side from a
+    vertex to itself (a triangle collapsed by the weld) is no edge."""
     f = np.asarray(indices, np.int64).reshape(-1, 3)
     e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    e = e[e[:, 0] != e[:, 1]]
     n = int(e.max()) + 1 if e.size else 1
     codes, counts = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)  # one int per edge: a 1-D sort
     return np.stack([codes // n, codes % n], axis=1), counts
 
 
-def _welded(positions: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(positions, triangle indices) with vertices at the same position merged: a UV seam or a hard
-    edge splits vertices, which is no hole."""
-    p = np.ascontiguousarray(np.asarray(positions, np.float32) + np.float32(0.0))  # -0.0 -> 0.0
+@dataclass(frozen=True)
+class Welded:
+    """A triangle list with vertices at one position merged (:func:`weld`)."""
+
+    ids: np.ndarray  # (N,) int64: the welded vertex of each vertex
+    first: np.ndarray  # (W,) int64: each welded vertex's first vertex
+    positions: np.ndarray  # (W, 3) float64: each welded vertex's position
+    faces: np.ndarray  # (F, 3) int64: the triangles in welded vertices
+
+    def first_faces(self) -> np.ndarray:
+        """The triangles in original vertex indices, each welded vertex as its first copy."""
+        return self.first[self.faces]
+
+
+def weld(positions: np.ndarray, indices: np.ndarray) -> Welded:
+    """The triangles `indices` over `positions` with vertices at the same float32 position merged: a
+    UV seam or a hard edge splits vertices, which is no hole (-0.0 and 0.0 are one position)."""
+    p = np.ascontiguousarray(np.asarray(positions, np.float32).reshape(-1, 3) + np.float32(0.0))  # -0.0 -> 0.0
     rows = p.view(np.dtype((np.void, 12))).reshape(-1)  # each position's 12 bytes as one sortable key
     _, first, inverse = np.unique(rows, return_index=True, return_inverse=True)
-    return p[first].astype(np.float64), inverse.reshape(-1)[np.asarray(indices, np.int64)]
+    ids = inverse.reshape(-1).astype(np.int64)
+    f = ids[np.asarray(indices, np.int64).reshape(-1, 3)]
+    return Welded(ids, first.astype(np.int64), p[first].astype(np.float64), f)
+
+
+_WELDED: dict[tuple[int, int], Welded] = {}
+
+
+def welded_mesh(mesh) -> Welded:
+    """:func:`weld` of a mesh, once per mesh version (``Mesh.version``, bumped when its geometry
+    changes)."""
+    key = (mesh.uid, mesh.version)
+    hit = _WELDED.get(key)
+    if hit is None:
+        hit = _WELDED[key] = weld(mesh.positions, mesh.indices)
+        if len(_WELDED) > 32:
+            _WELDED.pop(next(iter(_WELDED)))
+    return hit
 
 
 _REPORTS: dict[tuple[int, int], EdgeReport] = {}
@@ -70,7 +111,8 @@ def edge_report(mesh) -> EdgeReport:
     version."""
     key = (mesh.uid, mesh.version)
     if key not in _REPORTS:
-        p, f = _welded(mesh.positions, mesh.indices)
+        w = welded_mesh(mesh)
+        p, f = w.positions, w.faces
         _, counts = _undirected_edges(f)
         holes = _hole_area(p, f) if (counts == 1).any() else 0.0
         _REPORTS[key] = EdgeReport(int(counts.size), int((counts == 1).sum()), int((counts > 2).sum()), holes)

@@ -5,7 +5,7 @@ Texture-space diffusion blurs irradiance in UV space. Where the surface continue
 wraps), the blur near the seam would read the empty (or dilated) gutter instead of the light on the
 other side. ``seam_extension`` builds, once per mesh and band width, the geometry that fixes this:
 
-- seam edges: 3D edges (positions welded exactly, as atlas generators split vertices) shared by two
+- seam edges: 3D edges (positions welded exactly, as atlas generators split vertices: mesh_topology.weld) shared by two
   triangles whose UVs along the edge differ;
 - for every seam edge, seen from each side (owner triangle A, source triangle B): the similarity
   transform of the UV plane (rotation, uniform scale, translation, and a reflection when the two charts
@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .mesh import Mesh
+from .mesh_topology import welded_mesh
 
 EDGE_EPS = 1e-12  # squared UV length under which an edge is degenerate (no transform through it)
 FLAT_EPS = 1e-3  # a triangle whose UV height over the seam edge is below this x the edge is degenerate
@@ -85,12 +86,6 @@ class SeamExtension:
         return self._mesh[0]
 
 
-def weld(positions: np.ndarray) -> np.ndarray:
-    """Welded position id per vertex (exactly equal positions share one)."""
-    _, pid = np.unique(np.asarray(positions, np.float32), axis=0, return_inverse=True)
-    return pid.ravel().astype(np.int64)
-
-
 def _edge_table(f: np.ndarray, key: np.ndarray):
     """Per triangle edge (T*3): triangle, local edge k, sorted key pair."""
     t = np.repeat(np.arange(len(f)), 3)
@@ -105,7 +100,7 @@ def charts(mesh: Mesh, pid: np.ndarray | None = None) -> np.ndarray:
     from scipy.sparse.csgraph import connected_components
 
     f = mesh.indices.astype(np.int64)
-    pid = weld(mesh.positions) if pid is None else pid
+    pid = welded_mesh(mesh).ids if pid is None else pid
     key = np.concatenate([pid[:, None].astype(np.float64), mesh.uv_array("chart finding").astype(np.float64)], 1)
     _, uvid = np.unique(key, axis=0, return_inverse=True)
     t, _, lo, hi = _edge_table(f, uvid.ravel())
@@ -121,7 +116,7 @@ def border_edges(mesh: Mesh, pid: np.ndarray | None = None) -> tuple[np.ndarray,
     """(triangles, local edges k: corners k, k+1) of every chart border edge: an edge no other
     triangle shares in UV (a seam, or the mesh's own boundary)."""
     f = mesh.indices.astype(np.int64)
-    pid = weld(mesh.positions) if pid is None else pid
+    pid = welded_mesh(mesh).ids if pid is None else pid
     key = np.concatenate([pid[:, None].astype(np.float64), mesh.uv_array("chart finding").astype(np.float64)], 1)
     _, uvid = np.unique(key, axis=0, return_inverse=True)
     t, k, lo, hi = _edge_table(f, uvid.ravel())
@@ -176,7 +171,7 @@ def seam_edges(mesh: Mesh):
     """(pairs (S, 2) triangles, local edges (S, 2), endpoint position ids (S, 2), pid per vertex): every
     manifold 3D edge whose two triangles' UVs along it differ."""
     f = mesh.indices.astype(np.int64)
-    pid = weld(mesh.positions)
+    pid = welded_mesh(mesh).ids
     t, k, lo, hi = _edge_table(f, pid)
     order = np.lexsort((hi, lo))
     t, k, lo, hi = t[order], k[order], lo[order], hi[order]

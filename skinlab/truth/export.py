@@ -55,7 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from skinlab.scene.graph import LightNode, MeshNode, Scene
-from skinlab.scene.mesh_topology import edge_report
+from skinlab.scene.mesh_topology import edge_report, weld
 from skinlab.scene.optics.constants import MIN_MFP_MM
 from skinlab.scene.optics.rough_dielectric import SMOOTH_ALPHA  # below it a smooth dielectric (rough one degenerates)
 from skinlab.scene.optics.similarity import real_albedo, real_mfp
@@ -164,20 +164,11 @@ def boundary_loops(faces: np.ndarray) -> list[list[int]]:
     return loops
 
 
-def welded(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Faces re-indexed so that vertices at the same position (UV seams, sharp normals) share one
-    index: the surface's topology, for finding its holes."""
-    span = float(np.ptp(positions, axis=0).max()) or 1.0
-    q = np.round(positions.astype(np.float64) / (span * 1e-7)).astype(np.int64)
-    _, first, inv = np.unique(q, axis=0, return_index=True, return_inverse=True)
-    return first[inv.ravel()][faces].astype(np.int64)
-
-
 def close_holes(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray):
     """A watertight copy for the medium: each boundary loop of the welded surface capped by a fan
     around its centroid, wound like the rest of the mesh. Returns (positions, normals, faces, loops
     closed)."""
-    loops = boundary_loops(welded(positions, faces))
+    loops = boundary_loops(weld(positions, faces).first_faces())
     if not loops:
         return positions, normals, faces, 0
     pos, nrm, tri = [positions], [normals], [faces]

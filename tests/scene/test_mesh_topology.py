@@ -8,7 +8,7 @@ import pytest
 from skinlab.render.plan import plan_frame
 from skinlab.render.settings import RenderSettings
 from skinlab.scene.mesh import Mesh
-from skinlab.scene.mesh_topology import close_mesh, edge_report, folded_triangles, open_mesh_warning
+from skinlab.scene.mesh_topology import close_mesh, edge_report, folded_triangles, open_mesh_warning, weld, welded_mesh
 from skinlab.scene.scenefile import load_scene
 from tests.tsd_scenes import light_from, quad_mesh, slab_scene
 
@@ -41,6 +41,47 @@ def test_edge_report_counts_holes_and_non_manifold_edges():
     faces = CUBE_F.copy()
     faces[0, 0] = 8
     assert edge_report(Mesh("seam", split, faces)).closed
+
+
+def test_one_weld_one_answer_to_is_it_closed():
+    """The UV seams, the truth's hole capping and the thickness's closed test weld with
+    mesh_topology.weld: exactly equal float32 positions (-0.0 and 0.0 one), nothing merely near."""
+    from skinlab.scene.mesh_thickness import is_closed
+    from skinlab.scene.uv_seams import seam_edges
+    from skinlab.truth.export import boundary_loops
+
+    w = weld(np.array([[0, 0, 0], [-0.0, 0, 0], [1e-7, 0, 0], [1, 0, 0]], np.float32), np.array([[0, 2, 3]]))
+    assert w.ids[0] == w.ids[1] != w.ids[2] and len(w.positions) == 3 and w.first_faces().tolist() == [[0, 2, 3]]
+    # the cube with a UV seam (vertex 0 repeated as 8) is closed for all three; moved by 1e-6 it is open
+    split = np.vstack([CUBE_P, CUBE_P[:1]])
+    faces = CUBE_F.copy()
+    faces[0, 0] = 8
+    uvs = np.zeros((9, 2), np.float32)
+    uvs[8] = 1.0  # vertex 0's other chart
+    seam = Mesh("seam", split, faces, uvs=uvs)
+    gap = split.copy()
+    gap[8, 1] += 1e-6
+    torn = Mesh("torn", gap, faces, uvs=uvs)
+    for mesh, closed in ((seam, True), (torn, False)):
+        loops = boundary_loops(weld(mesh.positions, mesh.indices).first_faces())
+        assert (edge_report(mesh).closed, is_closed(mesh), loops == []) == (closed,) * 3, mesh.name
+    # the seam's two edges at vertex 0/8 are found; the torn cube's cut edges are no seam (one side each)
+    assert len(seam_edges(seam)[0]) == len(seam_edges(torn)[0]) + 2
+    # a triangle the weld collapses to a point adds no edge: still closed
+    collapsed = Mesh("collapsed", split, np.vstack([faces, [[0, 8, 0]]]))
+    assert edge_report(collapsed).closed and is_closed(collapsed)
+    point = Mesh("point", np.zeros((3, 3), np.float32), np.array([[0, 1, 2]]))  # no edge at all: not closed
+    assert not edge_report(point).closed and not is_closed(point) and "no edges" in open_mesh_warning(point, "x")
+
+
+def test_weld_is_kept_per_mesh_version():
+    mesh = Mesh("cube", CUBE_P.copy(), CUBE_F.copy())
+    first = welded_mesh(mesh)
+    assert welded_mesh(mesh) is first and len(first.positions) == 8
+    mesh.positions[1] = mesh.positions[0]  # geometry changed: the version says so
+    mesh.version += 1
+    again = welded_mesh(mesh)
+    assert again is not first and len(again.positions) == 7 and again.ids[0] == again.ids[1]
 
 
 def test_close_mesh_fills_a_hole_and_drops_doubled_triangles():
