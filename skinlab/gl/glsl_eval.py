@@ -17,6 +17,7 @@ import numpy as np
 
 from .programs import compile_program
 from .shader_source import ShaderLibrary
+from .state import gl_state
 
 _GLSL_TYPES = {1: "float", 2: "vec2", 3: "vec3", 4: "vec4"}
 _SWIZZLE = {1: "x", 2: "xy", 3: "xyz", 4: "xyzw"}
@@ -118,8 +119,8 @@ class GLSLEvaluator:
             fbo = self.ctx.framebuffer(color_attachments=[target])
             vao = self.ctx.vertex_array(prog, [(self._vbo, "2f", "in_pos")])
             fbo.use()
-            self.ctx.disable(moderngl.BLEND | moderngl.DEPTH_TEST | moderngl.CULL_FACE)
-            vao.render(moderngl.TRIANGLES)
+            with gl_state(self.ctx):  # nothing enabled: every fragment written as it is
+                vao.render(moderngl.TRIANGLES)
             out = np.frombuffer(fbo.read(components=4, dtype="f4"), np.float32).reshape(h * w, 4)
             vao.release()
             fbo.release()

@@ -258,7 +258,6 @@ class BouncePass(RenderPass):
         ctx = self.r.ctx
         prm: BounceParams = p.params
         tr = prm.transfer
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         exitance, efbo = self._target(p.resolution, "exitance")
         efbo.use()
         efbo.clear(0.0, 0.0, 0.0, 0.0)

@@ -11,6 +11,7 @@ import numpy as np
 
 from skinlab.gl.programs import ProgramCache
 from skinlab.gl.shader_source import ShaderLibrary
+from skinlab.gl.state import gl_state
 from skinlab.scene.graph import Scene
 
 from .bounce import BouncePass
@@ -177,7 +178,7 @@ class Renderer:
                     p.reused_since = since
                     continue
             record.forget(outputs)  # a run that fails half-way leaves them holding nothing known
-            with self.timer.measure(p.name):
+            with self.timer.measure(p.name), gl_state(self.ctx):  # each pass from the baseline, and back
                 impl.run(frame, p)
             if outputs:
                 record.record(outputs, key, self.frame_number)

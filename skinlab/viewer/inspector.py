@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from skinlab.gl.state import gl_state
+
 FINAL = "ldr_color"
 MODES = {"ldr": 0, "color": 1, "grey": 2, "rg": 3}
 
@@ -247,7 +249,6 @@ class Inspector:
         if mode is None:
             return False
         self.ctx.viewport = viewport
-        self.ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
         texture.use(0)
         self.sampler.use(0)
         try:
@@ -255,7 +256,8 @@ class Inspector:
             self.prog["u_mode"].value = MODES[mode]
             self.prog["u_scale"].value = float(view.scale)
             self.prog["u_offset"].value = float(view.offset)
-            self.vao.render(moderngl.TRIANGLES)
+            with gl_state(self.ctx):  # nothing enabled (the panel's drawing may have left blending on)
+                self.vao.render(moderngl.TRIANGLES)
         finally:
             self.sampler.clear(0)  # the renderer's passes rely on the textures' own state
         return True

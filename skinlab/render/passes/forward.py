@@ -12,9 +12,12 @@ the same depth, the one drawn last shows instead of the one drawn first)."""
 
 from __future__ import annotations
 
+from contextlib import ExitStack
+
 import moderngl
 import numpy as np
 
+from skinlab.gl.state import gl_state
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.alpha import bind_mask, blended, draw_order, mask_defines
 from skinlab.render.ambient import ambient_defines, bind_ambient
@@ -80,24 +83,24 @@ class ForwardPass(RenderPass):
         color, depth, fbo, extra = self.targets(p.resolution, hook.outputs)
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        ctx.enable(moderngl.DEPTH_TEST)
-        ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
         per_frame = {
             "u_view_proj": frame.view_proj,
             "u_camera_pos": frame.camera_pos,
             "u_ambient": frame.scene.environment.ambient,
         }
         prepass = frame.settings.depth_prepass
-        if prepass:
-            self.depth_prepass(frame, per_frame)
-            fbo.use()
-            ctx.depth_func, fbo.depth_mask = "<=", False
-        try:
-            self.shade(frame, prm, per_frame)
-        finally:
+        with gl_state(ctx, moderngl.DEPTH_TEST):
             if prepass:
-                ctx.depth_func, fbo.depth_mask = "<", True
-        self.background(frame, color, depth, per_frame)
+                self.depth_prepass(frame, per_frame)
+                fbo.use()
+            # after the pre-pass: each visible pixel shaded once, where its depth equals the pre-pass's
+            with gl_state(ctx, depth_func="<=" if prepass else "<"):
+                fbo.depth_mask = not prepass
+                try:
+                    self.shade(frame, prm, per_frame)
+                finally:
+                    fbo.depth_mask = True
+            self.background(frame, color, depth, per_frame)
         frame.targets["hdr_color"] = color
         frame.targets["depth"] = depth
         for name, tex in zip(hook.outputs, extra):
@@ -116,7 +119,7 @@ class ForwardPass(RenderPass):
             self._bg_fbo = (color, ctx.framebuffer([color], depth))
         fbo = self._bg_fbo[1]
         fbo.use()
-        ctx.depth_func, fbo.depth_mask = "<=", False
+        fbo.depth_mask = False
         try:
             prog = self.r.programs.get("passes/background.vert", "passes/background.frag")
             units = TextureUnits(ctx)
@@ -125,9 +128,10 @@ class ForwardPass(RenderPass):
             )
             set_uniforms(prog, {"u_inv_view_proj": np.linalg.inv(per_frame["u_view_proj"])})
             units.bind(prog, "u_env_background", data["background"])
-            self.r.fullscreen(prog)
+            with gl_state(ctx, depth_func="<="):
+                self.r.fullscreen(prog)
         finally:
-            ctx.depth_func, fbo.depth_mask = "<", True
+            fbo.depth_mask = True
 
     def depth_prepass(self, frame, per_frame) -> None:
         assert self._depth_fbo is not None  # made with the targets
@@ -150,17 +154,15 @@ class ForwardPass(RenderPass):
         fbo = self._targets[2]
         depth_mask = fbo.depth_mask
         blending = False
-        try:
+        with ExitStack() as scope:
             for node in draw_order(frame.scene.mesh_nodes(), frame.camera_pos):
-                if blended(node.material) and not blending:
-                    ctx.enable(moderngl.BLEND)
-                    ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA
+                if blended(node.material) and not blending:  # premultiplied over what is behind
+                    scope.enter_context(
+                        gl_state(ctx, enable=moderngl.BLEND, blend_func=(moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA))
+                    )
+                    scope.callback(setattr, fbo, "depth_mask", depth_mask)
                     fbo.depth_mask, blending = False, True
                 self.shade_node(frame, prm, per_frame, node)
-        finally:
-            ctx.disable(moderngl.BLEND)
-            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-            fbo.depth_mask = depth_mask
 
     def shade_node(self, frame, prm: ForwardParams, per_frame, node) -> None:
         ctx, hook, nmax = self.r.ctx, prm.hook, frame.settings.max_lights

@@ -9,6 +9,7 @@ import math
 import moderngl
 import numpy as np
 
+from skinlab.gl.state import gl_state
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.alpha import bind_mask, blended, mask_defines
 from skinlab.render.frame_plan import ShadowParams
@@ -155,19 +156,16 @@ class ShadowPass(RenderPass):
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         if dist is not None:  # "no surface": as far as it gets
             fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
-        ctx.enable(moderngl.DEPTH_TEST)
-        ctx.disable(moderngl.CULL_FACE)
-        ctx.polygon_offset = (2.0, 2.0)
-        for node in frame.scene.mesh_nodes():
-            if blended(node.material):
-                continue  # a see-through surface (alpha_mode "blend") casts no shadow
-            # a masked material's cut-away pixels cast no shadow (skinlab/render/alpha.py)
-            prog = self.r.programs.get(
-                "passes/shadow.vert", "passes/shadow.frag", {**base, **mask_defines(node.material)}
-            )
-            set_uniforms(prog, {"u_light_eye": light_eye(light)})
-            set_uniforms(prog, {"u_model": node.world_matrix, "u_light_view_proj": vp})
-            bind_mask(self.r.resources, prog, node.material, TextureUnits(ctx))
-            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
-        ctx.polygon_offset = (0.0, 0.0)
+        with gl_state(ctx, moderngl.DEPTH_TEST, polygon_offset=(2.0, 2.0)):
+            for node in frame.scene.mesh_nodes():
+                if blended(node.material):
+                    continue  # a see-through surface (alpha_mode "blend") casts no shadow
+                # a masked material's cut-away pixels cast no shadow (skinlab/render/alpha.py)
+                prog = self.r.programs.get(
+                    "passes/shadow.vert", "passes/shadow.frag", {**base, **mask_defines(node.material)}
+                )
+                set_uniforms(prog, {"u_light_eye": light_eye(light)})
+                set_uniforms(prog, {"u_model": node.world_matrix, "u_light_view_proj": vp})
+                bind_mask(self.r.resources, prog, node.material, TextureUnits(ctx))
+                self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         self.publish(frame, p)

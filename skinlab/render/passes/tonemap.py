@@ -41,7 +41,6 @@ class TonemapPass(RenderPass):
         return self._target
 
     def run(self, frame, p) -> None:
-        ctx = self.r.ctx
         n = frame.settings.supersample
         tex, fbo, hdr = self.targets(p.resolution, n > 1)
         env = frame.data.get("environment")
@@ -67,7 +66,6 @@ class TonemapPass(RenderPass):
             dispatch(cs, p.resolution)
         else:
             fbo.use()
-            ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
             self.r.fullscreen(cast(moderngl.Program, prog))
         frame.targets["ldr_color"] = tex
         if hdr is not None:

@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
@@ -46,7 +45,7 @@ class DiskPass(RenderPass):
         self._gpu.release()
 
     def run(self, frame, p) -> None:
-        ctx, prm = self.r.ctx, p.params
+        prm = p.params
         w, h = p.resolution
         filtered, out = self._gpu.at((w, h))
         ffilt, fout = self._gpu.fbos
@@ -82,7 +81,6 @@ class DiskPass(RenderPass):
             dispatch(prog, (w, h))
             publish_composite(frame, out, filtered, "disk_filtered")
             return
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         ffilt.use()
         self.r.fullscreen(prog)
         composite(self.r, frame, fout, out, filtered, "disk_filtered")

@@ -83,7 +83,6 @@ class TsdExactPass(TsdPass):
             bind_images(prog, {"u_dst": dst})
             dispatch(prog, (size, size))
         else:
-            ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
             t.fbo(ctx, dst).use()
             ctx.viewport = (0, 0, size, size)
             self.r.fullscreen(prog)

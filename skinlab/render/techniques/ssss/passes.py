@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_array, set_uniforms
@@ -37,7 +36,7 @@ class SsssBlurPass(RenderPass):
         self._gpu.release()
 
     def run(self, frame, p) -> None:
-        ctx, plan = self.r.ctx, p.params.ssss
+        plan = p.params.ssss
         w, h = p.resolution
         tmp, blurred, out = self._gpu.at((w, h))
         ftmp, fblur, fout = self._gpu.fbos
@@ -98,7 +97,6 @@ class SsssBlurPass(RenderPass):
             dispatch(vertical, (w, h))
             publish_composite(frame, out, blurred, "ssss_blurred")
             return
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
         for src, _, fbo, d, ppu in steps:
             fbo.use()
             src.use(0)

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import moderngl
 import numpy as np
 
+from skinlab.gl.state import gl_state
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
 from skinlab.render.ambient import ambient_defines, bind_ambient
 from skinlab.render.boundary import bind_boundary
@@ -104,18 +105,14 @@ class TsdNodeTargets:
             fbo.use()
             ctx.viewport = (0, 0, self.size, self.size)
             fbo.clear(depth=0.0)
-            ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
-            ctx.enable(moderngl.DEPTH_TEST)
-            ctx.depth_func = "1"  # always: every strip texel gets depth 0.5
             if len(strips):
                 prog = renderer.programs.get("passes/fullscreen.vert", "passes/depth_only.frag")
                 vbo = ctx.buffer(strips.tobytes())
                 vao = ctx.vertex_array(prog, [(vbo, "2f", "in_pos")])
-                vao.render(moderngl.TRIANGLES)
+                with gl_state(ctx, moderngl.DEPTH_TEST, depth_func="1"):  # always: every strip texel gets depth 0.5
+                    vao.render(moderngl.TRIANGLES)
                 vao.release()
                 vbo.release()
-            ctx.depth_func = "<"
-            ctx.disable(moderngl.DEPTH_TEST)
             fbo.release()
             self.strips = (strips, mask)
         return self.strips[1]
@@ -256,22 +253,17 @@ def frame_nodes(frame) -> dict:
 
 
 def _uv_raster_setup(ctx, fbo, size: int) -> None:
+    """`fbo` drawn into at `size` (the pass's scope has no depth test, culling or blending)."""
     fbo.use()
     ctx.viewport = (0, 0, size, size)
-    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
 
 
 @contextmanager
 def raster_mask(ctx, t: TsdNodeTargets, what: str, fbo):
     """Around a UV raster into `fbo` (its depth attachment t.coverage_mask(what), cleared to 1): every
     triangle writes its depth (0.5) whatever is there, so the mask marks the covered texels."""
-    ctx.enable(moderngl.DEPTH_TEST)
-    ctx.depth_func = "1"  # always: the last triangle wins, as without the mask
-    try:
+    with gl_state(ctx, enable=moderngl.DEPTH_TEST, depth_func="1"):  # always: the last triangle wins
         yield
-    finally:
-        ctx.depth_func = "<"
-        ctx.disable(moderngl.DEPTH_TEST)
     t.masks[what][1] = True
 
 
@@ -302,10 +294,8 @@ def dilate(
             if out is not src:
                 ctx.copy_framebuffer(t.fbo(ctx, out), t.fbo(ctx, src))
     prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_dilate.frag")
-    if mask is not None:
-        ctx.enable(moderngl.DEPTH_TEST)  # the fullscreen triangle's 0.5 passes "<" only where no triangle was
-        ctx.depth_func = "<"
-    try:
+    # with the mask, the fullscreen triangle's 0.5 passes "<" only where no triangle was
+    with gl_state(ctx, enable=moderngl.DEPTH_TEST if mask is not None else 0, depth_func="<"):
         for out in outs:
             fbo = t.fbo(ctx, out, depth=mask)
             fbo.depth_mask = False
@@ -315,8 +305,6 @@ def dilate(
             set_uniform(prog, "u_src", 0)
             renderer.fullscreen(prog)
             src = out
-    finally:
-        ctx.disable(moderngl.DEPTH_TEST)
 
 
 def dilate_compute(
@@ -489,20 +477,14 @@ def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | 
     fbo.depth_mask = False
     fbo.use()
     ctx.viewport = (0, 0, t.size, t.size)
-    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
     units = TextureUnits(ctx)
     for name, tex in zip(("u_raw", "u_through0", "u_through1", "u_through_cos"), (t.raw, *t.through_raw_record(ctx))):
         units.bind(prog, name, tex)
     if seams:
         units.bind(prog, "u_seam", t.seam_map(ctx).texture)
-    if mask is not None:  # only the strips (0.5 <= their depth 0.5; 0 elsewhere): an early depth test
-        ctx.enable(moderngl.DEPTH_TEST)
-        ctx.depth_func = "<="
-    try:
+    # with the mask only the strips (0.5 <= their depth 0.5; 0 elsewhere): an early depth test
+    with gl_state(ctx, enable=moderngl.DEPTH_TEST if mask is not None else 0, depth_func="<="):
         renderer.fullscreen(prog)
-    finally:
-        ctx.depth_func = "<"
-        ctx.disable(moderngl.DEPTH_TEST)
 
 
 class TsdDilatePass(TsdPass):
@@ -559,7 +541,6 @@ def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.
     prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_seam_fill.frag")
     t.fbo(ctx, dst).use()
     ctx.viewport = (0, 0, t.size, t.size)
-    ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
     src.use(0)
     t.seam_map(ctx).texture.use(1)
     set_uniforms(prog, {"u_src": 0, "u_seam": 1})
@@ -588,7 +569,6 @@ class TsdBlurPass(TsdPass):
             prog = self.r.programs.compute("techniques/tsd/blur.comp")
         else:
             prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
-            ctx.disable(moderngl.DEPTH_TEST | moderngl.CULL_FACE | moderngl.BLEND)
         taps_t, taps_w = blur_taps(step.taps)
         set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
         set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)

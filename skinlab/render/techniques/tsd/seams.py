@@ -28,6 +28,7 @@ import moderngl
 import numpy as np
 
 from skinlab.cache import content_key, stored
+from skinlab.gl.state import gl_state
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.scene.mesh import mesh_key
 from skinlab.scene.optics.constants import TSD_TAP_RANGE
@@ -131,13 +132,10 @@ class SeamMap:
         size = self.texture.size[0]
         self.fbo.use()
         self.ctx.viewport = (0, 0, size, size)
-        self.ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
-        self.ctx.enable(moderngl.DEPTH_TEST)
-        self.ctx.depth_func = "<"
         self.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         set_uniforms(prog, {"u_depth_range": float(ext.band_uv) * 2.0})
-        self.vao.render(moderngl.TRIANGLES)
-        self.ctx.disable(moderngl.DEPTH_TEST)
+        with gl_state(self.ctx, moderngl.DEPTH_TEST, depth_func="<"):
+            self.vao.render(moderngl.TRIANGLES)
 
     def release_vertices(self) -> None:
         if self.vao is not None:
