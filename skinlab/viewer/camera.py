@@ -101,9 +101,6 @@ class OrbitCamera:
         t, d, y, p = self._home
         self.target, self.distance, self.yaw, self.pitch = t.copy(), d, y, p
 
-    def set_home(self) -> None:
-        self._home = (self.target.copy(), self.distance, self.yaw, self.pitch)
-
     # -- interaction ----------------------------------------------------------------------
     def orbit(self, dx_px: float, dy_px: float) -> None:
         """Drag by (dx, dy) pixels (y up, as pyglet reports): dragging right turns the scene right."""

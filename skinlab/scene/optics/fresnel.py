@@ -46,11 +46,6 @@ def fresnel_dielectric(cos_i, eta):
     return np.where(tir, 1.0, f)
 
 
-def fresnel_transmittance(cos_i, eta):
-    """1 - F for light arriving from outside (cos_i >= 0) or leaving (cos_i < 0)."""
-    return 1.0 - fresnel_dielectric(cos_i, eta)
-
-
 def hg_phase(cos_theta, g):
     """Henyey-Greenstein phase function, cos_theta between the propagation directions before and
     after scattering (g > 0 forward). Normalised to 1 over the sphere."""

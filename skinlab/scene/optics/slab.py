@@ -50,10 +50,6 @@ def slab_mu_nodes() -> np.ndarray:
     return np.linspace(0.0, 1.0, SLAB_MU_NODES)
 
 
-def slab_log2_tau_nodes() -> np.ndarray:
-    return LOG2_TAU_MIN + 0.5 * np.arange(SLAB_TAU_NODES)
-
-
 def _doubling_steps(a: float, log2_d0: float, steps: int, mu_probe: np.ndarray):
     """Yield (tau, mu, w, t) for slabs of optical thickness 2^(log2_d0 + k), k = 0..steps: the
     cosines (Gauss-Legendre, then the probes with weight 0), their weights and the flux matrix T

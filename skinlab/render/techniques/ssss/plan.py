@@ -42,14 +42,6 @@ class SsssPlan:
     def weights(self) -> np.ndarray:
         return self.kernels[0].weights
 
-    @property
-    def range_mm(self) -> float:
-        return self.kernels[0].range_mm
-
-    @property
-    def scattering(self) -> set:
-        return set(self.profile)
-
     def table(self) -> np.ndarray:
         """(profiles, taps, 4) float32: rgb weight, a offset mm (the blur's u_table)."""
         t = np.zeros((len(self.kernels), len(self.offsets_mm), 4), np.float32)
