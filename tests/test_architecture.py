@@ -400,3 +400,15 @@ def test_citations_resolve_inside_the_repo():
                 assert anchor in sections, (f, anchor)
                 cited.add(anchor)
     assert len(cited) >= 8, cited
+
+
+def test_tools_run_as_modules_of_the_repository_without_editing_sys_path():
+    """tools/ is a package run from the repository root (``python -m tools.NAME``): no script puts
+    itself on sys.path; only full_over_plain's --code puts another checkout first, on purpose."""
+    tools = ROOT / "tools"
+    assert (tools / "__init__.py").is_file()
+    editing = sorted(p.name for p in tools.glob("*.py") if "sys.path" in p.read_text(encoding="utf-8"))
+    assert editing == ["__init__.py", "full_over_plain.py"], editing  # __init__ only says so
+    assert "if args.code:" in (tools / "full_over_plain.py").read_text(encoding="utf-8")
+    docs = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    assert not [d.name for d in docs if "python tools/" in d.read_text(encoding="utf-8")]

@@ -1,7 +1,7 @@
 """Regenerate the accuracy table of docs/accuracy.md: every profile model against the Monte Carlo
 reference (skinlab/scene/optics/montecarlo.py) for reduced albedos 0.1 .. 0.99.
 
-    .venv/bin/python tools/accuracy_table.py [--photons 200000] [--eta 1.3] [--seed 1] [--out FILE]
+    .venv/bin/python -m tools.accuracy_table [--photons 200000] [--eta 1.3] [--seed 1] [--out FILE]
 
 Set-up: semi-infinite medium, mean free path 1 (results are scale free), isotropic phase (the
 reduced coefficients), normally incident light, per photon entering (entry Fresnel excluded, as in
@@ -16,15 +16,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from skinlab.scene.optics.media import Medium  # noqa: E402
-from skinlab.scene.optics.montecarlo import simulate  # noqa: E402
-from skinlab.scene.optics.profiles import evaluate_profile, total_reflectance  # noqa: E402
+from skinlab.scene.optics.media import Medium
+from skinlab.scene.optics.montecarlo import simulate
+from skinlab.scene.optics.profiles import evaluate_profile, total_reflectance
 
 ALBEDOS = (0.1, 0.3, 0.5, 0.7, 0.8, 0.9, 0.95, 0.99)
 MODELS = ("dipole", "dipole+ss", "pbd", "burley", "blender-burley", "gaussians")

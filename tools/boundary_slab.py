@@ -3,7 +3,7 @@ material (default head-skin1: skin1 at index 1.3 under a rough dielectric, rough
 traced by Mitsuba (tiny renders, cached like every reference) against the NumPy boundary model and
 Skinlab's frame. Used for docs/ground-truth.md "The rough boundary at index 1.3".
 
-    python tools/boundary_slab.py [SCENE] [--roughness R,R,...] [--technique tsd]
+    python -m tools.boundary_slab [SCENE] [--roughness R,R,...] [--technique tsd]
 
 Rows: the slab under a uniform sky of radiance 1 seen from 0, 45 and 70 degrees (by reciprocity its
 directional albedo at that cosine, boundary reflection included: 8x8 pixels, 1024 spp), and lit by

@@ -4,7 +4,7 @@ of machine load hits both alike, every pass run (no reuse) with glFinish after e
 median process CPU time (every thread's: on software GL the rasteriser's own work, which a loaded
 machine inflates less than wall time) and, on a GPU, the median timer-query time.
 
-    .venv/bin/python tools/compute_cost.py [--scene head] [--technique tsd] [--size 640] [--rounds 5]
+    .venv/bin/python -m tools.compute_cost [--scene head] [--technique tsd] [--size 640] [--rounds 5]
                                            [--tsd-size N]
 
 Prints one line per pass: fragment, compute, compute / fragment. Passes without a compute variant run
@@ -16,9 +16,6 @@ import argparse
 import os
 import statistics
 import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
 def main(argv=None) -> int:

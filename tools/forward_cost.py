@@ -5,7 +5,7 @@ round by round so that a change of machine load hits all alike. Whole frames wit
 read-back, as the peer bench times them. The variants are measurements only (copies of shaders/
 under a temporary folder); none of them is what the renderer runs.
 
-    .venv/bin/python tools/forward_cost.py [--size 640] [--rounds 7]
+    .venv/bin/python -m tools.forward_cost [--size 640] [--rounds 7]
 
 Variants: base (as shipped), aniso1 (the maps filtered without anisotropy), no_maps (no colour or
 normal map fetches), no_prepass (RenderSettings.depth_prepass off), raster_only (the interpolated
@@ -25,8 +25,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 FWD = "passes/forward.frag"
 EDITS = {

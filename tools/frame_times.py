@@ -4,7 +4,7 @@ whatever GL the machine has, for the fragment and the compute path of every pass
 ("Measured") came from this on a lent H100 (see docs/interreflection.md for how to carry the project
 there).
 
-    python tools/frame_times.py [--size 1920x1080] [--frames 15] [--warmup-s 10] [--compute off,on]
+    python -m tools.frame_times [--size 1920x1080] [--frames 15] [--warmup-s 10] [--compute off,on]
                                 [--scenes head,bunny-skimmilk] [--techniques tsd,ssss] [--out times.json]
 
 For each scene (the head, the skim-milk bunny), setting and compute mode (`off`: fragment shaders,
@@ -26,8 +26,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 SETTINGS = (
     ("none", {"bounces": 0}),

@@ -6,7 +6,7 @@ What `skinlab bench orbit` reports as full_over_plain(_cpu), for any revision:
 ``--code DIR`` imports skinlab from DIR first (a ``git archive REV | tar -x -C DIR`` of an older
 revision), so the same measurement times the code before a change.
 
-    .venv/bin/python tools/full_over_plain.py [--frames 7] [--size 640] [--code DIR]
+    .venv/bin/python -m tools.full_over_plain [--frames 7] [--size 640] [--code DIR]
 
 Prints one JSON object: per scene the medians (cpu_ms, wall_ms) and the ratios, the load average."""
 
@@ -28,7 +28,8 @@ def main(argv=None) -> int:
     ap.add_argument("--size", type=int, default=640)
     ap.add_argument("--code", default=None, help="a folder holding the skinlab package to time")
     args = ap.parse_args(argv)
-    sys.path.insert(0, str(Path(args.code).resolve() if args.code else Path(__file__).resolve().parents[1]))
+    if args.code:  # time another checkout's package (its folder first on the path), else this one's
+        sys.path.insert(0, str(Path(args.code).resolve()))
     import skinlab
     import skinlab.render.timing as timing
     from skinlab.gl.context import create_headless_context

@@ -2,9 +2,9 @@
 the cases a 2-core CPU cannot make quiet enough (the head at its real index, docs/ground-truth.md:
 "Known hard case"). Three steps:
 
-    python tools/gpu_reference.py export SCENE.toml --size 96x96 --out DIR      # here: the description
-    python tools/gpu_reference.py render DIR/NAME.npz --spp N --out RESULT.npz  # there: numpy + Mitsuba only
-    python tools/gpu_reference.py store SCENE.toml RESULT.npz                   # here: into the cache
+    python -m tools.gpu_reference export SCENE.toml --size 96x96 --out DIR      # here: the description
+    python -m tools.gpu_reference render DIR/NAME.npz --spp N --out RESULT.npz  # there: numpy + Mitsuba only
+    python -m tools.gpu_reference store SCENE.toml RESULT.npz                   # here: into the cache
 
 ``render`` imports only skinlab/truth/description.py (no scene graph, no GL), so the GPU machine needs
 nothing but numpy and Mitsuba. ``store`` files the result under the cache key of the request it was
@@ -21,7 +21,6 @@ from pathlib import Path
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
 
 
 def _size(text: str) -> tuple[int, int]:

@@ -4,9 +4,9 @@ the variants interleaved round by round so that a change of machine load hits al
 forward pass of the same frame beside it. The variants are measurements only (copies of shaders/
 under a temporary folder); none of them is what the renderer runs.
 
-    .venv/bin/python tools/irradiance_cost.py [--size 640] [--rounds 7] [--scene PATH]
-    .venv/bin/python tools/irradiance_cost.py --coverage [--rounds 9]
-    .venv/bin/python tools/irradiance_cost.py --against 9f5625f [--rounds 7]
+    .venv/bin/python -m tools.irradiance_cost [--size 640] [--rounds 7] [--scene PATH]
+    .venv/bin/python -m tools.irradiance_cost --coverage [--rounds 9]
+    .venv/bin/python -m tools.irradiance_cost --against 9f5625f [--rounds 7]
 
 --against REV[,REV...]: the pass as shipped against the shaders/ of git revisions (the same Python
 code drives them; a revision without passes/tsd_through_fill.frag gets today's), interleaved: what a
@@ -38,8 +38,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 IRR = "passes/tsd_irradiance.frag"
 VARIANTS = {

@@ -3,7 +3,7 @@ Perry-Smith head's eye sockets, a cornea cap over each, a lash card above each u
 both), as one GLB of plain meshes (skinlab/scenes/head-eyes.toml gives each its material), and the iris
 and lash textures, procedural (seeded) PNGs.
 
-    python tools/make_face_parts.py          # rewrites skinlab/assets/face-parts/{face-parts.glb,iris.png,lashes.png}
+    python -m tools.make_face_parts          # rewrites skinlab/assets/face-parts/{face-parts.glb,iris.png,lashes.png}
 
 Geometry is in the head's own units (the scan's, 45 mm per unit: head.toml). The eye centres were
 read off the scan by casting rays along -z over the face (the lids' bulge, symmetric about the nose at
@@ -127,7 +127,6 @@ def lashes_png(w: int = 128, h: int = 32, seed: int = 7) -> np.ndarray:
 
 
 def main() -> int:
-    sys.path.insert(0, str(ROOT))
     from PIL import Image
 
     from skinlab.scene.gltf_export import export_gltf

@@ -10,7 +10,7 @@ around its centroid and cuts out (and fills again) the few places where that sti
 (skinlab/scene/mesh_topology.py ``close_mesh``); the result is watertight with consistent winding.
 
     git show 4bd519b:skinlab/assets/stanford-bunny/bunny.ply > /tmp/bunny-scan.ply   # the scan as it was
-    .venv/bin/python tools/repair_bunny.py --source /tmp/bunny-scan.ply [--out PLY]
+    .venv/bin/python -m tools.repair_bunny --source /tmp/bunny-scan.ply [--out PLY]
 
 The repaired file is what the repository ships (run on the original scan, not on its own output:
 the filled base meets the sides at a right angle, which the fold search would take for a fold).
@@ -24,10 +24,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from skinlab.atomic_write import write_text_atomic  # noqa: E402
-from skinlab.scene.mesh_topology import close_mesh  # noqa: E402
+from skinlab.atomic_write import write_text_atomic
+from skinlab.scene.mesh_topology import close_mesh
 
 BUNNY = Path(__file__).resolve().parents[1] / "skinlab" / "assets" / "stanford-bunny" / "bunny.ply"
 

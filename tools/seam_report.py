@@ -4,7 +4,7 @@ cost of the passes with seams on and off (interleaved, median of --rounds frames
 the gutter of the UV layout (how far its texels are from a chart), and with --truth the error against
 the cached 96x96 path-traced references with seams off and on (tools/truth_table.py's measure).
 
-    .venv/bin/python tools/seam_report.py [--scenes a,b] [--size 320] [--rounds 3] [--truth]
+    .venv/bin/python -m tools.seam_report [--scenes a,b] [--size 320] [--rounds 3] [--truth]
 """
 
 from __future__ import annotations
@@ -12,24 +12,20 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
+from scipy.ndimage import distance_transform_edt
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-
-from scipy.ndimage import distance_transform_edt  # noqa: E402
-
-from skinlab.bench.sweep import QUICK  # noqa: E402
-from skinlab.bench.truth_ledger import REFERENCE_SCENES, TruthSpec, load_truth  # noqa: E402
-from skinlab.gl.context import create_headless_context  # noqa: E402
-from skinlab.render.renderer import Renderer  # noqa: E402
-from skinlab.render.settings import RenderSettings  # noqa: E402
-from skinlab.render.techniques.tsd.passes import frame_nodes, read_texture  # noqa: E402
-from skinlab.scene.mesh import with_atlas  # noqa: E402
-from skinlab.scene.scenefile import load_scene  # noqa: E402
-from skinlab.scene.uv_seams import seam_extension  # noqa: E402
-from skinlab.truth.compare import image_error  # noqa: E402
+from skinlab.bench.sweep import QUICK
+from skinlab.bench.truth_ledger import REFERENCE_SCENES, TruthSpec, load_truth
+from skinlab.gl.context import create_headless_context
+from skinlab.render.renderer import Renderer
+from skinlab.render.settings import RenderSettings
+from skinlab.render.techniques.tsd.passes import frame_nodes, read_texture
+from skinlab.scene.mesh import with_atlas
+from skinlab.scene.scenefile import load_scene
+from skinlab.scene.uv_seams import seam_extension
+from skinlab.truth.compare import image_error
 
 
 def pass_key(name: str) -> str:

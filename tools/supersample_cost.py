@@ -2,7 +2,7 @@
 head frame at 640x640 with N = 1, 2, 4, interleaved rounds, every pass run each frame (reuse off);
 median frame time and the forward, tone-mapping and shadow passes, with the load average.
 
-    python tools/supersample_cost.py [ROUNDS] [FRAMES_PER_ROUND]      # default 5 3
+    python -m tools.supersample_cost [ROUNDS] [FRAMES_PER_ROUND]      # default 5 3
 
 Used for the README's timing table."""
 

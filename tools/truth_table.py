@@ -4,7 +4,7 @@
 target (8x8 blocks more than 15 % off among those the truth's noise allows to judge: over/judged,
 skinlab/truth/compare.py judged_blocks), the truth's noise.
 
-    python tools/truth_table.py [SCENES] [TECHNIQUES]      # comma-separated; default all
+    python -m tools.truth_table [SCENES] [TECHNIQUES]      # comma-separated; default all
 
 SKINLAB_SSS_MODEL=<model> overrides every material's sss_model (burley, dipole, pbd, ...).
 SKINLAB_SUPERSAMPLE=N renders the frames at N x N samples per pixel (default: the ledger's,

@@ -38,7 +38,7 @@ def test_rendered_elsewhere_stored_and_preferred_by_the_ledger(tmp_path, monkeyp
     scene.source = tmp_path / "quiet-box.toml"  # the ledger finds a scene's quiet references by its file's stem
     desc_path = tmp_path / "box.npz"
     save(describe(scene, 8, 8), desc_path)
-    tool = [sys.executable, str(ROOT / "tools" / "gpu_reference.py")]
+    tool = [sys.executable, "-m", "tools.gpu_reference"]  # from the repository root (cwd)
     res = tmp_path / "res.npz"
     run = subprocess.run(
         [*tool, "render", str(desc_path), "--spp", "8", "--passes", "2", "--variant", "scalar_rgb", "--seed", "3",
