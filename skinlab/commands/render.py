@@ -9,15 +9,14 @@ import json
 import sys
 from pathlib import Path
 
-from skinlab.commands.scene_options import add_scene_edit_options, scene_edits_from_args
-from skinlab.commands.technique_options import (
-    add_render_options,
-    add_technique_options,
-    render_options_from_args,
-    technique_from_args,
+from skinlab.commands.scene_options import (
+    add_scene_edit_options,
+    add_scene_look_options,
+    scene_edits_from_args,
+    scene_look_from_args,
 )
+from skinlab.commands.technique_options import add_frame_options, render_settings_from_args
 from skinlab.render.settings import RenderSettings, parse_size
-from skinlab.scene.materials import SSS_MODELS
 
 
 def register(sub) -> None:
@@ -35,15 +34,6 @@ def register(sub) -> None:
         "(default out/render.png)",
     )
     p.add_argument("--size", default="640x640", help="image size WIDTHxHEIGHT in pixels (default 640x640)")
-    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)")
-    add_render_options(p)  # --supersample N, from RenderSettings' declarations
-    p.add_argument(
-        "--exposure",
-        type=float,
-        default=None,
-        help="linear multiplier on radiance before tone mapping, > 0 (default: the scene's [environment] exposure, "
-        "1.0 if unset); EXR output is radiance, unaffected",
-    )
     p.add_argument(
         "--camera-orbit",
         type=float,
@@ -52,24 +42,8 @@ def register(sub) -> None:
         help="swing the scene's camera DEG degrees about the vertical axis through the meshes' centre "
         "(positive: the camera moves to its right; default 0)",
     )
-    p.add_argument(
-        "--environment",
-        metavar="MAP",
-        default=None,
-        help="light the scene with an HDR environment map: a bundled one by name (studio, city, courtyard, "
-        "interior) or an .exr/.hdr file (replaces the scene's [environment] map; a scene without one "
-        "loses its uniform ambient, as with a map in the scene file)",
-    )
-    p.add_argument("--environment-rotation", type=float, default=None, metavar="DEG", help="turn the map about +Y")
-    p.add_argument("--environment-intensity", type=float, default=None, metavar="X", help="scale the map's radiance")
-    p.add_argument("--background", action="store_true", help="draw the environment map behind the scene")
-    p.add_argument(
-        "--sss",
-        choices=SSS_MODELS,
-        default=None,
-        help="subsurface model for every material (default: each material's own sss_model)",
-    )
-    add_technique_options(p)  # an option of another technique than --technique is an error naming it
+    add_scene_look_options(p)  # --exposure, --environment MAP and its rotation, intensity, --background
+    add_frame_options(p)  # --shadow-size, --supersample, --bounces, ..., --sss, --technique and its options
     add_scene_edit_options(p)  # --preset, --set KEY=VALUE, --mm-per-unit
     p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
@@ -137,64 +111,21 @@ def render_with_progress(renderer, scene, settings, what: str, readback=True):
 
 
 def settings_from_args(args, w: int, h: int) -> RenderSettings:
-    return RenderSettings(
-        w,
-        h,
-        shadow_size=args.shadow_size,
-        sss_model=args.sss,
-        technique=technique_from_args(args),
-        **render_options_from_args(args),
-    )
-
-
-def environment_from_args(args, scene) -> None:
-    """--environment, --environment-rotation, --environment-intensity, --background on the scene."""
-    import math
-
-    from skinlab.scene.envmap import load_pixels, resolve_map
-
-    env = scene.environment
-    if args.environment is not None:
-        path = resolve_map(args.environment, Path.cwd())
-        load_pixels(path)
-        if env.map is None:
-            env.ambient = env.ambient * 0.0
-        env.map = path
-    given = [f for f in ("environment_rotation", "environment_intensity") if getattr(args, f) is not None]
-    if (given or args.background) and env.map is None:
-        flag = "--" + (given[0] if given else "background").replace("_", "-")
-        raise ValueError(f"{flag}: the scene has no environment map (give --environment MAP)")
-    if args.environment_rotation is not None:
-        if not math.isfinite(args.environment_rotation):
-            raise ValueError(
-                f"--environment-rotation: expected a finite angle in degrees, got {args.environment_rotation}"
-            )
-        env.rotation_deg = args.environment_rotation
-    if args.environment_intensity is not None:
-        if not (math.isfinite(args.environment_intensity) and args.environment_intensity >= 0):
-            raise ValueError(
-                f"--environment-intensity: expected a finite number >= 0, got {args.environment_intensity}"
-            )
-        env.intensity = args.environment_intensity
-    if args.background:
-        env.show_background = True
+    return render_settings_from_args(args, w, h)
 
 
 def run(args) -> int:
     w, h = parse_size(args.size)
     settings = settings_from_args(args, w, h)
     edits = scene_edits_from_args(args)
-    if args.exposure is not None and not (args.exposure > 0 and args.exposure < float("inf")):
-        raise ValueError(f"--exposure: expected a finite multiplier > 0, got {args.exposure}")
+    look = scene_look_from_args(args)  # --exposure, --environment ...
     if args.camera_orbit != args.camera_orbit or abs(args.camera_orbit) == float("inf"):
         raise ValueError(f"--camera-orbit: expected a finite angle in degrees, got {args.camera_orbit}")
 
     def prepare(scene):
-        if args.exposure is not None:
-            scene.environment.exposure = args.exposure
+        look(scene)
         if args.camera_orbit:
             scene.orbit_camera(args.camera_orbit)
-        environment_from_args(args, scene)
 
     scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare, args.reuse, edits)
     for warning in result.plan.warnings:

@@ -1,8 +1,13 @@
-"""The options that change a scene before it is built, shared by `skinlab render`, `skinlab reference`
-and `skinlab view`: --preset NAME, --set KEY=VALUE (repeatable), --mm-per-unit MM
-(skinlab/scene/scene_edits.py applies them to the scene file's data, so they are validated as its keys)."""
+"""The options that change a scene, shared by `skinlab render`, `skinlab reference`, `skinlab export` and
+`skinlab view`: --preset NAME, --set KEY=VALUE (repeatable), --mm-per-unit MM before it is built
+(skinlab/scene/scene_edits.py applies them to the scene file's data, so they are validated as its keys);
+and, for the commands that draw it (render, view), --exposure and the environment map's options on the
+built scene (:func:`scene_look_from_args`)."""
 
 from __future__ import annotations
+
+import math
+from pathlib import Path
 
 
 def add_scene_edit_options(p) -> None:
@@ -45,3 +50,71 @@ def scene_edits_from_args(args):
         getattr(args, "sets", None) or [],
         option="--",
     )
+
+
+def add_scene_look_options(p) -> None:
+    """--exposure, --environment MAP, --environment-rotation, --environment-intensity, --background:
+    how the built scene is lit and exposed (`skinlab render` and `skinlab view`)."""
+    p.add_argument(
+        "--exposure",
+        type=float,
+        default=None,
+        help="linear multiplier on radiance before tone mapping, > 0 (default: the scene's [environment] exposure, "
+        "1.0 if unset); EXR output is radiance, unaffected",
+    )
+    p.add_argument(
+        "--environment",
+        metavar="MAP",
+        default=None,
+        help="light the scene with an HDR environment map: a bundled one by name (studio, city, courtyard, "
+        "interior) or an .exr/.hdr file (replaces the scene's [environment] map; a scene without one "
+        "loses its uniform ambient, as with a map in the scene file)",
+    )
+    p.add_argument("--environment-rotation", type=float, default=None, metavar="DEG", help="turn the map about +Y")
+    p.add_argument("--environment-intensity", type=float, default=None, metavar="X", help="scale the map's radiance")
+    p.add_argument("--background", action="store_true", help="draw the environment map behind the scene")
+
+
+def scene_look_from_args(args):
+    """A function applying --exposure and the environment options to a built scene (errors name the
+    option); the values that need no scene are checked now, before a scene is loaded."""
+    exposure = getattr(args, "exposure", None)
+    if exposure is not None and not (exposure > 0 and exposure < float("inf")):
+        raise ValueError(f"--exposure: expected a finite multiplier > 0, got {exposure}")
+    rotation = getattr(args, "environment_rotation", None)
+    if rotation is not None and not math.isfinite(rotation):
+        raise ValueError(f"--environment-rotation: expected a finite angle in degrees, got {rotation}")
+    intensity = getattr(args, "environment_intensity", None)
+    if intensity is not None and not (math.isfinite(intensity) and intensity >= 0):
+        raise ValueError(f"--environment-intensity: expected a finite number >= 0, got {intensity}")
+
+    def apply(scene) -> None:
+        if exposure is not None:
+            scene.environment.exposure = exposure
+        environment_from_args(args, scene)
+
+    return apply
+
+
+def environment_from_args(args, scene) -> None:
+    """--environment, --environment-rotation, --environment-intensity, --background on the scene."""
+    from skinlab.scene.envmap import load_pixels, resolve_map
+
+    env = scene.environment
+    if getattr(args, "environment", None) is not None:
+        path = resolve_map(args.environment, Path.cwd())
+        load_pixels(path)
+        if env.map is None:
+            env.ambient = env.ambient * 0.0
+        env.map = path
+    background = getattr(args, "background", False)
+    given = [f for f in ("environment_rotation", "environment_intensity") if getattr(args, f, None) is not None]
+    if (given or background) and env.map is None:
+        flag = "--" + (given[0] if given else "background").replace("_", "-")
+        raise ValueError(f"{flag}: the scene has no environment map (give --environment MAP)")
+    if getattr(args, "environment_rotation", None) is not None:
+        env.rotation_deg = float(args.environment_rotation)
+    if getattr(args, "environment_intensity", None) is not None:
+        env.intensity = float(args.environment_intensity)
+    if background:
+        env.show_background = True

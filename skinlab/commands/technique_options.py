@@ -103,3 +103,36 @@ def render_options_from_args(args) -> dict:
             flag = "--" + name.replace("_", "-")
             values[name] = o.check(_parse(raw, o.kind, flag, o), flag)
     return values
+
+
+def add_frame_options(parser: argparse.ArgumentParser) -> None:
+    """The frame's settings that `skinlab render` and `skinlab view` share, each declared once here or
+    in RenderSettings: --shadow-size, the declared render settings (:func:`add_render_options`:
+    --supersample, --bounces, ...), --sss and the technique's options (:func:`add_technique_options`)."""
+    from skinlab.scene.materials import SSS_MODELS
+
+    parser.add_argument(
+        "--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)"
+    )
+    add_render_options(parser)  # --supersample N, --bounces N, ... from RenderSettings' declarations
+    parser.add_argument(
+        "--sss",
+        choices=SSS_MODELS,
+        default=None,
+        help="subsurface model for every material (default: each material's own sss_model)",
+    )
+    add_technique_options(parser)  # an option of another technique than --technique is an error naming it
+
+
+def render_settings_from_args(args, w: int, h: int):
+    """RenderSettings from the options of :func:`add_frame_options` (errors name the option)."""
+    from skinlab.render.settings import RenderSettings
+
+    return RenderSettings(
+        w,
+        h,
+        shadow_size=args.shadow_size,
+        sss_model=args.sss,
+        technique=technique_from_args(args),
+        **render_options_from_args(args),
+    )

@@ -6,8 +6,14 @@ from __future__ import annotations
 import logging
 import sys
 
-from skinlab.commands.technique_options import add_technique_options, technique_from_args
-from skinlab.render.settings import RenderSettings, parse_size
+from skinlab.commands.scene_options import (
+    add_scene_edit_options,
+    add_scene_look_options,
+    scene_edits_from_args,
+    scene_look_from_args,
+)
+from skinlab.commands.technique_options import add_frame_options, render_settings_from_args
+from skinlab.render.settings import parse_size
 
 
 def register(sub) -> None:
@@ -21,8 +27,12 @@ def register(sub) -> None:
         "a plain grey material); default: the Lee Perry-Smith head",
     )
     p.add_argument("--size", default="960x720", help="window size WIDTHxHEIGHT (default 960x720)")
-    p.add_argument("--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)")
-    add_technique_options(p)  # the technique the viewer starts with (T cycles) and its settings
+    # the frame and the scene as `skinlab render` takes them, from the same declarations: --shadow-size,
+    # --supersample, --bounces, ..., --sss, --technique (T cycles) and its settings; --exposure and the
+    # environment map; --preset, --set KEY=VALUE, --mm-per-unit (applied again on every scene reload)
+    add_frame_options(p)
+    add_scene_look_options(p)
+    add_scene_edit_options(p)
     w = p.add_mutually_exclusive_group()
     w.add_argument(
         "--watch",
@@ -51,6 +61,17 @@ def register(sub) -> None:
     p.set_defaults(func=run)
 
 
+def view_start(args, size: tuple[int, int]) -> dict:
+    """What the viewer starts from, checked (errors name the option): ``settings`` (RenderSettings of
+    the window's size), ``edits`` (SceneEdits) and ``prepare`` (--exposure, --environment ... on each
+    loaded scene): ViewerCore's and ViewerWindow's keywords of those names."""
+    return {
+        "settings": render_settings_from_args(args, *size),
+        "edits": scene_edits_from_args(args),
+        "prepare": scene_look_from_args(args),
+    }
+
+
 def run(args) -> int:
     from skinlab.image_output import image_format
 
@@ -63,8 +84,7 @@ def run(args) -> int:
         image_format(args.screenshot)  # fail before opening a window
     if not (0.0 <= args.settle <= 10.0):
         raise ValueError(f"--settle: expected seconds in [0, 10], got {args.settle}")
-    technique = technique_from_args(args)  # errors name the option
-    RenderSettings(shadow_size=args.shadow_size, technique=technique)
+    start = view_start(args, size)  # errors name the option, before a window opens
     if not logging.getLogger().handlers:
         logging.basicConfig(level=logging.INFO, stream=sys.stderr, format="skinlab view: %(message)s")
     logging.getLogger("OpenGL").setLevel(logging.WARNING)  # PyOpenGL's "no OpenGL_accelerate" notice
@@ -77,10 +97,9 @@ def run(args) -> int:
         watch=args.watch,
         screenshot_dir=args.screenshot_dir,
         shader_root=args.shader_dir,
-        shadow_size=args.shadow_size,
-        technique=technique,
         settle_s=args.settle,
         continuous=args.continuous,
         show_ui=not args.no_ui,
+        **start,
     )
     return win.run(frames=args.frames, screenshot=args.screenshot)

@@ -71,7 +71,11 @@ class ViewerCore:
         settle_s: float = 0.05,
         use_watchdog: bool = True,
         background: bool = False,
+        edits=None,
+        prepare=None,
     ):
+        """``edits`` and ``prepare``: see skinlab/viewer/watch.py scene_reloader (the command line's
+        scene options, applied on every reload)."""
         self.ctx = ctx
         self.settings = settings or RenderSettings()
         self._technique_settings: dict = {}  # technique name -> its settings when last left
@@ -80,7 +84,9 @@ class ViewerCore:
             raise FileNotFoundError(f"--shader-dir: no such folder: {library.root}")
         self.renderer = Renderer(ctx, library)
         # background: scene reloads load on a worker thread (the window's loop keeps answering)
-        self.scene_src = scene_reloader(scene_path, settle_s, watch, use_watchdog, background)  # raises on a bad file
+        self.scene_src = scene_reloader(  # raises on a bad file
+            scene_path, settle_s, watch, use_watchdog, background, edits=edits, prepare=prepare
+        )
         self.presets = preset_reloader(settle_s, watch, use_watchdog)
         self.shaders = (
             ShaderWatcher(self.renderer.programs, library.root, settle_s=settle_s, use_watchdog=use_watchdog)

@@ -215,12 +215,28 @@ def scene_files(scene) -> set[Path]:
 
 
 def scene_reloader(
-    path, settle_s: float = 0.1, watch: bool = True, use_watchdog: bool = True, background: bool = False
+    path,
+    settle_s: float = 0.1,
+    watch: bool = True,
+    use_watchdog: bool = True,
+    background: bool = False,
+    edits=None,
+    prepare=None,
 ) -> Reloadable:
+    """The scene file, reloaded when it or a file it references changes. ``edits`` (SceneEdits: the
+    command line's --preset, --set, --mm-per-unit) change its data before each build and ``prepare(scene)``
+    (--exposure, --environment ...) the built scene, on every reload as on the first load."""
     from skinlab.scene.scenefile import load_scene, resolve_scene_path
 
     path = resolve_scene_path(path)
-    return Reloadable(f"scene {path}", lambda: load_scene(path), scene_files, settle_s, watch, use_watchdog, background)
+
+    def load():
+        scene = load_scene(path, edits)
+        if prepare is not None:
+            prepare(scene)
+        return scene
+
+    return Reloadable(f"scene {path}", load, scene_files, settle_s, watch, use_watchdog, background)
 
 
 def load_presets() -> dict:

@@ -14,6 +14,7 @@ and sleeps, so an idle window costs little CPU on llvmpipe.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 import sys
@@ -64,7 +65,12 @@ class ViewerWindow:
         settle_s: float = 0.05,
         continuous: bool = False,
         show_ui: bool = True,
+        settings: RenderSettings | None = None,
+        edits=None,
+        prepare=None,
     ):
+        """``settings`` (its size follows the window) replaces ``shadow_size`` and ``technique`` when given;
+        ``edits`` and ``prepare``: the command line's scene options (skinlab/viewer/core.py ViewerCore)."""
         if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             raise ViewerError(
                 "no X display (DISPLAY is not set); on a machine without a screen run it under "
@@ -92,10 +98,20 @@ class ViewerWindow:
         from .core import ViewerCore
 
         fw, fh = self.window.get_framebuffer_size()
-        settings = RenderSettings(max(fw, 1), max(fh, 1), shadow_size=shadow_size, technique=technique)
+        if settings is None:
+            settings = RenderSettings(shadow_size=shadow_size, technique=technique)
+        settings = dataclasses.replace(settings, width=max(fw, 1), height=max(fh, 1))
         try:
             self.core = ViewerCore(
-                self.ctx, scene_path, settings, watch=watch, shader_root=shader_root, settle_s=settle_s, background=True
+                self.ctx,
+                scene_path,
+                settings,
+                watch=watch,
+                shader_root=shader_root,
+                settle_s=settle_s,
+                background=True,
+                edits=edits,
+                prepare=prepare,
             )
         except BaseException:
             self.window.close()
