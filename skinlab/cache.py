@@ -218,11 +218,14 @@ def stored(
     what: str = "",
     count_as: str | None = None,
     code: str | None = None,
+    valid: Callable[[Any], bool] | None = None,
 ) -> Any:
     """The value cached on disk as ``cache_dir()/kind/KEY.npz``, else ``compute()`` stored there.
     ``what`` names it in the warning printed when a stored file was unusable; ``count_as`` the
     name it is counted under in BUILT / LOADED (default ``kind``); ``code`` a module name whose
-    :func:`code_version` joins the key (the result depends on the code, not only on the data)."""
+    :func:`code_version` joins the key (the result depends on the code, not only on the data);
+    ``valid(value)`` False for a stored value makes it a miss, computed and stored again (a cached
+    mesh whose extracted textures were deleted)."""
     label = count_as or kind
     if code is not None:
         key = f"{key}-{code_version(code)}"
@@ -240,8 +243,9 @@ def stored(
             )
             path.unlink(missing_ok=True)
         else:
-            LOADED[label] += 1
-            return value
+            if valid is None or valid(value):
+                LOADED[label] += 1
+                return value
     BUILT[label] += 1
     with _working(what or label):
         value = compute()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -174,3 +175,32 @@ def test_parallel_map_equals_the_loop():
     assert cache.parallel_map(lambda x: np.sin(np.arange(1000.0) * x).sum(), items) == [
         np.sin(np.arange(1000.0) * x).sum() for x in items
     ]
+
+
+def test_a_cached_mesh_whose_extracted_textures_were_deleted_is_loaded_again(disk, tmp_path):
+    """Meshes are cached by the file's bytes (``meshes/``), the textures taken out of a GLB apart
+    (``gltf/``): deleting only the textures must not leave a cached mesh naming files that are gone."""
+    import shutil
+
+    from skinlab.scene import loaders
+    from tests.gltf_builder import GlbBuilder, checker
+
+    b = GlbBuilder()
+    b.quad("card", b.material(name="m", pbr={"baseColorTexture": {"index": b.image(checker(8))}}))
+    glb = b.save(tmp_path / "card.glb")
+
+    def load():
+        loaders._CACHE.clear()  # a new process: only the disk cache is left
+        return loaders.load_mesh_file(glb)[0].material.values["base_color_map"]
+
+    first = Path(load())
+    assert first.is_file() and first.parent == disk / "gltf"
+    before = dict(cache.BUILT), dict(cache.LOADED)
+    assert Path(load()) == first and cache.LOADED["meshes"] == before[1].get("meshes", 0) + 1  # a hit
+    shutil.rmtree(disk / "gltf")
+    again = Path(load())
+    assert again == first and again.is_file()  # re-extracted, same content-named file
+    assert cache.BUILT["meshes"] == before[0].get("meshes", 0) + 1  # the stale entry was a miss
+    assert Path(load()).is_file() and cache.LOADED["meshes"] == before[1].get("meshes", 0) + 2  # and a hit again
+    shutil.rmtree(disk / "gltf")  # within one process, the in-memory copy too
+    assert Path(loaders.load_mesh_file(glb)[0].material.values["base_color_map"]).is_file()

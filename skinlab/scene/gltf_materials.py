@@ -8,7 +8,8 @@ which glTF primitive each of trimesh's geometries is (trimesh names them in orde
 data URIs) are written once, named by their content, under the cache directory
 (``$SKINLAB_CACHE_DIR/gltf``) so that a material map is a file like any other; a glTF texture whose
 channels mean different things (metallicRoughness: G roughness, B metalness) is split there into the
-one-channel maps Skinlab reads (R channel).
+one-channel maps Skinlab reads (R channel). A cached load (skinlab/scene/loaders.py) naming a map that is
+no longer there (the folder was deleted) is a cache miss: the file is read again and its textures re-extracted.
 
 An extension this module does not read is named in one warning per file (the render summary and
 ``skinlab render --json`` list it) instead of being dropped silently.

@@ -42,15 +42,34 @@ def load_mesh_file(path: str | Path, warnings: list[str] | None = None) -> list[
     if path.suffix.lower() not in SUPPORTED:
         raise ValueError(f"{path}: unsupported mesh format {path.suffix!r}; expected one of {', '.join(SUPPORTED)}")
     key = (str(absolute(path)), path.stat().st_mtime)
-    if key not in _CACHE:  # on disk too, by the file's content: no trimesh import on the next start
+    # on disk too, by the file's content: no trimesh import on the next start; in memory and on disk, a load
+    # whose extracted textures were deleted since is made again
+    if key not in _CACHE or not _files_present(_CACHE[key]):
         _CACHE[key] = stored(
-            "meshes", content_key(path.suffix.lower(), path.read_bytes()), lambda: _load(path), str(path), code=__name__
+            "meshes",
+            content_key(path.suffix.lower(), path.read_bytes()),
+            lambda: _load(path),
+            str(path),
+            code=__name__,
+            valid=_files_present,  # textures taken out of the file live apart, under $SKINLAB_CACHE_DIR/gltf
         )
     # fresh Mesh objects per call would re-upload; share them (meshes are data, not mutated by the renderer)
     nodes, found = _CACHE[key]
     if warnings is not None:
         warnings.extend(w for w in found if w not in warnings)
     return nodes
+
+
+def _files_present(loaded: tuple[list[LoadedNode], list[str]]) -> bool:
+    """Whether every file a cached load refers to still exists: the textures its materials name
+    (written under $SKINLAB_CACHE_DIR/gltf, which may be deleted apart from the cached meshes)."""
+    nodes, _found = loaded
+    for n in nodes:
+        if n.material is not None:
+            for k, v in n.material.values.items():
+                if k.endswith("_map") and isinstance(v, str | Path) and not Path(v).is_file():
+                    return False
+    return True
 
 
 _OBJ_FACE = re.compile(rb"^[ \t]*f[ \t]+([^\r\n#]*)", re.M)
