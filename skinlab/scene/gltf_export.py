@@ -194,13 +194,12 @@ class _Writer:
         self.g.scenes[0].nodes.append(len(self.g.nodes) - 1)
 
     def light(self, light: LightNode) -> None:
+        """A directional, point or spot light as KHR_lights_punctual (colour, intensity, the spot's cone
+        half-angles; the node's -Z is the direction, as Skinlab's). Area lights have no glTF form: the
+        caller leaves them out (:func:`export_gltf` names them in its warning)."""
+        assert not light.is_area, light.kind
         lights = self.g.extensions.setdefault("KHR_lights_punctual", {"lights": []})["lights"]
-        if light.is_area:  # KHR_lights_punctual has no area lights
-            self.warnings.append(
-                f"light {light.name!r}: a {light.kind} area light is written as a point light with its colour and "
-                "intensity (KHR_lights_punctual has no area lights; the brightness will differ)"
-            )
-        kind = light.kind if light.kind in ("directional", "spot") else "point"
+        kind = light.kind
         colour = np.asarray(light.color, float).tolist()
         entry = {"name": light.name, "type": kind, "color": colour, "intensity": float(light.intensity)}
         if kind == "spot":
@@ -319,8 +318,23 @@ def export_gltf(scene: Scene, path: str | Path, aspect: float | None = None) -> 
     w = _Writer(scene)
     for node in scene.mesh_nodes(visible_only=True):
         w.mesh(node)
+    left_out = []
     for light in scene.lights():
-        w.light(light)
+        if light.is_area:
+            left_out.append(f"the {light.kind} light {light.name!r}")
+        else:
+            w.light(light)
+    env = scene.environment
+    if env.map is not None:
+        left_out.append(
+            f"the environment map {Path(env.map).name} (rotation {float(env.rotation_deg):g} deg, intensity "
+            f"{float(env.intensity):g}{', shown behind the scene' if env.show_background else ''})"
+        )
+    if left_out:  # one warning for all of it
+        w.warnings.append(
+            "not written, glTF has no form for them (KHR_lights_punctual holds directional, point and spot "
+            "lights only): " + ", ".join(left_out)
+        )
     if scene.camera is not None:
         w.camera(scene.camera, aspect)
     return w.save(path), w.warnings

@@ -153,6 +153,8 @@ def scene_toml(scene: Scene) -> str:
         entry |= {k: float(getattr(light, k)) for k in shape.get(light.kind, ())}
         entry |= {"color": np.asarray(light.color).tolist(), "intensity": light.intensity}
         entry["cast_shadow"] = light.cast_shadow
+        if not light.visible:  # switched off (the viewer's scene tree): kept, and off again when loaded
+            entry["visible"] = False
         lines += _table("[[lights]]", entry)
     return "\n".join(lines)
 

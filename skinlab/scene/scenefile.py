@@ -229,6 +229,7 @@ SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
             "square of the distance in metres) or emitted radiance (rect, sphere)",
         ),
         Key("cast_shadow", "boolean", "false", "render a shadow map (at most 2 lights; needed for translucency)"),
+        Key("visible", "boolean", "true", "false: the light is off, kept in the scene (the viewer's Ctrl+S writes it)"),
         Key("inner_deg", "number in [0, outer_deg]", "30", "spot: half-angle of the full beam, degrees"),
         Key(
             "outer_deg",
@@ -774,6 +775,7 @@ def _light(where: str, entry: dict, i: int) -> LightNode:
         )
     except ValueError as exc:
         raise SceneFileError(f"{where}: {exc}") from None
+    light.visible = _bool(f"{where}.visible", entry.get("visible", True))
     if "position" in own:
         if "position" not in entry:
             raise SceneFileError(f"{where}: a {kind} light needs 'position'")

@@ -188,6 +188,15 @@ def _bsdf(s: ShapeDesc, texture_file: str | None, opacity_file: str | None = Non
     return b
 
 
+# [environment] show_background has no counterpart in the truth: the reference hides the emitters (its alpha
+# is the objects' coverage, as the frame's), and so does the XML, saying how to show the map
+ENVMAP_BACKGROUND_NOTE = (
+    "    <!-- hide_emitters true: the environment map lights the scene but is not drawn behind it, as skinlab "
+    "reference renders it (alpha = coverage); set it to false to see the map behind the scene, as [environment] "
+    "show_background does in the frame -->"
+)
+
+
 def write_mitsuba_xml(desc: ReferenceDescription, folder: str | Path, spp: int = 256) -> Path:
     """``folder/scene.xml`` and its meshes and textures; returns the XML's path."""
     from skinlab.atomic_write import write_text_atomic
@@ -195,8 +204,10 @@ def write_mitsuba_xml(desc: ReferenceDescription, folder: str | Path, spp: int =
 
     folder = Path(folder)
     (folder / "meshes").mkdir(parents=True, exist_ok=True)
-    lines = ['<?xml version="1.0" encoding="utf-8"?>', "<!-- written by skinlab reference --export-xml -->",
+    lines = ['<?xml version="1.0" encoding="utf-8"?>', "<!-- written by skinlab reference (its export-xml option) -->",
              '<scene version="3.0.0">']  # fmt: skip
+    if any(e["kind"] == "envmap" for e in desc.emitters):
+        lines.append(ENVMAP_BACKGROUND_NOTE)
     lines += dict_to_xml(desc.integrator, "integrator")
     cam = np.asarray(desc.camera_to_world, np.float64)
     lines += [

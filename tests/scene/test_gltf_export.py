@@ -2,6 +2,7 @@
 camera written as KHR_lights_punctual and a perspective camera."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pygltflib
@@ -119,3 +120,90 @@ def test_the_textured_head_round_trips_with_its_colour_map(tmp_path):
     a, b = head.mesh_nodes()[0].material, back.mesh_nodes()[0].material
     same_material(a, b)
     assert np.allclose(back.mesh_nodes()[0].mesh.uvs, head.mesh_nodes()[0].mesh.uvs, atol=1e-6)
+
+
+def gltf_lights(glb) -> dict:
+    """name -> (type, colour, intensity, cone half-angles in degrees, position, direction) of the
+    KHR_lights_punctual lights in a glTF file, read back with pygltflib (Skinlab's importer reads
+    meshes and materials, not lights)."""
+    import math
+
+    g = pygltflib.GLTF2().load(str(glb))
+    defs = (g.extensions or {}).get("KHR_lights_punctual", {"lights": []})["lights"]
+    out = {}
+    for n in g.nodes:
+        ref = (n.extensions or {}).get("KHR_lights_punctual")
+        if ref is None:
+            continue
+        d = defs[ref["light"]]
+        m = np.asarray(n.matrix, np.float64).reshape(4, 4).T  # column-major
+        cone = d.get("spot", {})
+        out[d["name"]] = {
+            "type": d["type"],
+            "color": tuple(d["color"]),
+            "intensity": d["intensity"],
+            "cone_deg": tuple(
+                round(math.degrees(cone[k]), 9) for k in ("innerConeAngle", "outerConeAngle") if k in cone
+            ),
+            "position": tuple(np.round(m[:3, 3], 7)),
+            "direction": tuple(np.round(-m[:3, 2] / np.linalg.norm(m[:3, 2]), 7)),  # the node's -Z
+        }
+    return out
+
+
+def test_each_light_kind_in_the_glb_and_one_warning_for_what_glTF_cannot_hold(tmp_path):
+    """Directional, point and spot lights come back from the file with their colour, intensity, cone,
+    position and direction; rect and sphere lights and the environment map are left out, named in one
+    warning."""
+    from skinlab.scene import transform as tf
+    from skinlab.scene.envmap import bundled_maps
+    from skinlab.scene.graph import LightNode
+
+    scene = slab_scene()
+    for light in list(scene.lights()):
+        light.visible = False
+    kinds = {"far": ("directional", {}), "bulb": ("point", {}),
+             "cone": ("spot", {"inner_deg": 12.0, "outer_deg": 40.0}),
+             "panel": ("rect", {"width": 2.0, "height": 0.5}), "ball": ("sphere", {"radius": 0.3})}  # fmt: skip
+    for i, (name, (kind, shape)) in enumerate(kinds.items()):
+        light = LightNode(name, kind, color=(0.9, 0.5, 0.25 + 0.1 * i), intensity=1.5 + i, **shape)
+        light.translation = (0.5 * i, 1.0, 3.0)
+        light.rotation = tf.look_at_rotation((0, 0, 0), (0.1 * i, -0.3, -1.0))
+        scene.add(light)
+    scene.environment.map = bundled_maps()["studio"]
+    scene.environment.rotation_deg = 30.0
+    glb, warnings = export_gltf(scene, tmp_path / "lit.glb", aspect=1.0)
+    got = gltf_lights(glb)
+    assert sorted(got) == ["bulb", "cone", "far"]
+    for name, w in got.items():
+        light = scene.find(name)
+        assert w["type"] == light.kind and w["intensity"] == light.intensity
+        assert w["color"] == pytest.approx(tuple(light.color))
+        if light.kind != "directional":
+            assert w["position"] == pytest.approx(tuple(light.world_position), abs=1e-6)
+        if light.kind != "point":
+            assert w["direction"] == pytest.approx(tuple(light.direction), abs=1e-6)
+    assert got["cone"]["cone_deg"] == pytest.approx((12.0, 40.0))
+    assert len(warnings) == 1, warnings
+    (w,) = warnings
+    assert "'panel'" in w and "'ball'" in w and "rect" in w and "sphere" in w and "studio" in w and "30 deg" in w
+    for name in ("far", "bulb", "cone"):
+        assert f"'{name}'" not in w
+    # nothing left out: no warning
+    plain, none = export_gltf(slab_scene(), tmp_path / "plain.glb", aspect=1.0)
+    assert none == [] and gltf_lights(plain)
+
+
+def test_skinlab_export_prints_the_one_warning(tmp_path, capsys):
+    from skinlab.cli import main
+
+    bunny = (Path("skinlab/assets/stanford-bunny/bunny.ply")).resolve()
+    (tmp_path / "s.toml").write_text(
+        f'[environment]\nmap = "studio"\n[[meshes]]\nfile = "{bunny}"\n'
+        '[[lights]]\nname = "key"\ntype = "spot"\nposition = [0, 0, 3]\n'
+        '[[lights]]\nname = "soft"\ntype = "rect"\nposition = [0, 1, 3]\n'
+    )
+    assert main(["export", str(tmp_path / "s.toml"), "--out", str(tmp_path / "s.glb")]) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("warning: not written") and "'soft'" in err[0] and "studio" in err[0]
+    assert sorted(gltf_lights(tmp_path / "s.glb")) == ["key"]
