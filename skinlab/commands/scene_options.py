@@ -87,23 +87,30 @@ def scene_look_from_args(args):
     intensity = getattr(args, "environment_intensity", None)
     if intensity is not None and not (math.isfinite(intensity) and intensity >= 0):
         raise ValueError(f"--environment-intensity: expected a finite number >= 0, got {intensity}")
+    map_path = None
+    if getattr(args, "environment", None) is not None:  # the map is read (and checked) before any scene
+        from skinlab.scene.envmap import load_pixels, resolve_map
+
+        map_path = resolve_map(args.environment, Path.cwd())
+        load_pixels(map_path)
 
     def apply(scene) -> None:
         if exposure is not None:
             scene.environment.exposure = exposure
-        environment_from_args(args, scene)
+        environment_from_args(args, scene, map_path)
 
     return apply
 
 
-def environment_from_args(args, scene) -> None:
-    """--environment, --environment-rotation, --environment-intensity, --background on the scene."""
+def environment_from_args(args, scene, map_path: Path | None = None) -> None:
+    """--environment, --environment-rotation, --environment-intensity, --background on the scene
+    (``map_path``: --environment's map, resolved and read already)."""
     from skinlab.scene.envmap import load_pixels, resolve_map
 
     env = scene.environment
     if getattr(args, "environment", None) is not None:
-        path = resolve_map(args.environment, Path.cwd())
-        load_pixels(path)
+        path = map_path or resolve_map(args.environment, Path.cwd())
+        load_pixels(path)  # cached by the file's stamp: a changed file is read again
         if env.map is None:
             env.ambient = env.ambient * 0.0
         env.map = path

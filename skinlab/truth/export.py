@@ -414,8 +414,12 @@ def describe(
         emitters.append({"kind": "constant", "radiance": amb.tolist()})
         notes.append("ambient: a constant environment here (shadowed, seen through the medium); unshadowed in Skinlab")
     environment = _environment_emitter(scene, emitters, notes)
-    if not emitters:
-        raise ReferenceError(f"scene {scene.name!r}: no light (and no ambient): the reference would be black")
+    if not emitters:  # an all-black map (or one at intensity 0) is said, as the reason
+        black = [n for n in notes if n.startswith("environment map") and "black" in n]
+        raise ReferenceError(
+            f"scene {scene.name!r}: no light (and no ambient): the reference would be black"
+            + "".join(f"; {n}" for n in black)
+        )
     cam = scene.camera
     return ReferenceDescription(
         width=int(width),

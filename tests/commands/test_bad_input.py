@@ -113,6 +113,10 @@ def env_scene(keys: str, maps: dict | None = None) -> dict:
     return {**scene(ENV.format(keys)), **(maps or {})}
 
 
+TRUTH_COMMANDS = (
+    ("reference", ["reference", "{tmp}/s.toml", "--out", "{tmp}/out/r.exr", "--size", "8x8", "--spp", "8"]),
+    ("export-xml", ["reference", "{tmp}/s.toml", "--export-xml", "{tmp}/out/xml", "--size", "8x8"]),
+)
 # (id, files to write, argv ({tmp} = the case's folder), what stderr must contain)
 RENDER = ["render", "{tmp}/s.toml", "--out", "{tmp}/out/x.png", "--size", "8x8"]
 CASES = [
@@ -203,6 +207,43 @@ CASES = [
         ["--environment-intensity", ">= 0"],
     ),
     ("env-option-rotation-alone", scene(MESH), [*RENDER, "--environment-rotation", "30"], ["--environment-rotation"]),
+    # the same maps through --environment (skinlab render and skinlab view: read before any scene or window),
+    # and in a scene file given to skinlab reference (the truth), its --export-xml and skinlab export
+    *[
+        (f"env-{cmd}-option-{what}", {"m.exr": data}, argv + ["--environment", "{tmp}/m.exr"], ["m.exr", *said])
+        for what, data, said in (
+            ("1x1", exr(1, 1), ["1x1"]),
+            ("square", exr(16, 16), ["twice as wide"]),
+            ("nan", exr(8, 16, first=float("nan")), ["NaN"]),
+            ("inf", exr(8, 16, first=float("inf")), ["Inf"]),
+        )
+        for cmd, argv in (("render", ["render", "--out", "{tmp}/out/x.png", "--size", "8x8"]), ("view", ["view"]))
+    ],
+    ("env-view-option-missing", {}, ["view", "--environment", "{tmp}/nope.exr"], ["nope.exr", "not found"]),
+    (
+        "env-view-option-intensity",
+        {},
+        ["view", "--environment", "studio", "--environment-intensity", "-1"],
+        ["--environment-intensity", ">= 0"],
+    ),
+    *[
+        (f"env-{name}-{what}", env_scene(keys, maps), argv, ["s.toml", *said])
+        for what, keys, maps, said in (
+            ("missing", "map = 'nope.exr'", {}, ["[environment].map", "nope.exr", "not found"]),
+            ("1x1", "map = 'm.exr'", {"m.exr": exr(1, 1)}, ["[environment].map", "1x1"]),
+            ("square", "map = 'm.exr'", {"m.exr": exr(16, 16)}, ["m.exr", "twice as wide"]),
+            ("nan", "map = 'm.exr'", {"m.exr": exr(8, 16, first=float("nan"))}, ["m.exr", "NaN"]),
+            ("inf", "map = 'm.exr'", {"m.exr": exr(8, 16, first=float("inf"))}, ["m.exr", "Inf"]),
+            ("intensity", "map = 'm.exr'\nintensity = -1", {"m.exr": exr(8, 16)}, ["[environment].intensity"]),
+        )
+        for name, argv in (*TRUTH_COMMANDS, ("export-gltf", ["export", "{tmp}/s.toml", "--out", "{tmp}/out/s.glb"]))
+    ],
+    # an all-black map as the only light: the frame renders black and says so (DOCUMENTED below); the truth
+    # refuses, naming the map
+    *[
+        (f"env-{name}-black", env_scene("map = 'm.exr'", {"m.exr": exr(8, 16, 0.0)}), argv, ["no light", "m.exr"])
+        for name, argv in TRUTH_COMMANDS
+    ],
     # -- meshes --------------------------------------------------------------------------------
     (
         "ply-face-past-end",
