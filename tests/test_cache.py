@@ -190,7 +190,7 @@ def test_a_cached_mesh_whose_extracted_textures_were_deleted_is_loaded_again(dis
     glb = b.save(tmp_path / "card.glb")
 
     def load():
-        loaders._CACHE.clear()  # a new process: only the disk cache is left
+        loaders.clear_cache()  # a new process: only the disk cache is left
         return loaders.load_mesh_file(glb)[0].material.values["base_color_map"]
 
     first = Path(load())

@@ -72,6 +72,12 @@ def _files_present(loaded: tuple[list[LoadedNode], list[str]]) -> bool:
     return True
 
 
+def clear_cache() -> None:
+    """Forget the mesh files loaded in this process (the disk cache stays): the next load is a new
+    process's."""
+    _CACHE.clear()
+
+
 _OBJ_FACE = re.compile(rb"^[ \t]*f[ \t]+([^\r\n#]*)", re.M)
 
 
