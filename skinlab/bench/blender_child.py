@@ -42,6 +42,8 @@ def load_spec(path: str) -> tuple[dict, list[dict]]:
             arrays.append(
                 {k: z[f"obj{i}_{k}"] for k in ("positions", "normals", "faces", "uvs", "texture") if f"obj{i}_{k}" in z}
             )
+        if header.get("environment") is not None:
+            header["environment_pixels"] = np.asarray(z["environment"], np.float32)
     return header, arrays
 
 
@@ -125,18 +127,56 @@ def build(bpy, header: dict, arrays: list[dict]) -> None:
         ld.energy = light["strength"]
         if light["type"] == "SUN":
             ld.angle = light["angle"]
-        else:
-            ld.shadow_soft_size = 0.0
+        elif light["type"] == "AREA":
+            ld.shape = light["shape"]
+            ld.size, ld.size_y = light["size"], light["size_y"]
+        else:  # POINT (a sphere where it has a radius) and SPOT
+            ld.shadow_soft_size = light.get("radius", 0.0)
             ld.use_soft_falloff = False
+            if light["type"] == "SPOT":
+                ld.spot_size, ld.spot_blend = light["spot_size"], light["spot_blend"]
         lo = bpy.data.objects.new(light["name"], ld)
         lo.matrix_world = _matrix(light["matrix"])
+        lo.visible_camera = False  # as the truth's hidden emitters (a sphere or rect in view is not drawn)
         sc.collection.objects.link(lo)
+    sc.world = _world(bpy, header)
+
+
+def _world(bpy, header: dict):
+    """The ambient as the Background's colour; an environment map as an Environment Texture of its pixels
+    (read at the Mapping node's turn of the world direction) on a second Background, the two added."""
     world = bpy.data.worlds.new("world")
     world.use_nodes = True
-    bg = world.node_tree.nodes["Background"]
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    bg = nodes["Background"]
     bg.inputs["Color"].default_value = [*(header["world"] or [0.0, 0.0, 0.0]), 1.0]
     bg.inputs["Strength"].default_value = 1.0
-    sc.world = world
+    env = header.get("environment")
+    if env is None:
+        return world
+    px = header["environment_pixels"]
+    h, w = px.shape[:2]
+    img = bpy.data.images.new("environment", w, h, float_buffer=True)
+    img.colorspace_settings.name = "Linear Rec.709"
+    rgba = np.concatenate([px[::-1], np.ones((h, w, 1), np.float32)], axis=2)  # Blender: bottom row first
+    img.pixels.foreach_set(rgba.astype(np.float32).ravel())
+    coords = nodes.new("ShaderNodeTexCoord")  # Generated, in a world: the direction, in world axes
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.vector_type = "VECTOR"
+    mapping.inputs["Rotation"].default_value = env["rotation_euler"]
+    tex = nodes.new("ShaderNodeTexEnvironment")
+    tex.image, tex.projection, tex.interpolation = img, "EQUIRECTANGULAR", "Linear"
+    sky = nodes.new("ShaderNodeBackground")
+    sky.name = "Environment"
+    sky.inputs["Strength"].default_value = env["strength"]
+    add = nodes.new("ShaderNodeAddShader")
+    links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], tex.inputs["Vector"])
+    links.new(tex.outputs["Color"], sky.inputs["Color"])
+    links.new(bg.outputs["Background"], add.inputs[0])
+    links.new(sky.outputs["Background"], add.inputs[1])
+    links.new(add.outputs["Shader"], nodes["World Output"].inputs["Surface"])
+    return world
 
 
 def configure(bpy, header: dict, req: dict) -> None:
@@ -246,12 +286,39 @@ def readback(bpy, path: str) -> None:
                     "energy": ld.energy,
                     "color": list(ld.color),
                     "angle": getattr(ld, "angle", 0.0),
-                    "radius": ld.shadow_soft_size,
+                    "radius": getattr(ld, "shadow_soft_size", 0.0),
+                    "soft_falloff": getattr(ld, "use_soft_falloff", None),
+                    "spot_size": getattr(ld, "spot_size", None),
+                    "spot_blend": getattr(ld, "spot_blend", None),
+                    "shape": getattr(ld, "shape", None),
+                    "size": [getattr(ld, "size", 0.0), getattr(ld, "size_y", 0.0)],
+                    "visible_camera": ob.visible_camera,
                     "matrix_world": [list(r) for r in ob.matrix_world],
                 }
             )
-    bg = sc.world.node_tree.nodes["Background"]
-    info["world"] = list(bg.inputs["Color"].default_value)[:3]
+    nodes = sc.world.node_tree.nodes
+    info["world"] = list(nodes["Background"].inputs["Color"].default_value)[:3]
+    if "Environment" in nodes:
+        from mathutils import Euler
+
+        sky = nodes["Environment"]
+        tex = sky.inputs["Color"].links[0].from_node
+        mapping = tex.inputs["Vector"].links[0].from_node
+        rot = mapping.inputs["Rotation"].default_value
+        img = tex.image
+        info["environment"] = {
+            "strength": sky.inputs["Strength"].default_value,
+            "projection": tex.projection,
+            "vector_type": mapping.vector_type,
+            "coordinates": mapping.inputs["Vector"].links[0].from_socket.name,
+            "matrix": [list(r) for r in Euler(rot, "XYZ").to_matrix()],  # Blender's own Euler -> matrix
+            "size": list(img.size),
+            "colorspace": img.colorspace_settings.name,
+            "output": nodes["World Output"].inputs["Surface"].links[0].from_node.bl_idname,
+        }
+        px = np.zeros(img.size[0] * img.size[1] * 4, np.float32)
+        img.pixels.foreach_get(px)
+        arrays["environment"] = px.reshape(img.size[1], img.size[0], 4)[::-1, :, :3]  # row 0 at the top
     info["render"] = {
         "size": [sc.render.resolution_x, sc.render.resolution_y],
         "film_transparent": sc.render.film_transparent,

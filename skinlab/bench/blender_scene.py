@@ -14,7 +14,33 @@ same homogeneous medium, written as a Principled BSDF. What each Blender input i
   EEVEE, ``tests/bench/test_blender_peer.py``), angle 0 (a delta light, as Skinlab's);
 * point light: a Point of power P = 4 pi I (W) and radius 0, so that E = P / (4 pi d^2) = I / d^2
   with I the truth's intensity in the millimetre frame (Skinlab's intensity x 1000^2);
+* spot light: a Spot of the same power as that point light, P = 4 pi I (Blender states a spot's power
+  as a point light's that shines in every direction: the cone cuts light off, it does not concentrate
+  it), ``spot_size`` = 2 x the outer half-angle and ``spot_blend`` = (cos inner - cos outer) /
+  (1 - cos outer): Cycles' ``spot_light_attenuation`` is smoothstep((cos theta - cos outer) /
+  (blend (1 - cos outer))), so full light within the inner half-angle and none past the outer, as
+  Mitsuba's ``spot``; between them a smoothstep in cos theta, not Mitsuba's ramp linear in theta
+  (:func:`spot_falloffs` gives both: for the default cone, 30 and 45 degrees, they differ by up to
+  0.13 of the full light at 34 degrees and Blender's spot emits 2.2 % more power than Mitsuba's; no
+  reference scene has a spot);
+* rect light: an Area light, shape RECTANGLE, ``size`` x ``size_y`` the rect's width and height, its
+  local -Z the way it shines (one-sided, as the truth's), power P = pi A L for radiance L over area A
+  (Cycles' area light evaluates L = P / (pi A): ``eval_fac = M_1_PI_F * invarea``, light/area.h);
+* sphere light: a Point of radius r (``shadow_soft_size``, soft falloff off), power P = 4 pi^2 r^2 L
+  (a sphere of radiance L emits pi L per unit area over 4 pi r^2; Cycles' point light of radius r
+  evaluates P / (4 pi) / (pi r^2)). Not a sphere mesh with an Emission shader, which would carry the
+  radiance exactly: EEVEE takes no light from emitting meshes (only its light objects and the world),
+  and the peers must light both engines alike. The truth's sphere is also a shape that blocks light;
+  Blender's point of radius blocks none (keep it away from the objects' far side, as docs/lights.md
+  asks of the truth's);
 * ambient: the world's background colour (strength 1), hidden from the camera (film transparent);
+* environment map: the World's Environment Texture (equirectangular, linear, the map's pixels), its
+  Background's Strength the map's intensity; its vector the world direction turned by a Mapping node
+  (type VECTOR, Euler XYZ) onto Blender's axes: Cycles reads direction b at u = 0.5 - atan2(b.y, b.x) /
+  2 pi, v = acos(b.z) / pi from the top (``direction_to_equirectangular``, kernel/camera/projection.h),
+  Mitsuba and Skinlab read m at u = atan2(m.x, -m.z) / 2 pi, v = acos(m.y) / pi from the top
+  (skinlab/scene/envmap.py), so b = (m.z, m.x, m.y) with m = R_y(-rotation) w (:func:`environment_matrix`;
+  the Blender scene keeps the truth's Y-up frame, so Blender's world Z is the frame's Z);
 * a subsurface material: ``Subsurface Weight`` 1; the medium's mean free path per channel l =
   1/sigma_t' (the truth's, after its clamp) as Cycles' random walk reads it: ``Subsurface Radius``
   x ``Subsurface Scale`` = 4 pi l (Cycles' ``bssrdf_setup_radius`` multiplies by 1/(4 pi) and takes
@@ -193,6 +219,83 @@ def point_power(intensity) -> tuple[list[float], float]:
     return col, FOUR_PI * s
 
 
+def area_power(radiance, area: float) -> tuple[list[float], float]:
+    """(colour, power W) of a one-sided Area light of this RGB radiance and area: P = pi A L."""
+    col, s = sun_strength(radiance)
+    return col, math.pi * float(area) * s
+
+
+def sphere_power(radiance, radius: float) -> tuple[list[float], float]:
+    """(colour, power W) of a Point light of radius r with this RGB radiance: P = 4 pi^2 r^2 L."""
+    col, s = sun_strength(radiance)
+    return col, FOUR_PI * math.pi * float(radius) ** 2 * s
+
+
+def spot_blend(inner_deg: float, outer_deg: float) -> float:
+    """Blender's ``spot_blend`` for a cone full within `inner_deg` and dark past `outer_deg`: the
+    fraction of 1 - cos(outer) over which Cycles' smoothstep rises."""
+    co = math.cos(math.radians(outer_deg))
+    if co >= 1.0:
+        return 0.0
+    return float(min(max((math.cos(math.radians(inner_deg)) - co) / (1.0 - co), 0.0), 1.0))
+
+
+def spot_falloffs(theta_deg, inner_deg: float, outer_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """(Mitsuba's, Blender's) spot falloff at angles `theta_deg` from the axis: Mitsuba's linear in
+    the angle from outer to inner; Blender's smoothstep((cos theta - cos outer) / (blend (1 - cos outer)))."""
+    t = np.asarray(theta_deg, np.float64)
+    width = outer_deg - inner_deg
+    if width > 0:
+        mitsuba = np.clip((outer_deg - t) / width, 0.0, 1.0)
+    else:
+        mitsuba = (t <= outer_deg).astype(np.float64)
+    co = math.cos(math.radians(outer_deg))
+    blend = spot_blend(inner_deg, outer_deg)
+    x = np.cos(np.radians(t)) - co
+    if blend > 0:
+        x = np.clip(x / (blend * (1.0 - co)), 0.0, 1.0)
+        blender = x * x * (3.0 - 2.0 * x)
+    else:
+        blender = (x > 0).astype(np.float64)
+    return mitsuba, blender
+
+
+# Blender's world axes from the frame's: b = (m.z, m.x, m.y) (a cyclic permutation: a rotation)
+_MITSUBA_TO_BLENDER_ENV = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+
+def environment_matrix(rotation_deg: float) -> np.ndarray:
+    """(3, 3) M with b = M w: the direction Blender's Environment Texture must read for world
+    direction w so that it finds the texel Mitsuba's envmap (turned by rotation_deg about +Y) finds."""
+    from skinlab.scene.envmap import rotation_y
+
+    return _MITSUBA_TO_BLENDER_ENV @ rotation_y(rotation_deg).T
+
+
+def euler_xyz(m) -> list[float]:
+    """Euler angles (radians, Blender's XYZ order: R = Rz Ry Rx) of the rotation matrix m."""
+    m = np.asarray(m, np.float64)
+    sy = -float(np.clip(m[2, 0], -1.0, 1.0))
+    y = math.asin(sy)
+    if abs(sy) < 1.0 - 1e-9:
+        x = math.atan2(m[2, 1], m[2, 2])
+        z = math.atan2(m[1, 0], m[0, 0])
+    else:  # gimbal lock: put it all in x
+        z = 0.0  # then m[0, 1], m[0, 2] = sin(y) (sin x, cos x)
+        x = math.atan2(m[0, 1], m[0, 2]) if sy > 0 else math.atan2(-m[0, 1], -m[0, 2])
+    return [x, y, z]
+
+
+def euler_matrix(e) -> np.ndarray:
+    """Rz Ry Rx of Euler angles (x, y, z) (Cycles' euler_to_transform, util/transform.h)."""
+    cx, cy, cz = (math.cos(a) for a in e)
+    sx, sy, sz = (math.sin(a) for a in e)
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
 # -- the scene as data ---------------------------------------------------------------------------------------
 
 
@@ -212,10 +315,13 @@ class BlenderSpec:
     width: int
     height: int
     camera: dict  # {"matrix": 4x4 camera to world (looks down -Z, +Y up), "fov_y_deg", "clip": [near, far]}
-    lights: list[dict]  # {"name", "type": SUN | POINT, "matrix", "color", "strength", "angle"}
+    lights: list[dict]  # {"name", "type": SUN | POINT | SPOT | AREA, "matrix", "color", "strength", "angle", ...}
     world: list[float] | None  # background radiance (ambient), or None
     objects: list[BlenderObject]
     notes: list[str] = field(default_factory=list)
+    # the environment map: {"strength", "rotation_euler", "matrix"} and its pixels (H, W, 3), row 0 at the top
+    environment: dict | None = None
+    environment_pixels: np.ndarray | None = None
 
     def header(self) -> dict:
         return {
@@ -224,6 +330,7 @@ class BlenderSpec:
             "camera": self.camera,
             "lights": self.lights,
             "world": self.world,
+            "environment": self.environment,
             "notes": self.notes,
             "objects": [{"name": o.name, "material": o.material} for o in self.objects],
         }
@@ -240,6 +347,8 @@ def save_spec(spec: BlenderSpec, path: Path) -> Path:
             v = getattr(o, a)
             if v is not None:
                 arrays[f"obj{i}_{a}"] = np.ascontiguousarray(v)
+    if spec.environment_pixels is not None:
+        arrays["environment"] = np.ascontiguousarray(spec.environment_pixels, np.float32)
     with open(path, "wb") as fh:
         np.savez(fh, **arrays)
     return Path(path)
@@ -275,8 +384,27 @@ def _light(e: dict) -> dict | None:
         col, p = point_power(e["intensity"])
         return {"name": name, "type": "POINT", "matrix": _look_along([0.0, 0.0, 1.0], e["position"]),
                 "color": col, "strength": p, "angle": 0.0}  # fmt: skip
-    # spot and area lights and environment maps (issue 22) have no Blender mapping yet
-    raise ValueError(f"Blender peers: a {e['kind']} emitter ({name}) has no Blender equivalent here yet")
+    if e["kind"] == "spot":  # a Spot shines along its local -Z
+        col, p = point_power(e["intensity"])
+        return {"name": name, "type": "SPOT", "matrix": _look_along(-np.asarray(e["direction"]), e["position"]),
+                "color": col, "strength": p, "angle": 0.0, "spot_size": math.radians(2.0 * e["cutoff_deg"]),
+                "spot_blend": spot_blend(e["beam_deg"], e["cutoff_deg"])}  # fmt: skip
+    if e["kind"] == "sphere":
+        col, p = sphere_power(e["radiance"], e["radius"])
+        return {"name": name, "type": "POINT", "matrix": _look_along([0.0, 0.0, 1.0], e["centre"]),
+                "color": col, "strength": p, "angle": 0.0, "radius": float(e["radius"])}  # fmt: skip
+    if e["kind"] == "rect":  # an Area light: size along its local X, size_y along Y, shining along -Z
+        ex, ey, n = (np.asarray(e[k], np.float64) for k in ("ex", "ey", "normal"))
+        n = n / np.linalg.norm(n)
+        if np.dot(np.cross(ex, ey), n) > 0:  # right-handed with local Z = -n
+            ey = -ey
+        wx, wy = 2.0 * float(np.linalg.norm(ex)), 2.0 * float(np.linalg.norm(ey))
+        m = np.eye(4)
+        m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = ex / np.linalg.norm(ex), ey / np.linalg.norm(ey), -n, e["centre"]
+        col, p = area_power(e["radiance"], wx * wy)
+        return {"name": name, "type": "AREA", "matrix": m.tolist(), "color": col, "strength": p, "angle": 0.0,
+                "shape": "RECTANGLE", "size": wx, "size_y": wy}  # fmt: skip
+    raise ValueError(f"Blender peers: a {e['kind']} emitter ({name}) has no Blender equivalent")
 
 
 def subsurface_inputs(interior: dict, values: dict) -> tuple[dict, dict, list[str]]:
@@ -366,11 +494,22 @@ def blender_spec(scene, width: int, height: int, sun_deg: float = 0.0) -> Blende
             BlenderObject(s.name, s.positions, s.normals, np.asarray(s.faces, np.uint32),
                           None if uvs is None else uvs.astype(np.float32), mat, s.texture)
         )  # fmt: skip
-    lights, world = [], None
+    lights, world, env = [], None, None
     for e in desc.emitters:
         if e["kind"] == "constant":
             world = [float(x) for x in e["radiance"]]
+        elif e["kind"] == "envmap":
+            m = environment_matrix(e["rotation_deg"])
+            env = {"strength": float(e["scale"]), "rotation_euler": euler_xyz(m), "matrix": m.tolist()}
         else:
             lights.append(_light(e))
+    if any(e["kind"] == "sphere" for e in desc.emitters):
+        notes.append("sphere lights: Blender point lights of that radius, blocking no light (the truth's spheres do)")
+    if any(e["kind"] == "spot" for e in desc.emitters):
+        notes.append("spot lights: Blender's blend is a smoothstep in cos theta between the cone angles, Mitsuba's "
+                     "a ramp linear in theta")  # fmt: skip
     camera = {"matrix": _blender_camera(desc), "fov_y_deg": desc.fov_y_deg, "clip": [desc.near, desc.far]}
-    return BlenderSpec(int(width), int(height), camera, lights, world, objects, [*desc.notes, *notes])
+    return BlenderSpec(
+        int(width), int(height), camera, lights, world, objects, [*desc.notes, *notes],
+        env, None if env is None else np.asarray(desc.environment, np.float32),
+    )  # fmt: skip

@@ -67,6 +67,118 @@ def test_light_units():
     assert bs.sun_strength([0.0, 0.0, 0.0]) == ([1.0, 1.0, 1.0], 0.0)
 
 
+def place(light, position, direction):
+    from skinlab.scene import transform as tf
+
+    light.translation = position
+    light.rotation = tf.look_at_rotation(np.zeros(3), np.asarray(direction, np.float64))
+    return light
+
+
+def lit_scene(*lights, env=None) -> Scene:
+    """A 1 m Lambertian plate (albedo 0.5, no specular) in z = 0 seen straight down through a 1 degree
+    camera from 2 m, lit by `lights` (and `env`: (map path, rotation_deg, intensity)); metres."""
+    grey = Material("grey", {"base_color": (0.5, 0.5, 0.5), "specular": 0.0, "roughness": 1.0, "subsurface": 0.0})
+    s = Scene("plate", 1000.0)
+    s.environment.ambient = np.zeros(3)
+    if env is not None:
+        s.environment.map, s.environment.rotation_deg, s.environment.intensity = env
+    s.add(MeshNode("plate", box_mesh((1.0, 1.0, 0.01)), grey, translation=(0.0, 0.0, -0.005)))
+    for light in lights:
+        s.add(light)
+    cam = CameraNode("cam", yfov=math.radians(1.0), znear=0.1, zfar=10.0)
+    cam.look_at((0.0, 0.0, 2.0), (0.0, 0.0, 0.0))
+    s.add(cam)
+    return s
+
+
+def new_lights():
+    from skinlab.scene.graph import LightNode
+
+    return (
+        place(LightNode("spot", "spot", intensity=3.0, inner_deg=20.0, outer_deg=40.0), (0.1, 0, 0.5), (0.1, 0, -1)),
+        place(LightNode("ball", "sphere", intensity=2.0, radius=0.1), (-0.2, 0.1, 0.6), (0.0, 0.0, -1.0)),
+        place(LightNode("box", "rect", intensity=4.0, width=0.4, height=0.2), (0.0, -0.3, 0.5), (0.0, 0.5, -1.0)),
+    )
+
+
+def test_spot_rect_sphere_and_environment_map():
+    """Spot, rect and sphere lights and the environment map in the Blender spec: a spot of the point
+    light's power, cone 2 x outer, the blend that puts Blender's smoothstep between the inner and outer
+    half-angles; a rect as an Area light of power pi A L with its extents and the way it shines; a sphere
+    as a point of that radius with power 4 pi^2 r^2 L; the map's pixels, intensity and the turn onto
+    Blender's equirectangular axes."""
+    from skinlab.scene import envmap
+
+    spot, ball, box = new_lights()
+    desc = describe(lit_scene(spot, ball, box), 8, 8)
+    spec = bs.blender_spec(lit_scene(spot, ball, box), 8, 8)
+    es = {e["light"]: e for e in desc.emitters}
+    ls = {light["name"]: light for light in spec.lights}
+    sp = ls["spot"]
+    assert sp["type"] == "SPOT" and sp["strength"] == pytest.approx(4 * math.pi * 3.0e6)
+    assert sp["spot_size"] == pytest.approx(math.radians(80.0))
+    m = np.asarray(sp["matrix"])
+    np.testing.assert_allclose(-m[:3, 2], spot.direction, atol=1e-12)  # a Spot shines along its -Z
+    np.testing.assert_allclose(m[:3, 3], es["spot"]["position"], atol=1e-9)
+    mit, ble = bs.spot_falloffs([0.0, 19.9, 20.0, 30.0, 40.0, 40.1, 80.0], 20.0, 40.0)
+    np.testing.assert_allclose(ble[[0, 1, 2, 4, 5, 6]], [1, 1, 1, 0, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(mit, [1, 1, 1, 0.5, 0, 0, 0], atol=1e-12)
+    assert 0 < ble[3] < 1 and abs(ble[3] - mit[3]) > 0.01  # the two ramps differ between the cone angles
+    # Blender's smoothstep is 1/2 where cos theta is halfway between cos inner and cos outer
+    half = math.degrees(math.acos((math.cos(math.radians(20)) + math.cos(math.radians(40))) / 2))
+    assert bs.spot_falloffs([half], 20.0, 40.0)[1][0] == pytest.approx(0.5)
+    assert bs.spot_blend(40.0, 40.0) == 0 and bs.spot_blend(0.0, 40.0) == 1
+    b = ls["ball"]
+    assert b["type"] == "POINT" and b["radius"] == pytest.approx(100.0)
+    assert b["strength"] == pytest.approx(4 * math.pi**2 * 100.0**2 * 2.0)
+    np.testing.assert_allclose(np.asarray(b["matrix"])[:3, 3], es["ball"]["centre"])
+    r = ls["box"]
+    assert r["type"] == "AREA" and r["shape"] == "RECTANGLE" and (r["size"], r["size_y"]) == pytest.approx((400, 200))
+    assert r["strength"] == pytest.approx(math.pi * 400 * 200 * 4.0)
+    m = np.asarray(r["matrix"])
+    np.testing.assert_allclose(m[:3, :3].T @ m[:3, :3], np.eye(3), atol=1e-12)
+    assert np.linalg.det(m[:3, :3]) == pytest.approx(1.0)
+    np.testing.assert_allclose(-m[:3, 2], box.direction, atol=1e-12)
+    ex, ey = box.half_extents()
+    assert abs(m[:3, 0] @ ex) == pytest.approx(200.0 / 1000) and abs(m[:3, 1] @ ey) == pytest.approx(100.0 / 1000)
+    assert spec.environment is None and any("sphere lights" in n for n in spec.notes)
+    # the map: b = M w reads, in Blender's convention, the texel Mitsuba's envmap reads for w
+    rng = np.random.default_rng(3)
+    w = rng.normal(size=(64, 3))
+    w /= np.linalg.norm(w, axis=1, keepdims=True)
+    for rot in (0.0, 37.0, -120.0):
+        mm = bs.environment_matrix(rot)
+        bv = w @ mm.T
+        u_b, v_b = 0.5 - np.arctan2(bv[:, 1], bv[:, 0]) / (2 * math.pi), np.arccos(bv[:, 2]) / math.pi
+        mv = w @ envmap.rotation_y(rot)  # R_y(-rot) w
+        u_m, v_m = np.arctan2(mv[:, 0], -mv[:, 2]) / (2 * math.pi), np.arccos(mv[:, 1]) / math.pi
+        np.testing.assert_allclose(np.mod(u_b - u_m + 0.5, 1.0) - 0.5, 0, atol=1e-12)
+        np.testing.assert_allclose(v_b, v_m, atol=1e-12)
+        np.testing.assert_allclose(bs.euler_matrix(bs.euler_xyz(mm)), mm, atol=1e-12)
+    for k in range(20):  # the Euler decomposition, also near gimbal lock
+        e = rng.uniform(-3, 3, 3) if k < 18 else [0.4, (-1) ** k * math.pi / 2, 0.0]
+        np.testing.assert_allclose(bs.euler_matrix(bs.euler_xyz(bs.euler_matrix(e))), bs.euler_matrix(e), atol=1e-9)
+
+
+def environment_map(tmp_path, texel=None, value=1.0):
+    """A 32 x 16 map: uniform `value`, or black but for one texel (row, column) of `value`."""
+    from skinlab.scene import envmap
+
+    img = np.full((16, 32, 3), 0.0 if texel else value, np.float32)
+    if texel:
+        img[texel] = value
+    return envmap.write_map(tmp_path / f"env-{texel}.exr", img)
+
+
+def test_environment_map_in_the_spec(tmp_path):
+    spec = bs.blender_spec(lit_scene(env=(environment_map(tmp_path, (3, 16), 50.0), 90.0, 1.5)), 8, 8)
+    assert spec.environment["strength"] == 1.5 and spec.world is None
+    np.testing.assert_allclose(spec.environment["matrix"], bs.environment_matrix(90.0))
+    assert spec.environment_pixels.shape == (16, 32, 3) and spec.environment_pixels[3, 16, 0] == 50.0
+    assert spec.environment_pixels.sum() == pytest.approx(150.0)
+
+
 def test_spec_is_the_truths_scene():
     """The Blender spec of a reference scene holds the truth's geometry, camera, light and medium:
     Base Color maps back to the medium's albedo through Cycles' remap, Radius x Scale / 4 pi is the mean
@@ -166,6 +278,119 @@ def test_bpy_holds_the_mapped_scene(blender):
     assert info["render"]["size"] == [24, 16] and info["render"]["film_transparent"]
 
 
+def test_bpy_holds_the_new_lights_and_the_environment(blender, tmp_path):
+    """Spot, area and sphere lights and the World's environment texture read back from bpy: types,
+    powers, cones, sizes, placements; the Mapping node's rotation, turned into a matrix by Blender's own
+    Euler, is the spec's; the image holds the map's pixels; nothing rendered."""
+    env = (environment_map(tmp_path, (3, 16), 50.0), 90.0, 1.5)
+    spec = bs.blender_spec(lit_scene(*new_lights(), env=env), 8, 8)
+    blender.load(spec)
+    info, arr = blender.readback()
+    got = {light["name"]: light for light in info["lights"]}
+    for want in spec.lights:
+        g = got[want["name"]]
+        assert g["type"] == want["type"] and g["energy"] == pytest.approx(want["strength"], rel=1e-6)
+        np.testing.assert_allclose(g["color"], want["color"], atol=1e-6)
+        np.testing.assert_allclose(g["matrix_world"], want["matrix"], atol=1e-4)
+        assert g["visible_camera"] is False
+    assert got["spot"]["spot_size"] == pytest.approx(spec.lights[0]["spot_size"], rel=1e-6)
+    assert got["spot"]["spot_blend"] == pytest.approx(spec.lights[0]["spot_blend"], rel=1e-6)
+    assert got["spot"]["radius"] == 0 and got["spot"]["soft_falloff"] is False
+    assert got["ball"]["radius"] == pytest.approx(100.0) and got["ball"]["soft_falloff"] is False
+    assert got["box"]["shape"] == "RECTANGLE" and got["box"]["size"] == pytest.approx([400.0, 200.0])
+    e = info["environment"]
+    assert e["strength"] == pytest.approx(1.5) and e["projection"] == "EQUIRECTANGULAR"
+    assert e["vector_type"] == "VECTOR" and e["coordinates"] == "Generated" and e["output"] == "ShaderNodeAddShader"
+    assert e["size"] == [32, 16] and e["colorspace"] == "Linear Rec.709"
+    np.testing.assert_allclose(e["matrix"], spec.environment["matrix"], atol=1e-6)
+    np.testing.assert_array_equal(arr["environment"], spec.environment_pixels)
+
+
+def plate_reading(blender, scene, spp=16, engine="cycles"):
+    """The plate's centre (the 2 x 2 middle pixels of 4 x 4) in `engine`; scene None: the one loaded."""
+    if scene is not None:
+        blender.load(bs.blender_spec(scene, 4, 4))
+    img, _ = blender.render(engine, spp if engine == "cycles" else 1, (4, 4))
+    return img[1:3, 1:3, :3].reshape(-1, 3).mean(0)
+
+
+def test_new_light_units_on_a_lambertian_plate(blender, tmp_path):
+    """The plate's centre read by Cycles under each new kind, against its irradiance E: 0.5 E / pi.
+    A spot of intensity 3 straight above at 0.5 m: E = 3 / 0.25; tilted to where Blender's smoothstep is
+    at half (cos theta halfway between the cone's cosines): half that. A sphere of radiance 2 and radius
+    0.1 m at 0.5 m: E = pi L (r / d)^2. A rect of radiance 3, 0.4 x 0.2 m, 0.5 m above and facing the
+    plate: E from Lambert's polygon formula (skinlab/scene/optics/lighting.py). The lights hang between
+    the camera and the plate: hidden from the camera, as the truth's emitters are. A uniform map of
+    radiance 0.8 at intensity 1.5: E = pi 0.8 1.5."""
+    from skinlab.scene.graph import LightNode
+    from skinlab.scene.optics.lighting import rect_vector_irradiance
+
+    half = math.acos((math.cos(math.radians(20)) + math.cos(math.radians(40))) / 2)
+    rect = place(LightNode("box", "rect", intensity=3.0, width=0.4, height=0.2), (0.0, 0.0, 0.5), (0, 0, -1))
+    ex, ey = rect.half_extents()
+    e_rect = float(rect_vector_irradiance((0, 0, 0.5), ex, ey, rect.direction, [[0.0, 0.0, 0.0]])[0, 2]) * 3.0
+    cases = (
+        (place(LightNode("spot", "spot", intensity=3.0, inner_deg=20.0, outer_deg=40.0), (0, 0, 0.5), (0, 0, -1)),
+         None, 12.0, 2e-3),
+        (place(LightNode("spot", "spot", intensity=3.0, inner_deg=20.0, outer_deg=40.0), (0, 0, 0.5),
+               (math.sin(half), 0.0, -math.cos(half))), None, 6.0, 2e-3),
+        (place(LightNode("ball", "sphere", intensity=2.0, radius=0.1), (0, 0, 0.5), (0, 0, -1)), None,
+         math.pi * 2.0 * (0.1 / 0.5) ** 2, 0.02),
+        (rect, None, e_rect, 0.02),
+        (None, (environment_map(tmp_path, value=0.8), 30.0, 1.5), math.pi * 0.8 * 1.5, 0.02),
+    )  # fmt: skip
+    eevee = {}
+    for light, env, e, tol in cases:
+        name = light.kind if light else "environment"
+        got = plate_reading(blender, lit_scene(*([light] if light else []), env=env), spp=64)
+        np.testing.assert_allclose(got, 0.5 * e / math.pi, rtol=tol, err_msg=name)
+        eevee[name] = plate_reading(blender, None, engine="eevee")[0] / (0.5 * e / math.pi)
+    # EEVEE (1 sample) on the same plates: the spot and the map as Cycles reads them; the rect and the sphere
+    # about a fifth darker (measured 0.79 and 0.81 of the exact irradiance; the same with their shadows off)
+    assert abs(eevee["spot"] - 1) < 0.01 and abs(eevee["environment"] - 1) < 0.02, eevee
+    assert 0.7 < eevee["rect"] < 0.9 and 0.7 < eevee["sphere"] < 0.9, eevee
+
+
+def test_environment_orientation_in_cycles(blender, tmp_path):
+    """A black map with one bright texel up and toward the map's +Z (row 3 of 16, column 16 of 32),
+    turned 90 degrees about +Y: by Mitsuba's convention (skinlab/scene/envmap.py) its light comes from
+    world l = R_y(90) m, up and toward +X. Cycles' grey sphere seen from +Z (image +X right, +Y up) shares
+    its light among the image's quadrants as a Lambertian sphere lit from l does (orthographic, a point
+    source at the texel's centre: 0.68, 0.19, 0.12, 0.00 upper right, upper left, lower right, lower
+    left; measured 0.676, 0.195, 0.130, 0.0001), and so does EEVEE's. A mirrored u, a flipped v or the
+    turn's sign would light another quadrant."""
+    from skinlab.scene import envmap
+    from skinlab.scene.primitives import sphere_mesh
+
+    grey = Material("grey", {"base_color": (0.5, 0.5, 0.5), "specular": 0.0, "roughness": 1.0, "subsurface": 0.0})
+    s = Scene("ball", 1000.0)
+    s.environment.ambient = np.zeros(3)
+    s.environment.map, s.environment.rotation_deg = environment_map(tmp_path, (3, 16), 2000.0), 90.0
+    s.add(MeshNode("ball", sphere_mesh(0.1, 3), grey))
+    cam = CameraNode("cam", yfov=math.radians(8.0), znear=0.1, zfar=10.0)
+    cam.look_at((0.0, 0.0, 2.0), (0.0, 0.0, 0.0))
+    s.add(cam)
+    blender.load(bs.blender_spec(s, 16, 16))
+
+    def shares(lum):  # row 0 at the top
+        h = lum.shape[0] // 2
+        q = np.array([lum[:h, h:].mean(), lum[:h, :h].mean(), lum[h:, h:].mean(), lum[h:, :h].mean()])
+        return q / q.sum()
+
+    theta, phi = 3.5 / 16 * math.pi, 16.5 / 32 * 2 * math.pi  # the texel's centre: v = theta / pi, u = phi / 2 pi
+    m = np.array([math.sin(theta) * math.sin(phi), math.cos(theta), -math.sin(theta) * math.cos(phi)])
+    lx, ly, lz = envmap.rotation_y(90.0) @ m
+    n = 256
+    y, x = np.mgrid[0:n, 0:n]
+    x, y = (x + 0.5) / n * 2 - 1, 1 - (y + 0.5) / n * 2
+    z = np.sqrt(np.clip(1 - x * x - y * y, 0, 1))
+    want = shares(np.where(x * x + y * y < 1, np.clip(x * lx + y * ly + z * lz, 0, None), 0.0))
+    assert want[0] > 0.6 and want[3] < 0.01
+    for engine, spp in (("cycles", 16), ("eevee", 1)):  # EEVEE reads the same map the same way (0.678, 0.192, ...)
+        img, _ = blender.render(engine, spp, (16, 16))
+        np.testing.assert_allclose(shares(img[..., :3].mean(2)), want, atol=0.03, err_msg=engine)
+
+
 def test_cycles_random_walk_slab_reflects_chandrasekhars_albedo(blender):
     """Cycles' random walk at an index-matched boundary continues the camera ray into the medium and
     leaves through a Lambertian exit: under a uniform sky of radiance 1 it reads, by reciprocity,
@@ -195,20 +420,10 @@ def test_light_units_on_a_lambertian_plate(blender):
     units: the frame is in millimetres, the power 4 pi I 1000^2)."""
     from skinlab.scene.graph import LightNode
 
-    grey = Material("grey", {"base_color": (0.5, 0.5, 0.5), "specular": 0.0, "roughness": 1.0, "subsurface": 0.0})
-    cam = CameraNode("cam", yfov=math.radians(1.0), znear=0.1, zfar=10.0)
-    cam.look_at((0.0, 0.0, 2.0), (0.0, 0.0, 0.0))
     sun = light_from((0.0, math.sin(math.radians(60)), -math.cos(math.radians(60))), intensity=2.0)
     bulb = LightNode("bulb", "point", intensity=3.0, translation=(0.0, 0.0, 0.5))
     for light, want, tol in ((sun, 0.5 * 2.0 * 0.5 / math.pi, 2e-3), (bulb, 0.5 * 3.0 / 0.5**2 / math.pi, 5e-3)):
-        s = Scene("plate", 1000.0)
-        s.environment.ambient = np.zeros(3)
-        s.add(MeshNode("plate", box_mesh((1.0, 1.0, 0.01)), grey, translation=(0.0, 0.0, -0.005)))
-        s.add(light)
-        s.add(cam)
-        blender.load(bs.blender_spec(s, 4, 4))
-        img, _ = blender.render("cycles", 16, (4, 4))
-        np.testing.assert_allclose(img[1:3, 1:3, :3], want, rtol=tol, err_msg=light.kind)
+        np.testing.assert_allclose(plate_reading(blender, lit_scene(light)), want, rtol=tol, err_msg=light.kind)
 
 
 def test_eevee_frame_with_subsurface_scattering(blender):
