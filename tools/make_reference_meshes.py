@@ -1,4 +1,5 @@
-"""Write the slab meshes of the reference scenes (skinlab/assets/meshes/*.obj): `python -m tools.make_reference_meshes`.
+"""Write the slab and occluder meshes of the reference scenes (skinlab/assets/meshes/*.obj):
+`python -m tools.make_reference_meshes`.
 Sizes in millimetres (the scenes say mm_per_unit = 1)."""
 
 from pathlib import Path
@@ -10,6 +11,13 @@ MESHES = {
     "slab-160x160x40.obj": (160.0, 160.0, 40.0),  # a thick slab: a shadow edge on its top face
     "plate-400x200x4.obj": (400.0, 200.0, 4.0),  # the occluder casting the edge
     "slab-60x60x3.obj": (60.0, 60.0, 3.0),  # a thin slab lit from behind: translucency
+    # the slit scenes' mask: two black plates side by side with a gap between them, high above the
+    # slab and out of the camera's view (skinlab/assets/scenes/reference/slit-*.toml)
+    "plate-200x300x4.obj": (200.0, 300.0, 4.0),
+    # marble's diffusion reaches 30-50 mm: a wider, deeper slab for its slit
+    "slab-200x200x100.obj": (200.0, 200.0, 100.0),
+    # the back slab of the two back-lit slabs with an air gap (wider than the front one, 60 x 60 x 3)
+    "slab-100x100x3.obj": (100.0, 100.0, 3.0),
 }
 
 if __name__ == "__main__":
