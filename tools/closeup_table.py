@@ -219,7 +219,7 @@ def main(argv: list[str]) -> int:
         out = argv[k + 1]
         argv = argv[:k] + argv[k + 2 :]
     scenes = argv[0].split(",") if argv and argv[0] else list(CLOSEUPS)
-    techs = argv[1].split(",") if len(argv) > 1 else TECHNIQUES
+    techs = argv[1].split(",") if len(argv) > 1 and argv[1] else TECHNIQUES
     extra = {}
     if os.environ.get("SKINLAB_BOUNCES"):
         extra["bounces"] = int(os.environ["SKINLAB_BOUNCES"])

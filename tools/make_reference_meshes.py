@@ -11,11 +11,13 @@ MESHES = {
     "slab-160x160x40.obj": (160.0, 160.0, 40.0),  # a thick slab: a shadow edge on its top face
     "plate-400x200x4.obj": (400.0, 200.0, 4.0),  # the occluder casting the edge
     "slab-60x60x3.obj": (60.0, 60.0, 3.0),  # a thin slab lit from behind: translucency
-    # the slit scenes' mask: two black plates side by side with a gap between them, high above the
-    # slab and out of the camera's view (skinlab/assets/scenes/reference/slit-*.toml)
-    "plate-200x300x4.obj": (200.0, 300.0, 4.0),
-    # marble's diffusion reaches 30-50 mm: a wider, deeper slab for its slit
-    "slab-200x200x100.obj": (200.0, 200.0, 100.0),
+    # the slit scenes (skinlab/assets/scenes/reference/slit-*.toml): a slab and, high above it and out
+    # of the camera's view, two black plates side by side with the slit between them; all no larger
+    # than they must be, so that the shadow map's texels across the slit are small (0.04-0.06 mm)
+    "slab-80x80x40.obj": (80.0, 80.0, 40.0),
+    "plate-41x124x2.obj": (41.0, 124.0, 2.0),
+    "slab-120x120x60.obj": (120.0, 120.0, 60.0),
+    "plate-61x184x2.obj": (61.0, 184.0, 2.0),
     # the back slab of the two back-lit slabs with an air gap (wider than the front one, 60 x 60 x 3)
     "slab-100x100x3.obj": (100.0, 100.0, 3.0),
 }
