@@ -93,7 +93,7 @@ def _energy_radius(profile_fn, fraction):
 TAIL_FRACTIONS = (0.9, 0.99, 0.999, 0.9999)  # fit_gaussians(tail_weight > 0): the energy kept beyond these
 
 
-def _tail_energies(profile_fn, fractions=TAIL_FRACTIONS) -> tuple[np.ndarray, np.ndarray]:
+def tail_energies(profile_fn, fractions=TAIL_FRACTIONS) -> tuple[np.ndarray, np.ndarray]:
     """(radii (T,), energy beyond each (T, C)): the radii holding `fractions` of every channel's
     energy (the widest channel's, _energy_radius) and each channel's energy (int R 2 pi r dr)
     beyond them."""
@@ -155,7 +155,7 @@ def fit_gaussians(
     target = f64(profile_fn(r)).reshape(n_r, -1) * r[:, None]
     norms = np.sqrt(np.sum(target**2, axis=0))
     norms = np.where(norms > 0, norms, 1.0)
-    tail_r, tail_e = _tail_energies(profile_fn) if tail_weight > 0 else (np.zeros(0), np.zeros((0, target.shape[1])))
+    tail_r, tail_e = tail_energies(profile_fn) if tail_weight > 0 else (np.zeros(0), np.zeros((0, target.shape[1])))
     # tail rows, per channel: (energy beyond R_j of each unit Gaussian, the profile's) scaled so a
     # residual is tail_weight x the relative error of that energy, in units of the r R(r) norm
     tail_scale = float(tail_weight) * norms[None, :] / np.maximum(tail_e, 1e-300) / np.sqrt(max(len(tail_r), 1))

@@ -30,10 +30,10 @@ def line_spread(fn, x):
     return np.stack([2 * np.trapezoid(fn(np.hypot(xx, y)), y, axis=0) for xx in x])
 
 
-def test_tail_energies_of_one_gaussian_are_its_closed_form():
+def testtail_energies_of_one_gaussian_are_its_closed_form():
     v = 4.0  # one unit Gaussian of variance v puts e^{-R^2 / 2v} of its energy beyond R
     fn = lambda r: gaussians.gaussian_sum_profile(r, [v], [[1.0, 0.5, 0.0]])
-    radii, beyond = gaussians._tail_energies(fn)
+    radii, beyond = gaussians.tail_energies(fn)
     assert radii.shape == (len(gaussians.TAIL_FRACTIONS),) and beyond.shape == (len(radii), 3)
     assert np.all(np.diff(radii) > 0)
     closed = np.exp(-(radii**2) / (2 * v))
@@ -50,7 +50,7 @@ def test_tail_weight_keeps_marble_energy_beyond_the_diffusion_length():
     plain = gaussians.fit_gaussians(fn, 6)
     tailed = gaussians.fit_gaussians(fn, 6, tail_weight=1.0)
     assert (tailed.weights >= 0).all() and np.isfinite(tailed.rel_error).all()
-    radii, _ = gaussians._tail_energies(fn)
+    radii, _ = gaussians.tail_energies(fn)
     for R in radii[:3]:  # the radii holding 90, 99, 99.9 % of the energy (2.8, 6.0, 9.1 mm)
         truth = energy_beyond(fn, R)
         kept = energy_beyond(tailed.profile, R) / truth
