@@ -56,10 +56,10 @@ class Closeup:
 CLOSEUPS = {
     "slit-skin1": Closeup((256, 16), 256, kind="slit", mm_per_px=0.135),
     "slit-marble": Closeup((256, 16), 64, rr_depth=1024, kind="slit", mm_per_px=0.35),
-    "nose-shadow-skin1": Closeup((96, 96), 64, kind="shadow"),
+    "nose-shadow-skin1": Closeup((96, 96), 256, kind="shadow"),
     "ear-backlit-skin1": Closeup((96, 96), 64),
     "point-light-skin1": Closeup((64, 64), 128),
-    "slabs-gap-backlit-skin1": Closeup((64, 64), 128, kind="slabs"),
+    "slabs-gap-backlit-skin1": Closeup((64, 64), 512, kind="slabs"),
 }
 TAIL_MM = (2.0, 5.0, 10.0)
 DEEP_SHADOW_MM = 2.0  # deep shadow: more than this from any lit point (the red diffusion length is 2.3 mm)
