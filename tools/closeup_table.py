@@ -14,7 +14,7 @@ noise (the same measure between the halves of its passes):
 Nothing is path-traced here: the references must be cached (the commands are in CLOSEUPS and
 docs/ground-truth.md). Frames are supersampled like the truth's pixels (TRUTH_SUPERSAMPLE).
 
-    python tools/closeup_table.py [SCENES] [TECHNIQUES] [--profiles OUT.npz]   # comma-separated; default all
+    python -m tools.closeup_table [SCENES] [TECHNIQUES] [--profiles OUT.npz]   # comma-separated; default all
 
 SKINLAB_BOUNCES=N and SKINLAB_SSS_MODEL=<model> as in tools/truth_table.py; SKINLAB_TRANSLUCENCY=0
 renders with every technique's translucency off."""
