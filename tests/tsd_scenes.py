@@ -15,10 +15,14 @@ from skinlab.scene.primitives import box_mesh
 
 
 def quad_mesh(name, x0, x1, y0, y1, z=0.0, uv=((0, 0), (1, 1))) -> Mesh:
+    """A quad in the plane z; it faces +z, or -z where the corners run the other way (x0 > x1 or
+    y0 > y1, not both): its normals follow its winding."""
     (u0, v0), (u1, v1) = uv
     pos = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]], np.float32)
     uvs = np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]], np.float32)
-    return Mesh(name, pos, np.array([[0, 1, 2], [0, 2, 3]], np.uint32), normals=np.tile([0, 0, 1.0], (4, 1)), uvs=uvs)
+    facing = 1.0 if (x1 - x0) * (y1 - y0) >= 0 else -1.0
+    normals = np.tile([0, 0, facing], (4, 1))
+    return Mesh(name, pos, np.array([[0, 1, 2], [0, 2, 3]], np.uint32), normals=normals, uvs=uvs)
 
 
 def skin(model="burley", radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5), base=(1.0, 1.0, 1.0), **kw) -> Material:

@@ -1,4 +1,5 @@
-"""Write the slab meshes of the reference scenes (skinlab/assets/meshes/*.obj): `python -m tools.make_reference_meshes`.
+"""Write the slab and occluder meshes of the reference scenes (skinlab/assets/meshes/*.obj):
+`python -m tools.make_reference_meshes`.
 Sizes in millimetres (the scenes say mm_per_unit = 1)."""
 
 from pathlib import Path
@@ -10,6 +11,15 @@ MESHES = {
     "slab-160x160x40.obj": (160.0, 160.0, 40.0),  # a thick slab: a shadow edge on its top face
     "plate-400x200x4.obj": (400.0, 200.0, 4.0),  # the occluder casting the edge
     "slab-60x60x3.obj": (60.0, 60.0, 3.0),  # a thin slab lit from behind: translucency
+    # the slit scenes (skinlab/assets/scenes/reference/slit-*.toml): a slab and, high above it and out
+    # of the camera's view, two black plates side by side with the slit between them; all no larger
+    # than they must be, so that the shadow map's texels across the slit are small (0.04-0.06 mm)
+    "slab-80x80x40.obj": (80.0, 80.0, 40.0),
+    "plate-41x124x2.obj": (41.0, 124.0, 2.0),
+    "slab-120x120x60.obj": (120.0, 120.0, 60.0),
+    "plate-61x184x2.obj": (61.0, 184.0, 2.0),
+    # the back slab of the two back-lit slabs with an air gap (wider than the front one, 60 x 60 x 3)
+    "slab-100x100x3.obj": (100.0, 100.0, 3.0),
 }
 
 if __name__ == "__main__":

@@ -55,6 +55,11 @@ def register(sub) -> None:
         help="the noise --until-noise reads: block (relative L1 between the halves on 4x4 blocks, the ledger's) or "
         "pixel (per pixel) (default block)",
     )  # fmt: skip
+    p.add_argument(
+        "--rr-depth", type=int, default=64, help="path depth from which Russian roulette ends paths (default 64; "
+        "media with a single-scattering albedo near 1, whose light travels hundreds of scattering events, need "
+        "about 1 / (1 - albedo) or more: the slit-marble reference takes 1024)"
+    )  # fmt: skip
     p.add_argument("--no-cache", action="store_true", help="render even when an identical reference is cached")
     p.add_argument("--json", action="store_true", help="print the result (path, noise floor, time, notes) as JSON")
     p.add_argument(
@@ -97,7 +102,7 @@ def run(args) -> int:
     w, h = parse_size(args.size)
     req = ReferenceRequest(
         w, h, spp=args.spp, passes=args.passes, seed=args.seed, variant=args.variant,
-        sun_deg=args.sun_deg, max_depth=args.max_depth,
+        sun_deg=args.sun_deg, max_depth=args.max_depth, rr_depth=args.rr_depth,
     )  # fmt: skip
     scene = load_scene(args.scene, scene_edits_from_args(args))
     try:
@@ -120,6 +125,7 @@ def run(args) -> int:
         "spp": ref.meta.get("spp", req.spp),
         "passes": ref.meta.get("passes", req.passes),
         "variant": req.variant,
+        "rr_depth": req.rr_depth,
         "cached": ref.cached,
         "render_seconds": ref.meta["seconds"],
         "seconds_this_run": ref.meta.get("seconds_this_run", 0.0),

@@ -50,20 +50,33 @@ def thickness_shrink(frame) -> float:
     return cached["shrink"]
 
 
+# A surface farther along the light than the first part's exit by more than this many texels of the
+# distance maps (2 x thickness_shrink each) belongs to another part: its light crossed the first
+# part, then air (skinlab/shaders/passes/shadow.frag SHADOW_LAYER; lib/sss_translucency.glsl).
+PART_GAP_TEXELS = 4.0
+
+
+def part_gap(frame) -> float:
+    """Scene units: how far past the first part's exit a surface must lie to be another part."""
+    return PART_GAP_TEXELS * 2.0 * thickness_shrink(frame)
+
+
 def bind_translucency(prog, frame, units, fallback=None) -> None:
-    """The distance maps (u_distance0/1 on units from `units`), the lights' eyes and the shrink for
-    lib/sss_translucency.glsl. A slot without a distance map gets the other slot's (never sampled:
-    no light points at it) or `fallback` (a texture) when neither has one."""
-    maps = [frame.targets.get(f"shadow_distance{slot}") for slot in (0, 1)]
-    present = [m for m in maps if m is not None] or [fallback]
-    for slot, m in enumerate(maps):
-        tex = m if m is not None else present[0]
-        if tex is None:
-            raise RuntimeError("translucency: no shadow distance map this frame and no fallback texture")
-        units.bind(prog, f"u_distance{slot}", tex)
+    """The distance maps and their exit layers (u_distance0/1, u_exit0/1 on units from `units`), the
+    lights' eyes, the shrink and the part gap for lib/sss_translucency.glsl. A slot without a
+    distance map gets the other slot's (never sampled: no light points at it) or `fallback` (a
+    texture) when neither has one."""
+    for name in ("distance", "exit"):
+        maps = [frame.targets.get(f"shadow_{name}{slot}") for slot in (0, 1)]
+        present = [m for m in maps if m is not None] or [fallback]
+        for slot, m in enumerate(maps):
+            tex = m if m is not None else present[0]
+            if tex is None:
+                raise RuntimeError(f"translucency: no shadow {name} map this frame and no fallback texture")
+            units.bind(prog, f"u_{name}{slot}", tex)
     eyes = np.stack([frame.shadow_eyes.get(s, np.zeros(4)) for s in (0, 1)])
     set_array(prog, "u_light_eye", eyes, 2)
-    set_uniforms(prog, {"u_thickness_shrink": thickness_shrink(frame)})
+    set_uniforms(prog, {"u_thickness_shrink": thickness_shrink(frame), "u_part_gap": part_gap(frame)})
 
 
 def translucent_shading(material, hook: str, frame, through: bool, bind, subsurface: bool = True) -> NodeShading:

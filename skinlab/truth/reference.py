@@ -56,14 +56,21 @@ class ReferenceRequest:
     variant: str = "scalar_rgb"
     sun_deg: float = 0.0  # > 0: directional lights as distant disks of this angular diameter
     max_depth: int = -1  # volpath path length limit (-1: none; Russian roulette ends paths)
-    rr_depth: int = 64
+    rr_depth: int = 64  # Russian roulette from this depth (media with albedo near 1 need ~ 1 / (1 - albedo))
 
     @property
     def pass_spp(self) -> int:
         return max(1, self.spp // self.passes)
 
     def __post_init__(self) -> None:
-        for name, lo, hi in (("width", 1, 16384), ("height", 1, 16384), ("spp", 2, 1 << 24), ("passes", 2, 1024)):
+        limits = (
+            ("width", 1, 16384),
+            ("height", 1, 16384),
+            ("spp", 2, 1 << 24),
+            ("passes", 2, 1024),
+            ("rr_depth", 1, 1 << 20),
+        )
+        for name, lo, hi in limits:
             v = getattr(self, name)
             if not isinstance(v, int) or not lo <= v <= hi:
                 raise ValueError(f"reference {name}: expected an integer in [{lo}, {hi}], got {v!r}")

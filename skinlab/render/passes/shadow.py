@@ -13,6 +13,7 @@ from skinlab.gl.state import gl_state
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.alpha import bind_mask, blended, mask_defines
 from skinlab.render.frame_plan import ShadowParams
+from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SOFT_KEY, soft_shadow
 from skinlab.render.technique import RenderPass
 from skinlab.render.texture_units import TextureUnits
@@ -94,15 +95,21 @@ class ShadowPass(RenderPass):
         super().__init__(renderer)
         # slot -> (depth texture, framebuffer, distance texture or None)
         self.maps: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer, moderngl.Texture | None]] = {}
+        # with distance maps: per slot (exit texture, its framebuffer, the distance texture's second
+        # layer's framebuffer, their depth buffer)
+        self.layers: dict[int, tuple] = {}
 
     def target(self, slot: int, size: int, distance: bool = False):
-        """(depth texture, framebuffer, distance texture or None) for a slot."""
+        """(depth texture, framebuffer, distance texture or None) for a slot. With `distance`, the
+        distance texture holds two layers (R: the first surface, G: the entry into the next part)
+        and the slot also has an exit layer (self.layers[slot], skinlab/shaders/passes/shadow.frag)."""
         t = self.maps.get(slot)
         if t is None or t[0].size != (size, size) or (t[2] is not None) != distance:
             if t is not None:
                 for x in (t[1], t[0], t[2]):
                     if x is not None:
                         x.release()
+                self._release_layers(slot)
             ctx = self.r.ctx
             tex = ctx.depth_texture((size, size))
             tex.compare_func = "<="
@@ -110,12 +117,28 @@ class ShadowPass(RenderPass):
             tex.repeat_x = tex.repeat_y = False
             dist = None
             if distance:
-                dist = ctx.texture((size, size), 1, dtype="f4")
+                dist = ctx.texture((size, size), 2, dtype="f4")
                 dist.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 dist.repeat_x = dist.repeat_y = False
+                exit_tex = ctx.texture((size, size), 2, dtype="f4")
+                exit_tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                exit_tex.repeat_x = exit_tex.repeat_y = False
+                depth = ctx.depth_renderbuffer((size, size))
+                self.layers[slot] = (
+                    exit_tex,
+                    ctx.framebuffer([exit_tex], depth_attachment=depth),
+                    ctx.framebuffer([dist], depth_attachment=depth),
+                    depth,
+                )
             fbo = ctx.framebuffer([dist] if dist is not None else [], depth_attachment=tex)
             t = self.maps[slot] = (tex, fbo, dist)
         return t
+
+    def _release_layers(self, slot: int) -> None:
+        layers = self.layers.pop(slot, None)
+        if layers is not None:
+            for x in (layers[1], layers[2], layers[0], layers[3]):
+                x.release()
 
     def release(self) -> None:
         for tex, fbo, dist in self.maps.values():
@@ -123,11 +146,13 @@ class ShadowPass(RenderPass):
                 if x is not None:
                     x.release()
         self.maps.clear()
+        for slot in list(self.layers):
+            self._release_layers(slot)
 
     def outputs(self, frame, p) -> tuple:
         """The textures holding the pass's result (reuse across frames, skinlab/render/reuse.py)."""
         tex, _, dist = self.target(p.params.slot, p.resolution[0], p.params.distance)
-        return (tex,) if dist is None else (tex, dist)
+        return (tex,) if dist is None else (tex, dist, self.layers[p.params.slot][0])
 
     def publish(self, frame, p) -> None:
         """Hand the slot's maps and matrices to the frame (after run, or when reused)."""
@@ -138,6 +163,7 @@ class ShadowPass(RenderPass):
         frame.shadow_eyes[slot] = light_eye(light)
         if dist is not None:
             frame.targets[f"shadow_distance{slot}"] = dist
+            frame.targets[f"shadow_exit{slot}"] = self.layers[slot][0]
         lo, hi = frame.scene.world_bounds()
         m = CLIP_TO_TEXTURE @ light_view_proj(light, lo, hi)
         frame.shadow_matrices[slot] = m
@@ -151,21 +177,54 @@ class ShadowPass(RenderPass):
         tex, fbo, dist = self.target(slot, p.resolution[0], distance)
         lo, hi = frame.scene.world_bounds()
         vp = light_view_proj(light, lo, hi)
-        base = {"SHADOW_DISTANCE": 1} if distance else {}
-        fbo.use()
-        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        if dist is not None:  # "no surface": as far as it gets
+        if dist is None:
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        else:  # "no surface": as far as it gets
+            fbo.color_mask = (True, True, True, True)
             fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
-        with gl_state(ctx, moderngl.DEPTH_TEST, polygon_offset=(2.0, 2.0)):
-            for node in frame.scene.mesh_nodes():
-                if blended(node.material):
-                    continue  # a see-through surface (alpha_mode "blend") casts no shadow
-                # a masked material's cut-away pixels cast no shadow (skinlab/render/alpha.py)
-                prog = self.r.programs.get(
-                    "passes/shadow.vert", "passes/shadow.frag", {**base, **mask_defines(node.material)}
-                )
-                set_uniforms(prog, {"u_light_eye": light_eye(light)})
-                set_uniforms(prog, {"u_model": node.world_matrix, "u_light_view_proj": vp})
-                bind_mask(self.r.resources, prog, node.material, TextureUnits(ctx))
-                self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+            fbo.color_mask = (True, False, False, False)  # the first surface; G is the next part's entry
+        fbo.use()
+        # no polygon offset: its slope term (factor x the polygon's depth slope) grows without bound
+        # toward an occluder's silhouette in the light's view; the lookup's bias is sized to the
+        # texel instead (skinlab/shaders/lib/shadow.glsl)
+        with gl_state(ctx, moderngl.DEPTH_TEST):
+            self._draw(frame, {"SHADOW_DISTANCE": 1} if distance else {}, {"u_light_eye": light_eye(light)}, vp)
+            if distance:
+                self._draw_layers(frame, slot, light, vp)
         self.publish(frame, p)
+
+    def _draw(self, frame, defines: dict, uniforms: dict, vp, textures: dict | None = None) -> None:
+        """Every mesh that casts a shadow, each with its program (a masked material's cut-away pixels
+        cast no shadow, skinlab/render/alpha.py; a see-through surface, alpha_mode "blend", none)."""
+        for node in frame.scene.mesh_nodes():
+            if blended(node.material):
+                continue
+            prog = self.r.programs.get(
+                "passes/shadow.vert", "passes/shadow.frag", {**defines, **mask_defines(node.material)}
+            )
+            set_uniforms(prog, {**uniforms, **node_uniforms(node), "u_light_view_proj": vp})
+            units = TextureUnits(self.r.ctx)
+            for sampler, tex in (textures or {}).items():
+                units.bind(prog, sampler, tex)
+            bind_mask(self.r.resources, prog, node.material, units)
+            self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+
+    def _draw_layers(self, frame, slot: int, light: LightNode, vp) -> None:
+        """The distance maps' layers for light through thin parts (skinlab/shaders/passes/shadow.frag
+        SHADOW_LAYER): the exit from the first part, then the entry into the next."""
+        from skinlab.render.translucency import part_gap
+
+        exit_tex, exit_fbo, second_fbo, _ = self.layers[slot]
+        eye = light_eye(light)
+        exit_fbo.color_mask = (True, True, True, True)
+        exit_fbo.clear(1e30, 0.0, 0.0, 0.0, depth=1.0)
+        exit_fbo.use()
+        self._draw(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp)
+        second_fbo.color_mask = (False, True, False, False)  # clears and writes G only
+        second_fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
+        second_fbo.use()
+        self._draw(
+            frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 2}, {"u_light_eye": eye, "u_part_gap": part_gap(frame)},
+            vp, {"u_exit": exit_tex},
+        )  # fmt: skip
+        second_fbo.color_mask = (True, True, True, True)

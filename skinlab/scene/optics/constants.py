@@ -26,8 +26,17 @@ SRGB_ENCODED_THRESHOLD = 0.04045
 # Point lights: distances are clamped to at least this (metres) before the inverse square.
 MIN_LIGHT_DISTANCE_M = 1.0e-3
 
-# Shadow map depth bias in normalised light depth units (slope-scaled part added in shader).
-SHADOW_BIAS = 0.0015
+# Shadow-map depth bias, sized to the map's texel at the receiver (skinlab/shaders/lib/shadow.glsl,
+# skinlab/scene/optics/shadow.py): bias = texel x (SHADOW_BIAS_TEXELS + SHADOW_SLOPE_TEXELS x
+# min(tan theta, SHADOW_SLOPE_MAX)), theta the angle between the receiver's normal and the light. The
+# 3x3 PCF taps and their bilinear footprints reach 2 sqrt 2 texels from the receiver, over which a
+# plane tilted by theta changes depth by 2.83 texel tan theta: 3 texels of slope keep a lit plane lit.
+# The clamp bounds how far behind an occluder light can leak (16 texels at most, 3.2 mm on the head
+# with a 2048 map); past it (NoL < 0.2) a surface may shadow itself a little where it receives almost
+# no light anyway.
+SHADOW_BIAS_TEXELS = 1.0
+SHADOW_SLOPE_TEXELS = 3.0
+SHADOW_SLOPE_MAX = 5.0
 
 GLSL_CONSTANTS: dict[str, float] = {
     "PI": PI,
@@ -37,7 +46,9 @@ GLSL_CONSTANTS: dict[str, float] = {
     "SPECULAR_F0_SCALE": SPECULAR_F0_SCALE,
     "SRGB_LINEAR_THRESHOLD": SRGB_LINEAR_THRESHOLD,
     "SRGB_ENCODED_THRESHOLD": SRGB_ENCODED_THRESHOLD,
-    "SHADOW_BIAS": SHADOW_BIAS,
+    "SHADOW_BIAS_TEXELS": SHADOW_BIAS_TEXELS,
+    "SHADOW_SLOPE_TEXELS": SHADOW_SLOPE_TEXELS,
+    "SHADOW_SLOPE_MAX": SHADOW_SLOPE_MAX,
     "MIN_LIGHT_DISTANCE_M": MIN_LIGHT_DISTANCE_M,
 }
 

@@ -67,21 +67,40 @@ class NoEnergy(ValueError):
 ENERGY_GRID_MM = (1e-5, 1e4)  # where _energy_radius looks for a profile's energy
 
 
-def _energy_radius(profile_fn, fraction):
-    """Smallest radius holding `fraction` of every channel's energy (int R 2 pi r dr); NoEnergy if
-    no channel has any on ENERGY_GRID_MM."""
+def _cumulative_energy(profile_fn) -> tuple[np.ndarray, np.ndarray]:
+    """(r (N,) on ENERGY_GRID_MM, cumulative energy int_0^r R 2 pi r' dr' (N, C)) by the trapezoid rule in log r."""
     r = np.geomspace(*ENERGY_GRID_MM, 2000)
     f = np.maximum(f64(profile_fn(r)).reshape(len(r), -1), 0.0) * 2 * PI * r[:, None] ** 2
     cum = np.concatenate(
         [np.zeros((1, f.shape[1])), np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(np.log(r))[:, None], axis=0)]
     )
+    return r, cum
+
+
+def _energy_radius(profile_fn, fraction):
+    """Smallest radius holding `fraction` of every channel's energy (int R 2 pi r dr); NoEnergy if
+    no channel has any on ENERGY_GRID_MM."""
+    r, cum = _cumulative_energy(profile_fn)
     tot = cum[-1]
     if not np.all(np.isfinite(tot)):
         raise ValueError("profile_fn: profile has no finite energy to fit")
     if np.all(tot <= 0):
         raise NoEnergy("profile_fn: profile has no positive energy to fit")
-    idx = [np.searchsorted(cum[:, c], fraction * tot[c]) for c in range(f.shape[1]) if tot[c] > 0]
+    idx = [np.searchsorted(cum[:, c], fraction * tot[c]) for c in range(cum.shape[1]) if tot[c] > 0]
     return float(r[min(max(idx), len(r) - 1)])
+
+
+TAIL_FRACTIONS = (0.9, 0.99, 0.999, 0.9999)  # fit_gaussians(tail_weight > 0): the energy kept beyond these
+
+
+def tail_energies(profile_fn, fractions=TAIL_FRACTIONS) -> tuple[np.ndarray, np.ndarray]:
+    """(radii (T,), energy beyond each (T, C)): the radii holding `fractions` of every channel's
+    energy (the widest channel's, _energy_radius) and each channel's energy (int R 2 pi r dr)
+    beyond them."""
+    r, cum = _cumulative_energy(profile_fn)
+    radii = np.array([_energy_radius(profile_fn, q) for q in fractions])
+    inside = np.stack([np.interp(radii, r, cum[:, c]) for c in range(cum.shape[1])], axis=1)
+    return radii, np.maximum(cum[-1][None, :] - inside, 0.0)
 
 
 def _solve(basis, target):
@@ -104,6 +123,7 @@ def fit_gaussians(
     energy_fraction: float = 0.999,
     optimise: str = "free",
     variances: np.ndarray | None = None,
+    tail_weight: float = 0.0,
 ) -> GaussianFit:
     """Fit R(r) (``profile_fn(r_mm) -> (N, C)`` in 1/mm^2) by K Gaussians with shared variances.
 
@@ -112,10 +132,17 @@ def fit_gaussians(
     non-negative per-channel weights (NNLS). Variances: fixed if ``variances`` is given; else a
     geometric series v_k = v_0 q^k whose v_0, q minimise the summed squared relative error
     (``optimise="geometric"``), then (``optimise="free"``, default) all K log-variances refined
-    from there. Returns a :class:`GaussianFit` with the relative L2 error per channel.
+    from there. With ``tail_weight`` > 0 the least squares also asks, per channel, for the
+    profile's energy beyond the radii holding TAIL_FRACTIONS of it (a Gaussian of variance v puts
+    e^{-R^2/2v} of its energy beyond R: linear in the weights), each as a relative error times
+    ``tail_weight``: r R(r) weighs the tail by its density, so a fit to it alone lets the last
+    percent of the energy go (the diffusion's glow), which these rows keep. Returns a
+    :class:`GaussianFit` with the relative L2 error of r R(r) per channel.
     """
     if int(K) != K or K < 1:
         raise ValueError(f"K: need a positive integer number of Gaussians, got {K!r}")
+    if not (np.isfinite(tail_weight) and tail_weight >= 0):
+        raise ValueError(f"tail_weight: expected a finite number >= 0, got {tail_weight!r}")
     if optimise not in ("free", "geometric"):
         raise ValueError(f"optimise: expected 'free' or 'geometric', got {optimise!r}")
     K = int(K)
@@ -128,11 +155,26 @@ def fit_gaussians(
     target = f64(profile_fn(r)).reshape(n_r, -1) * r[:, None]
     norms = np.sqrt(np.sum(target**2, axis=0))
     norms = np.where(norms > 0, norms, 1.0)
+    tail_r, tail_e = tail_energies(profile_fn) if tail_weight > 0 else (np.zeros(0), np.zeros((0, target.shape[1])))
+    # tail rows, per channel: (energy beyond R_j of each unit Gaussian, the profile's) scaled so a
+    # residual is tail_weight x the relative error of that energy, in units of the r R(r) norm
+    tail_scale = float(tail_weight) * norms[None, :] / np.maximum(tail_e, 1e-300) / np.sqrt(max(len(tail_r), 1))
+    tail_scale = np.where(tail_e > 0, tail_scale, 0.0)
 
     def solve(logv):
         v = np.exp(np.sort(logv))
         basis = gaussian(v[None, :], r[:, None]) * r[:, None]
-        w, res = _solve(basis, target)
+        if not len(tail_r):
+            w, res = _solve(basis, target)
+            return v, w, res / norms
+        beyond = np.exp(-(tail_r[:, None] ** 2) / (2.0 * v[None, :]))  # (T, K)
+        w = np.zeros((len(v), target.shape[1]))
+        res = np.zeros(target.shape[1])
+        for c in range(target.shape[1]):
+            a = np.vstack([basis, beyond * tail_scale[:, c : c + 1]])
+            b = np.concatenate([target[:, c], tail_e[:, c] * tail_scale[:, c]])
+            wc, rc = _solve(a, b[:, None])
+            w[:, c], res[c] = wc[:, 0], rc[0]
         return v, w, res / norms
 
     def cost(logv):
@@ -166,4 +208,7 @@ def fit_gaussians(
             if fr.fun < cost(best):
                 best = fr.x
     v, w, rel = solve(best)
+    if len(tail_r):  # report the shape's error alone
+        basis = gaussian(v[None, :], r[:, None]) * r[:, None]
+        rel = np.sqrt(np.sum((basis @ w - target) ** 2, axis=0)) / norms
     return GaussianFit(v, w, rel, float(r_max))

@@ -1,29 +1,58 @@
 """NumPy twins of skinlab/shaders/lib/shadow.glsl (and lib/shadow_soft.glsl, below) for a depth-compare
 sampler with NEAREST filtering, clamp-to-edge addressing and compare function '<=' (the result of each
 tap is exactly 0 or 1, so the twin is exact). The renderer samples with LINEAR compare filtering, whose bilinear weights
-are implementation precision (llvmpipe uses 8-bit weights); those are not part of the twin."""
+are implementation precision (llvmpipe uses 8-bit weights); those are not part of the twin.
+
+The depth bias is sized to the map's texel at the receiver (constants.py SHADOW_BIAS_TEXELS,
+SHADOW_SLOPE_TEXELS, SHADOW_SLOPE_MAX): a texel and a bounded slope term, so that a lit surface
+stays lit under the 3x3 PCF and light leaks at most a few texels behind an occluder, whatever the
+scene's scale and the light's angle."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from .constants import SHADOW_BIAS
+from .constants import SHADOW_BIAS_TEXELS, SHADOW_SLOPE_MAX, SHADOW_SLOPE_TEXELS
 
 
-def shadow_bias(NoL):
-    cosl = np.clip(np.asarray(NoL, np.float64), 0.05, 1.0)
-    return SHADOW_BIAS * (1.0 + 3.0 * np.sqrt(1.0 - cosl * cosl) / cosl)
+def _light_space(shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
+    m = np.asarray(shadow_matrix, np.float64)
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    p = np.concatenate([world, np.ones((len(world), 1))], 1) @ m.T
+    return m, p
+
+
+def shadow_texel_scale(shadow_matrix, world, size) -> tuple[np.ndarray, np.ndarray]:
+    """(texel, depth_per_unit) at each point of world (N, 3) for a map of size (width, height): the
+    side of the map's texel there in world units (the larger of its two sides) and the texture depth
+    per world unit along the light. GLSL shadow_texel_scale."""
+    m, p = _light_space(shadow_matrix, world)
+    c = p[:, :3] / p[:, 3:4]
+    w = np.abs(p[:, 3])
+    r0, r1, r2, r3 = (m[k, :3][None, :] for k in range(4))
+    gu = np.linalg.norm(r0 - c[:, 0:1] * r3, axis=1) * float(size[0])
+    gv = np.linalg.norm(r1 - c[:, 1:2] * r3, axis=1) * float(size[1])
+    per_unit = np.minimum(gu, gv) / w
+    return 1.0 / np.maximum(per_unit, 1e-30), np.linalg.norm(r2 - c[:, 2:3] * r3, axis=1) / w
+
+
+def shadow_bias(NoL, shadow_matrix, world, size) -> np.ndarray:
+    """Depth bias (texture depth units) per point: texel x (SHADOW_BIAS_TEXELS + SHADOW_SLOPE_TEXELS
+    x min(tan theta, SHADOW_SLOPE_MAX)), theta the angle whose cosine is NoL. GLSL shadow_bias."""
+    cosl = np.clip(np.asarray(NoL, np.float64), 1e-3, 1.0)
+    slope = np.minimum(np.sqrt(1.0 - cosl * cosl) / cosl, SHADOW_SLOPE_MAX)
+    texel, depth = shadow_texel_scale(shadow_matrix, world, size)
+    return texel * depth * (SHADOW_BIAS_TEXELS + SHADOW_SLOPE_TEXELS * slope)
 
 
 def shadow_pcf(depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarray, NoL) -> np.ndarray:
     """depth_map: (H, W) with row 0 at texture v = 0 (GL order). world: (N, 3)."""
-    world = np.asarray(world, np.float64)
-    p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
+    m, p = _light_space(shadow_matrix, world)
     c = p[:, :3] / p[:, 3:4]
     outside = (c < 0).any(1) | (c > 1).any(1)
     h, w = depth_map.shape
-    ref = c[:, 2] - shadow_bias(NoL)
-    total = np.zeros(len(world))
+    ref = c[:, 2] - shadow_bias(NoL, m, world, (w, h))
+    total = np.zeros(len(c))
     for dy in (-1, 0, 1):
         for dx in (-1, 0, 1):
             u = c[:, 0] + dx / w
@@ -84,7 +113,9 @@ def shadow_soft(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL) -> np
     d_b = np.where(count > 0, total / np.maximum(count, 1), d_r)  # no blocker: lit (below)
     w = 2.0 * soft[0] * (d_r - d_b) / np.maximum(d_b, 1e-20) if local else 2.0 * soft[0] * (d_r - d_b)
     radius = np.maximum(0.5 * w * k, 1.5 * texel)
-    ref = c[:, 2] - shadow_bias(NoL)
+    ref = c[:, 2] - shadow_bias(NoL, shadow_matrix, world, depth_map.shape[::-1]) * np.maximum(
+        1.0, radius / (1.5 * texel)
+    )
     lit = np.zeros(len(world))
     for t in range(SOFT_TAPS):
         o = vogel_tap(t)

@@ -7,13 +7,21 @@ none), as in Jimenez, Whelan, Sundstedt & Gutierrez 2010, "Real-Time Realistic S
 looked up at the point moved `shrink` inward along its normal, times the cosine between the normal
 and the light (a flat slab's own thickness), plus the shrink (which a flat part's lookup lost); 0
 where the moved point is still in front of the first surface (a point that is itself the first
-surface reads 0, not the map's quantisation noise; so does a part thinner than the shrink). What
-crosses that thickness is the exact slab transmittance of skinlab/scene/optics/slab.py (`slab_through`: all
-orders of scattering, Fresnel in and out). Texture-space diffusion gathers it in its irradiance pass,
+surface reads 0, not the map's quantisation noise; so does a part thinner than the shrink). Only
+matter counts: the map has layers (skinlab/shaders/passes/shadow.frag SHADOW_LAYER) holding, per
+texel, where the light leaves the first part it crosses (the nearest surface facing away from it)
+with the cosine there, and where it enters the next part (the nearest surface facing it beyond that
+exit by more than the part gap); a point past the first part's exit by more than the gap gets the
+first part's thickness (its chord times the exit cosine) plus its own part's (from the next entry,
+times its own cosine), not the air between them. What crosses that thickness is the exact slab
+transmittance of skinlab/scene/optics/slab.py (`slab_through`: all orders of scattering, Fresnel in
+and out). Texture-space diffusion gathers it in its irradiance pass,
 the screen-space techniques in the forward pass; both call the same GLSL functions.
 
-Distance maps are (H, W) with row 0 at texture v = 0 (GL order), read texel by texel (texelFetch:
-the bilinear weights are computed, not the sampler's, so the twin is exact to fp32)."""
+Distance maps are (H, W) (the first surface) or (H, W, 2) (and the next part's entry), exit layers
+(H, W, 2) (the first part's exit, its cosine), row 0 at texture v = 0 (GL order), read texel by
+texel (texelFetch: the bilinear weights are computed, not the sampler's, so the twin is exact to
+fp32)."""
 
 from __future__ import annotations
 
@@ -29,13 +37,35 @@ def _points(world) -> np.ndarray:
     return np.atleast_2d(np.asarray(world, np.float64))
 
 
+def _first_layer(distance_map) -> np.ndarray:
+    d = np.asarray(distance_map, np.float64)
+    return d[..., 0] if d.ndim == 3 else d
+
+
+def part_layers(distance_map, exit_map, shadow_matrix, world) -> np.ndarray:
+    """(N, 3) at the texel containing each point (clamped to the map): the first part's exit, its
+    cosine to the light, the entry into the next part (NO_SURFACE-like 1e30 where the maps hold
+    none). GLSL part_layers."""
+    world = _points(world)
+    ex = np.asarray(exit_map, np.float64)
+    dist = np.asarray(distance_map, np.float64)
+    nxt = dist[..., 1] if dist.ndim == 3 else np.full(dist.shape, 1e30)
+    h, w = ex.shape[:2]
+    p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        uv = np.nan_to_num(p[:, :2] / p[:, 3:4], nan=0.0, posinf=0.0, neginf=0.0)
+    i = np.clip(np.floor(uv[:, 0] * w), 0, w - 1).astype(np.int64)
+    j = np.clip(np.floor(uv[:, 1] * h), 0, h - 1).astype(np.int64)
+    return np.stack([ex[j, i, 0], ex[j, i, 1], nxt[j, i]], 1)
+
+
 def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
     """(first, hit) per point of world (N, 3): the map's distance at the point's light-space
     position, bilinear between the four nearest texel centres (clamped to the map) where all four
     hold a surface, else the texel containing the point; hit False outside the map or where that
     texel holds no surface (first 0 outside). GLSL first_hit_distance."""
     world = _points(world)
-    dist = np.asarray(distance_map, np.float64)
+    dist = _first_layer(distance_map)
     h, w = dist.shape
     p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -65,14 +95,25 @@ def distance_from_light(eye, world) -> np.ndarray:
     return world @ eye[:3] if eye[3] == 0.0 else np.linalg.norm(world - eye[:3], axis=1)
 
 
-def thickness_mm(distance_map, shadow_matrix, eye, world, normal, back, shrink, mm_per_unit):
+def thickness_mm(
+    distance_map, shadow_matrix, eye, world, normal, back, shrink, mm_per_unit, exit_map=None, part_gap=0.0
+):
     """(d_mm, hit): the thickness (mm, along the normal) of matter between the light and each point;
     normal (N, 3) the outward geometric normal, back (N,) its cosine with the direction the light
-    travels, shrink in scene units. GLSL sss_thickness_mm."""
+    travels, shrink and part_gap in scene units; exit_map None: one part (no layers). GLSL
+    sss_thickness_mm."""
     p = _points(world) - float(shrink) * _points(normal)
     first, hit = first_hit_distance(distance_map, shadow_matrix, p)
-    inside = distance_from_light(eye, p) - first
-    d = np.where(inside > 0.0, (inside * np.asarray(back, np.float64) + float(shrink)) * float(mm_per_unit), 0.0)
+    at = distance_from_light(eye, p)
+    back = np.asarray(back, np.float64)
+    inside = at - first
+    d = np.where(inside > 0.0, (inside * back + float(shrink)) * float(mm_per_unit), 0.0)
+    if exit_map is not None:
+        lay = part_layers(distance_map, exit_map, shadow_matrix, p)
+        other = (lay[:, 0] < NO_SURFACE) & (at > lay[:, 0] + float(part_gap))
+        own = np.where(lay[:, 2] < at, at - lay[:, 2], 0.0)
+        through_both = np.maximum(lay[:, 0] - first, 0.0) * lay[:, 1] + own * back
+        d = np.where(other, (through_both + float(shrink)) * float(mm_per_unit), d)
     return np.where(hit, d, 0.0), hit
 
 

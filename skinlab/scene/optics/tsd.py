@@ -97,6 +97,10 @@ def material_medium(values) -> Medium:
     )
 
 
+FIT_TAIL_WEIGHT = 0.0  # fit_gaussians' tail_weight for the profile fits
+EXACT_ENERGY = 0.999  # the exact convolution's support: the radius holding this of every channel's energy
+
+
 @dataclass(frozen=True)
 class ProfileFit:
     model: str
@@ -135,7 +139,7 @@ def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
         # fit only the scattering channels; the others are identity
         fn = lambda r: prof.evaluate(np.asarray(r, np.float64), medium) * scatter[None, :]
         try:
-            fit = fit_gaussians(fn, K)
+            fit = fit_gaussians(fn, K, tail_weight=FIT_TAIL_WEIGHT)
             v, w, err = fit.variances_mm2, fit.weights.copy(), np.where(scatter, fit.rel_error, 0.0)
         except NoEnergy:  # the light spreads less than 1e-5 mm in every scattering channel: none scatters
             v, w, err = np.zeros(0), np.zeros((0, 3)), np.zeros(3)
@@ -406,9 +410,9 @@ def profile_tint(model: str, medium: Medium) -> np.ndarray:
     return R / R.max() if R.max() > 0 else np.ones(3)
 
 
-def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float = 0.999):
+def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float | None = None):
     """Tables for the brute-force texture-space convolution (skinlab/shaders/passes/tsd_exact.frag):
-    r_max (mm, the radius holding `energy` of every scattering channel's light), R(r) at
+    r_max (mm, the radius holding `energy` (default EXACT_ENERGY) of every scattering channel's light), R(r) at
     r_i = i r_max / (n - 1) normalised so its integral over the disc r <= r_max is 1 per channel, and
     the cumulative energy E(r_i) = int_0^r_i R 2 pi r dr (for the centre texel). Channels that do not
     scatter get R = 0 and E = 1 (a delta)."""
@@ -420,7 +424,7 @@ def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float = 
     from .gaussians import NoEnergy, _energy_radius
 
     try:
-        r_max = _energy_radius(fn, energy)
+        r_max = _energy_radius(fn, EXACT_ENERGY if energy is None else energy)
     except NoEnergy:  # the light spreads less than 1e-5 mm: a delta in every channel
         return 1e-3, np.zeros((n, 3)), np.ones((n, 3))
     r = np.linspace(0.0, r_max, n)

@@ -8,6 +8,7 @@
 // depth-compare sampler's own). Fully lit where the search finds no blocker; at least the 3 x 3 PCF's
 // width. NumPy twin: skinlab/scene/optics/shadow.py shadow_soft (exact for NEAREST compare filtering).
 #include "skinlab/constants.glsl"
+#include "lib/shadow.glsl"  // shadow_bias
 
 #define SOFT_SEARCH_TAPS 8   // blocker search taps
 #define SOFT_TAPS 12          // filter taps
@@ -50,8 +51,9 @@ float shadow_soft(sampler2DShadow map, sampler2D dist, mat4 m, vec4 soft, vec4 e
     float d_b = sum / n;
     float w = local ? 2.0 * soft.x * (d_r - d_b) / max(d_b, 1e-20) : 2.0 * soft.x * (d_r - d_b);
     float radius = max(0.5 * w * k, 1.5 * texel);
-    float cosl = clamp(NoL, 0.05, 1.0);
-    float zbias = SHADOW_BIAS * (1.0 + 3.0 * sqrt(1.0 - cosl * cosl) / cosl);
+    // lib/shadow.glsl's bias, sized to the texel at the receiver, grown with the filter's reach: a tap
+    // `radius` away on a sloped receiver sees its own surface that much nearer the light
+    float zbias = shadow_bias(m, p, size, NoL) * max(1.0, radius / (1.5 * texel));
     float lit = 0.0;
     for (int t = 0; t < SOFT_TAPS; ++t)
         lit += texture(map, vec3(c.xy + vogel_tap(t, SOFT_TAPS) * radius, c.z - zbias));

@@ -5,18 +5,36 @@
 // the distance the light travelled inside the object is its distance from the light minus the
 // distance of the first surface it met there (the shadow pass's distance map, passes/shadow.frag),
 // looked up at the position shrunk a little along the normal; what comes through is the exact slab
-// transmittance of lib/sss_boundary.glsl (sss_slab_through).
+// transmittance of lib/sss_boundary.glsl (sss_slab_through). Only matter counts: where the point lies
+// beyond the first part the light crossed (its exit, the map's exit layer), the air between that part
+// and the point's own part is left out (passes/shadow.frag SHADOW_LAYER).
 // NumPy twin: skinlab/scene/optics/translucency.py. Bound by skinlab/render/translucency.py.
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
 
-uniform sampler2D u_distance0;   // light-space distance of the first surface (scene units), slot 0
+uniform sampler2D u_distance0;   // light-space distance (scene units), slot 0: R the first surface, G the
+                                 // entry into the next part (the first surface facing the light past R's part)
 uniform sampler2D u_distance1;   // slot 1
+uniform sampler2D u_exit0;       // slot 0: R the first surface facing away from the light (the first
+                                 // part's exit), G its cosine to the light
+uniform sampler2D u_exit1;       // slot 1
 uniform vec4 u_light_eye[2];     // slot light position (w = 1) or the direction light travels (w = 0)
 uniform float u_thickness_shrink;  // scene units: about half a distance-map texel
+uniform float u_part_gap;        // scene units: past the first part's exit by more than this is another part
 
 float distance_texel(int slot, ivec2 t) {
     return slot == 0 ? texelFetch(u_distance0, t, 0).r : texelFetch(u_distance1, t, 0).r;
+}
+
+// At the texel containing world (clamped to the map): x the first part's exit, y its cosine to the
+// light, z the entry into the next part (1e30 where there is none).
+vec3 part_layers(int slot, vec3 world) {
+    vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
+    ivec2 size = slot == 0 ? textureSize(u_exit0, 0) : textureSize(u_exit1, 0);
+    ivec2 t = clamp(ivec2(floor(p.xy / p.w * vec2(size))), ivec2(0), size - 1);
+    vec2 e = slot == 0 ? texelFetch(u_exit0, t, 0).rg : texelFetch(u_exit1, t, 0).rg;
+    float next = slot == 0 ? texelFetch(u_distance0, t, 0).g : texelFetch(u_distance1, t, 0).g;
+    return vec3(e, next);
 }
 
 // Distance from the light of the first surface it meets on the way to world; false outside the map
@@ -55,14 +73,25 @@ float distance_from_light(int slot, vec3 world) {
 // inside along the light times that cosine (a flat slab's own thickness). The lookup point is
 // world - shrink ng (Jimenez et al. 2010): a fragment that is itself the first surface (within the
 // map's texel) or lies less than the shrink behind it reads 0, not the map's quantisation noise;
-// behind that, the shrink is added back, so a flat part keeps its exact thickness. False where the
-// map has no surface in front.
+// behind that, the shrink is added back, so a flat part keeps its exact thickness. Where the point
+// lies past the first part's exit by more than the part gap, its light crossed that part and then
+// air: the thickness is the first part's (its chord times the cosine at its exit) plus the point's
+// own part's (from the next entry, times `back`); index-matched parallel slabs transmit exactly as
+// one slab of their summed thickness. False where the map has no surface in front.
 bool sss_thickness_mm(int slot, vec3 world, vec3 ng, float back, out float d_mm) {
     vec3 p = world - u_thickness_shrink * ng;
     float first;
     d_mm = 0.0;
     if (!first_hit_distance(slot, p, first)) return false;
-    float inside = distance_from_light(slot, p) - first;
+    float at = distance_from_light(slot, p);
+    float inside = at - first;
+    vec3 layers = part_layers(slot, p);
+    if (layers.x < 1e29 && at > layers.x + u_part_gap) {
+        float own = layers.z < at ? at - layers.z : 0.0;
+        inside = max(layers.x - first, 0.0) * layers.y + own * back;
+        d_mm = (inside + u_thickness_shrink) * u_mm_per_unit;
+        return true;
+    }
     d_mm = inside > 0.0 ? (inside * back + u_thickness_shrink) * u_mm_per_unit : 0.0;
     return true;
 }

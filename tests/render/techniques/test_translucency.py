@@ -162,3 +162,27 @@ def test_reference_back_lit_slab_matches_tsd_and_numpy(renderer):
         np.testing.assert_allclose(blocks[t], ref, rtol=1e-3, err_msg=t)
     for t in SCREEN:
         np.testing.assert_allclose(blocks[t], blocks["tsd"], rtol=1e-3, err_msg=t)
+
+
+def sheets_apart(gap_mm, thickness_mm=3.0):
+    """Two sheets of thickness_mm, gap_mm of air between them, lit straight from behind: the
+    visible skin square (z = 0) and the three faces behind it (the front sheet's far face, the back
+    sheet's two), each facing where its sheet's outside is."""
+    s = sheet(thickness_mm)
+    for name, z_mm, facing in (("back_near", thickness_mm + gap_mm, 1), ("back_far", 2 * thickness_mm + gap_mm, -1)):
+        z = -z_mm / MM_PER_UNIT
+        q = quad_mesh(name, -1, 1, -1, 1, z=z) if facing > 0 else quad_mesh(name, -1, 1, 1, -1, z=z)
+        s.add(MeshNode(name, q, Material(name, {"specular": 0.0})))
+    return s
+
+
+@pytest.mark.parametrize("technique", (*SCREEN, "tsd"))
+def test_light_through_two_sheets_apart_crosses_their_matter_not_the_air(renderer, technique):
+    """Two 3 mm sheets 10 mm apart: the light reaching the visible face crossed 6 mm of matter
+    (index-matched parallel sheets transmit as one of their summed thickness), not 16 mm as if the
+    air between were tissue; one sheet 16 mm thick transmits as before (16 mm)."""
+    apart = renderer.render(sheets_apart(10.0), settings(technique)).hdr[24, 24, :3].astype(np.float64)
+    np.testing.assert_allclose(apart, expected_radiance(6.0), rtol=1e-3)
+    assert np.all(apart > 3 * expected_radiance(16.0))
+    thick = renderer.render(sheet(16.0), settings(technique)).hdr[24, 24, :3].astype(np.float64)
+    np.testing.assert_allclose(thick, expected_radiance(16.0), rtol=1e-3)

@@ -12,15 +12,24 @@ from tests.tsd_scenes import skin
 
 
 def _distance_texture(ctx, dist: np.ndarray):
-    h, w = dist.shape
-    tex = ctx.texture((w, h), 1, np.ascontiguousarray(dist, np.float32).tobytes(), dtype="f4")
+    """(H, W) or (H, W, 2) float map as a NEAREST texture."""
+    dist = np.asarray(dist)
+    h, w = dist.shape[:2]
+    comps = 1 if dist.ndim == 2 else dist.shape[2]
+    tex = ctx.texture((w, h), comps, np.ascontiguousarray(dist, np.float32).tobytes(), dtype="f4")
     tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
     tex.repeat_x = tex.repeat_y = False
     return tex
 
 
-def _lookup_setup(maps, matrices, eyes, shrink, mm_per_unit, material=None):
-    """A GLSLEvaluator setup binding lib/sss_translucency.glsl's uniforms and distance maps."""
+def _no_exit(ctx):
+    """An exit layer with no surface: one part everywhere (the lookup as without layers)."""
+    return _distance_texture(ctx, np.array([[[1e30, 0.0]]]))
+
+
+def _lookup_setup(maps, matrices, eyes, shrink, mm_per_unit, material=None, exits=(), part_gap=0.0):
+    """A GLSLEvaluator setup binding lib/sss_translucency.glsl's uniforms, distance maps and their
+    exit layers (`exits`, one texture per slot; _no_exit's for one part)."""
     from skinlab.gl.uniforms import set_array, set_uniforms
 
     def setup(prog):
@@ -28,11 +37,15 @@ def _lookup_setup(maps, matrices, eyes, shrink, mm_per_unit, material=None):
             tex.use(10 + slot)
             if f"u_distance{slot}" in prog:
                 prog[f"u_distance{slot}"].value = 10 + slot
+        for slot, tex in enumerate(exits):
+            tex.use(12 + slot)
+            if f"u_exit{slot}" in prog:
+                prog[f"u_exit{slot}"].value = 12 + slot
         if "u_shadow_matrix" in prog:
             mats = np.stack([m.T for m in matrices]).astype(np.float32)
             prog["u_shadow_matrix"].write(mats[: max(prog["u_shadow_matrix"].array_length, 1)].tobytes())
         set_array(prog, "u_light_eye", np.asarray(eyes, np.float64), 2)
-        set_uniforms(prog, {"u_thickness_shrink": shrink, "u_mm_per_unit": mm_per_unit})
+        set_uniforms(prog, {"u_thickness_shrink": shrink, "u_mm_per_unit": mm_per_unit, "u_part_gap": part_gap})
         if "u_light_shadow" in prog:
             ids = np.array([0, 1, -1, -1], np.int32)
             prog["u_light_shadow"].write(ids[: max(prog["u_light_shadow"].array_length, 1)].tobytes())
@@ -80,7 +93,8 @@ def test_thickness_lookup_matches_numpy_twin(ctx, glsl):
     back[:100] = rng.uniform(0.0, 1e-4, 100)  # grazing
     shrink, mm = 0.004, 20.0
     world, normal, back = (x.astype(np.float32).astype(np.float64) for x in (world, normal, back))
-    setup = _lookup_setup(texes, [m, m], eyes, shrink, mm)
+    none = _no_exit(ctx)
+    setup = _lookup_setup(texes, [m, m], eyes, shrink, mm, exits=(none, none))
     for slot in (0, 1):
         gpu = glsl.evaluate(
             "lib/sss_translucency.glsl",
@@ -96,7 +110,7 @@ def test_thickness_lookup_matches_numpy_twin(ctx, glsl):
         assert_close_fp32(gpu[:, 1], ref, rtol=1e-4, atol=1e-4, what=f"sss_thickness_mm slot {slot}")
         clamped = hit & (ref == 0)  # points in front of the first surface
         assert clamped.sum() > 50 and (ref[hit & ~clamped] >= shrink * mm).all()
-    for t in texes:
+    for t in (*texes, none):
         t.release()
 
 
@@ -194,7 +208,8 @@ def test_translucent_light_matches_numpy(ctx, glsl):
     l = np.array([0.0, 0.0, -1.0])
     e = np.array([2.0, 1.0, 0.5])
     shrink, mm = 0.01, 10.0
-    setup = _lookup_setup([tex, tex], [m, m], [eye, eye], shrink, mm, mat)
+    none = _no_exit(ctx)
+    setup = _lookup_setup([tex, tex], [m, m], [eye, eye], shrink, mm, mat, exits=(none, none))
     gpu = glsl.evaluate(
         "lib/sss_translucency.glsl",
         "sss_translucent_light(0, pos, nrm, vec3(0.0, 0.0, -1.0), vec3(2.0, 1.0, 0.5))",
@@ -210,3 +225,93 @@ def test_translucent_light_matches_numpy(ctx, glsl):
     assert np.all(ref[2] == 0) and np.all(ref[3] == 0)  # light in front; no surface in the map
     assert np.all(np.isfinite(ref[4])) and ref[4].max() < 1e-2 * ref[1].max()  # grazing: back ~ 0.001
     tex.release()
+    none.release()
+
+
+def test_layered_thickness_lookup_matches_numpy_twin(ctx, glsl):
+    """With the exit and next-entry layers (another part in front, air between): sss_thickness_mm
+    against thickness_mm on random layered maps, points in the first part, past its exit within and
+    beyond the part gap, with and without a next entry, exit cosines down to 0; within fp32."""
+    rng = np.random.default_rng(21)
+    h, w = 16, 24
+    first = rng.uniform(5.0, 6.0, (h, w))
+    exit_d = first + rng.uniform(0.5, 1.5, (h, w))
+    exit_c = rng.uniform(0.0, 1.0, (h, w))
+    nxt = exit_d + rng.uniform(1.0, 3.0, (h, w))
+    nxt[rng.uniform(size=(h, w)) < 0.15] = 1e30  # no next entry
+    exit_d[rng.uniform(size=(h, w)) < 0.1] = 1e30  # no exit: one part
+    dist = np.stack([first, nxt], -1)
+    ex = np.stack([exit_d, exit_c], -1)
+    tex, etex = _distance_texture(ctx, dist), _distance_texture(ctx, ex)
+    m = np.eye(4)
+    m[:3, :3] *= 0.5
+    m[:3, 3] = 0.5
+    eye = np.array([0.0, 0.0, 1.0, 0.0])  # travels +z
+    n = 3000
+    off = rng.uniform(0.12, 0.38, (n, 2)) + 0.5 * rng.integers(0, 2, (n, 2))
+    uv = (rng.integers(0, [w, h], (n, 2)) + off) / [w, h]
+    world = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, rng.uniform(5.2, 11.0, n)], 1)
+    normal = np.tile([0.0, 0.0, 1.0], (n, 1))
+    back = rng.uniform(0.05, 1.0, n)
+    shrink, gap, mm = 0.004, 0.3, 20.0
+    world, back = world.astype(np.float32).astype(np.float64), back.astype(np.float32).astype(np.float64)
+    setup = _lookup_setup([tex, tex], [m, m], [eye, eye], shrink, mm, exits=(etex, etex), part_gap=gap)
+    gpu = glsl.evaluate(
+        "lib/sss_translucency.glsl", "look(0, pos, nrm, c)", {"pos": world, "nrm": normal, "c": back}, 2,
+        prelude=LOOK, setup=setup,
+    )  # fmt: skip
+    ref, hit = tr.thickness_mm(dist, m, eye, world, normal, back, shrink, mm, exit_map=ex, part_gap=gap)
+    assert np.array_equal(gpu[:, 0] == 1.0, hit) and hit.all()
+    assert_close_fp32(gpu[:, 1], ref, rtol=1e-4, atol=1e-4, what="layered sss_thickness_mm")
+    lay = tr.part_layers(dist, ex, m, world - shrink * normal)
+    at = world[:, 2] - shrink
+    other = (lay[:, 0] < 1e29) & (at > lay[:, 0] + gap)
+    assert 500 < other.sum() < n - 500  # both cases present
+    one = tr.thickness_mm(dist[..., 0], m, eye, world, normal, back, shrink, mm)[0]
+    np.testing.assert_array_equal(ref[~other], one[~other])  # one part: as without layers
+    # past the first part the air between is not counted: thinner than the whole chord where the
+    # first part's exit cosine is no larger than the point's own
+    less = other & (lay[:, 1] <= back)
+    assert less.sum() > 200 and np.all(ref[less] < one[less])
+    for t in (tex, etex):
+        t.release()
+
+
+def _parallel_slabs_maps(direction, size, radius, faces):
+    """Layered distance maps of parallel slabs z in [a_k, b_k] (ascending along the light, which
+    travels along `direction` with d_z > 0): first surface, next part's entry, first part's exit and
+    its cosine, as skinlab/shaders/passes/shadow.frag writes them (its part gap ignored: the gaps are
+    wide)."""
+    first, m, eye = _slab_map(direction, size, radius, faces[0][0])
+    cos = float(direction[2] / np.linalg.norm(direction))
+    step = lambda z: first + (z - faces[0][0]) / cos  # the plane z's distance along each texel's ray
+    nxt = step(faces[1][0]) if len(faces) > 1 else np.full(first.shape, 1e30)
+    ex = np.stack([step(faces[0][1]), np.full(first.shape, cos)], -1)
+    return np.stack([first, nxt], -1), ex, m, eye
+
+
+def test_two_slabs_apart_are_not_one_thick_slab():
+    """Two 3 mm slabs 10 mm apart, lit at 30 degrees from behind: the front slab's far face reads
+    6 mm (the two slabs; index-matched parallel slabs transmit as one slab of their summed
+    thickness), not the 16 mm from the back slab's lit face (slab, air and slab as if all tissue);
+    the back slab's far face 3 mm; one slab 16 mm thick still reads 16 mm."""
+    d = (np.sin(np.radians(30)), 0.0, np.cos(np.radians(30)))
+    size, radius = 512, 40.0
+    shrink, gap = radius / size, 8 * radius / size
+    rng = np.random.default_rng(5)
+    xy = rng.uniform(-20, 20, (2000, 2))
+    nrm = np.tile([0.0, 0.0, 1.0], (2000, 1))
+    back = np.full(2000, d[2])
+    dist, ex, m, eye = _parallel_slabs_maps(d, size, radius, [(-16.0, -13.0), (-3.0, 0.0)])
+    front = np.column_stack([xy, np.zeros(2000)])
+    got, hit = tr.thickness_mm(dist, m, eye, front, nrm, back, shrink, 1.0, exit_map=ex, part_gap=gap)
+    assert hit.all()
+    np.testing.assert_allclose(got, 6.0, atol=1e-6)
+    air, _ = tr.thickness_mm(dist[..., 0], m, eye, front, nrm, back, shrink, 1.0)  # no layers: as before
+    np.testing.assert_allclose(air, 16.0, atol=1e-6)
+    back_face = np.column_stack([xy, np.full(2000, -13.0)])
+    got, _ = tr.thickness_mm(dist, m, eye, back_face, nrm, back, shrink, 1.0, exit_map=ex, part_gap=gap)
+    np.testing.assert_allclose(got, 3.0, atol=1e-6)
+    dist, ex, m, eye = _parallel_slabs_maps(d, size, radius, [(-16.0, 0.0)])
+    got, _ = tr.thickness_mm(dist, m, eye, front, nrm, back, shrink, 1.0, exit_map=ex, part_gap=gap)
+    np.testing.assert_allclose(got, 16.0, atol=1e-6)

@@ -1,11 +1,31 @@
+"""The shadow lookup (skinlab/shaders/lib/shadow.glsl) against its NumPy twin (skinlab/scene/optics/shadow.py),
+and its depth bias: sized to the map's texel at the receiver, so that a lit plane stays lit under
+the 3x3 PCF at any angle and light does not leak through a shadow at grazing incidence, whatever the
+scene's scale."""
+
+import math
+
 import moderngl
 import numpy as np
+import pytest
 
 from skinlab.gl.glsl_eval import assert_close_fp32
+from skinlab.scene import transform as tf
 from skinlab.scene.optics import shadow
+from skinlab.scene.optics.constants import SHADOW_BIAS_TEXELS, SHADOW_SLOPE_MAX, SHADOW_SLOPE_TEXELS
+
+ORTHO = np.eye(4)
+ORTHO[:3, :3] *= 0.5
+ORTHO[:3, 3] = 0.5  # world [-1, 1]^3 -> texture [0, 1]^3
+# a point light at z = 4 looking down -z, 40 degrees wide, depth 2..6 (clip -> texture space)
+CLIP_TO_TEXTURE = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1.0]])
+_VIEW = np.eye(4)
+_VIEW[2, 3] = -4.0  # the light at z = 4, looking down -z
+PERSPECTIVE = CLIP_TO_TEXTURE @ tf.perspective(math.radians(40), 1.0, 2.0, 6.0) @ _VIEW
 
 
-def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl):
+@pytest.mark.parametrize("matrix", ["orthographic", "perspective"])
+def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
     rng = np.random.default_rng(7)
     h, w = 16, 24
     depth = rng.uniform(0.2, 0.9, (h, w)).astype(np.float32)
@@ -13,16 +33,16 @@ def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl):
     tex.compare_func = "<="
     tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
     tex.repeat_x = tex.repeat_y = False
-    m = np.eye(4)
-    m[:3, :3] *= 0.5
-    m[:3, 3] = 0.5  # world [-1, 1]^3 -> texture [0, 1]^3
+    m = ORTHO if matrix == "orthographic" else PERSPECTIVE
     n = 2000
     # texel centres jittered away from texel borders, so NEAREST picks the same texel on both sides
     uv = (rng.integers(0, [w, h], (n, 2)) + rng.uniform(0.2, 0.8, (n, 2))) / [w, h]
     z = rng.uniform(0.0, 1.0, n)
-    world = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, z * 2 - 1], 1)
-    world[:50, 0] = 1.5  # outside the map: lit
-    nol = rng.uniform(-0.2, 1.0, n)  # includes grazing and back-facing (bias clamps)
+    ndc = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, z * 2 - 1, np.ones(n)], 1)
+    world = ndc @ np.linalg.inv(m @ np.linalg.inv(CLIP_TO_TEXTURE)).T if matrix == "perspective" else ndc
+    world = world[:, :3] / world[:, 3:]
+    world[:50, 0] = 50.0  # outside the map: lit
+    nol = rng.uniform(-0.2, 1.0, n)  # includes grazing and back-facing (the slope clamps)
     world, nol = world.astype(np.float32).astype(np.float64), nol.astype(np.float32).astype(np.float64)
     gpu = glsl.evaluate(
         "lib/shadow.glsl",
@@ -32,8 +52,94 @@ def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl):
         samplers={"u_map": ("sampler2DShadow", tex)},
     )[:, 0]
     ref = shadow.shadow_pcf(depth, m, world, nol)
+    p = np.c_[world, np.ones(n)] @ m.T
+    zt = p[:, 2] / p[:, 3]
     # a tap whose reference depth lies within fp32 rounding of the stored depth may flip
-    margin = np.abs(depth.reshape(-1)[None, :] - (z[:, None] - shadow.shadow_bias(nol)[:, None])).min(1) > 1e-5
+    bias = shadow.shadow_bias(nol, m, world, (w, h))
+    margin = np.abs(depth.reshape(-1)[None, :] - (zt[:, None] - bias[:, None])).min(1) > 1e-5
     assert margin.mean() > 0.95
     assert_close_fp32(gpu[margin], ref[margin], what="shadow_pcf")
     assert (ref[:50] == 1).all() and 0 < ref[50:].mean() < 1
+    # the bias term alone, GPU against NumPy (the texel scale from the matrix's rows)
+    gpu_bias = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_bias(u_m, u_m * vec4(world, 1.0), vec2(24.0, 16.0), nol)",
+        {"world": world[50:], "nol": nol[50:]},
+        uniforms={"u_m": ("mat4", m)},
+    )[:, 0]
+    assert_close_fp32(gpu_bias, bias[50:], rtol=1e-4, what="shadow_bias")
+
+
+def test_bias_is_sized_to_the_texel_and_bounded():
+    """The bias is a texel plus the slope over the PCF's reach in texels, clamped: scaling the scene
+    scales it in world units (a constant in normalised depth did not), a larger map shrinks it, and at
+    grazing incidence it stops growing (it was 0.0015 x (1 + 3 tan theta) of the map's depth range:
+    at NoL 0.05, 9 % of it)."""
+    nol = np.array([1.0, 0.707, 0.2, 0.05, 0.0, -0.5])
+    for scale in (1.0, 1000.0):
+        m = ORTHO.copy()
+        m[:3, :3] /= scale  # world [-scale, scale]^3 -> [0, 1]^3
+        world = np.zeros((len(nol), 3))
+        for size in (512, 2048):
+            texel_world = 2.0 * scale / size
+            got = shadow.shadow_bias(nol, m, world, (size, size)) * 2.0 * scale  # texture depth -> world
+            tan = np.minimum(np.sqrt(1 - np.clip(nol, 1e-3, 1) ** 2) / np.clip(nol, 1e-3, 1), SHADOW_SLOPE_MAX)
+            np.testing.assert_allclose(got, texel_world * (SHADOW_BIAS_TEXELS + SHADOW_SLOPE_TEXELS * tan), rtol=1e-12)
+            assert got[0] == pytest.approx(texel_world)  # facing the light: one texel
+            assert got[3] == got[4] == got[5] == pytest.approx(texel_world * 16.0)  # grazing: bounded
+    # perspective: the texel grows with the distance from the light
+    near = shadow.shadow_texel_scale(PERSPECTIVE, [[0.0, 0.0, 1.0]], (256, 256))[0]
+    far = shadow.shadow_texel_scale(PERSPECTIVE, [[0.0, 0.0, -1.0]], (256, 256))[0]
+    assert far[0] / near[0] == pytest.approx(5.0 / 3.0, rel=1e-9)  # distances 3 and 5 from the light
+    assert near[0] == pytest.approx(2 * 3 * math.tan(math.radians(20)) / 256, rel=1e-9)
+
+
+def _tilted_plane_map(size, slope):
+    """Orthographic depth map (texture depth) of the plane z = slope x seen by a light travelling
+    along -z through ORTHO (world [-1, 1]^3): each texel holds the plane's depth at its centre."""
+    x = (np.arange(size) + 0.5) / size * 2 - 1
+    zworld = slope * np.tile(x, (size, 1))
+    return (0.5 - 0.5 * zworld).astype(np.float64)  # ORTHO maps z to depth 0.5 z + 0.5; light looks down -z
+
+
+@pytest.mark.parametrize("degrees", [0.0, 30.0, 60.0, 75.0])
+def test_a_lit_plane_stays_lit(degrees):
+    """Points on a plane tilted by theta to the light, with its own depth map: all 9 taps lit (no
+    acne) up to tan theta = SHADOW_SLOPE_MAX."""
+    size, slope = 256, math.tan(math.radians(degrees))
+    # the map's depth runs the other way from ORTHO's z (the light travels -z): flip it
+    m = ORTHO.copy()
+    m[2, 2] = -0.5
+    dmap = _tilted_plane_map(size, slope)
+    rng = np.random.default_rng(1)
+    x = rng.uniform(-0.9, 0.9, 3000)
+    y = rng.uniform(-0.9, 0.9, 3000)
+    world = np.stack([x, y, slope * x], 1)
+    nol = np.full(len(x), math.cos(math.radians(degrees)))
+    assert np.all(shadow.shadow_pcf(dmap, m, world, nol) == 1.0)
+
+
+@pytest.mark.parametrize("degrees", [45.0, 80.0, 87.0])
+def test_no_light_through_a_close_occluder_at_grazing_light(degrees):
+    """An occluder 24 texels in front of a receiver along the light (a plane at constant depth over
+    the half x < 0 of a 1024 map whose depth range is 8 times its width, as a light's box around a
+    head seen at close range): receivers behind it are dark at every angle, grazing included. The
+    old constant bias, 0.0015 x (1 + 3 tan theta) of the depth range, let light through from 45
+    degrees on."""
+    size, depth_range = 1024, 16.0
+    m = np.eye(4)
+    m[0, 0] = m[1, 1] = 0.5  # x, y in [-1, 1] -> [0, 1]
+    m[0, 3] = m[1, 3] = 0.5
+    m[2, 2], m[2, 3] = -1.0 / depth_range, 0.5  # the light travels -z; z in [-8, 8] -> depth [1, 0]
+    texel = 2.0 / size
+    gap = 24 * texel  # along the light, world units
+    dmap = np.full((size, size), 0.5)  # the receiver's own surface at z = 0 (depth 0.5), lit half
+    dmap[:, : size // 2] = 0.5 - gap / depth_range  # the occluder, gap closer to the light, over x < 0
+    rng = np.random.default_rng(2)
+    world = np.stack([rng.uniform(-0.9, -0.1, 2000), rng.uniform(-0.9, 0.9, 2000), np.zeros(2000)], 1)
+    nol = np.full(2000, math.cos(math.radians(degrees)))
+    assert np.all(shadow.shadow_pcf(dmap, m, world, nol) == 0.0)
+    lit = world * [-1.0, 1.0, 1.0]  # the other half: lit
+    assert np.all(shadow.shadow_pcf(dmap, m, lit, nol) == 1.0)
+    old_bias = 0.0015 * (1.0 + 3.0 * math.tan(math.radians(min(degrees, 87.13)))) * depth_range  # world units
+    assert old_bias > gap  # what let the light through

@@ -1,0 +1,309 @@
+"""Every technique (default settings) on the close-up reference scenes against their cached
+path-traced truth (issue 21; docs/ground-truth.md, "Close-ups"): relative L1 on 4x4 blocks and per
+pixel, per-channel energy, and per scene what it was made to measure, each with the truth's own
+noise (the same measure between the halves of its passes):
+
+* slit scenes: the line profile (the image averaged along the slit, per channel): its relative L1
+  against the truth's, and the fraction of the energy in view beyond 2, 5 and 10 mm from the slit;
+* the nose's shadow: the mean radiance of the deep shadow (camera-visible points the light does not
+  reach, more than 2 mm from any lit one: a ray cast with Embree, independent of the shadow maps)
+  relative to the lit cheek's, and the relative L1 within 3 mm of the shadow's edges (edge region);
+* the two back-lit slabs: the front slab's and the back slab's energy apart (the light through
+  both slabs and through one).
+
+Nothing is path-traced here: the references must be cached (the commands are in CLOSEUPS and
+docs/ground-truth.md). Frames are supersampled like the truth's pixels (TRUTH_SUPERSAMPLE).
+
+    python -m tools.closeup_table [SCENES] [TECHNIQUES] [--profiles OUT.npz]   # comma-separated; default all
+
+SKINLAB_BOUNCES=N and SKINLAB_SSS_MODEL=<model> as in tools/truth_table.py; SKINLAB_TRANSLUCENCY=0
+renders with every technique's translucency off."""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+from skinlab.bench.truth_ledger import REFERENCE_SCENES, TRUTH_SUPERSAMPLE
+from skinlab.truth.compare import image_error
+
+TECHNIQUES = ["none", "tint", "tsd", "exact", "ssss", "disk", "preintegrated"]
+
+
+@dataclass(frozen=True)
+class Closeup:
+    size: tuple[int, int]
+    spp: int
+    rr_depth: int = 64
+    kind: str = ""  # "slit" | "shadow" | "slabs" | ""
+    mm_per_px: float = 0.0  # slit scenes: along the profile axis (the image's columns)
+
+    def command(self, scene: str) -> str:
+        rr = f" --rr-depth {self.rr_depth}" if self.rr_depth != 64 else ""
+        return (
+            f"skinlab reference skinlab/assets/scenes/reference/{scene}.toml --size {self.size[0]}x{self.size[1]} "
+            f"--spp {self.spp}{rr} --out out/truth/{scene}.exr"
+        )
+
+
+# the truths measured in docs/ground-truth.md ("Close-ups"): the smallest size and spp that decide the
+# comparison on a shared 2-core machine (a few minutes each; the truth's noise is printed beside every
+# figure). The slits keep their 256 columns (the profile's resolution) and average 16 rows.
+CLOSEUPS = {
+    "slit-skin1": Closeup((256, 16), 256, kind="slit", mm_per_px=0.135),
+    "slit-marble": Closeup((256, 16), 64, rr_depth=1024, kind="slit", mm_per_px=0.35),
+    "nose-shadow-skin1": Closeup((96, 96), 256, kind="shadow"),
+    "ear-backlit-skin1": Closeup((96, 96), 64),
+    "point-light-skin1": Closeup((64, 64), 128),
+    "slabs-gap-backlit-skin1": Closeup((64, 64), 512, kind="slabs"),
+}
+TAIL_MM = (2.0, 5.0, 10.0)
+DEEP_SHADOW_MM = 2.0  # deep shadow: more than this from any lit point (the red diffusion length is 2.3 mm)
+EDGE_MM = 3.0  # edge region: within this of the shadow's edge, both sides
+
+
+def load_closeup_truth(scene, spec: Closeup):
+    """The cached reference of `spec` (whole, or assembled from its cached passes), or None."""
+    from skinlab.truth.reference import ReferenceRequest, ReferenceUnavailable, render_reference
+
+    req = ReferenceRequest(spec.size[0], spec.size[1], spp=spec.spp, rr_depth=spec.rr_depth)
+    try:
+        return render_reference(scene, req, progress=False, render=False)
+    except ReferenceUnavailable:
+        return None
+
+
+def line_profile(img: np.ndarray) -> np.ndarray:
+    """(W, 3): the image averaged along the slit (its rows)."""
+    return np.asarray(img[..., :3], np.float64).mean(axis=0)
+
+
+def profile_error(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.abs(a - b).sum() / max(np.abs(b).sum(), 1e-30))
+
+
+def tail_fractions(profile: np.ndarray, mm_per_px: float) -> np.ndarray:
+    """(len(TAIL_MM), 3): the fraction of each channel's light in view farther than each distance
+    from the slit (the middle of the image)."""
+    w = profile.shape[0]
+    x = np.abs((np.arange(w) + 0.5 - w / 2) * mm_per_px)
+    tot = np.maximum(profile.sum(axis=0), 1e-30)
+    return np.array([profile[x > t].sum(axis=0) / tot for t in TAIL_MM])
+
+
+def camera_rays(scene, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Origins and unit directions (H*W, 3) through the pixels' centres, row 0 at the top."""
+    cam = scene.camera
+    m = np.asarray(cam.world_matrix, np.float64)
+    t = math.tan(cam.yfov / 2)
+    aspect = width / height
+    jj, ii = np.meshgrid(np.arange(height), np.arange(width), indexing="ij")
+    x = ((ii + 0.5) / width * 2 - 1) * t * aspect
+    y = (1 - (jj + 0.5) / height * 2) * t
+    d = np.stack([x, y, -np.ones_like(x)], -1).reshape(-1, 3) @ m[:3, :3].T
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    return np.broadcast_to(m[:3, 3], d.shape).copy(), d
+
+
+def ray_geometry(scene, width: int, height: int):
+    """Per pixel: the index of the visible mesh node its centre sees (-1: none) and whether the
+    first light reaches that point (shadow ray toward it; Embree through trimesh)."""
+    import trimesh
+    from trimesh.ray.ray_pyembree import RayMeshIntersector
+
+    from skinlab.scene.interreflection import world_geometry
+
+    nodes = scene.mesh_nodes()
+    pos, faces, owner, start = [], [], [], 0
+    for k, node in enumerate(nodes):
+        p, _ = world_geometry(node)
+        pos.append(p)
+        faces.append(node.mesh.indices.astype(np.int64) + start)
+        owner.append(np.full(len(node.mesh.indices), k))
+        start += len(p)
+    mesh = trimesh.Trimesh(np.concatenate(pos), np.concatenate(faces), process=False)
+    owner = np.concatenate(owner)
+    ray = RayMeshIntersector(mesh)
+    o, d = camera_rays(scene, width, height)
+    tri, idx, loc = ray.intersects_id(o, d, multiple_hits=False, return_locations=True)
+    node = np.full(len(o), -1)
+    node[idx] = owner[tri]
+    light = scene.lights()[0]
+    lit = np.zeros(len(o), bool)
+    if len(idx):
+        nrm = mesh.face_normals[tri]
+        nrm = np.where((np.einsum("ij,ij->i", nrm, d[idx]) > 0)[:, None], -nrm, nrm)
+        if light.kind == "directional":
+            to = np.broadcast_to(-light.direction, loc.shape)
+            far = np.full(len(loc), np.inf)
+        else:
+            v = light.world_position - loc
+            far = np.linalg.norm(v, axis=1)
+            to = v / far[:, None]
+        facing = np.einsum("ij,ij->i", nrm, to) > 0
+        eps = 1e-4 * float(np.linalg.norm(mesh.bounds[1] - mesh.bounds[0]))
+        t2, i2, l2 = ray.intersects_id(loc + nrm * eps, to, multiple_hits=False, return_locations=True)
+        blocked = np.zeros(len(loc), bool)
+        if len(i2):
+            blocked[i2] = np.linalg.norm(l2 - loc[i2], axis=1) < far[i2]
+        lit[idx] = facing & ~blocked
+    return node.reshape(height, width), lit.reshape(height, width)
+
+
+def mm_per_pixel(scene, width: int, height: int) -> np.ndarray:
+    """Approximate millimetres per pixel at each pixel's visible point (distance x pixel angle)."""
+    import trimesh
+    from trimesh.ray.ray_pyembree import RayMeshIntersector
+
+    from skinlab.scene.interreflection import world_geometry
+
+    pos, faces, start = [], [], 0
+    for node in scene.mesh_nodes():
+        p, _ = world_geometry(node)
+        pos.append(p)
+        faces.append(node.mesh.indices.astype(np.int64) + start)
+        start += len(p)
+    mesh = trimesh.Trimesh(np.concatenate(pos), np.concatenate(faces), process=False)
+    o, d = camera_rays(scene, width, height)
+    _, idx, loc = RayMeshIntersector(mesh).intersects_id(o, d, multiple_hits=False, return_locations=True)
+    dist = np.full(len(o), np.nan)
+    dist[idx] = np.linalg.norm(loc - o[idx], axis=1)
+    return (dist * 2 * math.tan(scene.camera.yfov / 2) / height * scene.mm_per_unit).reshape(height, width)
+
+
+def region_error(img, ref, mask) -> float:
+    a, b = np.asarray(img[..., :3], np.float64)[mask], np.asarray(ref[..., :3], np.float64)[mask]
+    return float(np.abs(a - b).sum() / max(b.sum(), 1e-30))
+
+
+def region_level(img, mask, lit) -> float:
+    """Mean luminance over `mask` relative to the mean over `lit`."""
+    lum = np.asarray(img[..., :3], np.float64) @ np.array([0.2126, 0.7152, 0.0722])
+    return float(lum[mask].mean() / max(lum[lit].mean(), 1e-30))
+
+
+def shadow_regions(scene, size):
+    """(deep shadow, lit, edge region) masks for a shadow scene."""
+    from scipy.ndimage import distance_transform_edt
+
+    node, lit = ray_geometry(scene, *size)
+    mm = np.nanmedian(mm_per_pixel(scene, *size))
+    seen = node >= 0
+    to_lit = distance_transform_edt(~lit) * mm
+    to_shadow = distance_transform_edt(lit | ~seen) * mm
+    deep = seen & ~lit & (to_lit > DEEP_SHADOW_MM)
+    lit_far = lit & (to_shadow > DEEP_SHADOW_MM)
+    edge = seen & (np.where(lit, to_shadow, to_lit) <= EDGE_MM)
+    return deep, lit_far, edge
+
+
+def main(argv: list[str]) -> int:
+    from skinlab.gl.context import create_headless_context
+    from skinlab.render.renderer import Renderer
+    from skinlab.render.settings import RenderSettings
+    from skinlab.scene.scenefile import load_scene
+
+    out = None
+    if "--profiles" in argv:
+        k = argv.index("--profiles")
+        out = argv[k + 1]
+        argv = argv[:k] + argv[k + 2 :]
+    scenes = argv[0].split(",") if argv and argv[0] else list(CLOSEUPS)
+    techs = argv[1].split(",") if len(argv) > 1 and argv[1] else TECHNIQUES
+    extra = {}
+    if os.environ.get("SKINLAB_BOUNCES"):
+        extra["bounces"] = int(os.environ["SKINLAB_BOUNCES"])
+    model = os.environ.get("SKINLAB_SSS_MODEL") or None
+    r = Renderer(create_headless_context())
+    saved = {}
+    print("load average at start: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
+    for s in scenes:
+        spec = CLOSEUPS[s]
+        scene = load_scene(REFERENCE_SCENES / f"{s}.toml")
+        truth = load_closeup_truth(scene, spec)
+        if truth is None:
+            print(f"{s}: no cached reference; render it with\n    {spec.command(s)}")
+            continue
+        t_img, ha, hb = truth.image, truth.half_a, truth.half_b
+        noise = truth.noise
+        head = (
+            f"{s:24s} truth {spec.size[0]}x{spec.size[1]} {spec.spp} spp: noise 4x4 "
+            f"{100 * noise['rel_l1_block']:.2f} %, px {100 * noise['rel_l1']:.2f} %"
+        )
+        masks = None
+        if spec.kind == "slit":
+            pa, pb, pt = line_profile(ha), line_profile(hb), line_profile(t_img)
+            head += f", profile {100 * profile_error(pa, pb):.2f} %"
+            ta, tb = tail_fractions(pa, spec.mm_per_px), tail_fractions(pb, spec.mm_per_px)
+            tt = tail_fractions(pt, spec.mm_per_px)
+            head += "; truth's light beyond " + ", ".join(
+                f"{d:g} mm "
+                + "/".join(f"{100 * v:.2f}" for v in tt[k])
+                + " (+-"
+                + "/".join(f"{50 * abs(x):.2f}" for x in ta[k] - tb[k])
+                + ") %"
+                for k, d in enumerate(TAIL_MM)
+            )
+            saved[f"{s}/truth"] = pt
+            saved[f"{s}/truth_a"], saved[f"{s}/truth_b"] = pa, pb
+        elif spec.kind == "shadow":
+            masks = shadow_regions(scene, spec.size)
+            deep, lit, edge = masks
+            lv = region_level(t_img, deep, lit)
+            lva, lvb = region_level(ha, deep, lit), region_level(hb, deep, lit)
+            head += (
+                f"; deep shadow {deep.sum()} px at {100 * lv:.3f} % of the lit level (+-{50 * abs(lva - lvb):.3f}), "
+                f"edge region {edge.sum()} px, noise {100 * region_error(ha, hb, edge):.2f} %"
+            )
+        elif spec.kind == "slabs":
+            node, _ = ray_geometry(scene, *spec.size)
+            masks = (node == 0, node == 1)
+        print(head, flush=True)
+        for t in techs:
+            own = {}
+            if os.environ.get("SKINLAB_TRANSLUCENCY") == "0" and t not in ("none", "tint"):
+                own["translucency"] = False
+            rs = RenderSettings.for_technique(
+                t, spec.size[0], spec.size[1], supersample=TRUTH_SUPERSAMPLE, sss_model=model, **extra, **own
+            )
+            img = r.render(scene, rs, readback=("hdr",)).hdr
+            e = image_error(img, t_img)
+            energy = "/".join(f"{100 * x:+.1f}" for x in e["energy"])
+            line = f"  {t:14s} 4x4 {100 * e['rel_l1_block']:6.2f} %  px {100 * e['rel_l1']:6.2f} %  energy {energy} %"
+            if spec.kind == "slit":
+                pf = line_profile(img)
+                tf = tail_fractions(pf, spec.mm_per_px)
+                line += f"  profile {100 * profile_error(pf, pt):6.2f} %  beyond " + ", ".join(
+                    f"{d:g} mm " + "/".join(f"{100 * v:.2f}" for v in tf[k]) for k, d in enumerate(TAIL_MM)
+                )
+                saved[f"{s}/{t}"] = pf
+            elif spec.kind == "shadow":
+                deep, lit, edge = masks
+                line += (
+                    f"  deep shadow {100 * region_level(img, deep, lit):.3f} %"
+                    f"  edge region {100 * region_error(img, t_img, edge):6.2f} %"
+                )
+            elif spec.kind == "slabs":
+                front, back = masks
+                ef = image_error(img, t_img, mask=front)["energy"]
+                eb = image_error(img, t_img, mask=back)["energy"]
+                line += (
+                    "  front slab "
+                    + "/".join(f"{100 * x:+.1f}" for x in ef)
+                    + " %  back slab "
+                    + "/".join(f"{100 * x:+.1f}" for x in eb)
+                    + " %"
+                )
+            print(line, flush=True)
+    print("load average at end: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
+    if out:
+        np.savez(out, **saved)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
