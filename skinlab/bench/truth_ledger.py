@@ -93,8 +93,19 @@ class TruthSpec:
         )
 
 
-def reference_scene_names() -> list[str]:
-    return sorted(p.stem for p in REFERENCE_SCENES.glob("*.toml"))
+def reference_scene_names(every: bool = False) -> list[str]:
+    """The bundled reference scenes the ledger measures by default: those whose ``[measure]`` does not
+    say ``ledger = false`` (read from the TOML alone, no scene built); ``every``: all of them."""
+    import tomllib
+
+    names = []
+    for p in sorted(REFERENCE_SCENES.glob("*.toml")):
+        if not every:
+            measure = tomllib.loads(p.read_text(encoding="utf-8")).get("measure", {})
+            if isinstance(measure, dict) and measure.get("ledger", True) is False:
+                continue
+        names.append(p.stem)
+    return names
 
 
 # Quieter references some scenes have, rendered elsewhere (tools/gpu_reference.py on a lent GPU, see

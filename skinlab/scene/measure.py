@@ -13,6 +13,7 @@ profile_band_mm = 40          # average only pixels within 40 mm of the origin a
 line_width_mm = 2             # a line's (slit's) width, for its edge region (default 0)
 edge_mm = 10                  # the edge region: within 10 mm of the edge (a line: of its sides)
                               # (default: 3 diffusion lengths of the scene's most diffuse material)
+ledger = false                # left out of the ledger's default scene list (default true)
 ```
 
 With no profile the edge region comes from the plain frame's light: pixels within ``edge_mm`` of
@@ -39,6 +40,7 @@ class MeasureSpec:
     profile_band_mm: float | None = None
     line_width_mm: float = 0.0
     edge_mm: float | None = None
+    ledger: bool = True  # in the ledger's default scene list (skinlab/bench/truth_ledger.py reference_scene_names)
 
     def __post_init__(self) -> None:
         if self.profile not in PROFILES:
@@ -58,9 +60,9 @@ class MeasureSpec:
         return self.profile != "none"
 
 
-def parse_measure(table: dict, num, vec, string) -> MeasureSpec:
+def parse_measure(table: dict, num, vec, string, boolean=None) -> MeasureSpec:
     """A MeasureSpec from a scene file's [measure] table, with the scene file's typed readers
-    (num(where, value, lo, hi, lo_open), vec(where, value), string(where, value))."""
+    (num(where, value, lo, hi, lo_open), vec(where, value), string(where, value), boolean(where, value))."""
     w = "[measure]"
     kw: dict = {}
     if "tests" in table:
@@ -76,4 +78,8 @@ def parse_measure(table: dict, num, vec, string) -> MeasureSpec:
     for key in ("line_width_mm", "edge_mm"):
         if key in table:
             kw[key] = num(f"{w}.{key}", table[key], 0.0, None, False)
+    if "ledger" in table:
+        if boolean is None:
+            raise ValueError("[measure].ledger: no boolean reader given")
+        kw["ledger"] = boolean(f"{w}.ledger", table["ledger"])
     return MeasureSpec(**kw)

@@ -275,6 +275,13 @@ SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
             "the line's sides, else of the plain frame's light edges; default 3 x 1/sigma_tr of the scene's most "
             "diffuse channel",
         ),
+        Key(
+            "ledger",
+            "boolean",
+            "true",
+            "false: left out of the ledger's default scene list (a scene whose truth needs its own frame shape or "
+            "path depth, such as the 16:1 slits; `--scenes` still takes it)",
+        ),
     ),
 }
 
@@ -715,7 +722,7 @@ def _build(path: Path, data: dict) -> Scene:
         table = _table("[measure]", data["measure"])
         _known("[measure]", table, _keys("[measure]"))
         try:
-            scene.measure = parse_measure(table, _num, _vec, _str)
+            scene.measure = parse_measure(table, _num, _vec, _str, _bool)
         except ValueError as exc:
             raise SceneFileError(str(exc)) from None
     if not scene.mesh_nodes(visible_only=False):

@@ -100,6 +100,7 @@ def test_measure_table_reads_and_names_bad_keys(tmp_path):
         ("edge_mm = -1", "[measure].edge_mm"),
         ("profile_range_mm = 0", "[measure].profile_range_mm"),
         ("colour = 3", "[measure]: unknown key(s) colour"),
+        ('ledger = "no"', "[measure].ledger"),
     ):
         p = tmp_path / "s.toml"
         meshes = str(SLAB_EDGE.parent.parent.parent / "meshes")
@@ -107,6 +108,19 @@ def test_measure_table_reads_and_names_bad_keys(tmp_path):
         with pytest.raises(SceneFileError) as exc:
             load_scene(p)
         assert str(exc.value).startswith(str(p)) and says in str(exc.value), str(exc.value)
+
+
+def test_scenes_that_say_ledger_false_are_left_out_of_the_default_list():
+    """The slits (16:1 frames, marble's path depth) say `ledger = false`: the ledger's default scene list
+    leaves them out, the full list and the scene itself keep them."""
+    from skinlab.bench.truth_ledger import reference_scene_names
+    from skinlab.scene.scenefile import load_scene
+
+    default, every = reference_scene_names(), reference_scene_names(every=True)
+    assert {"slit-skin1", "slit-marble"} <= set(every) - set(default)
+    assert {"head-skin1-matched", "slab-edge-skin1", "nose-shadow-skin1"} <= set(default)
+    assert load_scene("slit-skin1").measure.ledger is False
+    assert load_scene("slab-edge-skin1").measure.ledger is True
 
 
 def test_pixel_points_see_the_declared_edge_where_the_truth_has_it():
