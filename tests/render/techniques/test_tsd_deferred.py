@@ -87,3 +87,25 @@ def test_the_isotropic_maps_leave_the_forward_pass_anisotropic(ctx, head):
     finally:
         r.release()
     np.testing.assert_array_equal(got, want)
+
+
+def test_deferred_irradiance_carries_the_sky_occlusion(ctx, monkeypatch):
+    """Under an environment map the G-buffer carries each vertex's sky occlusion (lib/sky_vertex.glsl's
+    coefficients, techniques/tsd/surface.glsl): the deferred irradiance equals the rasterised one, and
+    the occlusion is really read (turning it off changes the texture)."""
+    from skinlab.scene.envmap import resolve_map
+    from skinlab.scene.scenefile import load_scene
+
+    scene = load_scene("head")
+    scene.environment.map = resolve_map("studio", None)
+    out = {}
+    for deferred in (False, True):
+        monkeypatch.setattr(tsd_plan, "deferred_irradiance", lambda device, d=deferred: d)
+        out[deferred] = _textures(ctx, scene, size=128)
+    (_, raster), (res_d, deferred) = out[False], out[True]
+    assert "sky_occlusion" in res_d.plan.names()
+    assert next(p for p in res_d.plan.passes if p.kind == "tsd_irradiance").params.deferred
+    a, b = raster[0], deferred[0]  # the raw irradiance
+    assert np.abs(a - b).max() <= 2e-5 * max(float(np.abs(a).max()), 1e-6), float(np.abs(a - b).max())
+    _, open_sky = _textures(ctx, scene, size=128, sky_occlusion=False)
+    assert np.abs(open_sky[0] - b).max() > 1e-3 * float(np.abs(b).max())
