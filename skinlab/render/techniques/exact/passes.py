@@ -9,7 +9,6 @@ import moderngl
 import numpy as np
 
 from skinlab.gl.uniforms import set_uniforms
-from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.techniques.tsd.passes import TsdPass, store
 from skinlab.render.techniques.tsd.plan import TsdExactParams
 from skinlab.scene.optics.tsd import exact_profile_lut, material_medium
@@ -79,12 +78,6 @@ class TsdExactPass(TsdPass):
         t.irradiance.use(0)
         t.stretch.use(1)
         lut.use(2)
-        if prm.compute:
-            bind_images(prog, {"u_dst": dst})
-            dispatch(prog, (size, size))
-        else:
-            t.fbo(ctx, dst).use()
-            ctx.viewport = (0, 0, size, size)
-            self.r.fullscreen(prog)
+        t.draw_into(self.r, prog, dst, prm.compute)
         t.irradiance.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self.publish(frame, p)

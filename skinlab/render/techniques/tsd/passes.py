@@ -92,6 +92,17 @@ class TsdNodeTargets:
             f = self.fbos[key] = ctx.framebuffer([tex, *more], depth)
         return f
 
+    def draw_into(self, renderer, prog, dst: moderngl.Texture, compute: bool) -> None:
+        """Run `prog` over every texel of `dst` (this node's size): a compute shader writing image
+        `u_dst`, or a fullscreen fragment pass into `dst` (the two paths of a blur or a gather)."""
+        if compute:
+            bind_images(prog, {"u_dst": dst})
+            dispatch(prog, (self.size, self.size))
+        else:
+            self.fbo(renderer.ctx, dst).use()
+            renderer.ctx.viewport = (0, 0, self.size, self.size)
+            renderer.fullscreen(prog)
+
     def strip_mask(self, renderer, strips: np.ndarray):
         """`strips` (seams.node_border_strips) drawn once into a depth renderbuffer (0.5 on them, 0
         elsewhere), kept until they change (a new mesh version or size): a fullscreen pass tested
@@ -557,7 +568,7 @@ class TsdBlurPass(TsdPass):
 
     def run(self, frame, p) -> None:
         prm: TsdBlurParams = p.params
-        ctx, size, step = self.r.ctx, prm.size, prm.step
+        ctx, step = self.r.ctx, prm.step
         t = self.node_targets(p)
         src = t.irradiance if step.level == 0 else t.level(ctx, step.level - 1)
         dst = t.level(ctx, step.level)
@@ -577,13 +588,7 @@ class TsdBlurPass(TsdPass):
         for axis, (a, b) in enumerate(steps):
             a.use(0)
             set_uniform(prog, "u_axis", axis)
-            if prm.compute:
-                bind_images(prog, {"u_dst": b})
-                dispatch(prog, (size, size))
-            else:
-                t.fbo(ctx, b).use()
-                ctx.viewport = (0, 0, size, size)
-                self.r.fullscreen(prog)
+            t.draw_into(self.r, prog, b, prm.compute)
         if seams:
             seam_fill(self.r, t, t.scratch, dst, prm.compute)
         self.publish(frame, p)
