@@ -34,7 +34,7 @@ from skinlab.scene.interreflection import MAX_RAYS, MIN_RAYS, BounceTransfer, bu
 
 from .environment import bind_environment, environment_defines, environment_state
 from .frame_plan import PlannedPass, shadow_pass_name
-from .gpu_resources import VERTEX_ATTRS, VERTEX_FORMAT, node_uniforms
+from .gpu_resources import node_uniforms
 from .lights import bind_shadow_maps, light_defines, set_light_uniforms
 from .reuse import light_state, material_state
 from .technique import RenderPass
@@ -173,7 +173,7 @@ class BouncePass(RenderPass):
         self.gathered: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None  # before the one-ring average
         # (transfer key, ray vertices, ray weights, ring index, ring entries)
         self.records: tuple | None = None
-        self._point_vaos: dict[tuple[int, int], moderngl.VertexArray] = {}
+        self._point_vaos: dict[tuple, moderngl.VertexArray] = {}
         self._footprints: dict[tuple[int, int], float] = {}  # (mesh uid, version) -> uv_footprint
 
     # -- GPU objects ---------------------------------------------------------------------
@@ -220,12 +220,10 @@ class BouncePass(RenderPass):
     def _points(self, node, prog) -> moderngl.VertexArray:
         """A mesh's vertices as points, without its index buffer (gl_VertexID = the vertex)."""
         gm = self.r.resources.mesh(node.mesh)
-        key = (id(gm.vbo), id(prog))
+        key = (id(gm.vbo), id(prog), gm.active)
         vao = self._point_vaos.get(key)
         if vao is None or vao.program is not prog:
-            vao = self._point_vaos[key] = self.r.ctx.vertex_array(
-                prog, [(gm.vbo, VERTEX_FORMAT, *VERTEX_ATTRS)], skip_errors=True
-            )
+            vao = self._point_vaos[key] = self.r.ctx.vertex_array(prog, gm.content(), skip_errors=True)
         return vao
 
     def _release_records(self) -> None:

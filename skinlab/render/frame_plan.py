@@ -9,6 +9,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from skinlab.scene.graph import LightNode
 
+    from .vertex_streams import VertexStream
+
 
 @dataclass
 class PlannedPass:
@@ -55,6 +57,8 @@ class FramePlan:
     # hints a user should see beside the result (the render summary prints them): what a setting costs
     # the image and what would change it; not problems
     notes: list[str] = field(default_factory=list)
+    # the extra vertex streams the frame's technique shades with (Technique.vertex_streams)
+    vertex_streams: tuple[VertexStream, ...] = ()
 
     def names(self) -> list[str]:
         return [p.name for p in self.passes]

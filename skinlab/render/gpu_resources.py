@@ -9,19 +9,21 @@ import numpy as np
 
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.scene.mesh import Mesh
-from skinlab.scene.optics.preintegrated import vertex_curvature
 from skinlab.scene.textures import load_texture
 
-VERTEX_FORMAT = "3f 3f 2f 4f 1f 4f"
-# in_curvature: per-vertex mean curvature (1/scene unit; skinlab/scene/optics/preintegrated.py), for the
-# techniques that look it up (pre-integrated skin); in_color: the vertex colour (glTF COLOR_0, linear RGBA;
-# 1 where the mesh has none), multiplying the base colour and alpha
-VERTEX_ATTRS = ("in_position", "in_normal", "in_uv", "in_tangent", "in_curvature", "in_color")
+from .vertex_streams import VertexStream
+
+VERTEX_FORMAT = "3f 3f 2f 4f 4f"
+# in_color: the vertex colour (glTF COLOR_0, linear RGBA; 1 where the mesh has none), multiplying the
+# base colour and alpha. A technique's extra inputs (pre-integrated skin's in_curvature) are its
+# vertex streams (skinlab/render/vertex_streams.py), in buffers of their own
+VERTEX_ATTRS = ("in_position", "in_normal", "in_uv", "in_tangent", "in_color")
 
 
 class GpuMesh:
     def __init__(self, ctx: moderngl.Context, mesh: Mesh):
         self.ctx = ctx
+        self.mesh = mesh
         self.version = mesh.version
         n = len(mesh.positions)
         uv = mesh.uvs if mesh.uvs is not None else np.zeros((n, 2), np.float32)
@@ -29,24 +31,38 @@ class GpuMesh:
             tan = mesh.ensure_tangents()
         else:
             tan = np.tile(np.array([1, 0, 0, 1], np.float32), (n, 1))
-        curv = vertex_curvature(mesh.positions, mesh.normals, mesh.indices)[:, None]
         col = mesh.colors if mesh.colors is not None else np.ones((n, 4), np.float32)
-        data = np.concatenate([mesh.positions, mesh.normals, uv, tan, curv, col], axis=1).astype(np.float32)
+        data = np.concatenate([mesh.positions, mesh.normals, uv, tan, col], axis=1).astype(np.float32)
         self.vbo = ctx.buffer(np.ascontiguousarray(data).tobytes())
         self.ibo = ctx.buffer(mesh.indices.astype(np.uint32).tobytes())
         self.count = mesh.indices.size
-        self._vaos: dict[int, moderngl.VertexArray] = {}
+        self.streams: dict[VertexStream, moderngl.Buffer] = {}  # the extra streams uploaded so far
+        self.active: tuple[VertexStream, ...] = ()  # those the current frame's technique asks for
+        self._vaos: dict[tuple, moderngl.VertexArray] = {}
+
+    def use_streams(self, streams: tuple[VertexStream, ...]) -> bool:
+        """Make `streams` the ones bound (computed and uploaded on first use); True if any was uploaded."""
+        uploaded = False
+        for s in streams:
+            if s not in self.streams:
+                n = len(self.mesh.positions)
+                data = np.asarray(s.compute(self.mesh), np.float32).reshape(n, -1)
+                self.streams[s] = self.ctx.buffer(np.ascontiguousarray(data).tobytes())
+                uploaded = True
+        self.active = streams
+        return uploaded
+
+    def content(self) -> list[tuple]:
+        """The vertex array content: the common buffer and the active streams'."""
+        extra = [(self.streams[s], s.format, s.attribute) for s in self.active]
+        return [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRS), *extra]
 
     def vao(self, program: moderngl.Program) -> moderngl.VertexArray:
-        key = id(program)
+        key = (id(program), self.active)
         vao = self._vaos.get(key)
         if vao is None or vao.program is not program:
             vao = self.ctx.vertex_array(
-                program,
-                [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRS)],
-                index_buffer=self.ibo,
-                index_element_size=4,
-                skip_errors=True,
+                program, self.content(), index_buffer=self.ibo, index_element_size=4, skip_errors=True
             )
             self._vaos[key] = vao
         return vao
@@ -54,6 +70,8 @@ class GpuMesh:
     def release(self) -> None:
         for v in self._vaos.values():
             v.release()
+        for b in self.streams.values():
+            b.release()
         self.vbo.release()
         self.ibo.release()
 
@@ -75,6 +93,8 @@ class GpuResources:
         self.meshes: dict[int, GpuMesh] = {}
         self.textures: dict[tuple[str, str], moderngl.Texture] = {}
         self.uploads = 0
+        # the extra vertex streams of the current frame's technique (Renderer sets them per frame)
+        self.vertex_streams: tuple[VertexStream, ...] = ()
         self._isotropic: moderngl.Sampler | None = None
         self._sampled_units: set[int] = set()
 
@@ -84,6 +104,8 @@ class GpuResources:
             if g is not None:
                 g.release()
             g = self.meshes[mesh.uid] = GpuMesh(self.ctx, mesh)
+            self.uploads += 1
+        if g.active != self.vertex_streams and g.use_streams(self.vertex_streams):
             self.uploads += 1
         return g
 

@@ -64,6 +64,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
     prefetch_bounce(scene, settings, meshes, lights)  # rays are cast while the technique plans
     prefetch_sky(scene, settings, meshes)  # (the same records, for what the scene hides of the map)
     tp = technique.plan(PlanContext(scene, settings, meshes, lights, shadow_lights[:2], plan, state, device))
+    plan.vertex_streams = tuple(technique.vertex_streams) if meshes else ()
     sky = plan_sky(scene, settings, meshes, plan, environment)
     if sky is not None:
         environment.append(sky)

@@ -139,6 +139,7 @@ class Renderer:
         plan = self.plan(scene, settings)
         for st in self.states.values():  # a technique's state keeps what this frame uses
             st.begin_frame(plan)
+        self.resources.vertex_streams = plan.vertex_streams  # the meshes' extra inputs this frame
         frame = Frame(
             scene,
             settings,

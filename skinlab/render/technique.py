@@ -10,6 +10,8 @@ A technique (skinlab/render/techniques/<name>/, registered in skinlab/render/reg
   the frame plan) and how the forward pass shades each mesh (a :class:`ForwardHook`);
 - ``passes``: its pass classes by kind (each derived from :class:`RenderPass`), made once per renderer;
 - ``state``: GPU state it keeps across frames (per renderer; a :class:`TechniqueState`), if any;
+- ``vertex_streams``: extra per-vertex inputs its shaders read (:class:`VertexStream`, e.g.
+  pre-integrated skin's curvature), computed and uploaded only in the frames it renders;
 - for the accuracy ledger (skinlab/bench/): :meth:`Technique.edge_response` and its :class:`LedgerStyle`.
 
 The forward pass (skinlab/render/passes/forward.py) shades every mesh with skinlab/shaders/passes/forward.frag;
@@ -36,6 +38,7 @@ from skinlab.scene.optics.edges import step_edge
 from .compute import Device, PassPath, choose_path
 from .frame_plan import FramePlan, PlannedPass
 from .options import TechniqueSettings
+from .vertex_streams import VertexStream
 
 if TYPE_CHECKING:
     import moderngl
@@ -223,6 +226,8 @@ class Technique(Generic[S]):
     # not empty: why a frame may take long (an image reference); the viewer's T key skips the technique
     # and its panel marks it with this, so a slow GPU is not stalled by one key press
     slow: str = ""
+    # extra per-vertex inputs of its shaders, beyond position, normal, uv, tangent and colour
+    vertex_streams: tuple[VertexStream, ...] = ()
 
     def plan(self, ctx: PlanContext[S]) -> TechniquePlan:
         return TechniquePlan()

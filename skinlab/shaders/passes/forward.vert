@@ -4,7 +4,7 @@ in vec3 in_position;
 in vec3 in_normal;
 in vec2 in_uv;
 in vec4 in_tangent;
-in float in_curvature;  // per-vertex mean curvature, 1/scene unit (pre-integrated skin)
+in float in_curvature;  // pre-integrated skin's vertex stream (1/scene unit); 0 in frames of other techniques
 in vec4 in_color;       // the vertex colour (glTF COLOR_0, linear; 1 where the mesh has none)
 #include "lib/bounce_vertex.glsl"
 #include "lib/sky_vertex.glsl"

@@ -116,6 +116,33 @@ def test_flat_slab_shades_like_the_unblurred_subsurface_term(renderer):
     np.testing.assert_allclose(res.hdr[24, 24, :3], tsd_img, rtol=2e-3)
 
 
+def test_curvature_is_computed_only_in_its_frames(renderer, monkeypatch):
+    """The curvature stream is the technique's (Technique.vertex_streams): a frame of another technique
+    computes and binds none; the first pre-integrated frame computes it once per mesh, later ones
+    reuse it, and a frame of another technique after it binds it no more."""
+    from skinlab.render.techniques import preintegrated as technique
+
+    calls = []
+
+    def counted(*args):
+        calls.append(1)
+        return pis.vertex_curvature(*args)
+
+    monkeypatch.setattr(technique, "vertex_curvature", counted)
+    scene = slab_scene(material=skin("burley"))
+    mesh = scene.mesh_nodes()[0].mesh
+    tsd_settings = RenderSettings(16, 16, technique=TsdSettings(size=32))
+    renderer.render(scene, tsd_settings)
+    gm = renderer.resources.meshes[mesh.uid]
+    assert calls == [] and gm.streams == {} and gm.active == ()
+    for _ in range(2):
+        res = renderer.render(scene, RenderSettings(16, 16, technique="preintegrated"))
+        assert res.plan.vertex_streams == (technique.CURVATURE,)
+        assert calls == [1] and gm.active == (technique.CURVATURE,) and technique.CURVATURE in gm.streams
+    renderer.render(scene, tsd_settings)
+    assert calls == [1] and gm.active == ()
+
+
 def test_sphere_follows_the_table(renderer, multiple_only):
     """A sphere of radius 10 mm lit from the side, seen along z (nearly orthographic): along the
     middle row each pixel is base x E x [max(N.L, 0) entry(N.L) + (D(N.L, 1/R) - max(N.L, 0)) entry_d]

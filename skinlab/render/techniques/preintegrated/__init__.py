@@ -25,10 +25,20 @@ from skinlab.render.technique import (
     TechniqueState,
 )
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
-from skinlab.scene.optics.preintegrated import LUT_CURV, LUT_NOL, preintegrated_lut
+from skinlab.render.vertex_streams import VertexStream
+from skinlab.scene.optics.preintegrated import LUT_CURV, LUT_NOL, preintegrated_lut, vertex_curvature
 from skinlab.scene.optics.tsd import material_medium, profile_fit
 
 HOOK = "techniques/preintegrated/forward.glsl"
+
+
+def mesh_curvature(mesh) -> np.ndarray:
+    """(n, 1) per-vertex mean curvature, 1/scene unit (the hook's in_curvature)."""
+    return vertex_curvature(mesh.positions, mesh.normals, mesh.indices)[:, None]
+
+
+# the hook looks the table up with it (forward.vert's in_curvature -> v_curvature)
+CURVATURE = VertexStream("in_curvature", "1f", mesh_curvature)
 
 
 @dataclass(frozen=True)
@@ -126,6 +136,7 @@ class PreintegratedTechnique(Technique[PreintegratedSettings]):
     settings_type = PreintegratedSettings
     state = ("preintegrated_luts", LutTextures)
     ledger = LedgerStyle("v", "tab:brown")
+    vertex_streams = (CURVATURE,)
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         nodes = {}
