@@ -16,15 +16,18 @@ A technique (skinlab/render/techniques/<name>/, registered in skinlab/render/reg
 
 The forward pass (skinlab/render/passes/forward.py) shades every mesh with skinlab/shaders/passes/forward.frag;
 the subsurface part of the diffuse term is one GLSL hook, ``skinlab/sss_hook.glsl``, which each
-mesh's :class:`NodeShading` resolves to a technique's file (skinlab/shaders/techniques/<name>/forward.glsl):
+mesh's :class:`NodeShading` resolves to a technique's file (skinlab/shaders/techniques/<name>/forward.glsl).
+The pass builds the surface inputs once, a ``Surface`` (skinlab/shaders/lib/surface_inputs.glsl:
+position, normals, tangent frame, view, uv, the material sample ``m``, the subsurface weight
+``sss_weight``), and hands it to each function of the hook:
 
-    float sss_plain_weight();                        // weight of the surface's own Burley diffuse
-    void  sss_add_light(vec3 e, float vis, float NoL);  // per light: irradiance e, shadow vis, cosine
-    vec3  sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv);  // after the lights: the
-                                                     // subsurface radiance added toward the viewer
+    float sss_plain_weight(Surface s);                  // weight of the surface's own Burley diffuse
+    void  sss_add_light(Surface s, vec3 e, float vis, float NoL);  // per light: irradiance, shadow, cosine
+    vec3  sss_radiance(Surface s);                      // after the lights: the subsurface radiance
+                                                        // added toward the viewer
 
-``base`` is the subsurface albedo at the fragment: subsurface_color x the colour map x the vertex
-colour (the colour rule, docs/scenes.md), not the plain part's base colour.
+``s.m.sss_albedo`` is the subsurface albedo at the fragment: subsurface_color x the colour map x the
+vertex colour (the colour rule, docs/scenes.md), not the plain part's base colour (``s.m.base``).
 """
 
 from __future__ import annotations

@@ -1,5 +1,6 @@
 """NumPy twins of skinlab/shaders/lib/surface.glsl: the surface inputs a glTF material brings beyond the
-principled BRDF (occlusion strength, opacity and its mask, the texture transform, diffuse transmission).
+principled BRDF (occlusion strength, opacity and its mask, the texture transform, diffuse transmission),
+and the map-free parts of lib/material_sample.glsl and lib/surface_inputs.glsl.
 Same names, same clamps."""
 
 from __future__ import annotations
@@ -38,3 +39,33 @@ def diffuse_transmission_btdf(NoL, weight, colour):
     NoL = np.asarray(NoL, np.float64)[..., None]
     w = np.clip(np.asarray(weight, np.float64), 0.0, 1.0)[..., None] if np.ndim(weight) else np.clip(weight, 0, 1)
     return np.where(NoL < 0.0, np.asarray(colour, np.float64) * w / np.pi, 0.0)
+
+
+def material_sample(values, vertex_color):
+    """NumPy twin of lib/material_sample.glsl material_sample for a material without maps and without
+    a texture transform: `values` the material's plain values (base_color, subsurface_color, alpha,
+    roughness, metallic), `vertex_color` (..., 4). A dict of the struct's fields."""
+    c = np.asarray(vertex_color, np.float64)
+    return {
+        "base": np.asarray(values["base_color"], np.float64) * c[..., :3],
+        "sss_albedo": np.asarray(values["subsurface_color"], np.float64) * c[..., :3],
+        "alpha": surface_alpha(values["alpha"], 1.0, c[..., 3]),
+        "roughness": np.full(c.shape[:-1], float(values["roughness"])),
+        "metallic": np.full(c.shape[:-1], float(values["metallic"])),
+        "occlusion": np.ones(c.shape[:-1]),
+    }
+
+
+def surface_inputs(world, normal, tangent, camera, front):
+    """NumPy twin of lib/surface_inputs.glsl surface_inputs' geometry for a material without a normal
+    map: the geometric normal turned to the side seen (`front` False: a back face), the tangent turned
+    with it, the view direction and dot(n, v). Arrays (..., 3) ((..., 4) for the tangent)."""
+    world, camera = np.asarray(world, np.float64), np.asarray(camera, np.float64)
+    side = np.where(np.asarray(front), 1.0, -1.0)[..., None]
+    ng = np.asarray(normal, np.float64)
+    ng = ng / np.linalg.norm(ng, axis=-1, keepdims=True) * side
+    v = camera - world
+    v = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    t = np.asarray(tangent, np.float64)
+    tangent_seen = np.concatenate([t[..., :3] * side, t[..., 3:]], axis=-1)
+    return {"ng": ng, "n": ng, "tangent": tangent_seen, "v": v, "NoV": (ng * v).sum(-1)}

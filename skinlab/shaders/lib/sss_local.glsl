@@ -1,11 +1,13 @@
 // The subsurface part of the diffuse term without a convolution, for the hooks of techniques that
-// scatter locally or in screen space (tint, ssss): the same entry/exit model as texture-space
+// scatter locally or in screen space (tint, ssss, disk, tsd's narrow fallback): the same entry/exit
+// model as texture-space
 // diffusion (lib/sss_boundary.glsl: the multiple-scattering albedo at the light's incidence in, its
 // angular distribution out) so that only the convolution differs between the techniques. Needs the
 // material uniforms and lib/ambient.glsl. Variant SSS_TRANSLUCENCY: plus the light through thin parts
 // (lib/sss_translucency.glsl, the same term texture-space diffusion gathers in its irradiance
 // pass), entering with the rest, so a screen-space blur spreads it as texture-space diffusion's does.
 #include "lib/sss_boundary.glsl"
+#include "lib/surface_inputs.glsl"
 #include "lib/ambient.glsl"
 #include "lib/ambient_entering.glsl"
 #ifdef SSS_TRANSLUCENCY
@@ -14,18 +16,19 @@
 
 vec3 sss_in = vec3(0.0);  // irradiance entering the medium (this fragment)
 
-void sss_add_light(vec3 e, float vis, float NoL) {
+void sss_add_light(Surface s, vec3 e, float vis, float NoL) {
     sss_in += e * (vis * NoL) * sss_entry(NoL);
 }
 
-// The radiance leaving the medium toward the viewer for subsurface weight sss_w (ambient included).
-vec3 sss_local_radiance(vec3 base, float NoV, float occlusion, float sss_w) {
-    vec3 entering = sss_in + ambient_entering(occlusion);
-    vec3 leaving = entering * sss_exit(abs(NoV));
+// The radiance leaving the medium toward the viewer at s for subsurface weight sss_w (ambient
+// included), with the subsurface albedo s.m.sss_albedo.
+vec3 sss_local_radiance(Surface s, float sss_w) {
+    vec3 entering = sss_in + ambient_entering(s.m.occlusion);
+    vec3 leaving = entering * sss_exit(abs(s.NoV));
 #ifdef SSS_TRANSLUCENCY
     // light through thin parts leaves with its own angular distribution (lib/sss_boundary.glsl sss_slab_exit)
     vec3 through_in;
-    leaving += sss_translucent_toward(v_world, gl_FrontFacing ? normalize(v_normal) : -normalize(v_normal), abs(NoV), through_in);
+    leaving += sss_translucent_toward(s.position, s.ng, abs(s.NoV), through_in);
 #endif
-    return base * leaving * ((1.0 - u_metallic) * sss_w * INV_PI);
+    return s.m.sss_albedo * leaving * ((1.0 - u_metallic) * sss_w * INV_PI);
 }

@@ -2,12 +2,13 @@
 // Principled shading (Burley diffuse + GGX specular) with up to MAX_LIGHTS lights and two
 // shadow maps. Variants: HAS_<MAP> per map set (skinlab/material.glsl, generated from the material's
 // parameter declarations), ALPHA_MASK (pixels below the alpha cutoff discarded) and ALPHA_BLEND
-// (premultiplied colour and alpha, blended by passes/forward.py); lib/surface.glsl for occlusion
-// strength and opacity; the vertex colour multiplies the base colour and alpha; emission is added. The subsurface part
+// (premultiplied colour and alpha, blended by passes/forward.py); the surface inputs (normals, the
+// material's maps, the subsurface weight) are built once, lib/surface_inputs.glsl; the vertex colour
+// multiplies the base colour and alpha; emission is added. The subsurface part
 // of the diffuse term is the technique's hook (skinlab/sss_hook.glsl, resolved per program to
-// skinlab/shaders/techniques/<name>/forward.glsl; the contract is in skinlab/render/technique.py): plain
-// Burley diffuse weighted by sss_plain_weight(), the hook told about each light, and its radiance
-// added after the lights. Specular and ambient specular as usual. Single scattering (Jensen 2001,
+// skinlab/shaders/techniques/<name>/forward.glsl; the contract is in skinlab/render/technique.py), handed
+// the surface inputs: plain Burley diffuse weighted by sss_plain_weight(s), the hook told about each
+// light, and its radiance added after the lights. Specular and ambient specular as usual. Single scattering (Jensen 2001,
 // lib/sss_boundary.glsl) is added per light, and for ambient light, for a mesh whose technique
 // scatters (u_sss_single > 0): it leaves within about a mean free path of where it entered, so no
 // technique blurs it. Ambient light is the sky and, with variant BOUNCE, the light the scene's
@@ -20,7 +21,7 @@
 #include "lib/lights.glsl"
 #include "lib/ambient.glsl"
 #include "lib/surface.glsl"
-#include "lib/material_uv.glsl"
+#include "lib/surface_inputs.glsl"
 #include "skinlab/material.glsl"
 #ifdef ENV_MAP
 #include "lib/env_single.glsl"
@@ -37,50 +38,24 @@ uniform vec3 u_camera_pos;
 layout(location = 0) out vec4 f_color;
 
 #include "skinlab/sss_hook.glsl"
-#include "lib/sss_maps.glsl"
 
 void main() {
-    vec2 muv = material_uv(v_uv);  // where the material's maps are read (its texture transform)
-    vec3 ng = normalize(v_normal);
-    vec3 v = normalize(u_camera_pos - v_world);
-    if (!gl_FrontFacing) ng = -ng;
-    vec3 n = ng;
-#ifdef HAS_NORMAL_MAP
-    n = perturb_normal(ng, vec4(gl_FrontFacing ? v_tangent.xyz : -v_tangent.xyz, v_tangent.w),
-                       texture(u_normal_map, muv).rgb, u_normal_scale);
-#endif
-    vec4 base_map = vec4(1.0);
-#ifdef HAS_BASE_COLOR_MAP
-    base_map = texture(u_base_color_map, muv);
-#endif
-    vec3 base = u_base_color * base_map.rgb * v_color.rgb;  // the plain diffuse part's albedo, a metal's F0
-    // the colour rule (docs/scenes.md): the colour map and vertex colour multiply the subsurface
-    // colour too; the hooks and single scattering take this albedo
-    vec3 sss_albedo = u_subsurface_color * base_map.rgb * v_color.rgb;
-    float alpha = surface_alpha(u_alpha, base_map.a, v_color.a);
+    // the surface inputs, once: normals, view direction, the material's maps, the subsurface weight
+    Surface s = surface_inputs(v_world, v_normal, v_uv, v_tangent, v_color, u_camera_pos, gl_FrontFacing);
 #ifdef ALPHA_MASK
-    if (!alpha_kept(alpha, u_alpha_cutoff)) discard;
+    if (!alpha_kept(s.m.alpha, u_alpha_cutoff)) discard;
 #endif
-    float rough = u_roughness;
-#ifdef HAS_ROUGHNESS_MAP
-    rough *= texture(u_roughness_map, muv).r;
-#endif
-    float metal = u_metallic;  // the subsurface hooks weigh their term by u_metallic (no map)
-#ifdef HAS_METALLIC_MAP
-    metal *= texture(u_metallic_map, muv).r;
-#endif
-    float occlusion = 1.0;
-#ifdef HAS_OCCLUSION_MAP
-    occlusion = occlusion_at_strength(texture(u_occlusion_map, muv).r, u_occlusion_strength);
-#endif
+    vec3 ng = s.ng, n = s.n, v = s.v;
+    vec3 base = s.m.base;  // the plain diffuse part's albedo, a metal's F0
+    float rough = s.m.roughness, metal = s.m.metallic, occlusion = s.m.occlusion;
     ambient_set_normal(n);               // the environment map's diffuse light at this normal
-    float plain = sss_plain_weight();    // weight of the surface's own Burley diffuse
+    float plain = sss_plain_weight(s);   // weight of the surface's own Burley diffuse
     vec3 f0 = principled_f0(base, metal, u_specular);
     float a = ggx_alpha(rough);
-    float NoV = dot(n, v);
+    float NoV = s.NoV;
     vec3 color = vec3(0.0);
     bool single = any(greaterThan(u_sss_single, vec3(0.0)));
-    vec3 single_w = sss_albedo * ((1.0 - metal) * sss_weight_at(v_uv));  // x the weight map
+    vec3 single_w = s.m.sss_albedo * ((1.0 - metal) * s.sss_weight);  // x the weight map
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, e;
@@ -115,10 +90,8 @@ void main() {
         color += e * vis * (diffuse + spec) * NoL;
 #endif
         if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
-        // the technique's diffusion: shadowed where it entered (oblique entry, lib/sss_oblique.glsl)
-        vec3 z0 = u_sss_mfp * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
-        vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
-        sss_add_light(e, u_light_shadow[i] >= 0 ? light_visibility(i, entry, dot(ng, l)) : 1.0, NoL);
+        // the technique's diffusion: shadowed where it entered (oblique entry, lib/surface_inputs.glsl)
+        sss_add_light(s, e, sss_entry_visibility(s, i, l), NoL);
     }
     vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
     float kept = 1.0;
@@ -135,14 +108,14 @@ void main() {
     color += ambient * (base * ((1.0 - metal) * plain * kept) + f0);
     if (single) color += ambient * single_w * sss_single_ambient(NoV);  // its single scattering
 #endif
-    color += sss_radiance(sss_albedo, NoV, occlusion, v_uv);
+    color += sss_radiance(s);
     vec3 emission = u_emissive;
 #ifdef HAS_EMISSIVE_MAP
-    emission *= texture(u_emissive_map, muv).rgb;
+    emission *= texture(u_emissive_map, s.m.uv).rgb;
 #endif
     color += emission;
 #ifdef ALPHA_BLEND
-    f_color = vec4(color * alpha, alpha);  // premultiplied: blended over what lies behind (passes/forward.py)
+    f_color = vec4(color * s.m.alpha, s.m.alpha);  // premultiplied: blended over what lies behind (passes/forward.py)
 #else
     f_color = vec4(color, 1.0);
 #endif

@@ -79,3 +79,65 @@ def test_diffuse_transmission_btdf(glsl):
     assert np.all(want[nol >= 0] == 0) and want[(nol < 0) & (w == 1.0)][0] == pytest.approx(
         np.array([0.2, 0.6, 1.0]) / np.pi
     )
+
+
+MATERIAL = {"base_color": (0.8, 0.4, 0.1), "subsurface_color": (0.9, 0.5, 0.3), "alpha": 0.7, "roughness": 0.35,
+            "metallic": 0.25, "subsurface": 0.6}  # fmt: skip
+
+
+def set_material(values):
+    from skinlab.gl.uniforms import set_uniform
+
+    def setup(prog):
+        for k, v in values.items():
+            set_uniform(prog, f"u_{k}", v)
+
+    return setup
+
+
+# vertex colours: none (1), black, a colour with alpha 0 and one beyond 1
+COLOURS = f32([[1, 1, 1, 1], [0, 0, 0, 1], [0.2, 0.6, 1.0, 0.0], [1.5, 1.0, 0.5, 2.0]])
+
+
+@pytest.mark.parametrize("field,n", [("base", 3), ("sss_albedo", 3), ("alpha", 1), ("roughness", 1), ("metallic", 1)])
+def test_material_sample_without_maps(glsl, field, n):
+    """lib/material_sample.glsl: the plain values x the vertex colour (the colour rule), opacity clamped."""
+    uv = f32(np.tile([[0.25, 0.75]], (len(COLOURS), 1)))
+    gpu = glsl.evaluate(
+        "lib/material_sample.glsl", f"material_sample(uv, c).{field}", {"uv": uv, "c": COLOURS}, n,
+        setup=set_material(MATERIAL),
+    )  # fmt: skip
+    want = np.asarray(surface.material_sample(MATERIAL, COLOURS)[field]).reshape(len(COLOURS), n)
+    assert_close_fp32(gpu, want, what=f"material_sample.{field}")
+    uvs = glsl.evaluate("lib/material_sample.glsl", "material_sample(uv, c).uv", {"uv": uv, "c": COLOURS}, 2)
+    assert np.array_equal(uvs, uv)  # no texture transform: the maps read at the mesh's uv
+    occ = glsl.evaluate("lib/material_sample.glsl", "material_sample(uv, c).occlusion", {"uv": uv, "c": COLOURS})
+    assert np.all(occ == 1.0)
+
+
+@pytest.mark.parametrize("field,n", [("ng", 3), ("n", 3), ("tangent", 4), ("v", 3), ("NoV", 1), ("sss_weight", 1)])
+def test_surface_inputs_without_maps(glsl, field, n):
+    """lib/surface_inputs.glsl: the normal turned to the side seen (back faces), unnormalised and tiny
+    normals, grazing and head-on views, the weight without its map (the plain subsurface value)."""
+    rng = np.random.default_rng(3)
+    m = 24
+    world = f32(rng.uniform(-1, 1, (m, 3)))
+    normal = f32(np.concatenate([rng.normal(size=(m - 4, 3)) * 3, [[0, 0, 1e-3], [0, 0, 5.0], [1, 0, 0], [0, 1, 0]]]))
+    camera = world + f32(normal / np.linalg.norm(normal, axis=1, keepdims=True) * 2.0)
+    camera[-2:] = world[-2:] + f32([[0, 0, 1.0], [0, 0, 1.0]])  # views at 90 degrees to the normal: NoV = 0
+    tangent = f32(np.concatenate([rng.normal(size=(m, 3)), np.sign(rng.normal(size=(m, 1)))], 1))
+    front = np.arange(m) % 2 == 0
+    inputs = {"w": world, "nn": normal, "t": tangent, "cam": camera, "front": front.astype(np.float64)}
+    gpu = glsl.evaluate(
+        "lib/surface_inputs.glsl",
+        f"surface_inputs(w, nn, vec2(0.5), t, vec4(1.0), cam, front > 0.5).{field}",
+        inputs, n, setup=set_material(MATERIAL),
+    )  # fmt: skip
+    if field == "sss_weight":
+        assert np.allclose(gpu, MATERIAL["subsurface"])
+        return
+    want = np.asarray(surface.surface_inputs(world, normal, tangent, camera, front)[field]).reshape(m, n)
+    assert_close_fp32(gpu, want, what=f"surface_inputs.{field}")
+    if field == "NoV":  # seen from the front side: toward the viewer; from the back: away (turned)
+        assert np.all(want[front & (np.arange(m) < m - 2)] > 0) and np.all(want[~front & (np.arange(m) < m - 2)] < 0)
+        assert np.allclose(want[-2:], 0.0, atol=1e-7)

@@ -5,16 +5,15 @@
 // this hook while the technique runs, so the second target is written everywhere.
 // Contract: skinlab/render/technique.py.
 #include "lib/sss_local.glsl"
-#include "lib/sss_maps.glsl"
 
 uniform float u_disk_profile;  // profile index + 1, 0 for a material that does not scatter
 layout(location = 1) out vec4 f_diffuse;
 
-float sss_plain_weight() { return u_disk_profile > 0.0 ? 1.0 - sss_weight_at(v_uv) : 1.0; }
+float sss_plain_weight(Surface s) { return u_disk_profile > 0.0 ? 1.0 - s.sss_weight : 1.0; }
 
-vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
-    float w = u_disk_profile > 0.0 ? sss_weight_at(v_uv) : 0.0;
-    float scale = u_disk_profile > 0.0 ? 0.5 * clamp(sss_radius_scale_at(uv), 0.0, 1.98) : 0.0;
-    f_diffuse = vec4(sss_local_radiance(base, NoV, occlusion, w), u_disk_profile + scale);
+vec3 sss_radiance(Surface s) {
+    float w = u_disk_profile > 0.0 ? s.sss_weight : 0.0;
+    float scale = u_disk_profile > 0.0 ? 0.5 * clamp(s.sss_radius_scale, 0.0, 1.98) : 0.0;
+    f_diffuse = vec4(sss_local_radiance(s, w), u_disk_profile + scale);
     return vec3(0.0);
 }

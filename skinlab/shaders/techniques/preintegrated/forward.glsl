@@ -16,8 +16,7 @@
 #ifdef SSS_TRANSLUCENCY
 #include "lib/sss_translucency.glsl"
 #endif
-#include "lib/sss_maps.glsl"
-#include "lib/sss_oblique.glsl"
+#include "lib/surface_inputs.glsl"
 #include "lib/preintegrated.glsl"
 
 in float v_curvature;            // 1/scene unit (forward.vert)
@@ -27,18 +26,15 @@ uniform float u_pis_curv_scale;  // 1/scene unit -> 1/mm (the node's scale and t
 uniform float u_pis_curv_max;    // 1/mm at the last row (0: the table is max(N.L, 0) everywhere)
 uniform vec3 u_pis_soften;       // per channel: 0 the normal-mapped normal, 1 the geometric normal
 
-float sss_plain_weight() { return 1.0 - sss_weight_at(v_uv); }
+float sss_plain_weight(Surface s) { return 1.0 - s.sss_weight; }
 
-void sss_add_light(vec3 e, float vis, float NoL) {}  // the hook runs its own light loop (below)
+void sss_add_light(Surface s, vec3 e, float vis, float NoL) {}  // the hook runs its own light loop (below)
 
-vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
-    vec3 ng = normalize(v_normal);
-    if (!gl_FrontFacing) ng = -ng;
-    vec3 n = ng;
-#ifdef HAS_NORMAL_MAP
-    n = perturb_normal(ng, vec4(gl_FrontFacing ? v_tangent.xyz : -v_tangent.xyz, v_tangent.w),
-                       texture(u_normal_map, uv).rgb, u_normal_scale);
-#endif
+// Its own light loop: each light is looked up past the terminator too (the forward pass's loop skips
+// lights behind the shading normal) and by the geometric normal (the table is over it), with the
+// shared surface inputs (normals, weight) and the shared shadow at the entry point.
+vec3 sss_radiance(Surface s) {
+    vec3 ng = s.ng, n = s.n;
     float curv = abs(v_curvature) * u_pis_curv_scale;
     float t = u_pis_curv_max > 0.0 ? curv / u_pis_curv_max : 0.0;
 #ifdef HAS_NORMAL_MAP
@@ -50,14 +46,11 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, e;
-        light_incidence(i, v_world, ng, l, e);
+        light_incidence(i, s.position, ng, l, e);
         float nlg = dot(ng, l);
         // shadow maps only where the light faces the surface; past the terminator the ring's light
-        // comes from the lit side
-        // (looked up where the light entered: oblique entry, lib/sss_oblique.glsl)
-        vec3 z0 = u_sss_mfp * sss_radius_scale_at(v_uv);
-        vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
-        float vis = (u_light_shadow[i] >= 0 && nlg > 0.0) ? light_visibility(i, entry, nlg) : 1.0;
+        // comes from the lit side (looked up where the light entered, lib/surface_inputs.glsl)
+        float vis = nlg > 0.0 ? sss_entry_visibility(s, i, l) : 1.0;
 #ifdef HAS_NORMAL_MAP
         vec3 D = vec3(pis_lookup(u_pis_lut, u_pis_lut_size, dot(nr, l), t).r,
                       pis_lookup(u_pis_lut, u_pis_lut_size, dot(nG, l), t).g,
@@ -69,10 +62,11 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
         entering += e * vis * (flat_nl * sss_entry(flat_nl) + (D - flat_nl) * u_sss_entry_diffuse);
 #ifdef SSS_TRANSLUCENCY
         vec3 te;  // light through thin parts leaves with its own angular distribution
-        sss_translucent_light_toward(i, v_world, ng, l, e, abs(NoV), te);
+        sss_translucent_light_toward(i, s.position, ng, l, e, abs(s.NoV), te);
         through_exit += te;
 #endif
     }
-    entering += ambient_entering(occlusion);
-    return base * (entering * sss_exit(abs(NoV)) + through_exit) * ((1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI);
+    entering += ambient_entering(s.m.occlusion);
+    return s.m.sss_albedo * (entering * sss_exit(abs(s.NoV)) + through_exit)
+           * ((1.0 - u_metallic) * s.sss_weight * INV_PI);
 }

@@ -2,12 +2,11 @@
 // subsurface part of the diffuse term is the locally scattered light times u_sss_tint (the profile
 // at one radius, brightest channel = 1). Contract: skinlab/render/technique.py.
 #include "lib/sss_local.glsl"
-#include "lib/sss_maps.glsl"
 
 uniform vec3 u_sss_tint;
 
-float sss_plain_weight() { return 1.0 - sss_weight_at(v_uv); }
+float sss_plain_weight(Surface s) { return 1.0 - s.sss_weight; }
 
-vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
-    return sss_local_radiance(base, NoV, occlusion, sss_weight_at(v_uv)) * u_sss_tint;
+vec3 sss_radiance(Surface s) {
+    return sss_local_radiance(s, s.sss_weight) * u_sss_tint;
 }

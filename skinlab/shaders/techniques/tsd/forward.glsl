@@ -12,7 +12,7 @@
 // the blur brought there (at least 0). Contract: skinlab/render/technique.py.
 #include "lib/sss_boundary.glsl"
 #include "skinlab/constants.glsl"
-#include "lib/sss_maps.glsl"
+#include "lib/surface_inputs.glsl"
 
 uniform float u_tsd_mix;
 uniform vec3 u_tsd_identity;         // weight of the unblurred irradiance per channel
@@ -73,11 +73,14 @@ vec3 tsd_diffused(vec2 uv) {
     return d;
 }
 
-float sss_plain_weight() { return 1.0 - sss_weight_at(v_uv); }
+float sss_plain_weight(Surface s) { return 1.0 - s.sss_weight; }
 
-void sss_add_light(vec3 e, float vis, float NoL) {}  // the irradiance pass gathered the light
+void sss_add_light(Surface s, vec3 e, float vis, float NoL) {}  // the irradiance pass gathered the light
 
-vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
+vec3 sss_radiance(Surface s) {
+    vec3 base = s.m.sss_albedo;
+    float NoV = s.NoV;
+    vec2 uv = s.uv;
     // the diffused light leaving toward the viewer: the angular distribution of what leaves the
     // medium (lib/sss_boundary.glsl; the irradiance pass applied the entry factor)
     vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
@@ -91,5 +94,5 @@ vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
 #endif
     leaving = max(leaving + max(base, vec3(0.0)) * diff, vec3(0.0));
 #endif
-    return (1.0 - u_metallic) * sss_weight_at(v_uv) * INV_PI * leaving;
+    return (1.0 - u_metallic) * s.sss_weight * INV_PI * leaving;
 }

@@ -5,10 +5,9 @@
 // mixed with plain Burley diffuse by the subsurface weight (x its map). Contract:
 // skinlab/render/technique.py.
 #include "lib/sss_local.glsl"
-#include "lib/sss_maps.glsl"
 
-float sss_plain_weight() { return 1.0 - sss_weight_at(v_uv); }
+float sss_plain_weight(Surface s) { return 1.0 - s.sss_weight; }
 
-vec3 sss_radiance(vec3 base, float NoV, float occlusion, vec2 uv) {
-    return sss_local_radiance(base, NoV, occlusion, sss_weight_at(v_uv));
+vec3 sss_radiance(Surface s) {
+    return sss_local_radiance(s, s.sss_weight);
 }

@@ -1,0 +1,52 @@
+// The forward pass's surface inputs at a fragment, built once (passes/forward.frag) and handed to the
+// technique's hook (the contract: skinlab/render/technique.py): where it is, its normals and tangent
+// frame turned to the side seen, the view direction, the material sample (lib/material_sample.glsl)
+// and the subsurface weight and radius scale from their maps (lib/sss_maps.glsl). A hook reads these
+// instead of forward.frag's varyings and computes none of them again. NumPy twin of the parts that
+// are not map reads: skinlab/scene/optics/surface.py surface_inputs.
+#include "lib/lighting.glsl"
+#include "lib/lights.glsl"
+#include "lib/material_sample.glsl"
+#include "lib/sss_boundary.glsl"
+#include "lib/sss_maps.glsl"
+#include "lib/sss_oblique.glsl"
+
+struct Surface {
+    vec3 position;            // world space
+    vec3 ng;                  // the geometric normal, turned to the side seen
+    vec3 n;                   // the shading normal: ng through the normal map (variant HAS_NORMAL_MAP)
+    vec4 tangent;             // the tangent (xyz, turned with ng) and its handedness (w)
+    vec3 v;                   // toward the camera
+    float NoV;                // dot(n, v)
+    vec2 uv;                  // the mesh's uv (the maps are read at m.uv, through the texture transform)
+    MaterialSample m;
+    float sss_weight;         // subsurface x its map: the subsurface share of the diffuse term
+    float sss_radius_scale;   // the radius map's scale of the profile and the mean free path (1 without)
+};
+
+Surface surface_inputs(vec3 world, vec3 normal, vec2 uv, vec4 tangent, vec4 color, vec3 camera, bool front) {
+    Surface s;
+    s.position = world;
+    s.uv = uv;
+    s.m = material_sample(uv, color);
+    s.ng = normalize(normal);
+    s.v = normalize(camera - world);
+    if (!front) s.ng = -s.ng;
+    s.tangent = vec4(front ? tangent.xyz : -tangent.xyz, tangent.w);
+    s.n = s.ng;
+#ifdef HAS_NORMAL_MAP
+    s.n = perturb_normal(s.ng, s.tangent, texture(u_normal_map, s.m.uv).rgb, u_normal_scale);
+#endif
+    s.NoV = dot(s.n, s.v);
+    s.sss_weight = sss_weight_at(uv);
+    s.sss_radius_scale = sss_radius_scale_at(uv);
+    return s;
+}
+
+// Light i's shadow where the diffusion leaving at s entered (oblique entry, lib/sss_oblique.glsl: the
+// mean free path x the radius map toward the light l); 1 for a light without a shadow map.
+float sss_entry_visibility(Surface s, int i, vec3 l) {
+    if (u_light_shadow[i] < 0) return 1.0;
+    vec3 entry = sss_entry_point(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, u_sss_eta, u_mm_per_unit);
+    return light_visibility(i, entry, dot(s.ng, l));
+}
