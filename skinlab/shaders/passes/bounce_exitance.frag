@@ -6,8 +6,9 @@
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/bounce.glsl"
-#include "skinlab/material.glsl"
-#include "lib/material_uv.glsl"
+uniform float u_albedo_lod;           // mip level of the colour map for one vertex's area
+#define MATERIAL_LOD u_albedo_lod      // the maps read at it (lib/material_sample.glsl)
+#include "lib/material_sample.glsl"
 
 #ifdef ENV_MAP
 #include "lib/sky_occlusion.glsl"
@@ -18,7 +19,6 @@ in vec3 v_normal;
 in vec2 v_uv;
 
 uniform vec3 u_ambient;
-uniform float u_albedo_lod;           // mip level of the colour map for one vertex's area
 uniform sampler2D u_bounce_previous;  // the previous order's irradiance per vertex
 uniform int u_has_previous;           // 0 for the first order
 
@@ -32,10 +32,9 @@ void main() {
     vec3 n = normalize(v_normal);
     // the diffuse albedo seen: the plain part's base colour and the scattering part's subsurface
     // colour, by the subsurface weight, both x the colour map (the colour rule, docs/scenes.md)
-    vec3 base = mix(u_base_color, u_subsurface_color, clamp(u_subsurface, 0.0, 1.0));
-#ifdef HAS_BASE_COLOR_MAP
-    base *= textureLod(u_base_color_map, material_uv(v_uv), u_albedo_lod).rgb;
-#endif
+    // (the bounce pass carries no vertex colour: 1)
+    MaterialSample m = material_sample(v_uv, vec4(1.0));
+    vec3 base = mix(m.base, m.sss_albedo, clamp(u_subsurface, 0.0, 1.0));
     vec3 e = PI * u_ambient;
 #ifdef ENV_MAP
     e += env_diffuse_irradiance(n);  // the environment map, less what the scene hides of it here

@@ -21,8 +21,7 @@
 #include "lib/sss_oblique.glsl"
 #include "skinlab/material.glsl"
 #include "lib/sss_maps.glsl"
-#include "lib/surface.glsl"
-#include "lib/material_uv.glsl"
+#include "lib/material_sample.glsl"
 
 #ifdef DEFERRED_SURFACE
 #include "techniques/tsd/surface.glsl"  // the inputs from the surface G-buffer, one fragment per texel
@@ -85,19 +84,14 @@ void main() {
 #ifdef DEFERRED_SURFACE
     if (!load_surface()) discard;
 #endif
+    MaterialSample m = material_sample(v_uv, v_color);  // the material's maps, as the forward pass reads them
     vec3 ng = normalize(v_normal);
     vec3 n = ng;
 #ifdef HAS_NORMAL_MAP
-    n = perturb_normal(ng, v_tangent, texture(u_normal_map, material_uv(v_uv)).rgb, u_normal_scale);
+    n = perturb_normal(ng, v_tangent, texture(u_normal_map, m.uv).rgb, u_normal_scale);
 #endif
-    vec3 base = u_subsurface_color * v_color.rgb;  // the subsurface albedo (the colour rule, docs/scenes.md)
-#ifdef HAS_BASE_COLOR_MAP
-    base *= texture(u_base_color_map, material_uv(v_uv)).rgb;
-#endif
-    float occlusion = 1.0;
-#ifdef HAS_OCCLUSION_MAP
-    occlusion = occlusion_at_strength(texture(u_occlusion_map, material_uv(v_uv)).r, u_occlusion_strength);
-#endif
+    vec3 base = m.sss_albedo;  // the subsurface albedo (the colour rule, docs/scenes.md)
+    float occlusion = m.occlusion;
     ambient_set_normal(n);  // the environment map's diffuse light at this normal (lib/ambient.glsl)
     vec3 e_in = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {   // the lights without a shadow map
