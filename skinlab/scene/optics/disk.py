@@ -1,7 +1,7 @@
 """Importance-sampled Burley disk SSS in screen space (Golubev, "Efficient Screen-Space Subsurface
 Scattering Using Burley's Normalized Diffusion in Real-Time", SIGGRAPH 2018 course; what Unity HDRP
 and Blender EEVEE Next ship; docs/references.md#golubev-2018). NumPy reference of the kernel
-skinlab/shaders/passes/disk_sss.frag applies and of its helpers in skinlab/shaders/lib/disk.glsl.
+skinlab/shaders/techniques/disk/gather.frag applies and of its helpers in skinlab/shaders/lib/disk.glsl.
 
 Per pixel, n samples on a disc around it: sample i at radius r_i = CDF^{-1}(xi_i) of the normalised
 Burley profile of shape d_s (Golubev's closed-form inverse, skinlab/scene/optics/burley.py), xi_i = (i + 1/2)/n
@@ -34,7 +34,7 @@ from .media import Medium
 
 GOLDEN_ANGLE = PI * (3.0 - math.sqrt(5.0))  # radians, 2.39996...
 SAMPLE_ENERGY = 0.99  # fraction of the widest channel's energy inside the sampled disc's outer samples
-MAX_DISK_SAMPLES = 64  # skinlab/shaders/passes/disk_sss.frag
+MAX_DISK_SAMPLES = 64  # skinlab/shaders/techniques/disk/gather.frag
 MAX_DISK_PROFILES = 16  # profiles per frame (one row each in the frame's profile table)
 
 
@@ -127,7 +127,7 @@ def disk_edge_response(x_mm, kernel: DiskKernel) -> np.ndarray:
 
 
 def disk_filter_reference(img, alpha, view_z, kernels, reach_mm, mm_per_unit, pixels_per_unit, phi) -> np.ndarray:
-    """NumPy model of the disk pass (skinlab/shaders/passes/disk_sss.frag) on the forward pass's targets, in
+    """NumPy model of the disk pass (skinlab/shaders/techniques/disk/gather.frag) on the forward pass's targets, in
     GL row order (row 0 at the bottom): img (H, W, 3) subsurface diffuse, alpha (H, W) profile index
     + 1 + radius scale / 2 (0: not scattering), view_z (H, W) view depth in scene units, kernels
     (profiles, n, 4) rgb weight and radius mm, reach_mm (profiles,), phi (H, W) rotations (radians).

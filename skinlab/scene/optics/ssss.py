@@ -1,7 +1,7 @@
 """Screen-space separable subsurface scattering (Jimenez, Sundstedt & Gutierrez 2009; Jimenez et al.
 2015 "Separable Subsurface Scattering"; docs/references.md#jimenez-ssss): one 1-D kernel applied horizontally then
 vertically in screen space, its width in pixels from each pixel's depth. NumPy reference of the kernel used by
-skinlab/shaders/passes/ssss_blur.frag.
+skinlab/shaders/techniques/ssss/blur.frag.
 
 The 1-D kernel is built from the same normalised Gaussian fit as texture-space diffusion: at offset
 x (mm), k(x) = I delta(x) + sum_k W_k g(v_k, x) with g the 1-D Gaussian of variance v_k. Applied along

@@ -1,5 +1,5 @@
 // Importance-sampled Burley disk SSS (Golubev 2018): the per-sample helpers of
-// skinlab/shaders/passes/disk_sss.frag. NumPy twins: skinlab/scene/optics/disk.py; docs/references.md#golubev-2018.
+// skinlab/shaders/techniques/disk/gather.frag. NumPy twins: skinlab/scene/optics/disk.py; docs/references.md#golubev-2018.
 #include "skinlab/constants.glsl"
 
 const float GOLDEN_ANGLE = 2.399963229728653;  // PI (3 - sqrt 5)

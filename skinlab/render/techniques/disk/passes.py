@@ -1,5 +1,5 @@
 """The disk pass: importance-sampled Burley disk SSS over the forward pass's subsurface diffuse
-target (skinlab/shaders/passes/disk_sss.frag, the per-pixel code in techniques/disk/gather.glsl), then the
+target (skinlab/shaders/techniques/disk/gather.frag, the per-pixel code in techniques/disk/gather.glsl), then the
 composite with the rest of the lit image; with ``DiskParams.compute`` both in one compute dispatch
 (techniques/disk/gather.comp)."""
 
@@ -54,7 +54,7 @@ class DiskPass(RenderPass):
         if prm.compute:
             prog = self.r.programs.compute("techniques/disk/gather.comp")
         else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/disk_sss.frag")
+            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/disk/gather.frag")
         reach = np.array([k.reach_mm for k in prm.kernels], np.float32)
         set_array(prog, "u_reach_mm", reach, MAX_DISK_PROFILES)
         set_uniforms(

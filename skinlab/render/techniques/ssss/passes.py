@@ -1,6 +1,6 @@
 """Screen-space separable SSS (Jimenez et al.): blur the forward pass's subsurface diffuse target
 horizontally then vertically with the profile's 1-D kernel (skinlab/scene/optics/ssss.py) and add it back.
-The per-pixel code is techniques/ssss/blur.glsl, run by passes/ssss_blur.frag or, with
+The per-pixel code is techniques/ssss/blur.glsl, run by techniques/ssss/blur.frag or, with
 ``SsssBlurParams.compute``, by techniques/ssss/blur.comp (the vertical pass writing the composite too)."""
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ class SsssBlurPass(RenderPass):
         if p.params.compute:
             prog = self.r.programs.compute("techniques/ssss/blur.comp")
         else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/ssss_blur.frag")
+            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/ssss/blur.frag")
         n = len(plan.offsets_mm)
         table = self._gpu.table(plan.table())
         ranges = np.array([k.range_mm for k in plan.kernels], np.float32)

@@ -1,6 +1,6 @@
 #version 430 core
 // Disk SSS as a compute shader (RenderSettings.compute; skinlab/render/compute.py): one invocation per
-// pixel, the per-pixel code of passes/disk_sss.frag (techniques/disk/gather.glsl) at the pixel's
+// pixel, the per-pixel code of techniques/disk/gather.frag (techniques/disk/gather.glsl) at the pixel's
 // centre, and the lit image with the filtered subsurface light added back (passes/ssss_composite.frag).
 layout(local_size_x = 8, local_size_y = 8) in;
 #include "techniques/disk/gather.glsl"

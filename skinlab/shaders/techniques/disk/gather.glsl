@@ -1,5 +1,5 @@
 // Importance-sampled Burley disk SSS in screen space at one pixel (Golubev 2018; skinlab/scene/optics/disk.py),
-// shared by passes/disk_sss.frag and techniques/disk/gather.comp (RenderSettings.compute): per pixel,
+// shared by techniques/disk/gather.frag and techniques/disk/gather.comp (RenderSettings.compute): per pixel,
 // u_samples samples on a disc, radii drawn from the Burley profile's CDF (mm on the surface, turned
 // into pixels with the pixel's view depth), angles on a golden-angle spiral rotated per pixel
 // (interleaved gradient noise), each weighted by the pixel's own profile over the sampling pdf

@@ -1,6 +1,6 @@
 #version 430 core
 // Screen-space separable SSS as a compute shader (RenderSettings.compute; skinlab/render/compute.py):
-// one invocation per pixel, the per-pixel code of passes/ssss_blur.frag (techniques/ssss/blur.glsl) at
+// one invocation per pixel, the per-pixel code of techniques/ssss/blur.frag (techniques/ssss/blur.glsl) at
 // the pixel's centre. Variant SSSS_COMPOSITE (the vertical pass): also the lit image with its blurred
 // subsurface light added back (passes/ssss_composite.frag), into u_composite.
 layout(local_size_x = 8, local_size_y = 8) in;

@@ -1,4 +1,4 @@
-// Screen-space separable SSS (Jimenez et al. 2009/2015) at one pixel, shared by passes/ssss_blur.frag
+// Screen-space separable SSS (Jimenez et al. 2009/2015) at one pixel, shared by techniques/ssss/blur.frag
 // and techniques/ssss/blur.comp (RenderSettings.compute): one 1-D pass of the pixel's profile's kernel
 // along u_dir over the subsurface diffuse target (its alpha: the profile index + 1, 0 where nothing
 // scatters; the kernels are rows of u_table). Offsets are in millimetres on the surface; a pixel at
