@@ -198,7 +198,12 @@ def test_core_modules_never_name_a_technique():
         "skinlab/render/plan.py",
         "skinlab/render/renderer.py",
         "skinlab/render/passes/forward.py",
+        "skinlab/render/gpu_resources.py",
+        "skinlab/render/vertex_streams.py",
         "skinlab/shaders/passes/forward.frag",
+        "skinlab/shaders/passes/forward.vert",
+        "skinlab/shaders/lib/surface_inputs.glsl",
+        "skinlab/shaders/lib/material_sample.glsl",
         "skinlab/commands/render.py",
         "skinlab/commands/technique_options.py",
         "skinlab/viewer/core.py",
@@ -209,6 +214,17 @@ def test_core_modules_never_name_a_technique():
         code = "\n".join(line.split("#")[0].split("//")[0] for line in text.splitlines())
         for n in names:
             assert not re.search(rf"[\"'/]{n}[\"'/_]|\b{n.upper()}_", code), (f, n)
+
+
+def test_pass_shaders_of_one_technique_live_in_its_folder():
+    """skinlab/shaders/passes/ holds the core's pass shaders: each is named by code outside the technique
+    packages; a technique's own pass shaders are under skinlab/shaders/techniques/<name>/."""
+    core = [p for p in (ROOT / "skinlab").rglob("*.py") if "techniques" not in p.relative_to(ROOT / "skinlab").parts]
+    text = "\n".join(p.read_text(encoding="utf-8") for p in core)
+    shaders = sorted((ROOT / "skinlab" / "shaders" / "passes").iterdir())
+    assert any(p.name == "forward.frag" for p in shaders)
+    for p in shaders:
+        assert f"passes/{p.name}" in text, f"skinlab/shaders/passes/{p.name}: no core module uses it"
 
 
 # -- imports ----------------------------------------------------------------------------------------------
@@ -357,7 +373,7 @@ def test_every_program_binding_materials_uses_the_declared_uniforms(renderer):
             assert "u_subsurface" in active, key
         if "('HAS_NORMAL_MAP', '1')" in str(key):
             assert {"u_normal_map", "u_normal_scale"} <= active, key
-    irr = [e.program for k, e in renderer.programs.entries.items() if k[1] == "passes/tsd_irradiance.frag"]
+    irr = [e.program for k, e in renderer.programs.entries.items() if k[1] == "techniques/tsd/irradiance.frag"]
     # the irradiance pass weighs each light by the shared entry factor (skinlab/render/boundary.py)
     assert irr and all({"u_subsurface_color", "u_sss_entry"} <= set(p) for p in irr)
 

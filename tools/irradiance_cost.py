@@ -1,5 +1,5 @@
 """Where the texture-space irradiance pass's time goes: the pass on the head at the default settings,
-run again with one part of skinlab/shaders/passes/tsd_irradiance.frag (or of lib/shadow.glsl) taken out,
+run again with one part of skinlab/shaders/techniques/tsd/irradiance.frag (or of lib/shadow.glsl) taken out,
 the variants interleaved round by round so that a change of machine load hits all alike; the
 forward pass of the same frame beside it. The variants are measurements only (copies of shaders/
 under a temporary folder); none of them is what the renderer runs.
@@ -9,7 +9,7 @@ under a temporary folder); none of them is what the renderer runs.
     .venv/bin/python -m tools.irradiance_cost --against 9f5625f [--rounds 7]
 
 --against REV[,REV...]: the pass as shipped against the shaders/ of git revisions (the same Python
-code drives them; a revision without passes/tsd_through_fill.frag gets today's), interleaved: what a
+code drives them; a revision without techniques/tsd/through_fill.frag gets today's), interleaved: what a
 change of the shaders saved.
 
 --coverage: the pass on a square whose UVs cover 100 %, 25 %, 6.25 % and 1 % of a 512x512 layout
@@ -39,7 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
-IRR = "passes/tsd_irradiance.frag"
+IRR = "techniques/tsd/irradiance.frag"
 VARIANTS = {
     "base": [],
     "pcf_1tap": [
@@ -137,7 +137,7 @@ def main(argv=None) -> int:
                     raise SystemExit(f"--against: git archive {name} failed: {archive.stderr.decode().strip()}")
                 subprocess.run(["tar", "-x", "-C", str(root)], input=archive.stdout, check=True)
                 root, edits = root / "shaders", []
-                fill = "passes/tsd_through_fill.frag"  # (older revisions: the pass ends with today's record fill)
+                fill = "techniques/tsd/through_fill.frag"  # (older revisions: the pass ends with today's record fill)
                 if not (root / fill).exists() and (SHADER_ROOT / fill).exists():
                     shutil.copy(SHADER_ROOT / fill, root / fill)
             else:

@@ -13,7 +13,7 @@ targets (vertex i of the frame's meshes at texel (i % 1024, i / 1024)):
 
 The last order's target holds all orders' light (each order's senders carry the previous ones). The
 passes that shade ambient light read it per vertex (lib/bounce_vertex.glsl in forward.vert and
-tsd_uv.vert, lib/ambient.glsl in the fragment shaders: variant ``BOUNCE``) and treat it like the
+techniques/tsd/uv.vert, lib/ambient.glsl in the fragment shaders: variant ``BOUNCE``) and treat it like the
 sky's light: it enters the medium (texture-space diffusion blurs it) and is reflected. The passes
 only depend on geometry, lights and materials, so an orbiting camera reuses them. How, what it changes
 against the truth and what it costs: docs/interreflection.md; sources: docs/references.md#interreflection.

@@ -77,7 +77,7 @@ class GpuMesh:
 
 
 def node_uniforms(node) -> dict:
-    """A mesh node's transform uniforms (forward.vert, tsd_uv.vert)."""
+    """A mesh node's transform uniforms (forward.vert; a technique's vertex shaders that read u_model)."""
     model = node.world_matrix
     return {"u_model": model, "u_normal_matrix": np.linalg.inv(model[:3, :3]).T}
 

@@ -1,6 +1,6 @@
 """Whether a mesh has a part thinner than a given distance: a vertex whose ray, straight in along
 its normal, leaves the mesh within that distance through a triangle facing away from it (the far
-side). Texture-space translucency (skinlab/shaders/passes/tsd_irradiance.frag) measures the same kind of
+side). Texture-space translucency (skinlab/shaders/techniques/tsd/irradiance.frag) measures the same kind of
 thickness - the slab between a surface facing the light and the point - so a material whose light
 dies out within a distance cannot shine through a mesh with no part that thin
 (skinlab/render/techniques/tsd/plan.py).

@@ -17,7 +17,7 @@ LIGHTS = {"MAX_LIGHTS": 4, "SHADOW_SLOTS": 1}
 PROGRAMS = [  # a few programs whose files cover lib/, passes/ and a technique's hook
     ("passes/fullscreen.vert", "passes/tonemap.frag", {}, {}),
     ("passes/forward.vert", "passes/forward.frag", LIGHTS, {"skinlab/sss_hook.glsl": "techniques/tsd/forward.glsl"}),
-    ("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", LIGHTS, {}),
+    ("techniques/tsd/uv.vert", "techniques/tsd/irradiance.frag", LIGHTS, {}),
 ]
 
 

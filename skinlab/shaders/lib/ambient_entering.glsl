@@ -1,5 +1,5 @@
 // The ambient light entering a medium's multiple scattering, per unit base colour (every technique's
-// entering light: passes/tsd_irradiance.frag, lib/sss_local.glsl, techniques/preintegrated). The
+// entering light: techniques/tsd/irradiance.frag, lib/sss_local.glsl, techniques/preintegrated). The
 // uniform sky and the bounce light enter as light from all around, pi L x u_sss_entry_diffuse; with
 // variant ENV_MAP the map's light (at the normal set with ambient_set_normal, less what the scene
 // hides) enters by its SH bands: a sky sum L_lm Y_lm brings sum_l eps_l sum_m L_lm Y_lm(n) into the

@@ -1,7 +1,7 @@
 // The material at a fragment: its plain values times its maps, read once through the texture
 // transform (lib/material_uv.glsl), and the vertex colour (the colour rule, docs/scenes.md: the colour
 // map and the vertex colour multiply the base colour, the subsurface colour and the opacity). Shared
-// by the passes that shade a surface (passes/forward.frag, passes/tsd_irradiance.frag,
+// by the passes that shade a surface (passes/forward.frag, techniques/tsd/irradiance.frag,
 // passes/bounce_exitance.frag). Variant MATERIAL_LOD (a float expression): the maps read at that
 // mip level (textureLod), for a pass whose fragment stands for more than a texel (the bounce
 // pass's vertices). NumPy twin: skinlab/scene/optics/surface.py material_sample (without maps).

@@ -1,5 +1,5 @@
 // Light through thin parts, shared by every technique that has it: texture-space diffusion's
-// irradiance pass (passes/tsd_irradiance.frag, d'Eon & Luebke 2007) and the forward hooks of the
+// irradiance pass (techniques/tsd/irradiance.frag, d'Eon & Luebke 2007) and the forward hooks of the
 // techniques without a texture-space pass (screen-space SSS, disk, pre-integrated skin), in the
 // manner of Jimenez, Whelan, Sundstedt & Gutierrez 2010 ("Real-Time Realistic Skin Translucency"):
 // the distance the light travelled inside the object is its distance from the light minus the

@@ -1,4 +1,4 @@
-// One texel of one ring of dilation past UV chart borders, shared by passes/tsd_dilate.frag and
+// One texel of one ring of dilation past UV chart borders, shared by techniques/tsd/dilate.frag and
 // techniques/tsd/dilate.comp (RenderSettings.compute): an empty texel (alpha <= COVERAGE_EPS) takes
 // the mean of its covered 8-neighbours (s / s.a) and becomes covered; a covered one is kept. The
 // includer defines DILATE_FETCH(q): the texel q's value, vec4(0.0) outside the texture. NumPy twin:

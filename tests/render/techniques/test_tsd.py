@@ -19,7 +19,7 @@ def tsd_node(renderer, scene, name="slab"):
 
 
 def test_dilation_pass_matches_its_twin(renderer):
-    """passes/tsd_dilate.frag against dilate_reference on a texture with islands, holes and edges."""
+    """techniques/tsd/dilate.frag against dilate_reference on a texture with islands, holes and edges."""
     from types import SimpleNamespace
 
     from skinlab.render.techniques.tsd.passes import dilate

@@ -1,5 +1,5 @@
 """The texture-space irradiance pass shades the lights without a shadow map in its light loop and
-each filled shadow slot's light once, with its translucency (skinlab/shaders/passes/tsd_irradiance.frag,
+each filled shadow slot's light once, with its translucency (skinlab/shaders/techniques/tsd/irradiance.frag,
 u_slot_light): the frame must not depend on the lights' order or on which slot holds a light. With
 no ambient light the frame is linear in the lights, so two shadow-casting lights together (one in
 slot 0, one in slot 1) render the sum of each alone (in slot 0)."""

@@ -40,7 +40,7 @@ def _random_seam_case(n=40, seed=3):
 
 
 def test_seam_fill_and_the_blur_with_seams_match_their_numpy_twins(renderer):
-    """passes/tsd_seam_fill.frag against seam_fill_reference, and a blur level with its gutter filled
+    """techniques/tsd/seam_fill.frag against seam_fill_reference, and a blur level with its gutter filled
     across the seams against diffuse_reference(seam=...), 1e-4."""
     n = 40
     img, seam, real, ext = _random_seam_case(n)
@@ -143,7 +143,7 @@ def test_seam_map_is_built_and_used_on_the_bunny_and_the_head(renderer, name):
 
 
 def test_through_fill_matches_its_numpy_twin(renderer):
-    """passes/tsd_through_fill.frag against through_fill_reference, 1e-4, with and without the seam
+    """techniques/tsd/through_fill.frag against through_fill_reference, 1e-4, with and without the seam
     map: random records on two charts (some covered texels without light through), the marked gutter
     pointing at random UVs; covered texels keep their records, the gutter next to a chart is filled,
     a slot's thickness is averaged only over texels that hold its light."""

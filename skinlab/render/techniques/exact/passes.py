@@ -1,5 +1,5 @@
 """The exact technique's pass: brute-force convolution of the dilated irradiance with the exact
-radial profile (skinlab/shaders/passes/tsd_exact.frag; the per-texel code techniques/exact/gather.glsl,
+radial profile (skinlab/shaders/techniques/exact/gather.frag; the per-texel code techniques/exact/gather.glsl,
 run by techniques/exact/gather.comp with ``TsdExactParams.compute``) into level 0, which the
 texture-space gather then reads with weight 1 (plan.UNIT_KERNEL)."""
 
@@ -61,7 +61,7 @@ class TsdExactPass(TsdPass):
         if prm.compute:
             prog = self.r.programs.compute("techniques/exact/gather.comp")
         else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_exact.frag")
+            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/exact/gather.frag")
         set_uniforms(
             prog,
             {

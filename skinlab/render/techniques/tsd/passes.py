@@ -304,7 +304,7 @@ def dilate(
         for out in {id(o): o for o in outs}.values():
             if out is not src:
                 ctx.copy_framebuffer(t.fbo(ctx, out), t.fbo(ctx, src))
-    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_dilate.frag")
+    prog = renderer.programs.get("passes/fullscreen.vert", "techniques/tsd/dilate.frag")
     # with the mask, the fullscreen triangle's 0.5 passes "<" only where no triangle was
     with gl_state(ctx, enable=moderngl.DEPTH_TEST if mask is not None else 0, depth_func="<"):
         for out in outs:
@@ -366,7 +366,7 @@ class TsdStretchPass(TsdPass):
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         radius_map = {k: v for k, v in node.material.textures().items() if k == "u_subsurface_radius_map"}
         defines = {"HAS_SUBSURFACE_RADIUS_MAP": "1"} if radius_map else {}
-        prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_stretch.frag", defines)
+        prog = self.r.programs.get("techniques/tsd/uv.vert", "techniques/tsd/stretch.frag", defines)
         set_uniforms(prog, {**node_uniforms(node), "u_mm_per_unit": frame.scene.mm_per_unit})
         units = TextureUnits(ctx)
         for sampler, (path, cs) in radius_map.items():
@@ -410,7 +410,7 @@ class TsdIrradiancePass(TsdPass):
             gbuf = t.fbo(ctx, *surface, depth=t.coverage_mask(ctx, "irradiance"))
             _uv_raster_setup(ctx, gbuf, size)
             gbuf.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            raster = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_surface.frag", carried)
+            raster = self.r.programs.get("techniques/tsd/uv.vert", "techniques/tsd/surface.frag", carried)
             set_uniforms(raster, node_uniforms(node))
             bind_ambient(frame, node, raster, TextureUnits(ctx))
             with raster_mask(ctx, t, "irradiance", gbuf):  # the dilation's mask
@@ -425,9 +425,9 @@ class TsdIrradiancePass(TsdPass):
             defines["TSD_TRANSLUCENCY"] = 1
         if prm.deferred:
             defines["DEFERRED_SURFACE"] = 1
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_irradiance.frag", defines)
+            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/tsd/irradiance.frag", defines)
         else:
-            prog = self.r.programs.get("passes/tsd_uv.vert", "passes/tsd_irradiance.frag", defines)
+            prog = self.r.programs.get("techniques/tsd/uv.vert", "techniques/tsd/irradiance.frag", defines)
         units = TextureUnits(ctx)
         for k, tex in enumerate(surface):
             units.bind(prog, f"u_surface{k}", tex)
@@ -465,7 +465,7 @@ def square_footprint(material) -> bool:
 
 def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | None = None, slots: int = 2) -> None:
     """The irradiance pass's light-through record (t.through_raw_record, read with t.raw's coverage)
-    into t.through_record with its gutter filled (skinlab/shaders/passes/tsd_through_fill.frag): the texels
+    into t.through_record with its gutter filled (skinlab/shaders/techniques/tsd/through_fill.frag): the texels
     the seam map marks from across the seam (`seams`: the node's seam map is drawn), the others one
     ring from their covered neighbours. The gather reads the record with nearest filtering, so a
     fragment by a chart border reads the gutter texels whose square overlaps the chart: without the
@@ -482,7 +482,7 @@ def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | 
         if k != 1 or slots > 1:  # the covered texels' records
             ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, src))
     defines = {"TSD_THROUGH_SLOTS": 2 if slots > 1 else 1, **({"TSD_SEAMS": 1} if seams else {})}
-    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_through_fill.frag", defines)
+    prog = renderer.programs.get("passes/fullscreen.vert", "techniques/tsd/through_fill.frag", defines)
     mask = t.strip_mask(renderer, strips) if strips is not None else None
     fbo = t.fbo(ctx, *t.through_record(ctx), depth=mask)
     fbo.depth_mask = False
@@ -532,14 +532,14 @@ class TsdSeamPass(TsdPass):
 
     def run(self, frame, p) -> None:
         t = self.node_targets(p)
-        prog = self.r.programs.get("passes/tsd_seam.vert", "passes/tsd_seam.frag")
+        prog = self.r.programs.get("techniques/tsd/seam.vert", "techniques/tsd/seam.frag")
         t.seam_map(self.r.ctx).draw(prog, p.params.seams, p.params.node.mesh)
         self.publish(frame, p)
 
 
 def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.Texture, compute: bool = False) -> None:
     """`src` into `dst` (another texture), the texels the seam map marks read across the seam
-    (skinlab/shaders/passes/tsd_seam_fill.frag; `compute`: techniques/tsd/blur.comp's TSD_SEAM_FILL)."""
+    (skinlab/shaders/techniques/tsd/seam_fill.frag; `compute`: techniques/tsd/blur.comp's TSD_SEAM_FILL)."""
     ctx = renderer.ctx
     if compute:
         cs = renderer.programs.compute("techniques/tsd/blur.comp", {"TSD_SEAM_FILL": 1})
@@ -549,7 +549,7 @@ def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.
         bind_images(cs, {"u_dst": dst})
         dispatch(cs, (t.size, t.size))
         return
-    prog = renderer.programs.get("passes/fullscreen.vert", "passes/tsd_seam_fill.frag")
+    prog = renderer.programs.get("passes/fullscreen.vert", "techniques/tsd/seam_fill.frag")
     t.fbo(ctx, dst).use()
     ctx.viewport = (0, 0, t.size, t.size)
     src.use(0)
@@ -579,7 +579,7 @@ class TsdBlurPass(TsdPass):
         if prm.compute:
             prog = self.r.programs.compute("techniques/tsd/blur.comp")
         else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "passes/tsd_blur.frag")
+            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/tsd/blur.frag")
         taps_t, taps_w = blur_taps(step.taps)
         set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
         set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)

@@ -14,7 +14,7 @@ the surface across every UV seam into the gutter of each chart ("extension trian
   mesh or the band changes.
 
 The stretch pass also draws the extension triangles (their own mm per texel in this chart's frame);
-the dilation pass first fills the gutter from the seam map (skinlab/shaders/passes/tsd_seam_fill.frag), and
+the dilation pass first fills the gutter from the seam map (skinlab/shaders/techniques/tsd/seam_fill.frag), and
 so does every blur pass after its v step: the next blur's u step then reads, in the gutter, the
 previous level across the seam (its v step reads the u step's gutter texels as they are: the u blur
 in this chart's frame, continued), and the gather's bilinear lookup at a border reads across too.

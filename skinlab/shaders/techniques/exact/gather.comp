@@ -1,6 +1,6 @@
 #version 430 core
 // The exact convolution as a compute shader (RenderSettings.compute; skinlab/render/compute.py): one
-// invocation per texel, the per-texel code of passes/tsd_exact.frag (techniques/exact/gather.glsl).
+// invocation per texel, the per-texel code of techniques/exact/gather.frag (techniques/exact/gather.glsl).
 layout(local_size_x = 8, local_size_y = 8) in;
 #include "techniques/exact/gather.glsl"
 layout(rgba32f) writeonly uniform image2D u_dst;

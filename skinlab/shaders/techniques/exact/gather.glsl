@@ -1,5 +1,5 @@
 // Brute-force texture-space convolution with the exact radial profile at one texel (the image reference
-// for the realtime techniques; slow on purpose), shared by passes/tsd_exact.frag and
+// for the realtime techniques; slow on purpose), shared by techniques/exact/gather.frag and
 // techniques/exact/gather.comp (RenderSettings.compute). Every texel within r_max (from a table of R(r)) contributes
 // R(r) x its area; the centre cell contributes the profile's energy inside its own area (the
 // cumulative table E, so a profile singular at r = 0 is integrated, not sampled). Distances use this

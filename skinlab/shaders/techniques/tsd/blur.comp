@@ -1,8 +1,8 @@
 #version 430 core
 // One separable step of the texture-space diffusion chain as a compute shader (RenderSettings.compute;
-// skinlab/render/compute.py): one invocation per texel, the per-texel code of passes/tsd_blur.frag
+// skinlab/render/compute.py): one invocation per texel, the per-texel code of techniques/tsd/blur.frag
 // (techniques/tsd/blur.glsl). Variant TSD_SEAM_FILL: instead, the gutter across UV seams filled
-// (lib/tsd_seams.glsl, as passes/tsd_seam_fill.frag).
+// (lib/tsd_seams.glsl, as techniques/tsd/seam_fill.frag).
 layout(local_size_x = 8, local_size_y = 8) in;
 #ifdef TSD_SEAM_FILL
 #include "lib/tsd_seams.glsl"

@@ -1,5 +1,5 @@
 // One separable step of the texture-space diffusion chain at one texel, shared by
-// passes/tsd_blur.frag and techniques/tsd/blur.comp (RenderSettings.compute): a 1-D Gaussian of
+// techniques/tsd/blur.frag and techniques/tsd/blur.comp (RenderSettings.compute): a 1-D Gaussian of
 // u_sigma_mm millimetres along u_axis (0 = u, 1 = v), the step in texels from the stretch map (mm per
 // texel) at this texel. Taps at t_i sigma with weights from skinlab/scene/optics/tsd.py blur_taps();
 // linear interpolation between the two nearest texels by hand (two fetches), so the NumPy twin

@@ -1,11 +1,11 @@
 #version 430 core
 // Dilation past UV chart borders as a compute shader (RenderSettings.compute; skinlab/render/compute.py):
-// RINGS rings of passes/tsd_dilate.frag (lib/tsd_dilate.glsl, the same per-texel code) in one dispatch.
+// RINGS rings of techniques/tsd/dilate.frag (lib/tsd_dilate.glsl, the same per-texel code) in one dispatch.
 // Each work group loads its 16 x 16 texels and RINGS texels around them into shared memory and runs
 // the rings there, ring r on the texels r or more from the tile's edge (they read only texels ring
 // r - 1 computed), so the result is the fragment path's, texel for texel. Variant TSD_SEAMS: the
 // texels are loaded through the seam map (lib/tsd_seams.glsl seam_fetch: the gutter across UV seams
-// read from the other chart), which is passes/tsd_seam_fill.frag run first.
+// read from the other chart), which is techniques/tsd/seam_fill.frag run first.
 layout(local_size_x = 16, local_size_y = 16) in;
 #define GROUP 16
 #define TILE (GROUP + 2 * RINGS)

@@ -1,8 +1,8 @@
 // Texture-space diffusion's surface G-buffer, the reading side (variant DEFERRED_SURFACE of
-// passes/tsd_irradiance.frag, drawn as one fullscreen triangle over the UV layout): the vertex
-// outputs of passes/tsd_uv.vert at each texel, as passes/tsd_surface.frag rasterised them, become the
+// techniques/tsd/irradiance.frag, drawn as one fullscreen triangle over the UV layout): the vertex
+// outputs of techniques/tsd/uv.vert at each texel, as techniques/tsd/surface.frag rasterised them, become the
 // globals the irradiance code reads (v_world, v_normal, v_uv, v_tangent, v_color, v_bounce for
-// lib/ambient.glsl and v_sky03/47/8 for lib/sky_occlusion.glsl). A vertex output added to tsd_uv.vert must be carried here too (the fullscreen
+// lib/ambient.glsl and v_sky03/47/8 for lib/sky_occlusion.glsl). A vertex output added to techniques/tsd/uv.vert must be carried here too (the fullscreen
 // pass would not link without it). The same values, so the same light, as rasterising the mesh with the shading in
 // the fragment shader, but each texel shaded once: a software rasteriser shades whole blocks of
 // pixels for every small UV triangle that touches them (about 2.4x the covered texels on the head).

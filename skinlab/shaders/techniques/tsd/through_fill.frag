@@ -1,5 +1,5 @@
 #version 330 core
-// The light-through records of the irradiance pass (passes/tsd_irradiance.frag f_through0/1,
+// The light-through records of the irradiance pass (techniques/tsd/irradiance.frag f_through0/1,
 // f_through_cos: per texel and shadow slot the light through thin parts, its thickness, its cosine
 // on the far face) with their gutter filled like the irradiance's, so that the gather's nearest
 // lookup at a chart border (techniques/tsd/forward.glsl) never reads an empty record where the

@@ -1,6 +1,6 @@
 #version 330 core
 // Texture-space diffusion's surface G-buffer, the writing side: the mesh rasterised at its UVs
-// (passes/tsd_uv.vert), each texel's interpolated vertex outputs written as they are, for the
+// (techniques/tsd/uv.vert), each texel's interpolated vertex outputs written as they are, for the
 // irradiance pass's variant DEFERRED_SURFACE to shade each texel once (techniques/tsd/surface.glsl);
 // with SKY_OCCLUSION the vertex's sky coefficients too (lib/sky_vertex.glsl).
 in vec3 v_world;
