@@ -178,7 +178,7 @@ GLSL_CONSTANTS.update(
 )
 
 # ---------------------------------------------------------------------------------------------
-# Texture-space diffusion (d'Eon & Luebke 2007; skinlab/scene/optics/tsd.py, skinlab/shaders/passes/tsd_*.frag)
+# Texture-space diffusion (d'Eon & Luebke 2007; skinlab/scene/optics/tsd.py, skinlab/shaders/techniques/tsd/*.frag)
 TSD_TAP_RANGE = 3.0  # blur taps span +-3 sigma
 TSD_MIN_MM_PER_TEXEL = 1e-6  # zero-area triangles (infinite stretch) clamp to this
 TSD_MAX_STEP_TEXELS = 4096.0  # one sigma never spans more texels than this (finite for any stretch)

@@ -1,5 +1,5 @@
 """Texture-space diffusion (d'Eon & Luebke 2007, GPU Gems 3 ch. 14; docs/references.md#deon-luebke-2007):
-the kernel design shared by the GPU passes (skinlab/render/techniques/tsd/, skinlab/shaders/passes/tsd_*.frag) and
+the kernel design shared by the GPU passes (skinlab/render/techniques/tsd/, skinlab/shaders/techniques/tsd/*.frag) and
 its NumPy reference twin.
 
 The diffusion step, per channel c, of an irradiance texture E (premultiplied by albedo^mix):
@@ -266,7 +266,7 @@ def seam_bilinear_reference(src: np.ndarray, uv: np.ndarray) -> np.ndarray:
 
 
 def seam_fill_reference(src: np.ndarray, seam: np.ndarray) -> np.ndarray:
-    """Twin of skinlab/shaders/passes/tsd_seam_fill.frag: the texels the seam map (H, W, 4: RG source UV, A
+    """Twin of skinlab/shaders/techniques/tsd/seam_fill.frag: the texels the seam map (H, W, 4: RG source UV, A
     marked) marks take src at the seam map's UV; the rest are copied."""
     src = np.asarray(src, np.float32)
     across = seam_bilinear_reference(src, seam[..., :2])
@@ -274,7 +274,7 @@ def seam_fill_reference(src: np.ndarray, seam: np.ndarray) -> np.ndarray:
 
 
 def blur_axis_reference(src: np.ndarray, mm_per_texel: np.ndarray, sigma_mm: float, taps: int, axis: str) -> np.ndarray:
-    """One 1-D pass of skinlab/shaders/passes/tsd_blur.frag: src (H, W, 4) premultiplied, mm_per_texel
+    """One 1-D pass of skinlab/shaders/techniques/tsd/blur.frag: src (H, W, 4) premultiplied, mm_per_texel
     (H, W, 2) (u, v); axis 'u' (columns) or 'v' (rows). float32 arithmetic like the shader."""
     src = np.asarray(src, np.float32)
     H, W, _ = src.shape
@@ -411,7 +411,7 @@ def profile_tint(model: str, medium: Medium) -> np.ndarray:
 
 
 def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float | None = None):
-    """Tables for the brute-force texture-space convolution (skinlab/shaders/passes/tsd_exact.frag):
+    """Tables for the brute-force texture-space convolution (skinlab/shaders/techniques/exact/gather.frag):
     r_max (mm, the radius holding `energy` (default EXACT_ENERGY) of every scattering channel's light), R(r) at
     r_i = i r_max / (n - 1) normalised so its integral over the disc r <= r_max is 1 per channel, and
     the cumulative energy E(r_i) = int_0^r_i R 2 pi r dr (for the centre texel). Channels that do not
@@ -441,7 +441,7 @@ def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float | 
 
 
 def dilate_reference(img: np.ndarray, rings: int) -> np.ndarray:
-    """Twin of skinlab/shaders/passes/tsd_dilate.frag applied `rings` times: an empty texel (alpha <=
+    """Twin of skinlab/shaders/techniques/tsd/dilate.frag applied `rings` times: an empty texel (alpha <=
     COVERAGE_EPS) takes the mean of its covered 8-neighbours (each un-premultiplied, rgba / a) and
     becomes covered; covered texels are kept."""
     cur = np.asarray(img, np.float32).copy()
@@ -464,7 +464,7 @@ def dilate_reference(img: np.ndarray, rings: int) -> np.ndarray:
 
 
 def through_fill_reference(raw, through0, through1, through_cos, seam=None):
-    """Twin of skinlab/shaders/passes/tsd_through_fill.frag: the irradiance pass's light-through records
+    """Twin of skinlab/shaders/techniques/tsd/through_fill.frag: the irradiance pass's light-through records
     (through0/1 (H, W, 4): a slot's light through and its thickness; through_cos (H, W, 2): the
     slots' cosines on the far face) with the gutter filled. A covered texel (raw's alpha >
     COVERAGE_EPS) keeps its record; a gutter texel the seam map marks takes the covered texels of the
