@@ -112,6 +112,8 @@ def startup_bench(scene: str | None = None, size: tuple[int, int] = (64, 64), ro
                 runs[kind].append(_run_child(scene, size, env, str(Path(tmp) / "x.png")))
     out = {"scene": scene or "head", "size": list(size), "rounds": rounds, "cpu_count": os.cpu_count()}
     out["loadavg_start"], out["loadavg_end"] = load_start, _loadavg()
+    # with PYTHONDONTWRITEBYTECODE set no .pyc is kept: every start compiles Skinlab's sources again
+    out["bytecode_cached"] = not os.environ.get("PYTHONDONTWRITEBYTECODE")
     for kind, rs in runs.items():
         out[kind] = {
             "wall_ms": statistics.median(r["wall_ms"] for r in rs),
@@ -135,6 +137,8 @@ def report(res: dict) -> str:
         f"skinlab render {res['scene']} --size {w}x{h}: median of {res['rounds']} fresh processes each; "
         f"load average {res['loadavg_start']} -> {res['loadavg_end']} on {res['cpu_count']} cores"
     ]
+    if not res.get("bytecode_cached", True):
+        lines.append("  (PYTHONDONTWRITEBYTECODE is set: no .pyc is kept, every start compiles the Python sources)")
     for kind in KINDS:
         r = res[kind]
         parts = ", ".join(f"{p} {r['phases_ms'][p]:.0f}" for p in PHASES)

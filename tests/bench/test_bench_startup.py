@@ -1,0 +1,30 @@
+"""`skinlab bench startup` (skinlab/bench/startup.py): a fresh, a cold and a warm start, each a fresh
+process, phase by phase, with what each computed and read. Its figures are printed, never asserted."""
+
+import json
+
+import pytest
+
+from skinlab.cli import main
+
+
+@pytest.mark.slow
+def test_startup_bench_counts_what_each_start_builds_and_reads(capsys, monkeypatch):
+    monkeypatch.setenv("PYTHONDONTWRITEBYTECODE", "1")
+    assert main(["bench", "startup", "reference/slab-edge-skin1", "--size", "16x16", "--rounds", "1", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["rounds"] == 1 and res["size"] == [16, 16] and res["bytecode_cached"] is False
+    for kind in ("fresh", "cold", "warm"):
+        r = res[kind]
+        assert r["wall_ms"] > 0 and set(r["phases_ms"]) == {
+            "imports", "scene", "gl", "plan", "first frame", "frame", "write"
+        }  # fmt: skip
+    # an empty cache builds the tables; the warm start reads what the cold one stored and builds none of them
+    assert res["fresh"]["built"] and not res["fresh"]["loaded"]
+    assert res["cold"]["built"] and not res["cold"]["loaded"]
+    assert res["warm"]["loaded"] and not set(res["warm"]["built"]) & set(res["warm"]["loaded"])
+
+
+def test_startup_bench_refuses_a_bad_round_count(capsys):
+    assert main(["bench", "startup", "--rounds", "0"]) == 2
+    assert "--rounds" in capsys.readouterr().err
