@@ -132,3 +132,36 @@ def test_viewer_docs_name_every_technique_the_t_key_reaches():
     row = next(line for line in text.splitlines() if line.startswith("| T / Shift+T"))
     for t in techniques():
         assert f"`{t.name}`" in row, t.name
+
+
+def test_each_light_kind_gets_its_shape_rows_and_edits_reach_the_light(core, ui):
+    """A spot's cone, a rect's size, a sphere's radius and every light's shadow have rows under that
+    light (panel.light_widgets, drawn in the per-light rows); an edit through the panel reaches the
+    light it names, clamped, and a spot's inner angle never passes its outer one."""
+    from skinlab.scene.graph import LightNode
+
+    added = [
+        LightNode("spot1", "spot", intensity=2.0, inner_deg=20.0, outer_deg=35.0),
+        LightNode("panel1", "rect", intensity=1.0, width=0.5, height=0.25),
+        LightNode("bulb1", "sphere", intensity=1.0, radius=0.1),
+    ]
+    for light in added:
+        light.translation = np.array([0.0, 2.0, 3.0])
+        core.scene.add(light)
+    try:
+        layout = frame(gui_module.Gui(core))
+        spot, rect, sphere = added
+        rows = {
+            spot: ("inner_deg", "outer_deg", "cast_shadow"),
+            rect: ("width", "height", "cast_shadow"),
+            sphere: ("radius", "cast_shadow"),
+        }
+        for light, names in rows.items():
+            for name in names:
+                assert any(k.startswith(f"light{light.uid}/{name}") for k in layout), (light.name, name, layout)
+        panel = core.panel
+        assert panel.edit_light("inner_deg", 60.0, spot) == 60.0 and spot.outer_deg == 60.0  # the cone widened
+        assert panel.edit_light("radius", -1.0, sphere) > 0.0  # clamped into its slider's range
+        assert panel.edit_light("cast_shadow", True, rect) is True and rect.cast_shadow
+    finally:
+        core.scene.root.children[:] = [n for n in core.scene.root.children if n not in added]
