@@ -83,8 +83,8 @@ def pixel_x(width: int, half: float) -> np.ndarray:
 
 def exact_profile(model, medium):
     """The exact radial profile of a material's sss_model (R(r_mm) -> (N, 3))."""
+    from skinlab.scene.optics.profile_fit import MODEL_PROFILES
     from skinlab.scene.optics.profiles import get_profile
-    from skinlab.scene.optics.tsd import MODEL_PROFILES
 
     return lambda r: get_profile(MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
 
@@ -97,8 +97,8 @@ def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab") -> float:
     light is sampled at the centres of a grid of grid_mm (irradiance texels, or pixels for the
     screen-space techniques) whose boundaries fall on x = 0: the sampled edge moves by the shift
     rounded to whole cells."""
+    from skinlab.scene.optics.material_medium import material_medium
     from skinlab.scene.optics.oblique import entry_offset
-    from skinlab.scene.optics.tsd import material_medium
 
     medium = material_medium(scene.find(node).material.values)
     z0 = np.asarray(medium.mfp_arr)  # 1 / mu_t' (isotropic phase): the shaders' u_sss_mfp

@@ -32,8 +32,8 @@ from skinlab.render.settings import RenderSettings
 from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Scene
 from skinlab.scene.materials import Material
 from skinlab.scene.optics.boundary import boundary_tables, single_ambient_albedo
+from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.rough_dielectric import SMOOTH_ALPHA, rough_albedos
-from skinlab.scene.optics.tsd import material_medium
 from skinlab.scene.primitives import box_mesh
 from skinlab.scene.scenefile import load_scene
 from skinlab.scene.transform import look_at_rotation

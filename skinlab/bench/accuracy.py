@@ -179,7 +179,7 @@ def run_sweep(
     from skinlab.render.renderer import Renderer
     from skinlab.render.scattering import effective_material
     from skinlab.render.settings import RenderSettings
-    from skinlab.scene.optics.tsd import material_medium
+    from skinlab.scene.optics.material_medium import material_medium
     from skinlab.scene.scenefile import load_scene
     from skinlab.truth.metrics import relative_map
 

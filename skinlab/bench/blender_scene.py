@@ -410,7 +410,7 @@ def _light(e: dict) -> dict | None:
 def subsurface_inputs(interior: dict, values: dict) -> tuple[dict, dict, list[str]]:
     """(common Principled inputs, per-method radius inputs, notes) for the truth's homogeneous medium
     `interior` (skinlab.truth.export.medium_dict) of a material with `values`."""
-    from skinlab.scene.optics.tsd import eta_from_specular
+    from skinlab.scene.optics.material_medium import eta_from_specular
 
     alpha = np.asarray(interior["albedo"]["value"], np.float64)
     sigma_t = np.asarray(interior["sigma_t"]["value"], np.float64) * float(interior["scale"])  # 1/mm
@@ -452,7 +452,7 @@ def subsurface_inputs(interior: dict, values: dict) -> tuple[dict, dict, list[st
 
 
 def surface_inputs(values: dict) -> dict:
-    from skinlab.scene.optics.tsd import eta_from_specular
+    from skinlab.scene.optics.material_medium import eta_from_specular
 
     eta = eta_from_specular(values["specular"])
     return {

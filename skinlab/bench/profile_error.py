@@ -120,6 +120,7 @@ def edge_response(technique: str, model: str, medium, plan):
 
 def fit_kernel(model: str, medium, K: int):
     """The K-Gaussian fit as a kernel with every Gaussian kept (no texel folding)."""
-    from skinlab.scene.optics.tsd import design_kernel, profile_fit
+    from skinlab.scene.optics.profile_fit import profile_fit
+    from skinlab.scene.optics.tsd import design_kernel
 
     return design_kernel(profile_fit(model, medium, K), 1e-12, 1e-12)

@@ -11,9 +11,9 @@ from skinlab.cache import table
 from skinlab.gl.uniforms import set_array, set_uniforms
 from skinlab.scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables
 from skinlab.scene.optics.fresnel import fdr
+from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
 from skinlab.scene.optics.similarity import real_albedo
 from skinlab.scene.optics.slab import LN_FLOOR, SLAB_MU_NODES, SLAB_TAU_NODES, slab_decay, slab_exit_tables, slab_table
-from skinlab.scene.optics.tsd import material_medium, subsurface_albedo
 
 _ZERO_TABLE = np.zeros((ANGULAR_NODES, 3))
 _SLAB_ROWS = SLAB_MU_NODES * SLAB_TAU_NODES

@@ -360,7 +360,7 @@ def bind_env_bands(prog, material) -> None:
         return
     from skinlab.render.boundary import boundary_ggx_alpha
     from skinlab.scene.optics.boundary import ANGULAR_NODES, SMOOTH_ALPHA
-    from skinlab.scene.optics.tsd import material_medium, subsurface_albedo
+    from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
 
     if material is None or not material.has_subsurface:
         single, entry = np.zeros((3, ANGULAR_NODES, 3)), np.zeros((3, 3))

@@ -133,8 +133,8 @@ class _Writer:
 
     def _volume(self, m: Material) -> dict:
         """KHR_materials_volume + KHR_materials_volume_scatter + diffuse transmission for a subsurface material."""
+        from .optics.material_medium import subsurface_albedo
         from .optics.similarity import van_de_hulst_albedo
-        from .optics.tsd import subsurface_albedo
 
         v = m.values
         g = float(v["subsurface_scatter_anisotropy"])

@@ -71,9 +71,9 @@ def openpbr_to_skinlab(table: dict[str, Any], current: dict[str, Any], mm_per_un
 def skinlab_radius(mfp_mm, values: dict) -> tuple[float, float, float]:
     """Skinlab's subsurface_radius (4 pi l', mm) for a real mean free path per channel (mm) in the
     medium of `values` (its subsurface albedo, index and g)."""
+    from .optics.material_medium import eta_from_specular, subsurface_albedo
     from .optics.media import invert_surface_albedo
     from .optics.similarity import real_albedo
-    from .optics.tsd import eta_from_specular, subsurface_albedo
 
     g = float(values.get("subsurface_scatter_anisotropy", 0.0))
     reduced = invert_surface_albedo(subsurface_albedo(values), eta_from_specular(values["specular"]))

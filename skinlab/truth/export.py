@@ -17,7 +17,7 @@ What the reference models (docs/ground-truth.md):
   with the same intensity (Skinlab's falls off with the distance in metres: the Mitsuba intensity is
   multiplied by 1000^2 since the reference frame measures distances in millimetres);
 * each subsurface material as a homogeneous medium inside its boundary, the medium Skinlab itself
-  derives from the material (``skinlab.scene.optics.tsd.material_medium``: subsurface_color is the surface
+  derives from the material (``skinlab.scene.optics.material_medium.material_medium``: subsurface_color is the surface
   albedo, subsurface_radius the artist radius R = 4 pi l, specular gives the index): reduced
   single-scattering albedo and reduced extinction 1/l per channel with an isotropic phase function
   (similarity theory, as the diffusion profiles assume), in 1/mm (the reference frame's unit); a
@@ -57,9 +57,9 @@ import numpy as np
 from skinlab.scene.graph import LightNode, MeshNode, Scene
 from skinlab.scene.mesh_topology import edge_report, weld
 from skinlab.scene.optics.constants import MIN_MFP_MM
+from skinlab.scene.optics.material_medium import eta_from_specular, material_medium
 from skinlab.scene.optics.rough_dielectric import SMOOTH_ALPHA  # below it a smooth dielectric (rough one degenerates)
 from skinlab.scene.optics.similarity import real_albedo, real_mfp
-from skinlab.scene.optics.tsd import eta_from_specular, material_medium
 
 # the description and its Mitsuba objects live in a module that needs no scene (it runs where only
 # numpy and Mitsuba are installed: a GPU machine rendering a saved description); re-exported here

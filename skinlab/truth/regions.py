@@ -90,7 +90,7 @@ def across(px: PixelPoints, spec) -> tuple[np.ndarray, np.ndarray]:
 
 def diffusion_length_mm(scene) -> float:
     """The longest 1 / sigma_tr (mm) over the channels of the scene's scattering materials (NaN: none)."""
-    from skinlab.scene.optics.tsd import material_medium
+    from skinlab.scene.optics.material_medium import material_medium
 
     best = math.nan
     for n in scene.mesh_nodes():

@@ -277,7 +277,7 @@ def test_edge_error_scores_a_step_one_and_the_reference_zero():
 def test_each_technique_gives_its_edge_response_from_the_frame_plan(renderer):
     """The ledger asks the technique (registry) for its edge response as the frame rendered it."""
     from skinlab.render.settings import RenderSettings
-    from skinlab.scene.optics.tsd import material_medium
+    from skinlab.scene.optics.material_medium import material_medium
     from tests.tsd_scenes import skin, slab_scene
 
     scene = slab_scene(material=skin("burley"))

@@ -14,7 +14,7 @@ from skinlab.bench.sweep import resolve_scene
 from skinlab.scene.graph import CameraNode, MeshNode, Scene
 from skinlab.scene.materials import Material
 from skinlab.scene.optics.boundary import albedo_isotropic
-from skinlab.scene.optics.tsd import material_medium
+from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.primitives import box_mesh
 from skinlab.scene.scenefile import load_scene
 from skinlab.truth.export import describe

@@ -90,8 +90,8 @@ def test_the_subsurface_frame_moves_the_shadow_edge_by_the_oblique_entry_offset(
     puts it 0.57 px above the plain frame's at this size (rows 42.84 and 43.41 at 1024 texels)."""
     from skinlab.bench.truth_ledger import REFERENCE_SCENES
     from skinlab.render.settings import RenderSettings
+    from skinlab.scene.optics.material_medium import material_medium
     from skinlab.scene.optics.oblique import LUMA
-    from skinlab.scene.optics.tsd import material_medium
     from skinlab.scene.scenefile import load_scene
 
     scene = load_scene(REFERENCE_SCENES / "slab-edge-skin1.toml")

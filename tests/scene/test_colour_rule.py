@@ -7,8 +7,8 @@ import pytest
 
 from skinlab.render.settings import RenderSettings
 from skinlab.scene.materials import Material, preset_values
+from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
 from skinlab.scene.optics.media import Medium, preset
-from skinlab.scene.optics.tsd import material_medium, subsurface_albedo
 from skinlab.scene.scenefile import load_scene
 from skinlab.viewer.panel import PanelModel
 from tests.tsd_scenes import skin, slab_scene

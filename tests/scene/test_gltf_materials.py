@@ -240,8 +240,8 @@ def _volume_glb(tmp_path, name, scatter_ext, scatter, thickness=1.0, dt=None):
 
 @pytest.mark.parametrize("ext", ["KHR_materials_volume_scatter", "KHR_materials_scatter"])
 def test_scattering_volume_drafts_become_the_subsurface_medium(tmp_path, ext):
+    from skinlab.scene.optics.material_medium import material_medium
     from skinlab.scene.optics.similarity import van_de_hulst_albedo
-    from skinlab.scene.optics.tsd import material_medium
 
     scatter = {"multiscatterColorFactor": [0.8, 0.6, 0.4], "scatterAnisotropy": 0.5}
     if ext == "KHR_materials_scatter":

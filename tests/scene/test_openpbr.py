@@ -11,8 +11,8 @@ from skinlab.render.boundary import material_boundary, single_scattering_factor
 from skinlab.render.settings import RenderSettings
 from skinlab.scene.materials import Material
 from skinlab.scene.optics import similarity as sim
+from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.media import invert_surface_albedo
-from skinlab.scene.optics.tsd import material_medium
 from skinlab.scene.scenefile import SceneFileError, load_scene
 from skinlab.truth.export import medium_dict
 from tests.tsd_scenes import skin, slab_scene

@@ -18,7 +18,7 @@ def test_every_key_and_parameter_is_documented_with_its_meaning():
             assert f"| `{k.name}` |" in text and k.doc
     for p in PRINCIPLED_PARAMS:
         assert f"| `{p.name}` |" in text and p.doc, p.name
-    # one meaning for the subsurface pair, the same as the code's (skinlab/scene/optics/tsd.material_medium)
+    # one meaning for the subsurface pair, the same as the code's (skinlab/scene/optics/material_medium.py)
     radius = next(p for p in PRINCIPLED_PARAMS if p.name == "subsurface_radius")
     colour = next(p for p in PRINCIPLED_PARAMS if p.name == "subsurface_color")
     assert "R = 4 pi l" in radius.doc and radius.unit == "mm"

@@ -11,8 +11,8 @@ import pytest
 from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Scene
 from skinlab.scene.materials import Material
 from skinlab.scene.mesh_topology import weld
+from skinlab.scene.optics.material_medium import eta_from_specular, material_medium
 from skinlab.scene.optics.media import preset
-from skinlab.scene.optics.tsd import eta_from_specular, material_medium
 from skinlab.scene.primitives import box_mesh
 from skinlab.truth import export as ex
 from skinlab.truth.description import chunk_plan

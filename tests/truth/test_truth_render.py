@@ -9,8 +9,8 @@ import pytest
 from skinlab.bench.truth_ledger import REFERENCE_SCENES
 from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Scene
 from skinlab.scene.materials import Material
+from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.montecarlo import exact_albedo_isotropic
-from skinlab.scene.optics.tsd import material_medium
 from skinlab.scene.primitives import box_mesh
 from skinlab.truth.compare import image_error, object_mask
 from skinlab.truth.reference import ReferenceRequest, render_reference

@@ -64,8 +64,8 @@ def _scatter(medium: Medium) -> np.ndarray:
 def disk_kernel(model: str, medium: Medium, samples: int) -> DiskKernel:
     """The disk samples for a material's sss_model and medium (cached per medium and count)."""
     from .gaussians import NoEnergy, _energy_radius
+    from .profile_fit import MODEL_PROFILES
     from .profiles import get_profile
-    from .tsd import MODEL_PROFILES
 
     if model not in MODEL_PROFILES:
         raise ValueError(

@@ -29,8 +29,9 @@ def scattering_channels(medium) -> np.ndarray:
 def model_edge(model: str, medium):
     """The edge response of a diffusion model's exact radial profile (channels that do not scatter
     get none), or None for a model without a profile."""
+    from skinlab.scene.optics.profile_fit import MODEL_PROFILES
     from skinlab.scene.optics.profiles import get_profile
-    from skinlab.scene.optics.tsd import MODEL_PROFILES, edge_response
+    from skinlab.scene.optics.tsd import edge_response
 
     if model not in MODEL_PROFILES:
         return None

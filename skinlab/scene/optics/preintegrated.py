@@ -6,7 +6,7 @@ table skinlab/shaders/techniques/preintegrated/forward.glsl reads, and of the pe
     D(theta, r) = int_{-pi}^{pi} max(cos(theta + x), 0) R(2 r sin(x/2)) dx / int_{-pi}^{pi} R(2 r sin(x/2)) dx
 
 with theta = acos(N.L) and R the material's radial profile through its normalised Gaussian fit
-(skinlab/scene/optics/tsd.py profile_fit; Penner integrated d'Eon's Gaussians): R(d) = sum_k W_k G(v_k, d).
+(skinlab/scene/optics/profile_fit.py profile_fit; Penner integrated d'Eon's Gaussians): R(d) = sum_k W_k G(v_k, d).
 Each Gaussian is integrated on its own grid (x within 8 sigma_k / r), so narrow Gaussians on wide
 rings stay resolved; a channel that does not scatter (the fit's identity weight) is max(N.L, 0), as
 is curvature 0 (a flat surface). The table's rows are curvature 0 .. curv_max (1/mm, linear), its
@@ -24,7 +24,7 @@ import numpy as np
 from skinlab.cache import table
 
 from .media import Medium
-from .tsd import profile_fit
+from .profile_fit import profile_fit
 
 LUT_NOL = 64  # columns: N.L from -1 to 1
 LUT_CURV = 64  # rows: curvature from 0 to curv_max

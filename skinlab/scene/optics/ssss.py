@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from .tsd import ProfileFit
+from .profile_fit import ProfileFit
 
 SSSS_RANGE_SIGMAS = 3.0
 

@@ -18,7 +18,7 @@ blur convolves (E a, a) and the gather divides, so texels outside the charts nev
 (normalised convolution), on top of the dilation of the irradiance past chart borders.
 
 The weights W come from a K-Gaussian fit with shared variances of the material's profile
-(skinlab.scene.optics.gaussians.fit_gaussians), normalised per channel to sum to 1: the kernel redistributes
+(skinlab/scene/optics/profile_fit.py profile_fit), normalised per channel to sum to 1: the kernel redistributes
 light, the colour comes from the albedo (pre-/post-scatter texturing), so a constant irradiance
 keeps its mean. Gaussians below NEGLIGIBLE_WEIGHT in every channel are dropped; Gaussians narrower
 than a texel cannot be resolved by the texture and join the identity weight I.
@@ -36,118 +36,20 @@ from skinlab.cache import table
 from .constants import (
     COVERAGE_EPS,
     MIN_MFP_MM,
-    SKIN6_VARIANCES,
-    SKIN6_WEIGHTS,
-    SPECULAR_F0_SCALE,
     TSD_MAX_STEP_TEXELS,
     TSD_MIN_MM_PER_TEXEL,
     TSD_TAP_RANGE,
 )
-from .gaussians import NoEnergy, fit_gaussians
 from .media import Medium
+from .profile_fit import MODEL_PROFILES, ProfileFit
 from .profiles import get_profile
 
 TSD_MIN_TAPS = 7  # d'Eon & Luebke's 7-tap kernel is the smallest
 TSD_MAX_TAPS = 31
 TSD_SUBTEXEL_SIGMA = 0.35  # a Gaussian whose sigma is below this many texels is the identity
 NEGLIGIBLE_WEIGHT = 1e-3  # a Gaussian below this weight in every channel is skipped
-MAX_TSD_LEVELS = 6
 
-# The radius the d'Eon & Luebke skin Gaussians correspond to (the default skin radius, mm): the
-# "gaussians" model scales their widths by the material's mean radius over this one.
-SKIN6_RADIUS_MM = (3.67, 1.37, 0.68)
-
-# material sss_model -> profile registry name used for the Gaussian fit
-MODEL_PROFILES = {
-    "dipole": "dipole",
-    "burley": "burley",
-    "blender-burley": "blender-burley",
-    "pbd": "pbd",
-    "gaussians": "deon-skin",
-}
-
-
-def eta_from_specular(specular: float) -> float:
-    """Relative index from the principled specular (F0 = 0.08 specular; eta = (1+sqrt F0)/(1-sqrt F0)),
-    clamped to [1, 2.5] (specular 0 would mean eta = 1: no interface)."""
-    f0 = SPECULAR_F0_SCALE * float(specular)
-    s = math.sqrt(max(f0, 0.0))
-    return float(min(max((1.0 + s) / (1.0 - s), 1.0), 2.5))
-
-
-def subsurface_albedo(values) -> np.ndarray:
-    """The medium's surface albedo (the colour the scattering part shows from afar, on average): the
-    subsurface colour x the mean of the colour map, if the material has one (docs/scenes.md, the colour
-    rule: the map multiplies the subsurface colour per texel; one homogeneous medium per material)."""
-    albedo = np.asarray(values["subsurface_color"], np.float64).reshape(3)
-    cmap = values.get("base_color_map")
-    if cmap is not None:
-        from skinlab.scene.textures import texture_mean
-
-        albedo = albedo * texture_mean(cmap, "srgb")
-    return np.clip(albedo, 0.0, 1.0)
-
-
-def material_medium(values) -> Medium:
-    """The homogeneous medium of a principled material: its subsurface albedo (:func:`subsurface_albedo`)
-    is the surface albedo, subsurface_radius the artist radius per channel (Blender's convention,
-    l = R / 4 pi): the reduced medium (similarity), whatever subsurface_scatter_anisotropy is."""
-    return Medium.from_artist_radius(
-        subsurface_albedo(values), values["subsurface_radius"], eta=eta_from_specular(values["specular"])
-    )
-
-
-FIT_TAIL_WEIGHT = 0.0  # fit_gaussians' tail_weight for the profile fits
 EXACT_ENERGY = 0.999  # the exact convolution's support: the radius holding this of every channel's energy
-
-
-@dataclass(frozen=True)
-class ProfileFit:
-    model: str
-    variances_mm2: np.ndarray  # (K,)
-    weights: np.ndarray  # (K, 3) normalised: identity + sum = 1 per channel
-    identity: np.ndarray  # (3,) weight of the unblurred irradiance (channels with no scattering)
-    rel_error: np.ndarray  # (3,) the fit's relative L2 error on r R(r)
-
-
-@table(disk=True, maxsize=128)
-def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
-    """K shared-variance Gaussians for `model` (a material sss_model) and `medium`, normalised."""
-    if model not in MODEL_PROFILES:
-        raise ValueError(
-            f"sss_model: texture-space diffusion has no profile for {model!r}; "
-            f"expected one of {', '.join(MODEL_PROFILES)}"
-        )
-    if not (isinstance(K, int) and 1 <= K <= MAX_TSD_LEVELS):
-        raise ValueError(f"tsd_gaussians: expected an integer in [1, {MAX_TSD_LEVELS}], got {K!r}")
-    # channels that scatter at all (mean free paths below MIN_MFP_MM are "no scattering" for every
-    # profile); the others keep the unblurred irradiance
-    scatter = (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
-    if model == "gaussians":
-        radius = np.where(scatter, medium.artist_radius_mm, 0.0)
-        scale = float(radius[scatter].mean() / np.mean(SKIN6_RADIUS_MM)) if scatter.any() else 0.0
-        v_all = np.asarray(SKIN6_VARIANCES) * scale**2
-        w_all = np.asarray(SKIN6_WEIGHTS, dtype=np.float64).reshape(-1, 3)  # (6, 3)
-        if K < len(v_all):  # keep the K widest-weighted Gaussians
-            keep = np.sort(np.argsort(-w_all.sum(axis=1))[:K])
-            v_all, w_all = v_all[keep], w_all[keep]
-        v, w, err = v_all, w_all, np.zeros(3)
-    elif not scatter.any():
-        v, w, err = np.zeros(0), np.zeros((0, 3)), np.zeros(3)
-    else:
-        prof = get_profile(MODEL_PROFILES[model])
-        # fit only the scattering channels; the others are identity
-        fn = lambda r: prof.evaluate(np.asarray(r, np.float64), medium) * scatter[None, :]
-        try:
-            fit = fit_gaussians(fn, K, tail_weight=FIT_TAIL_WEIGHT)
-            v, w, err = fit.variances_mm2, fit.weights.copy(), np.where(scatter, fit.rel_error, 0.0)
-        except NoEnergy:  # the light spreads less than 1e-5 mm in every scattering channel: none scatters
-            v, w, err = np.zeros(0), np.zeros((0, 3)), np.zeros(3)
-    w = np.where(scatter[None, :], w, 0.0)
-    tot = w.sum(axis=0)
-    ok = tot > 0
-    wn = np.where(ok[None, :], w / np.where(ok, tot, 1.0)[None, :], 0.0)
-    return ProfileFit(model, np.asarray(v, np.float64), wn, np.where(ok, 0.0, 1.0), err)
 
 
 @dataclass(frozen=True)

@@ -10,11 +10,12 @@ from skinlab.render.settings import RenderSettings
 from skinlab.render.techniques.disk import DiskSettings
 from skinlab.scene.graph import MeshNode
 from skinlab.scene.optics import burley, disk, tsd
+from skinlab.scene.optics.material_medium import material_medium
 from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 
 def medium(radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5)):
-    return tsd.material_medium({"subsurface_color": color, "subsurface_radius": radius, "specular": 0.0})
+    return material_medium({"subsurface_color": color, "subsurface_radius": radius, "specular": 0.0})
 
 
 @pytest.mark.parametrize("model", ["burley", "dipole", "pbd", "gaussians", "blender-burley"])

@@ -15,13 +15,14 @@ from skinlab.render.techniques.tsd import TsdSettings
 from skinlab.scene.graph import CameraNode, MeshNode, Scene
 from skinlab.scene.mesh import Mesh
 from skinlab.scene.optics import preintegrated as pis
-from skinlab.scene.optics import tsd
 from skinlab.scene.optics.boundary import table_lookup
+from skinlab.scene.optics.material_medium import material_medium
+from skinlab.scene.optics.profile_fit import profile_fit
 from tests.tsd_scenes import light_from, skin, slab_scene
 
 
 def medium(radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5)):
-    return tsd.material_medium({"subsurface_color": color, "subsurface_radius": radius, "specular": 0.0})
+    return material_medium({"subsurface_color": color, "subsurface_radius": radius, "specular": 0.0})
 
 
 def uv_sphere(radius=1.0, rings=96, segments=192):
@@ -51,7 +52,7 @@ def test_lut_rows_conserve_energy_and_wrap_past_the_terminator(model):
     assert np.all(np.diff(wrap, axis=0) >= -1e-9) and wrap[-1, 0] > 0.05 and wrap[-1, 0] > wrap[-1, 2]
     # the ring convolution keeps the ring's light: int_0^pi D(cos theta) dtheta = int_0^pi max(cos, 0) = 1
     th = np.linspace(0, math.pi, 2001)
-    fit = tsd.profile_fit(model, medium(), 6)
+    fit = profile_fit(model, medium(), 6)
     for r_mm in (1.0 / lut.curv_max, 5.0, 50.0):
         d = pis.ring_diffusion(np.cos(th), r_mm, fit.variances_mm2, fit.weights, fit.identity)
         np.testing.assert_allclose(np.trapezoid(d, th, axis=0), 1.0, rtol=2e-3)
@@ -67,7 +68,7 @@ def test_lut_hard_cases():
     assert np.all(np.isfinite(lut.table)) and lut.table[-1, pis.LUT_NOL // 2 - 1, 0] > 0
     np.testing.assert_allclose(lut.table[..., 1:], np.maximum(nol, 0)[None, :, None] * np.ones((pis.LUT_CURV, 1, 2)))
     # a ring of radius -> 0 or inf stays finite
-    fit = tsd.profile_fit("burley", medium(), 6)
+    fit = profile_fit("burley", medium(), 6)
     for r in (1e-6, 1e6, math.inf):
         assert np.all(np.isfinite(pis.ring_diffusion(nol, r, fit.variances_mm2, fit.weights, fit.identity)))
 
@@ -165,7 +166,7 @@ def test_sphere_follows_the_table(renderer, multiple_only):
     x = ((np.arange(size) + 0.5) / size * 2 - 1) * 1.1 * R
     inside = np.abs(x) < 0.9 * R  # away from the silhouette
     nol, nov = x / R, np.sqrt(np.maximum(1 - (x / R) ** 2, 0))
-    lut = pis.preintegrated_lut("burley", tsd.material_medium(mat.values))
+    lut = pis.preintegrated_lut("burley", material_medium(mat.values))
     D = pis.lut_lookup(lut, nol, np.full_like(x, 1.0 / (R * mm)))
     b = material_boundary(mat)
     flat = np.maximum(nol, 0.0)[:, None]

@@ -8,7 +8,9 @@ import pytest
 from skinlab.render.settings import RenderSettings
 from skinlab.render.techniques.ssss import SsssSettings
 from skinlab.scene.graph import MeshNode
-from skinlab.scene.optics import ssss, tsd
+from skinlab.scene.optics import ssss
+from skinlab.scene.optics.material_medium import material_medium
+from skinlab.scene.optics.profile_fit import profile_fit
 from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
 
@@ -27,7 +29,7 @@ def test_two_media_in_one_frame_match_each_rendered_alone(renderer):
     assert "2: 'slab' (burley), 'slab' (dipole)" in both.plan.passes[-2].reason
     # each kernel is its own medium's
     for k, mat in zip(plan.kernels, (wide, narrow)):
-        off, w, _ = ssss.ssss_kernel(tsd.profile_fit(mat["sss_model"], tsd.material_medium(mat.values), 6), 17)
+        off, w, _ = ssss.ssss_kernel(profile_fit(mat["sss_model"], material_medium(mat.values), 6), 17)
         np.testing.assert_allclose(k.weights, w)
     alone = {}
     for name in ("top", "bottom"):

@@ -10,6 +10,7 @@ from skinlab.render.techniques.ssss import SsssSettings
 from skinlab.render.techniques.tsd import TsdSettings
 from skinlab.render.techniques.tsd.passes import frame_nodes, read_texture
 from skinlab.scene.optics import ssss, tsd
+from skinlab.scene.optics.material_medium import material_medium
 from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, skin, slab_scene
 
 
@@ -26,7 +27,7 @@ def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer
     assert [p.kind for p in res.plan.passes].count("tsd_exact") == 1
     assert "tsd_blur" not in [p.kind for p in res.plan.passes]
     t = frame_nodes(renderer.last_frame)[scene.find("slab").uid]
-    medium = tsd.material_medium(t.material.values)
+    medium = material_medium(t.material.values)
     row, lit = edge_row(res, n)
     x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
         scene, 2 * scene.mm_per_unit / n
@@ -64,7 +65,7 @@ def test_screen_space_sss_follows_its_separable_kernel(renderer, multiple_only):
         own = ssss.separable_edge_response(-x_mm, plan.offsets_mm, plan.weights)
         err = np.abs(row / lit - own)
         assert err.max() < 0.02 + 1.0 / taps, (taps, err.max(axis=0))
-        medium = tsd.material_medium(plan.material.values)
+        medium = material_medium(plan.material.values)
         exact = tsd.edge_response(-x_mm, exact_profile("burley", medium), "profile")
         assert np.abs(row / lit - exact).max() < 0.06 + 1.0 / taps
     # the kernel itself: weights sum to 1 per channel, symmetric offsets

@@ -12,7 +12,7 @@ from skinlab.render.settings import RenderSettings
 from skinlab.scene.graph import MeshNode
 from skinlab.scene.materials import Material
 from skinlab.scene.optics import translucency as tr
-from skinlab.scene.optics.tsd import material_medium
+from skinlab.scene.optics.material_medium import material_medium
 from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
 SCREEN = ("ssss", "disk", "preintegrated")

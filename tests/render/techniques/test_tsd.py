@@ -9,6 +9,7 @@ from skinlab.render.techniques.tsd.passes import frame_nodes, read_texture, stor
 from skinlab.scene.mesh import Mesh
 from skinlab.scene.optics import tsd
 from skinlab.scene.optics.boundary import boundary_tables, table_lookup
+from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.single_scattering import single_scatter_brdf
 from skinlab.scene.optics.slab import slab_table, slab_through
 from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, quad_mesh, skin, slab_scene
@@ -77,7 +78,7 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
     np.testing.assert_allclose(stretch[cov, :2], 2 * 20.0 / 128, rtol=1e-5)
     _, diffused = tsd.diffuse_reference(irr, stretch, t.kernel)
     exact = tsd.exact_profile_convolution(
-        irr, (stretch[64, 64, 0], stretch[64, 64, 1]), exact_profile("burley", tsd.material_medium(t.material.values))
+        irr, (stretch[64, 64, 0], stretch[64, 64, 1]), exact_profile("burley", material_medium(t.material.values))
     )
     rel_l1 = np.abs(diffused - exact).sum(axis=(0, 1)) / np.abs(exact).sum(axis=(0, 1))
     print(f"K=6 Gaussian fit vs exact Burley convolution, relative L1 per channel: {rel_l1.round(4)}")
@@ -98,7 +99,7 @@ def test_shadow_edge_follows_the_profile_edge_response(renderer, model, multiple
     x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
         scene, 2 * scene.mm_per_unit / n
     )  # where the light entered
-    edge = tsd.edge_response(-x_mm, exact_profile(model, tsd.material_medium(t.material.values)), "profile")
+    edge = tsd.edge_response(-x_mm, exact_profile(model, material_medium(t.material.values)), "profile")
     err = np.abs(row / lit - edge)
     assert np.all(np.isfinite(err))
     assert err.max() < 0.02, (model, err.max(axis=0), int(err.argmax()) // 3)
@@ -125,7 +126,7 @@ def test_constant_irradiance_keeps_its_mean(renderer):
     # the irradiance being light x entry factor x albedo^mix; plus single scattering, albedo x
     # light x Jensen's term (skinlab/scene/optics/boundary.py)
     base = np.array([0.8, 0.6, 0.5])
-    medium = tsd.material_medium(t.material.values)
+    medium = material_medium(t.material.values)
     tab = boundary_tables(medium.alpha_arr, t.material["subsurface_color"], medium.eta)
     light = irr[64, 64] / (table_lookup(tab.entry, 1.0) * np.sqrt(base))
     z = np.array([0.0, 0.0, 1.0])
@@ -210,7 +211,7 @@ def test_translucency_through_thin_parts(renderer):
     renderer.render(st_thin, st, readback=False)
     t = frame_nodes(renderer.last_frame)[st_thin.find("slab").uid]
     irr = tsd.unpremultiply(read_texture(t.targets.irradiance))[32, 32]
-    medium = tsd.material_medium(t.material.values)
+    medium = material_medium(t.material.values)
     table = slab_table(medium.alpha_arr, t.material["subsurface_color"])
     through = slab_through(1.0, 0.5, table, medium.mfp_arr, medium.alpha_arr, medium.eta)
     mix = st.technique.albedo_mix
@@ -233,7 +234,7 @@ def test_uniform_sky_reflects_chandrasekhars_albedo(renderer, technique):
     scene.lights()[0].intensity = 0.0
     opts = {"size": 128} if technique == "tsd" else {}
     img = renderer.render(scene, RenderSettings.for_technique(technique, 48, 48, shadow_size=256, **opts)).hdr
-    medium = tsd.material_medium(scene.find("slab").material.values)
+    medium = material_medium(scene.find("slab").material.values)
     want = np.array([float(albedo_isotropic(a, 1.0)) for a in medium.alpha_arr])
     got = img[22:26, 22:26, :3].reshape(-1, 3).mean(0)
     np.testing.assert_allclose(got, want, rtol=0.01)

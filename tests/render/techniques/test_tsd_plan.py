@@ -10,6 +10,8 @@ from skinlab.resources import assets_root
 from skinlab.scene.materials import Material
 from skinlab.scene.mesh import Mesh
 from skinlab.scene.optics import tsd
+from skinlab.scene.optics.material_medium import material_medium
+from skinlab.scene.optics.profile_fit import ProfileFit, profile_fit
 from skinlab.scene.scenefile import load_scene
 from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
@@ -77,7 +79,7 @@ def test_texture_space_targets_are_released_when_no_longer_used(renderer):
 
 
 def test_negligible_and_subtexel_gaussians_are_skipped():
-    fit = tsd.ProfileFit(
+    fit = ProfileFit(
         "test",
         np.array([1e-4, 0.5, 2.0, 8.0]),
         np.array([[0.3, 0.3, 0.3], [0.4, 0.4, 0.4], [0.2999, 0.2999, 0.2999], [1e-4, 5e-4, 0.0]]),
@@ -163,20 +165,16 @@ def test_hard_material_values_stay_finite(renderer, model, values):
 
 
 def test_zero_radius_channel_is_unblurred():
-    m = tsd.material_medium(
-        {"subsurface_color": (0.8, 0.5, 0.4), "subsurface_radius": (5.0, 0.0, 1.0), "specular": 0.5}
-    )
-    f = tsd.profile_fit("burley", m, 4)
+    m = material_medium({"subsurface_color": (0.8, 0.5, 0.4), "subsurface_radius": (5.0, 0.0, 1.0), "specular": 0.5})
+    f = profile_fit("burley", m, 4)
     assert f.identity[1] == 1.0 and np.all(f.weights[:, 1] == 0)
     assert f.identity[0] == 0.0 and f.weights[:, 0].sum() == pytest.approx(1.0)
 
 
 def test_unknown_model_and_bad_settings_are_clear_errors():
-    m = tsd.material_medium(
-        {"subsurface_color": (0.8, 0.5, 0.4), "subsurface_radius": (5.0, 1.0, 1.0), "specular": 0.5}
-    )
-    with pytest.raises(ValueError, match="texture-space diffusion has no profile for 'fog'"):
-        tsd.profile_fit("fog", m, 4)
+    m = material_medium({"subsurface_color": (0.8, 0.5, 0.4), "subsurface_radius": (5.0, 1.0, 1.0), "specular": 0.5})
+    with pytest.raises(ValueError, match="sss_model: no Gaussian profile fit for 'fog'"):
+        profile_fit("fog", m, 4)
     with pytest.raises(ValueError, match="render setting sss_model: expected one of"):
         RenderSettings(sss_model="fog")
     with pytest.raises(ValueError, match=r"tsd setting gaussians: expected an integer in \[1, 6\], got 0"):
@@ -215,7 +213,7 @@ def test_sub_texel_profile_is_scattered_locally_with_the_boundary(renderer, tech
     res = renderer.render(scene, rs)
     assert not any(k.startswith("tsd") for k in kinds(res.plan))  # nothing to blur
     assert any("scattered locally" in why for _, why in res.plan.skipped), res.plan.skipped
-    m = tsd.material_medium(mat.values)
+    m = material_medium(mat.values)
     t = boundary_tables(m.alpha_arr, mat["subsurface_color"], m.eta)
     mu0 = np.sqrt(0.5)
     n, l, v = np.array([0.0, 0.0, 1.0]), np.array([-mu0, 0.0, mu0]), np.array([0.0, 0.0, 1.0])

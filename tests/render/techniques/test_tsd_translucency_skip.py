@@ -17,9 +17,9 @@ from skinlab.scene import transform as tf
 from skinlab.scene.graph import LightNode
 from skinlab.scene.mesh import Mesh
 from skinlab.scene.mesh_thickness import is_closed, thinner_than
+from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.slab import slab_table, slab_through
 from skinlab.scene.optics.translucency_reach import REACH_EPS, translucency_reach_mm, transmission_bound
-from skinlab.scene.optics.tsd import material_medium
 from skinlab.scene.scenefile import load_scene
 
 REF = assets_root() / "scenes" / "reference"

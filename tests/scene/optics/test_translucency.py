@@ -7,7 +7,7 @@ import numpy as np
 from skinlab.gl.glsl_eval import assert_close_fp32
 from skinlab.render.boundary import bind_boundary, material_boundary
 from skinlab.scene.optics import translucency as tr
-from skinlab.scene.optics.tsd import material_medium
+from skinlab.scene.optics.material_medium import material_medium
 from tests.tsd_scenes import skin
 
 

@@ -19,7 +19,7 @@ from skinlab.render.scattering import scattering_material
 from skinlab.render.technique import ForwardHook, LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from skinlab.scene.optics.disk import MAX_DISK_PROFILES, MAX_DISK_SAMPLES, disk_edge_response, disk_kernel
-from skinlab.scene.optics.tsd import material_medium
+from skinlab.scene.optics.material_medium import material_medium
 
 from .passes import DIFFUSE_TARGET, DiskParams, DiskPass
 

@@ -26,8 +26,9 @@ from skinlab.render.technique import (
 )
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from skinlab.render.vertex_streams import VertexStream
+from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.preintegrated import LUT_CURV, LUT_NOL, preintegrated_lut, vertex_curvature
-from skinlab.scene.optics.tsd import material_medium, profile_fit
+from skinlab.scene.optics.profile_fit import profile_fit
 
 HOOK = "techniques/preintegrated/forward.glsl"
 

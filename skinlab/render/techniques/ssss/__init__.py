@@ -101,8 +101,8 @@ class SsssTechnique(Technique[SsssSettings]):
         kernel's best case), at the frame's tap count."""
         for p in plan.passes:
             if isinstance(p.params, SsssBlurParams):
+                from skinlab.scene.optics.profile_fit import profile_fit
                 from skinlab.scene.optics.ssss import ssss_kernel
-                from skinlab.scene.optics.tsd import profile_fit
 
                 offsets, weights, _ = ssss_kernel(
                     profile_fit(model, medium, p.params.gaussians), len(p.params.ssss.offsets_mm)

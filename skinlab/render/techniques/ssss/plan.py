@@ -10,8 +10,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skinlab.render.scattering import scattering_material
+from skinlab.scene.optics.material_medium import material_medium
+from skinlab.scene.optics.profile_fit import profile_fit
 from skinlab.scene.optics.ssss import ssss_kernel
-from skinlab.scene.optics.tsd import material_medium, profile_fit
 
 MAX_SSSS_PROFILES = 16  # skinlab/shaders/techniques/ssss/blur.glsl
 

@@ -18,7 +18,8 @@ from skinlab.render.technique import (
     Technique,
     TechniquePlan,
 )
-from skinlab.scene.optics.tsd import material_medium, profile_tint
+from skinlab.scene.optics.material_medium import material_medium
+from skinlab.scene.optics.tsd import profile_tint
 
 HOOK = "techniques/tint/forward.glsl"
 

@@ -23,6 +23,8 @@ from skinlab.render.scattering import scattering_material
 from skinlab.render.translucency import plan_translucency
 from skinlab.scene.mesh import with_atlas
 from skinlab.scene.mesh_thickness import thinner_than
+from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
+from skinlab.scene.optics.profile_fit import profile_fit
 from skinlab.scene.optics.translucency_reach import REACH_EPS, translucency_reach_mm
 from skinlab.scene.optics.tsd import (
     NEGLIGIBLE_WEIGHT,
@@ -30,9 +32,6 @@ from skinlab.scene.optics.tsd import (
     BlurStep,
     DiffusionKernel,
     design_kernel,
-    material_medium,
-    profile_fit,
-    subsurface_albedo,
 )
 from skinlab.scene.uv_checks import analyse_uvs
 
