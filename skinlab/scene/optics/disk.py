@@ -35,7 +35,6 @@ from .media import Medium
 GOLDEN_ANGLE = PI * (3.0 - math.sqrt(5.0))  # radians, 2.39996...
 SAMPLE_ENERGY = 0.99  # fraction of the widest channel's energy inside the sampled disc's outer samples
 MAX_DISK_SAMPLES = 64  # skinlab/shaders/techniques/disk/gather.frag
-MAX_DISK_PROFILES = 16  # profiles per frame (one row each in the frame's profile table)
 
 
 @dataclass(frozen=True)

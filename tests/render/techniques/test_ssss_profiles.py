@@ -44,20 +44,23 @@ def test_two_media_in_one_frame_match_each_rendered_alone(renderer):
 
 @pytest.mark.parametrize("technique", ["ssss", "disk"])
 def test_more_profiles_than_the_table_holds_warns(renderer, technique):
-    from skinlab.render.techniques.ssss.plan import MAX_SSSS_PROFILES
-    from skinlab.scene.optics.disk import MAX_DISK_PROFILES
+    from skinlab.render.profile_table import MAX_PROFILES
+    from skinlab.resources import shader_root
 
-    assert MAX_DISK_PROFILES == MAX_SSSS_PROFILES
+    # the one table size (skinlab/render/profile_table.py) is the size both shaders declare
+    define = {"ssss": ("blur.glsl", "MAX_SSSS_PROFILES"), "disk": ("gather.glsl", "MAX_DISK_PROFILES")}[technique]
+    src = (shader_root() / "techniques" / technique / define[0]).read_text(encoding="utf-8")
+    assert f"#define {define[1]} {MAX_PROFILES}\n" in src
 
     scene = slab_scene(material=skin("burley"))
     scene.find("slab").visible = False
-    for i in range(MAX_SSSS_PROFILES + 1):
-        y = -1.0 + 2.0 * i / (MAX_SSSS_PROFILES + 1)
+    for i in range(MAX_PROFILES + 1):
+        y = -1.0 + 2.0 * i / (MAX_PROFILES + 1)
         m = skin("burley", radius=(1.0 + i, 1.0, 1.0))
         scene.add(MeshNode(f"strip{i}", quad_mesh(f"strip{i}", -1.0, 1.0, y, y + 0.1), m))
     res = renderer.render(scene, RenderSettings(32, 32, shadow_size=128, technique=technique))
     prm = res.plan.passes[-2].params
     kernels = prm.ssss.kernels if technique == "ssss" else prm.kernels
-    assert len(kernels) == MAX_SSSS_PROFILES
-    assert any(f"keeps {MAX_SSSS_PROFILES} profiles per frame: node 'strip16'" in w for w in res.plan.warnings)
+    assert len(kernels) == MAX_PROFILES
+    assert any(f"{technique} keeps {MAX_PROFILES} profiles per frame: node 'strip16'" in w for w in res.plan.warnings)
     assert np.all(np.isfinite(res.hdr))

@@ -15,11 +15,10 @@ from dataclasses import dataclass, field
 from skinlab.gl.uniforms import set_uniform
 from skinlab.render.frame_plan import FramePlan, PlannedPass
 from skinlab.render.options import TechniqueSettings, option
-from skinlab.render.scattering import scattering_material
+from skinlab.render.profile_table import plan_profile_table
 from skinlab.render.technique import ForwardHook, LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
-from skinlab.scene.optics.disk import MAX_DISK_PROFILES, MAX_DISK_SAMPLES, disk_edge_response, disk_kernel
-from skinlab.scene.optics.material_medium import material_medium
+from skinlab.scene.optics.disk import MAX_DISK_SAMPLES, disk_edge_response, disk_kernel
 
 from .passes import DIFFUSE_TARGET, DiskParams, DiskPass
 
@@ -67,28 +66,6 @@ class DiskForward(ForwardHook):
         return translucent_shading(mat, HOOK, frame, through, bind, subsurface=index >= 0)
 
 
-def plan_profiles(ctx: PlanContext):
-    """Node uid -> (material, profile index) and the distinct (model, medium) profiles, in order."""
-    keys, labels, nodes = [], [], {}
-    for n in ctx.meshes:
-        mat = scattering_material(n, ctx.settings, ctx.plan, f"disk[{n.name}]")
-        if mat is None:
-            continue
-        key = (mat["sss_model"], material_medium(mat.values))
-        if key not in keys:
-            if len(keys) == MAX_DISK_PROFILES:
-                ctx.plan.warnings.append(
-                    f"disk SSS keeps {MAX_DISK_PROFILES} profiles per frame: node '{n.name}' "
-                    f"(material '{mat.name}') uses material '{labels[-1]}''s profile"
-                )
-                nodes[n.uid] = (mat, len(keys) - 1)
-                continue
-            keys.append(key)
-            labels.append(mat.name)
-        nodes[n.uid] = (mat, keys.index(key))
-    return nodes, keys, labels
-
-
 class DiskTechnique(Technique[DiskSettings]):
     name = "disk"
     description = "importance-sampled Burley disk SSS in screen space (Golubev 2018; HDRP, EEVEE Next)"
@@ -104,7 +81,8 @@ class DiskTechnique(Technique[DiskSettings]):
 
     def plan(self, ctx: PlanContext) -> TechniquePlan:
         o = ctx.options
-        nodes, keys, labels = plan_profiles(ctx)
+        table = plan_profile_table(ctx.meshes, ctx.settings, ctx.plan, self.name)
+        nodes, keys, labels = table.nodes, table.keys, [m.name for m in table.materials]
         if not keys:
             ctx.plan.skipped.append(("disk_sss", "no visible material scatters below the surface"))
             return TechniquePlan()

@@ -13,8 +13,8 @@ import numpy as np
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
 from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
+from skinlab.render.profile_table import MAX_PROFILES
 from skinlab.render.technique import RenderPass
-from skinlab.scene.optics.disk import MAX_DISK_PROFILES
 
 DIFFUSE_TARGET = "disk_diffuse"
 
@@ -56,7 +56,7 @@ class DiskPass(RenderPass):
         else:
             prog = self.r.programs.get("passes/fullscreen.vert", "techniques/disk/gather.frag")
         reach = np.array([k.reach_mm for k in prm.kernels], np.float32)
-        set_array(prog, "u_reach_mm", reach, MAX_DISK_PROFILES)
+        set_array(prog, "u_reach_mm", reach, MAX_PROFILES)
         set_uniforms(
             prog,
             {

@@ -13,9 +13,10 @@ import numpy as np
 from skinlab.gl.uniforms import set_array, set_uniforms
 from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
+from skinlab.render.profile_table import MAX_PROFILES
 from skinlab.render.technique import RenderPass
 
-from .plan import MAX_SSSS_PROFILES, SsssPlan
+from .plan import SsssPlan
 
 MAX_SSSS_TAPS = 63  # skinlab/shaders/techniques/ssss/blur.glsl
 
@@ -51,7 +52,7 @@ class SsssBlurPass(RenderPass):
         n = len(plan.offsets_mm)
         table = self._gpu.table(plan.table())
         ranges = np.array([k.range_mm for k in plan.kernels], np.float32)
-        set_array(prog, "u_range_mm", ranges, MAX_SSSS_PROFILES)
+        set_array(prog, "u_range_mm", ranges, MAX_PROFILES)
         set_uniforms(
             prog,
             {
@@ -76,7 +77,7 @@ class SsssBlurPass(RenderPass):
             bind_images(prog, {"u_dst": tmp})
             dispatch(prog, (w, h))
             vertical = self.r.programs.compute("techniques/ssss/blur.comp", {"SSSS_COMPOSITE": 1})
-            set_array(vertical, "u_range_mm", ranges, MAX_SSSS_PROFILES)
+            set_array(vertical, "u_range_mm", ranges, MAX_PROFILES)
             tmp.use(0)
             frame.targets["hdr_color"].use(3)
             set_uniforms(

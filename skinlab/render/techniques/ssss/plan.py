@@ -1,7 +1,7 @@
-"""Planning screen-space separable SSS: one 1-D kernel per distinct profile (material sss_model and
-medium) among the visible scattering meshes, up to MAX_SSSS_PROFILES per frame; the forward pass
-writes each pixel's profile index, so each pixel is blurred with its own material's kernel (as
-HDRP keeps a table of profiles)."""
+"""Planning screen-space separable SSS: one 1-D kernel per row of the frame's profile table (the
+distinct material sss_model and medium among the visible scattering meshes, up to MAX_PROFILES:
+skinlab/render/profile_table.py); the forward pass writes each pixel's profile index, so each pixel
+is blurred with its own material's kernel (as HDRP keeps a table of profiles)."""
 
 from __future__ import annotations
 
@@ -9,12 +9,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skinlab.render.scattering import scattering_material
-from skinlab.scene.optics.material_medium import material_medium
+from skinlab.render.profile_table import plan_profile_table
 from skinlab.scene.optics.profile_fit import profile_fit
 from skinlab.scene.optics.ssss import ssss_kernel
-
-MAX_SSSS_PROFILES = 16  # skinlab/shaders/techniques/ssss/blur.glsl
 
 
 @dataclass
@@ -53,25 +50,12 @@ class SsssPlan:
 
 
 def plan_ssss(meshes, settings, plan, gaussians: int, taps: int) -> SsssPlan | None:
-    keys, kernels, profile = [], [], {}
-    for n in meshes:
-        mat = scattering_material(n, settings, plan, f"ssss[{n.name}]")
-        if mat is None:
-            continue
-        key = (mat["sss_model"], material_medium(mat.values))
-        if key not in keys:
-            if len(keys) == MAX_SSSS_PROFILES:
-                plan.warnings.append(
-                    f"screen-space SSS keeps {MAX_SSSS_PROFILES} profiles per frame: node '{n.name}' "
-                    f"(material '{mat.name}') is blurred with material '{kernels[-1].material.name}''s profile"
-                )
-                profile[n.uid] = len(keys) - 1
-                continue
-            keys.append(key)
-            offsets, weights, rng = ssss_kernel(profile_fit(key[0], key[1], gaussians), taps)
-            kernels.append(SsssKernel(mat, offsets, weights, rng))
-        profile[n.uid] = keys.index(key)
-    if not kernels:
+    table = plan_profile_table(meshes, settings, plan, "ssss")
+    if not table.keys:
         plan.skipped.append(("ssss_blur", "no visible material scatters below the surface"))
         return None
-    return SsssPlan(kernels, profile)
+    kernels = []
+    for mat, (model, medium) in zip(table.materials, table.keys):
+        offsets, weights, rng = ssss_kernel(profile_fit(model, medium, gaussians), taps)
+        kernels.append(SsssKernel(mat, offsets, weights, rng))
+    return SsssPlan(kernels, {uid: index for uid, (_, index) in table.nodes.items()})
