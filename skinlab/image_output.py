@@ -84,14 +84,7 @@ def write_image(path: str | Path, pixels: np.ndarray) -> Path:
     if c == 4:
         spec.channelnames = ("R", "G", "B", "A")
         spec.alpha_channel = 3
-    with atomic_path(path) as tmp:
-        out = oiio.ImageOutput.create(str(tmp))
-        if out is None or not out.open(str(tmp), spec):
-            raise OSError(f"{path}: cannot open for writing: {oiio.geterror()}")
-        ok = out.write_image(pixels)
-        out.close()
-        if not ok:
-            raise OSError(f"{path}: write failed: {oiio.geterror()}")
+    write_pixels(path, pixels, spec)
     return path
 
 
@@ -125,3 +118,18 @@ def contact_sheet(tiles: list[tuple[np.ndarray, str]], columns: int = 3, label_p
         sheet.paste(Image.fromarray(np.ascontiguousarray(img[..., :3])).convert("RGBA"), (x, y))  # opaque
         draw.text((x + 4, y + h + 3), label, fill=(230, 230, 230, 255))
     return np.asarray(sheet)
+
+
+def write_pixels(path: Path, pixels: np.ndarray, spec) -> None:
+    """`pixels` written with OpenImageIO under `spec` (its format from the file name: PNG, EXR, Radiance
+    .hdr), to a temporary name beside `path` and renamed into place; OSError naming `path` on failure."""
+    import OpenImageIO as oiio
+
+    with atomic_path(path) as tmp:
+        out = oiio.ImageOutput.create(str(tmp))
+        if out is None or not out.open(str(tmp), spec):
+            raise OSError(f"{path}: cannot open for writing: {oiio.geterror().strip()}")
+        ok = out.write_image(pixels)
+        out.close()
+        if not ok:
+            raise OSError(f"{path}: write failed: {oiio.geterror().strip()}")

@@ -417,16 +417,12 @@ def write_map(path: str | Path, pixels: np.ndarray) -> Path:
     name first (tests, tools)."""
     import OpenImageIO as oiio
 
-    from skinlab.atomic_write import atomic_path
+    from skinlab.image_output import write_pixels
 
     px = np.ascontiguousarray(pixels, np.float32)
     path = Path(path)
-    with atomic_path(path) as tmp:
-        out = oiio.ImageOutput.create(str(tmp))
-        if out is None or not out.open(str(tmp), oiio.ImageSpec(px.shape[1], px.shape[0], px.shape[2], "float")):
-            raise EnvironmentMapError(f"environment map {path}: cannot write it: {oiio.geterror().strip()}")
-        ok = out.write_image(px)
-        out.close()
-        if not ok:
-            raise EnvironmentMapError(f"environment map {path}: cannot write it: {oiio.geterror().strip()}")
+    try:
+        write_pixels(path, px, oiio.ImageSpec(px.shape[1], px.shape[0], px.shape[2], "float"))
+    except OSError as exc:
+        raise EnvironmentMapError(f"environment map {exc}") from None
     return path
