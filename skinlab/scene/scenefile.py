@@ -497,14 +497,14 @@ def _material_table(where: str, material: Material, values: dict, base: Path, mm
 
 def _check_textures(where: str, material: Material) -> None:
     """Every map set on the material exists and decodes (cached: the renderer reuses the pixels)."""
-    from .textures import load_texture
+    from .textures import read_texture
 
     for p in material.params:
         tex = material.values.get(p.name) if p.kind == "texture" else None
         if tex is None:
             continue
         try:
-            load_texture(tex, p.colorspace)
+            read_texture(tex)
         except (ValueError, OSError) as exc:
             raise SceneFileError(f"{where}.{p.name}: {exc}") from None
 
