@@ -38,7 +38,9 @@ def run(args) -> int:
     out = Path(args.out)
     if args.gallery:
         check_output_path(out / "gallery" / "gallery.png", "--out")
-    scene, result, written, ctx = render_to_files(None, [out / "head.png", out / "head.exr"], RenderSettings(w, h))
+    scene, result, written, ctx = render_to_files(
+        None, [out / "head.png", out / "head.exr"], RenderSettings(w, h), timed=True
+    )
     print(f"Rendered '{scene.name}' ({scene.source}) at {w}x{h} on {describe(ctx)}")
     print(result.plan.explain())
     print(result.timings.table())

@@ -1,5 +1,5 @@
 """`skinlab render [SCENE|MESH] --out PATH --size WxH [--supersample N] [--technique NAME] [--preset NAME]
-[--set KEY=VALUE] [--mm-per-unit MM] [--json] [--explain] [--reuse]`: the technique options come from the
+[--set KEY=VALUE] [--mm-per-unit MM] [--json] [--explain] [--time] [--reuse]`: the technique options come from the
 registered techniques and --supersample from RenderSettings' declaration (skinlab/commands/technique_options.py);
 --preset/--set/--mm-per-unit edit the scene before it is built (skinlab/commands/scene_options.py)."""
 
@@ -48,22 +48,35 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
     p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
     p.add_argument(
+        "--time",
+        action="store_true",
+        help="render a warm-up frame first and write and time the second, so that the per-pass times leave "
+        "out shader compiles and texture uploads. Default: one frame, its times include them",
+    )
+    p.add_argument(
         "--reuse",
         action="store_true",
-        help="the timed frame reuses the warm-up frame's results whose inputs did not change (shadow maps, "
-        "texture-space irradiance and blurs: what the viewer does while only the camera moves); --explain "
-        "lists them as 'reused: inputs unchanged since frame 1'. Default: every pass runs",
+        help="implies --time; the timed frame reuses the warm-up frame's results whose inputs did not change "
+        "(shadow maps, texture-space irradiance and blurs: what the viewer does while only the camera moves); "
+        "--explain lists them as 'reused: inputs unchanged since frame 1'. Default: every pass runs",
     )
     p.set_defaults(func=run)
 
 
 def render_to_files(
-    scene_path, outputs: list[Path], settings: RenderSettings, prepare=None, reuse: bool = False, edits=None
+    scene_path,
+    outputs: list[Path],
+    settings: RenderSettings,
+    prepare=None,
+    reuse: bool = False,
+    edits=None,
+    timed: bool = False,
 ):
-    """Render once and write each output (PNG from the tone-mapped image, EXR linear).
+    """Render and write each output (PNG from the tone-mapped image, EXR linear).
     ``prepare(scene)`` may adjust the loaded scene (camera, exposure) before rendering; ``edits``
-    (SceneEdits: --preset, --set, --mm-per-unit) change it before it is built. A warm-up frame comes
-    first; with `reuse` the written frame reuses its view-independent results."""
+    (SceneEdits: --preset, --set, --mm-per-unit) change it before it is built. One frame, unless
+    ``timed`` (or ``reuse``): then a warm-up frame comes first and the second is written and timed;
+    with ``reuse`` it reuses the warm-up's view-independent results."""
     from skinlab.gl.context import create_headless_context
     from skinlab.image_output import check_output_path, image_format, write_image
     from skinlab.render.renderer import Renderer
@@ -76,11 +89,12 @@ def render_to_files(
         prepare(scene)
     ctx = create_headless_context()
     renderer = Renderer(ctx)
-    # warm-up: compiles and uploads are not frame time
-    render_with_progress(renderer, scene, settings, "warm-up frame", readback=False)
-    if not reuse:
-        renderer.forget_reuse()  # the timed frame runs every pass
-    result = render_with_progress(renderer, scene, settings, "timed frame")
+    if timed or reuse:
+        # warm-up: compiles and uploads are not frame time
+        render_with_progress(renderer, scene, settings, "warm-up frame", readback=False)
+        if not reuse:
+            renderer.forget_reuse()  # the timed frame runs every pass
+    result = render_with_progress(renderer, scene, settings, "timed frame" if timed or reuse else "frame")
     written = []
     for o in outputs:
         pixels = result.ldr if image_format(o) == "png" else result.hdr
@@ -89,6 +103,9 @@ def render_to_files(
 
 
 PROGRESS_AFTER_S = 2.0
+# what the reported times are of (the table's last line, and render --json's "timed_frame")
+FRAME_FIRST = "the first frame: shader compiles and texture uploads included; --time for a warmed-up frame"
+FRAME_TIMED = "the second frame, after a warm-up frame"
 
 
 def render_with_progress(renderer, scene, settings, what: str, readback=True):
@@ -127,7 +144,10 @@ def run(args) -> int:
         if args.camera_orbit:
             scene.orbit_camera(args.camera_orbit)
 
-    scene, result, written, ctx = render_to_files(args.scene, [Path(args.out)], settings, prepare, args.reuse, edits)
+    timed = args.time or args.reuse
+    scene, result, written, ctx = render_to_files(
+        args.scene, [Path(args.out)], settings, prepare, args.reuse, edits, timed=timed
+    )
     for warning in result.plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)
     if args.explain:  # the warnings were printed above, once
@@ -143,6 +163,7 @@ def run(args) -> int:
                     "size": [w, h],
                     "gl": describe(ctx),
                     "timings": result.timings.as_dict(),
+                    "timed_frame": FRAME_TIMED if timed else FRAME_FIRST,
                     "plan": result.plan.as_dict(),
                     "warnings": result.plan.warnings,
                     "notes": result.plan.notes,
@@ -156,6 +177,7 @@ def run(args) -> int:
         for note in result.plan.notes:  # what a setting costs this image, and what would change it
             print(f"note: {note}")
         print(result.timings.table())
+        print(f"  ({FRAME_TIMED if timed else FRAME_FIRST})")
         for name in result.plan.reused():
             print(f"  {name}: reused, inputs unchanged since the warm-up frame")
     return 0

@@ -26,7 +26,9 @@ def test_render_json_png_and_exr(tmp_path):
     d = json.loads(p.stdout)
     assert d["outputs"] == [str(png)] and d["size"] == [48, 40]
     passes = d["timings"]["passes"]
-    # the head's skin scatters: texture-space diffusion runs; the timed frame runs every pass
+    # one frame (no --time): its times are the first frame's, compiles and uploads included
+    assert d["timed_frame"].startswith("the first frame")
+    # the head's skin scatters: texture-space diffusion runs; the frame runs every pass
     head = "LeePerrySmith"
     assert {"shadow[key]", f"tsd_stretch[{head}]", f"tsd_irradiance[{head}]", f"tsd_dilate[{head}]"} <= set(passes)
     assert {"forward", "tonemap"} <= set(passes) and any(n.startswith(f"tsd_blur[{head}]") for n in passes)
@@ -36,6 +38,7 @@ def test_render_json_png_and_exr(tmp_path):
     # --reuse: the view-independent passes keep the warm-up frame's results
     p = skinlab("render", "--out", str(png), "--size", "48x40", "--json", "--reuse", "--tsd-size", "256")
     d = json.loads(p.stdout)
+    assert d["timed_frame"] == "the second frame, after a warm-up frame"  # --reuse implies --time
     assert set(d["timings"]["passes"]) == {"forward", "tonemap"}
     reused = {q["name"]: q["reused_since"] for q in d["plan"]["passes"] if q["reused_since"] is not None}
     assert f"tsd_irradiance[{head}]" in reused and "shadow[key]" in reused and set(reused.values()) == {1}
