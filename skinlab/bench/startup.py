@@ -9,8 +9,8 @@ included):
 - ``gl``: the headless EGL context and the renderer;
 - ``plan``: planning the first frame (profile fits, tables, interreflection rays, UV seams: the work
   skinlab/cache.py keeps on disk);
-- ``first frame``: the first frame's passes (shader compiles, uploads);
-- ``frame``: a second frame with every pass run (what `render` times and reports);
+- ``frame``: the frame `render` renders without ``--time``: every pass, shader compiles and texture
+  uploads included, and its read-back;
 - ``write``: the PNG.
 
 Three starts per round, in a temporary folder: ``fresh`` as on a new machine (Skinlab's cache and
@@ -34,7 +34,7 @@ import time
 from pathlib import Path
 
 KINDS = ("fresh", "cold", "warm")
-PHASES = ("imports", "scene", "gl", "plan", "first frame", "frame", "write")
+PHASES = ("imports", "scene", "gl", "plan", "frame", "write")
 
 
 # what the timed process runs: the command line's imports and parser first (as `skinlab render`
@@ -65,9 +65,6 @@ def child(scene: str | None, size: tuple[int, int], out: str, t_start: float, t_
     t["gl"] = time.perf_counter()
     renderer.plan(sc, settings)
     t["plan"] = time.perf_counter()
-    renderer.render(sc, settings, readback=False)
-    t["first frame"] = time.perf_counter()
-    renderer.forget_reuse()
     result = renderer.render(sc, settings)
     t["frame"] = time.perf_counter()
     from skinlab.image_output import write_image

@@ -17,7 +17,7 @@ def test_startup_bench_counts_what_each_start_builds_and_reads(capsys, monkeypat
     for kind in ("fresh", "cold", "warm"):
         r = res[kind]
         assert r["wall_ms"] > 0 and set(r["phases_ms"]) == {
-            "imports", "scene", "gl", "plan", "first frame", "frame", "write"
+            "imports", "scene", "gl", "plan", "frame", "write"
         }  # fmt: skip
     # an empty cache builds the tables; the warm start reads what the cold one stored and builds none of them
     assert res["fresh"]["built"] and not res["fresh"]["loaded"]
