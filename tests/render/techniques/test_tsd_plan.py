@@ -224,3 +224,25 @@ def test_sub_texel_profile_is_scattered_locally_with_the_boundary(renderer, tech
     np.testing.assert_allclose(got, want, rtol=2e-3)
     plain = renderer.render(scene, RenderSettings.for_technique("none", 48, 48)).hdr[23:25, 23:25, :3]
     assert np.abs(plain.reshape(-1, 3).mean(0) / want - 1).max() > 0.05  # the old fallback was off
+
+
+def test_the_uv_check_is_stored_by_mesh_content_and_read_back_equal(tmp_path, monkeypatch):
+    """uv_report keeps analyse_uvs' report on disk (the head's takes about 0.1 s per start): a new
+    process (here: the memory cache emptied) reads an equal report; another texel count is another key."""
+    from skinlab import cache
+    from skinlab.render.techniques.tsd import plan as tsd_plan
+    from skinlab.scene.graph import MeshNode
+
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path))
+    node = MeshNode("q", quad_mesh("q", 0.0, 1.0, 0.0, 1.0), skin())
+    monkeypatch.setattr(tsd_plan, "_UV_CACHE", {})
+    built, loaded = cache.BUILT["uv_report"], cache.LOADED["uv_report"]
+    first = tsd_plan.uv_report(node, 1.0, 64)
+    tsd_plan._UV_CACHE.clear()
+    again = tsd_plan.uv_report(node, 1.0, 64)
+    assert (cache.BUILT["uv_report"], cache.LOADED["uv_report"]) == (built + 1, loaded + 1)
+    assert again is not first and again.uv_coverage == first.uv_coverage and again.texels == 64
+    np.testing.assert_array_equal(again.mm_per_texel, first.mm_per_texel)
+    assert again.mm_per_texel_percentiles == first.mm_per_texel_percentiles
+    tsd_plan.uv_report(node, 1.0, 128)
+    assert cache.BUILT["uv_report"] == built + 2

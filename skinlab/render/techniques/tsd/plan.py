@@ -15,13 +15,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from skinlab.cache import content_key, stored
 from skinlab.render.compute import PassPath
 from skinlab.render.environment import environment_state
 from skinlab.render.frame_plan import PlannedPass, shadow_pass_name
 from skinlab.render.reuse import light_state, material_state, node_geometry
 from skinlab.render.scattering import scattering_material
 from skinlab.render.translucency import plan_translucency
-from skinlab.scene.mesh import with_atlas
+from skinlab.scene.mesh import mesh_key, with_atlas
 from skinlab.scene.mesh_thickness import thinner_than
 from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
 from skinlab.scene.optics.profile_fit import profile_fit
@@ -67,8 +68,13 @@ def uv_report(node, mm_per_unit: float, size: int):
     if r is None:
         if len(_UV_CACHE) > 512:  # a scene of hundreds of parts keeps them all from frame to frame
             _UV_CACHE.pop(next(iter(_UV_CACHE)))
-        r = _UV_CACHE[key] = analyse_uvs(
-            mesh, mm_per_unit, texels=size, grid=min(512, size), model_scale=model_scale(node.world_matrix)
+        scale, grid = model_scale(node.world_matrix), min(512, size)
+        r = _UV_CACHE[key] = stored(  # on disk too: the head's layout takes about 0.1 s to check
+            "uv_report",
+            content_key(mesh_key(mesh), float(mm_per_unit), scale, size, grid),
+            lambda: analyse_uvs(mesh, mm_per_unit, texels=size, grid=grid, model_scale=scale),
+            f"the UV check of mesh {mesh.name!r}",
+            code=analyse_uvs.__module__,
         )
     return r
 
