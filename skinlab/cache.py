@@ -12,7 +12,7 @@ A dataclass field with ``metadata={"transient": True}`` is not stored (a process
 the rebuilt object makes it anew. Files are written to a temporary name and renamed; a file that
 does not load (truncated, garbage, another layout) is discarded with a one-line warning and the
 result computed again. ``BUILT`` and ``LOADED`` count, per name, the results computed and the ones
-read from disk in this process (the startup benchmark reports them; a test asserts that importing
+read from disk in this process (``BUILT_S`` the seconds the computing took) (the startup benchmark reports them; a test asserts that importing
 the package builds nothing). ``SKINLAB_CACHE_DIR=off`` keeps everything in memory only.
 """
 
@@ -27,6 +27,7 @@ import os
 import sys
 import tempfile
 import threading
+import time
 from collections import Counter
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -37,6 +38,7 @@ import numpy as np
 
 __all__ = [
     "BUILT",
+    "BUILT_S",
     "LOADED",
     "Memo",
     "cache_dir",
@@ -52,6 +54,9 @@ __all__ = [
 
 BUILT: Counter[str] = Counter()
 LOADED: Counter[str] = Counter()
+# wall seconds spent computing each name's results (what it computes inside included: a table that builds
+# another counts that one's time too; a result made on a worker thread counts there)
+BUILT_S: Counter[str] = Counter()
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -61,13 +66,16 @@ _ACTIVE_LOCK = threading.Lock()
 
 
 @contextmanager
-def _working(label: str) -> Iterator[None]:
+def _working(label: str, counted: str) -> Iterator[None]:
+    """``label`` listed by :func:`computing` meanwhile; the time spent counted in BUILT_S[counted]."""
     with _ACTIVE_LOCK:
         _ACTIVE[label] += 1
+    start = time.perf_counter()
     try:
         yield
     finally:
         with _ACTIVE_LOCK:
+            BUILT_S[counted] += time.perf_counter() - start
             _ACTIVE[label] -= 1
             if _ACTIVE[label] <= 0:
                 del _ACTIVE[label]
@@ -247,7 +255,7 @@ def stored(
                 LOADED[label] += 1
                 return value
     BUILT[label] += 1
-    with _working(what or label):
+    with _working(what or label, label):
         value = compute()
     try:
         _write(path, value)
@@ -349,7 +357,7 @@ def table(name: str | None = None, *, disk: bool = False, version: int = 1, maxs
             def compute() -> Any:
                 if not disk:
                     BUILT[label] += 1
-                    with _working(label):
+                    with _working(label, label):
                         return fn(*args, **kwargs)
                 digest = content_key(label, version, key)
                 return stored(

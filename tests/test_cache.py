@@ -204,3 +204,12 @@ def test_a_cached_mesh_whose_extracted_textures_were_deleted_is_loaded_again(dis
     assert Path(load()).is_file() and cache.LOADED["meshes"] == before[1].get("meshes", 0) + 2  # and a hit again
     shutil.rmtree(disk / "gltf")  # within one process, the in-memory copy too
     assert Path(loaders.load_mesh_file(glb)[0].material.values["base_color_map"]).is_file()
+
+
+def test_built_s_counts_the_seconds_a_result_took(disk):
+    before = cache.BUILT_S["timed"]
+    cache.stored("timed", "k", lambda: time.sleep(0.02) or np.zeros(1), count_as="timed")
+    assert cache.BUILT_S["timed"] - before >= 0.02
+    after = cache.BUILT_S["timed"]
+    cache.stored("timed", "k", lambda: pytest.fail("recomputed"), count_as="timed")  # read, not built
+    assert cache.BUILT_S["timed"] == after

@@ -71,11 +71,12 @@ def child(scene: str | None, size: tuple[int, int], out: str, t_start: float, t_
 
     write_image(Path(out), result.ldr)
     t["write"] = time.perf_counter()
-    from skinlab.cache import BUILT, LOADED
+    from skinlab.cache import BUILT, BUILT_S, LOADED
 
     keys = ["start", *PHASES]
     phases = {p: (t[p] - t[keys[i]]) * 1e3 for i, p in enumerate(keys[1:])}
-    return {"phases_ms": phases, "built": dict(BUILT), "loaded": dict(LOADED)}
+    built_ms = {k: BUILT_S[k] * 1e3 for k in BUILT}
+    return {"phases_ms": phases, "built": dict(BUILT), "built_ms": built_ms, "loaded": dict(LOADED)}
 
 
 def _run_child(scene: str | None, size: tuple[int, int], env: dict, out: str) -> dict:
@@ -116,6 +117,7 @@ def startup_bench(scene: str | None = None, size: tuple[int, int] = (64, 64), ro
             "wall_ms": statistics.median(r["wall_ms"] for r in rs),
             "phases_ms": {p: statistics.median(r["phases_ms"][p] for r in rs) for p in PHASES},
             "built": rs[-1]["built"],
+            "built_ms": {k: statistics.median(r["built_ms"].get(k, 0.0) for r in rs) for k in rs[-1]["built"]},
             "loaded": rs[-1]["loaded"],
         }
     return out
@@ -142,8 +144,9 @@ def report(res: dict) -> str:
         lines.append(
             f"  {kind:4s} {r['wall_ms'] / 1e3:6.2f} s wall   ({parts} ms; the rest is the interpreter's start)"
         )
-        built = ", ".join(f"{k} {v}" for k, v in sorted(r["built"].items())) or "nothing"
+        ms = r.get("built_ms", {})
+        built = ", ".join(f"{k} {v} ({ms.get(k, 0.0):.0f} ms)" for k, v in sorted(r["built"].items())) or "nothing"
         loaded = ", ".join(f"{k} {v}" for k, v in sorted(r["loaded"].items())) or "nothing"
-        lines.append(f"        computed: {built}")
+        lines.append(f"        computed (count, wall time, what it computes inside included): {built}")
         lines.append(f"        read from the cache: {loaded}")
     return "\n".join(lines)

@@ -22,6 +22,9 @@ def test_startup_bench_counts_what_each_start_builds_and_reads(capsys, monkeypat
     # an empty cache builds the tables; the warm start reads what the cold one stored and builds none of them
     assert res["fresh"]["built"] and not res["fresh"]["loaded"]
     assert res["cold"]["built"] and not res["cold"]["loaded"]
+    # with the time each computed name took, one entry per name (not asserted: figures)
+    assert set(res["cold"]["built_ms"]) == set(res["cold"]["built"])
+    assert all(v >= 0.0 for v in res["cold"]["built_ms"].values())
     assert res["warm"]["loaded"] and not set(res["warm"]["built"]) & set(res["warm"]["loaded"])
 
 
