@@ -12,8 +12,9 @@ A dataclass field with ``metadata={"transient": True}`` is not stored (a process
 the rebuilt object makes it anew. Files are written to a temporary name and renamed; a file that
 does not load (truncated, garbage, another layout) is discarded with a one-line warning and the
 result computed again. ``BUILT`` and ``LOADED`` count, per name, the results computed and the ones
-read from disk in this process (``BUILT_S`` the seconds the computing took) (the startup benchmark reports them; a test asserts that importing
-the package builds nothing). ``SKINLAB_CACHE_DIR=off`` keeps everything in memory only.
+read from disk in this process, ``BUILT_S`` the seconds the computing took (the startup benchmark
+reports them; a test asserts that importing the package builds nothing). ``SKINLAB_CACHE_DIR=off``
+keeps everything in memory only.
 """
 
 from __future__ import annotations
