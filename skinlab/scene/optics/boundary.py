@@ -63,6 +63,7 @@ import numpy as np
 from skinlab.cache import table
 
 from .fresnel import clamp_eta, fresnel_dielectric
+from .quadrature import gauss_legendre
 from .rough_dielectric import SMOOTH_ALPHA, rough_albedos
 
 ANGULAR_NODES = 17  # table cosines i/16; GLSL SSS_ANGULAR_NODES
@@ -80,7 +81,7 @@ def _gl(n: int = _GL_N):
 def _h_quadrature(n: int = _H_N):
     """Nodes theta in (0, pi/2) and weights for Chandrasekhar's integral form of H; theta = (pi/2) t^2
     takes the logarithmic singularity at theta = 0 (conservative scattering) out of the integrand."""
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = gauss_legendre(n)  # not leggauss: an 800 x 800 eigenproblem
     t = 0.5 * (x + 1.0)
     th = 0.5 * np.pi * t * t
     cot_term = np.where(th > 1e-6, th / np.tan(np.maximum(th, 1e-6)), 1.0 - th * th / 3.0)  # theta cot theta
