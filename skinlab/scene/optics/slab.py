@@ -163,39 +163,39 @@ def slab_through(back, d_mm, table, mfp_mm, alpha, eta) -> np.ndarray:
     in the cosine; below 1/16 mean free path linear in tau to 0, beyond 64 mean free paths decaying as
     e^{-k (tau - 64)} 64 / tau. At eta > 1: Fresnel
     transmission in at `back`, the table at the refracted cosine, and 1 - F_dr(eta) out (the
-    interface's internal reflections between the faces are left out). GLSL twin sss_slab_through."""
+    interface's internal reflections between the faces are left out). GLSL twin sss_slab_through.
+    `back` and `d_mm` may be arrays (broadcast together): the result is then (..., 3), each entry
+    what the scalar call gives."""
     eta = float(clamp_eta(eta))
-    b = float(np.clip(back, 0.0, 1.0))
-    t_in, t_out = 1.0, 1.0
+    b, d = np.broadcast_arrays(np.clip(np.asarray(back, np.float64), 0.0, 1.0), np.asarray(d_mm, np.float64))
+    d = np.maximum(d, 0.0)
+    t_in = np.ones_like(b)
+    t_out = 1.0
     if eta > 1.0:
-        t_in = 1.0 - float(fresnel_dielectric(b, eta))
-        b = float(np.sqrt(max((eta - 1.0) * (eta + 1.0) + b * b, 0.0)) / eta)
+        t_in = 1.0 - np.asarray(fresnel_dielectric(b, eta), np.float64)
+        b = np.sqrt(np.maximum((eta - 1.0) * (eta + 1.0) + b * b, 0.0)) / eta
         t_out = 1.0 - float(fdr(eta))
     l = np.asarray(mfp_mm, np.float64).reshape(3)
     k = slab_decay(alpha)
     tab = np.asarray(table, np.float64).reshape(SLAB_MU_NODES, SLAB_TAU_NODES, 3)
     xm = b * (SLAB_MU_NODES - 1)
-    i = min(int(np.floor(xm)), SLAB_MU_NODES - 2)
-    fm = xm - i
-    out = np.zeros(3)
-    d = max(float(d_mm), 0.0)
-    for c in range(3):
-        if l[c] <= 0 or d <= 0:
-            continue
-        tau = d / l[c]
-        tmin, tmax = 2.0**LOG2_TAU_MIN, 2.0**LOG2_TAU_MAX
-        tc = min(max(tau, tmin), tmax)
-        j = min(int(np.floor((np.log2(tc) - LOG2_TAU_MIN) * 2.0)), SLAB_TAU_NODES - 2)
-        t0 = 2.0 ** (LOG2_TAU_MIN + 0.5 * j)
-        ft = min(max((tc - t0) / (t0 * (np.sqrt(2.0) - 1.0)), 0.0), 1.0)
-        rows = np.exp(tab[i : i + 2, j, c] * (1.0 - ft) + tab[i : i + 2, j + 1, c] * ft)
-        v = rows[0] * (1.0 - fm) + rows[1] * fm
-        if tau < tmin:
-            v *= tau / tmin
-        elif tau > tmax:
-            v *= np.exp(-k[c] * (tau - tmax)) * tmax / tau
-        out[c] = v
-    return t_in * t_out * out
+    i = np.minimum(np.floor(xm).astype(np.int64), SLAB_MU_NODES - 2)[..., None]
+    fm = (xm - i[..., 0])[..., None]
+    crosses = (l > 0) & (d[..., None] > 0)  # (..., 3): light to carry (no medium or no thickness: none)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = np.where(crosses, d[..., None] / np.where(l > 0, l, 1.0), 1.0)
+    tmin, tmax = 2.0**LOG2_TAU_MIN, 2.0**LOG2_TAU_MAX
+    tc = np.minimum(np.maximum(tau, tmin), tmax)
+    j = np.minimum(np.floor((np.log2(tc) - LOG2_TAU_MIN) * 2.0).astype(np.int64), SLAB_TAU_NODES - 2)
+    t0 = 2.0 ** (LOG2_TAU_MIN + 0.5 * j)
+    ft = np.minimum(np.maximum((tc - t0) / (t0 * (np.sqrt(2.0) - 1.0)), 0.0), 1.0)
+    c = np.arange(3)
+    rows0 = np.exp(tab[i, j, c] * (1.0 - ft) + tab[i, j + 1, c] * ft)
+    rows1 = np.exp(tab[i + 1, j, c] * (1.0 - ft) + tab[i + 1, j + 1, c] * ft)
+    v = rows0 * (1.0 - fm) + rows1 * fm
+    v = np.where(tau < tmin, v * tau / tmin, v)
+    v = np.where(tau > tmax, v * np.exp(-k * (tau - tmax)) * tmax / tau, v)
+    return t_in[..., None] * t_out * np.where(crosses, v, 0.0)
 
 
 # -- the angular distribution of the light that comes through -------------------------------------------

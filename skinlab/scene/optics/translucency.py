@@ -126,8 +126,7 @@ def through(back, d_mm, tables: BoundaryTables, medium, colour) -> np.ndarray:
     back = np.atleast_1d(np.asarray(back, np.float64))
     d = np.broadcast_to(np.atleast_1d(np.asarray(d_mm, np.float64)), back.shape)
     table = slab_table(medium.alpha_arr, colour)
-    out = [slab_through(c, x, table, medium.mfp_arr, medium.alpha_arr, tables.eta) for c, x in zip(back, d)]
-    return np.array(out, np.float64).reshape(-1, 3)
+    return slab_through(back, d, table, medium.mfp_arr, medium.alpha_arr, tables.eta).reshape(-1, 3)
 
 
 def translucent_irradiance(e, back, d_mm, hit, tables: BoundaryTables, medium, colour) -> np.ndarray:

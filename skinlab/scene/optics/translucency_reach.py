@@ -33,7 +33,7 @@ def transmission_bound(d_mm, alpha, mfp_mm, eta, colour) -> np.ndarray:
     table = slab_table(alpha, colour)
     d = np.atleast_1d(np.asarray(d_mm, np.float64))
     nodes = np.linspace(0.0, 1.0, SLAB_MU_NODES)
-    t = np.array([[slab_through(m, x, table, mfp_mm, alpha, 1.0) for m in nodes] for x in d]).max(axis=1)
+    t = slab_through(nodes[None, :], d[:, None], table, mfp_mm, alpha, 1.0).max(axis=1)  # (N, nodes, 3)
     with np.errstate(divide="ignore", invalid="ignore"):
         r = t / front
     return np.where(front > 0, r, 0.0)

@@ -208,3 +208,22 @@ def test_slab_exit_glsl_twin(glsl, eta):
     ref = np.array([s.slab_exit(m, m0, d, table, (norm, h, ab), mfp, eta) for m, m0, d in zip(mus, mu0s, ds)])
     assert np.all(np.isfinite(gpu))
     assert_close_fp32(gpu, ref, what="sss_slab_exit", atol=1e-4)
+
+
+@pytest.mark.parametrize("eta", [1.0, 1.4])
+def test_slab_through_over_arrays_is_the_scalar_call_per_entry(eta):
+    """The translucency reach and the NumPy twin of sss_through call slab_through on whole grids: each
+    entry is what the scalar call gives, hard cases included (d = 0 and tiny, far past the table, grazing
+    and normal light, a channel with no mean free path)."""
+    table = s.slab_table([0.9, 0.7, 0.3], [0.8, 0.5, 0.3])
+    rng = np.random.default_rng(7)
+    backs = np.concatenate([[0.0, 1.0, 0.5, 1e-9, 1.0], rng.random(40)])
+    ds = np.concatenate([[0.0, 1e-9, 1e5, 3.0, -1.0], 10 ** rng.uniform(-4, 3, 40)])
+    mfp, alpha = [1.0, 0.3, 0.0], [0.9, 0.7, 0.3]
+    many = s.slab_through(backs, ds, table, mfp, alpha, eta)
+    one = np.array([s.slab_through(b, d, table, mfp, alpha, eta) for b, d in zip(backs, ds)])
+    assert many.shape == (len(backs), 3) and np.all(np.isfinite(many))
+    np.testing.assert_array_equal(many, one)
+    assert np.all(many[:, 2] == 0.0) and np.all(many[[0, 4]] == 0.0)  # no mean free path; no thickness
+    grid = s.slab_through(backs[None, :5], ds[:3, None], table, mfp, alpha, eta)  # broadcast (3, 5, 3)
+    np.testing.assert_array_equal(grid[1, 2], s.slab_through(backs[2], ds[1], table, mfp, alpha, eta))
