@@ -210,3 +210,6 @@ def test_radial_integral_in_chunks_is_the_same_sum():
     np.testing.assert_allclose(pbd.radial_integral(fn, n=600), whole, rtol=1e-12, atol=0)
     np.testing.assert_allclose(pbd.radial_integral(fn, n=600, chunk=7), whole, rtol=1e-12, atol=0)
     assert np.all(np.isfinite(whole)) and whole[0] == 0.0 and np.all(np.diff(whole) > 0)
+    # pbd_total's coarser grid (the albedo table's cost) stays within 1e-6 of the 600-radius sum
+    np.testing.assert_allclose(pbd.pbd_total(alpha, 1.4), whole, rtol=0, atol=1e-6)
+    assert pbd.PBD_TOTAL_RADII < 600
