@@ -101,7 +101,7 @@ def _blender_section() -> str:
 
 _GLTF_INTRO = """\
 A glTF/GLB file (`skinlab render model.glb`, or a `[[meshes]]` entry without `material`) brings its own
-materials, read with pygltflib (skinlab/scene/gltf_materials.py, from the table `GLTF_MAPPING` there). A
+materials, read from the file's JSON (skinlab/scene/gltf_materials.py, from the table `GLTF_MAPPING` there). A
 `material` named in the scene file (on the entry or a node) replaces the file's; `overrides` apply on top
 of either. Textures embedded in the file are written once under `$SKINLAB_CACHE_DIR/gltf`, named by their
 content. An extension Skinlab does not read is named in one warning (the render summary, `skinlab render
