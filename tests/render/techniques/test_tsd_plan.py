@@ -227,22 +227,20 @@ def test_sub_texel_profile_is_scattered_locally_with_the_boundary(renderer, tech
 
 
 def test_the_uv_check_is_stored_by_mesh_content_and_read_back_equal(tmp_path, monkeypatch):
-    """uv_report keeps analyse_uvs' report on disk (the head's takes about 0.1 s per start): a new
-    process (here: the memory cache emptied) reads an equal report; another texel count is another key."""
+    """uv_report keeps analyse_uvs' report on disk (the head's takes about 0.1 s per start): another mesh
+    of the same content (as a new process loads it) reads an equal report; another texel count is
+    another key."""
     from skinlab import cache
-    from skinlab.render.techniques.tsd import plan as tsd_plan
+    from skinlab.render.techniques.tsd.plan import uv_report
     from skinlab.scene.graph import MeshNode
 
     monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path))
-    node = MeshNode("q", quad_mesh("q", 0.0, 1.0, 0.0, 1.0), skin())
-    monkeypatch.setattr(tsd_plan, "_UV_CACHE", {})
     built, loaded = cache.BUILT["uv_report"], cache.LOADED["uv_report"]
-    first = tsd_plan.uv_report(node, 1.0, 64)
-    tsd_plan._UV_CACHE.clear()
-    again = tsd_plan.uv_report(node, 1.0, 64)
+    first = uv_report(MeshNode("q", quad_mesh("q", 0.0, 1.0, 0.0, 1.0), skin()), 1.0, 64)
+    again = uv_report(MeshNode("q", quad_mesh("q", 0.0, 1.0, 0.0, 1.0), skin()), 1.0, 64)
     assert (cache.BUILT["uv_report"], cache.LOADED["uv_report"]) == (built + 1, loaded + 1)
     assert again is not first and again.uv_coverage == first.uv_coverage and again.texels == 64
     np.testing.assert_array_equal(again.mm_per_texel, first.mm_per_texel)
     assert again.mm_per_texel_percentiles == first.mm_per_texel_percentiles
-    tsd_plan.uv_report(node, 1.0, 128)
+    uv_report(MeshNode("q", quad_mesh("q", 0.0, 1.0, 0.0, 1.0), skin()), 1.0, 128)
     assert cache.BUILT["uv_report"] == built + 2
