@@ -29,7 +29,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections import Counter
+from collections import Counter, defaultdict
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -57,7 +57,7 @@ BUILT: Counter[str] = Counter()
 LOADED: Counter[str] = Counter()
 # wall seconds spent computing each name's results (what it computes inside included: a table that builds
 # another counts that one's time too; a result made on a worker thread counts there)
-BUILT_S: Counter[str] = Counter()
+BUILT_S: dict[str, float] = defaultdict(float)
 
 F = TypeVar("F", bound=Callable[..., Any])
 
