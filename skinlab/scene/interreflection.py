@@ -194,9 +194,14 @@ def one_rings(positions, faces, first, inverse) -> tuple[np.ndarray, np.ndarray,
     )
     area = np.bincount(f.ravel(), np.repeat(tri_area / 3.0, 3), minlength=nw)
     edges = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]], np.stack([np.arange(nw)] * 2, 1)])
-    edges = np.unique(np.sort(np.concatenate([edges, edges[:, ::-1]]), axis=1), axis=0)
-    pairs = np.concatenate([edges, edges[edges[:, 0] != edges[:, 1]][:, ::-1]])  # both directions, self once
-    pairs = pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]
+    # each undirected edge (and each vertex with itself) once as the key a * nw + b, a <= b: unique
+    # over integers, not rows (np.unique(axis=0) sorts structured rows, 6x slower on the head)
+    a, b = np.minimum(edges[:, 0], edges[:, 1]), np.maximum(edges[:, 0], edges[:, 1])
+    key = np.unique(a * nw + b)
+    a, b = key // nw, key % nw
+    other = a != b
+    key = np.sort(np.concatenate([key, b[other] * nw + a[other]]))  # both directions, self once, by (from, to)
+    pairs = np.stack([key // nw, key % nw], 1)
     w = area[pairs[:, 1]]
     total = np.bincount(pairs[:, 0], w, minlength=nw)
     w = np.where(total[pairs[:, 0]] > 0, w / np.maximum(total[pairs[:, 0]], 1e-300), 0.0)
@@ -279,14 +284,20 @@ def sky_blocked(dirs, blocked, rays: int, inverse, no_normal, rings) -> np.ndarr
     from .optics.sh import sh9_basis
 
     nw = len(dirs) // rays
-    per = (sh9_basis(dirs) * blocked[:, None]).reshape(nw, rays, 9).sum(1) * (np.pi / rays)
+    # the blocked rays' SH, summed per vertex in ray order (the unblocked ones add nothing)
+    hit = np.flatnonzero(blocked)
+    per = _sum_rows(hit // rays, sh9_basis(dirs[hit]), nw) * (np.pi / rays)
     per = per[inverse]
     per[no_normal] = 0.0
     offsets, ring_vertices, ring_weights = rings
     owner = np.repeat(np.arange(len(per)), np.diff(offsets))
-    out = np.zeros_like(per)
-    np.add.at(out, owner, ring_weights.astype(np.float64)[:, None] * per[ring_vertices])
-    return out.astype(np.float32)
+    return _sum_rows(owner, ring_weights.astype(np.float64)[:, None] * per[ring_vertices], len(per)).astype(np.float32)
+
+
+def _sum_rows(owner: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
+    """(n, C): the rows of `values` (M, C) summed by `owner` (M,) in their order (np.add.at's sums,
+    through bincount per column: several times faster)."""
+    return np.stack([np.bincount(owner, values[:, k], minlength=n) for k in range(values.shape[1])], 1)
 
 
 def gather(transfer: BounceTransfer, exitance: np.ndarray) -> np.ndarray:

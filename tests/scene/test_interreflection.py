@@ -12,6 +12,7 @@ from skinlab.scene.interreflection import (
     clear_cache,
     cosine_directions,
     gather,
+    one_rings,
     sender_albedo,
     smooth,
     weld,
@@ -202,3 +203,35 @@ def test_one_ring_average_keeps_constants_and_sums_to_one():
     # an interior grid vertex averages itself and its 6 neighbours; a corner fewer
     counts = np.diff(tr.ring_offsets)
     assert counts.max() == 7 and counts.min() >= 3
+
+
+def test_one_rings_match_a_vertex_by_vertex_construction():
+    """one_rings (CSR over integer edge keys) against the definition written out vertex by vertex: each
+    vertex's ring is itself and its edge neighbours on the welded mesh (as their first copies, in
+    ascending order), weighted by a third of their incident triangles' areas, summing to 1; a welded
+    vertex no triangle uses has itself alone at weight 1; copies of a vertex have the same ring."""
+    rng = np.random.default_rng(3)
+    positions = rng.random((12, 3))
+    positions[10] = positions[2]  # a copy of vertex 2 (a seam): welded with it
+    normals = np.tile([0.0, 0.0, 1.0], (12, 1))
+    faces = np.array([[0, 1, 2], [1, 3, 2], [3, 4, 10], [4, 5, 6], [6, 7, 8], [0, 8, 7], [1, 9, 3]])  # 11 unused
+    first, inverse = weld(positions, normals)
+    offsets, ring_vertices, ring_weights = one_rings(positions, faces, first, inverse)
+    nw = len(first)
+    wf = inverse[faces]
+    area = np.zeros(nw)
+    for tri, (i, j, k) in zip(wf, faces):
+        a = 0.5 * np.linalg.norm(np.cross(positions[j] - positions[i], positions[k] - positions[i]))
+        area[tri] += a / 3.0
+    for v in range(len(positions)):
+        w = inverse[v]
+        ring = {w} | {int(x) for tri in wf if w in tri for x in tri}
+        ring = sorted(ring)
+        weights = area[ring] / area[ring].sum() if area[ring].sum() > 0 else np.array([1.0])
+        got = slice(offsets[v], offsets[v + 1])
+        np.testing.assert_array_equal(ring_vertices[got], first[ring])
+        np.testing.assert_allclose(ring_weights[got], weights, rtol=1e-6)
+    assert offsets[11 + 1] - offsets[11] == 1 and ring_weights[offsets[11]] == 1.0  # the unused vertex
+    np.testing.assert_array_equal(
+        ring_vertices[offsets[2] : offsets[3]], ring_vertices[offsets[10] : offsets[11]]
+    )  # copies share the ring
