@@ -29,6 +29,7 @@ The GPU side (skinlab/render/techniques/tsd/seams.py) rasterises the extension t
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -259,123 +260,163 @@ def clip_triangles(attrs: np.ndarray, d: np.ndarray) -> np.ndarray:
     return np.concatenate(out)
 
 
+class _Seam(NamedTuple):
+    """One side of a seam edge: owner triangle A, source triangle B, B's UVs mapped into A's frame."""
+
+    owner: int  # A
+    source: int  # B
+    m: np.ndarray  # (2, 2) the similarity's linear part (seam_transform)
+    c: np.ndarray  # (2,) its translation
+    a0: np.ndarray  # the edge's first corner in A's UVs
+    t_hat: np.ndarray  # unit UV direction along A's edge
+    n_hat: np.ndarray  # unit UV normal of A's edge, away from A (positive depth)
+    length: float  # the edge's UV length in A's frame
+    centre: np.ndarray  # the edge's midpoint in B's UVs (where its source triangles are looked for)
+    radius: float  # the UV query radius around it
+    reach3: float  # how far (3D) from the edge's midpoint a source triangle may lie
+    mid3: np.ndarray  # the edge's 3D midpoint
+    jac: np.ndarray  # (3, 2) A's UV-to-3D map (continued linearly past the edge)
+    p0: np.ndarray  # the edge's first corner in 3D
+    length3: float  # the edge's 3D length
+
+
+def _directed_seam(f, uv, pos, pid, own, src, p, band_uv: float, reach: float) -> _Seam | None:
+    """The seam edge seen from `own` = (A, A's local edge) with source `src` = (B, B's local edge), `p`
+    the welded position id of the edge's first endpoint; None where it is not continued (a degenerate
+    transform, or a UV scale jump beyond SCALE_LIMIT). `reach`: the largest triangle's UV radius."""
+    (A, kA), (B, kB) = own, src
+    va, vb = f[A, [kA, (kA + 1) % 3]], f[B, [kB, (kB + 1) % 3]]
+    if pid[va[0]] != p:
+        va = va[::-1]
+    if pid[vb[0]] != p:
+        vb = vb[::-1]
+    a0, a1, a2 = uv[va[0]], uv[va[1]], uv[f[A, (kA + 2) % 3]]
+    b0, b1, b2 = uv[vb[0]], uv[vb[1]], uv[f[B, (kB + 2) % 3]]
+    tr = seam_transform(a0, a1, a2, b0, b1, b2)
+    if tr is None:
+        return None
+    m, c = tr
+    d_uv = np.stack([uv[f[A, 1]] - uv[f[A, 0]], uv[f[A, 2]] - uv[f[A, 0]]], 1)
+    jac = np.stack([pos[f[A, 1]] - pos[f[A, 0]], pos[f[A, 2]] - pos[f[A, 0]]], 1) @ np.linalg.inv(d_uv)
+    scale = float(np.sqrt(abs(np.linalg.det(m))))
+    if not 1.0 / SCALE_LIMIT <= scale <= SCALE_LIMIT:
+        return None
+    la = float(np.linalg.norm(a1 - a0))
+    t_hat = (a1 - a0) / la
+    n_hat = np.array([t_hat[1], -t_hat[0]])
+    if (a2 - a0) @ n_hat > 0:
+        n_hat = -n_hat  # positive depth: away from A
+    radius = np.hypot(0.5 * la, band_uv) / scale + reach
+    e3 = pos[va[1]] - pos[va[0]]
+    reach3 = REACH_3D * np.hypot(0.5 * np.linalg.norm(e3), band_uv * np.linalg.norm(e3) / la)
+    return _Seam(
+        A, B, m, c, a0, t_hat, n_hat, la, 0.5 * (b0 + b1), radius, reach3,
+        0.5 * (pos[va[0]] + pos[va[1]]), jac, pos[va[0]], float(np.linalg.norm(e3)),
+    )  # fmt: skip
+
+
+def directed_seams(mesh: Mesh, band_uv: float, edges=None) -> list[_Seam]:
+    """Both sides of every seam edge (`edges`: seam_edges(mesh), found here where not given) that is
+    continued: owner A, source B and the transform of B's UVs into A's frame, in seam-edge order."""
+    f = mesh.indices.astype(np.int64)
+    uv = mesh.uv_array("seam extensions").astype(np.float64)
+    pos = mesh.positions.astype(np.float64)
+    pairs, local, pids, pid = edges if edges is not None else seam_edges(mesh)
+    tri_uv = uv[f]  # (T, 3, 2)
+    reach = np.sqrt(((tri_uv - tri_uv.mean(1)[:, None]) ** 2).sum(-1)).max() if len(f) else 0.0
+    seams = []
+    for (ta, tb), (ka, kb), (p, _q) in zip(pairs, local, pids):
+        for own, src in (((ta, ka), (tb, kb)), ((tb, kb), (ta, ka))):
+            s = _directed_seam(f, uv, pos, pid, own, src, p, band_uv, reach)
+            if s is not None:
+                seams.append(s)
+    return seams
+
+
+def _stacked(seams: list[_Seam], name: str) -> np.ndarray:
+    """One field of every seam as an array (seam order)."""
+    return np.array([getattr(s, name) for s in seams])
+
+
+def _source_triangles(mesh: Mesh, seams: list[_Seam], chart: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(seam index, triangle) pairs: the triangles of each seam's source chart within its UV query
+    radius and near the edge in 3D too (a UV layout that overlaps itself, or a chart folded in UV,
+    puts far surface near in UV)."""
+    from scipy.spatial import cKDTree
+
+    f = mesh.indices.astype(np.int64)
+    pos = mesh.positions.astype(np.float64)
+    cen = mesh.uv_array("seam extensions").astype(np.float64)[f].mean(1)
+    size3 = np.sqrt(((pos[f] - pos[f].mean(1)[:, None]) ** 2).sum(-1)).max(1)  # 3D radius per triangle
+    hits = cKDTree(cen).query_ball_point(_stacked(seams, "centre"), _stacked(seams, "radius"))
+    sid = np.repeat(np.arange(len(seams)), [len(h) for h in hits])
+    cand = np.concatenate([np.asarray(h, np.int64) for h in hits]) if len(sid) else np.zeros(0, np.int64)
+    d3 = np.linalg.norm(pos[f[cand]].mean(1) - _stacked(seams, "mid3")[sid], axis=1) - size3[cand]
+    same = (chart[cand] == chart[_stacked(seams, "source")[sid]]) & (d3 < _stacked(seams, "reach3")[sid])
+    return sid[same], cand[same]
+
+
+def _in_owner_frame(seams: list[_Seam], sid: np.ndarray, corners_uv: np.ndarray):
+    """Source triangles' corners (n, 3, 2) in their seam's owner frame: (the UVs there, their offset from
+    the edge's first corner, the depth past the edge line, the position along the edge), each (n, 3[, 2])."""
+    w = np.einsum("nij,nkj->nki", _stacked(seams, "m")[sid], corners_uv) + _stacked(seams, "c")[sid][:, None, :]
+    rel = w - _stacked(seams, "a0")[sid][:, None, :]
+    dist = np.einsum("nkj,nj->nk", rel, _stacked(seams, "n_hat")[sid])
+    along = np.einsum("nkj,nj->nk", rel, _stacked(seams, "t_hat")[sid])
+    return w, rel, dist, along
+
+
+def _continues(seams: list[_Seam], sid: np.ndarray, rel: np.ndarray, corners3: np.ndarray) -> np.ndarray:
+    """Whether the owner's UV-to-3D map, continued linearly past the edge, puts each source triangle's
+    corners (`rel`: their offsets in the owner's frame) within CONTINUATION_TOL of their distance from
+    the edge of where they are (`corners3`)."""
+    mid3 = _stacked(seams, "mid3")[sid][:, None, :]
+    pred = _stacked(seams, "p0")[sid][:, None, :] + np.einsum("nij,nkj->nki", _stacked(seams, "jac")[sid], rel)
+    err = np.linalg.norm(pred - corners3, axis=2).max(1)
+    far = np.maximum(np.linalg.norm(pred - mid3, axis=2).max(1), _stacked(seams, "length3")[sid])
+    return err <= CONTINUATION_TOL * far
+
+
+def _extension_corners(mesh: Mesh, seams: list[_Seam], chart: np.ndarray, band_uv: float) -> np.ndarray:
+    """The extension triangles' corner attributes (n, 3, 13): position, normal, UV in the owner's frame,
+    own UV, source triangle, owner, depth; clipped to depth >= 0 (past the edge: affine there)."""
+    f = mesh.indices.astype(np.int64)
+    tri_uv = mesh.uv_array("seam extensions").astype(np.float64)[f]
+    sid, cand = _source_triangles(mesh, seams, chart)
+    w, rel, dist, along = _in_owner_frame(seams, sid, tri_uv[cand])
+    length = _stacked(seams, "length")[sid]
+    keep = (dist.max(1) > 0) & (dist.min(1) < band_uv) & (along.max(1) > 0) & (along.min(1) < length)
+    keep &= _continues(seams, sid, rel, mesh.positions.astype(np.float64)[f[cand]])
+    sid, cand, w, dist = sid[keep], cand[keep], w[keep], dist[keep]
+    n = len(cand)
+    at = np.concatenate(
+        [
+            mesh.positions[f[cand]].astype(np.float64),
+            mesh.normals[f[cand]].astype(np.float64),
+            w,
+            tri_uv[cand],
+            np.broadcast_to(cand[:, None, None], (n, 3, 1)).astype(np.float64),
+            np.broadcast_to(_stacked(seams, "owner")[sid][:, None, None], (n, 3, 1)).astype(np.float64),
+            dist[:, :, None],
+        ],
+        2,
+    )
+    return clip_triangles(at, dist)
+
+
 def seam_extension(mesh: Mesh, band_uv: float) -> SeamExtension:
     """Extension triangles reaching ``band_uv`` (UV units) past every seam edge of ``mesh``, on both
     sides; see the module docstring."""
-    from scipy.spatial import cKDTree
-
     if mesh.uvs is None:
         raise ValueError(f"mesh {mesh.name!r}: seam extensions need UVs")
     if not band_uv > 0:
         raise ValueError(f"band_uv: expected > 0, got {band_uv}")
-    f = mesh.indices.astype(np.int64)
-    uv = mesh.uvs.astype(np.float64)
-    pairs, local, pids, pid = seam_edges(mesh)
+    edges = seam_edges(mesh)
+    pairs, _local, pids, pid = edges
     chart = charts(mesh, pid)
     border = border_bands(mesh, band_uv, pid)
-    tri_uv = uv[f]  # (T, 3, 2)
-    cen = tri_uv.mean(1)
-    reach = np.sqrt(((tri_uv - cen[:, None]) ** 2).sum(-1)).max() if len(f) else 0.0
-
-    # one directed seam per side of each seam edge: owner A, source B, B's UVs -> A's frame
-    seams = []  # (A, B, M, c, a0, t_hat, n_hat, edge length, centre in B's frame, query radius, 3D reach)
-    pos = mesh.positions.astype(np.float64)
-    size3 = np.sqrt(((pos[f] - pos[f].mean(1)[:, None]) ** 2).sum(-1)).max(1)  # 3D radius per triangle
-    for (ta, tb), (ka, kb), (p, _q) in zip(pairs, local, pids):
-        for (A, kA), (B, kB) in (((ta, ka), (tb, kb)), ((tb, kb), (ta, ka))):
-            va, vb = f[A, [kA, (kA + 1) % 3]], f[B, [kB, (kB + 1) % 3]]
-            if pid[va[0]] != p:
-                va = va[::-1]
-            if pid[vb[0]] != p:
-                vb = vb[::-1]
-            a0, a1, a2 = uv[va[0]], uv[va[1]], uv[f[A, (kA + 2) % 3]]
-            b0, b1, b2 = uv[vb[0]], uv[vb[1]], uv[f[B, (kB + 2) % 3]]
-            tr = seam_transform(a0, a1, a2, b0, b1, b2)
-            if tr is None:
-                continue
-            m, c = tr
-            d_uv = np.stack([uv[f[A, 1]] - uv[f[A, 0]], uv[f[A, 2]] - uv[f[A, 0]]], 1)
-            jac = np.stack([pos[f[A, 1]] - pos[f[A, 0]], pos[f[A, 2]] - pos[f[A, 0]]], 1) @ np.linalg.inv(d_uv)
-            scale = float(np.sqrt(abs(np.linalg.det(m))))
-            if not 1.0 / SCALE_LIMIT <= scale <= SCALE_LIMIT:
-                continue
-            la = float(np.linalg.norm(a1 - a0))
-            t_hat = (a1 - a0) / la
-            n_hat = np.array([t_hat[1], -t_hat[0]])
-            if (a2 - a0) @ n_hat > 0:
-                n_hat = -n_hat  # positive depth: away from A
-            radius = np.hypot(0.5 * la, band_uv) / scale + reach
-            e3 = pos[va[1]] - pos[va[0]]
-            reach3 = REACH_3D * np.hypot(0.5 * np.linalg.norm(e3), band_uv * np.linalg.norm(e3) / la)
-            seams.append(
-                (
-                    A,
-                    B,
-                    m,
-                    c,
-                    a0,
-                    t_hat,
-                    n_hat,
-                    la,
-                    0.5 * (b0 + b1),
-                    radius,
-                    reach3,
-                    0.5 * (pos[va[0]] + pos[va[1]]),
-                    jac,
-                    pos[va[0]],
-                    np.linalg.norm(e3),
-                )
-            )
-    at, owner = np.zeros((0, 3, 13)), np.zeros(0, np.int64)
-    if seams:
-        A = np.array([x[0] for x in seams])
-        B = np.array([x[1] for x in seams])
-        M = np.array([x[2] for x in seams])
-        C = np.array([x[3] for x in seams])
-        A0 = np.array([x[4] for x in seams])
-        T_hat = np.array([x[5] for x in seams])
-        N_hat = np.array([x[6] for x in seams])
-        LA = np.array([x[7] for x in seams])
-        hits = cKDTree(cen).query_ball_point(np.array([x[8] for x in seams]), np.array([x[9] for x in seams]))
-        sid = np.repeat(np.arange(len(seams)), [len(h) for h in hits])
-        cand = np.concatenate([np.asarray(h, np.int64) for h in hits]) if len(sid) else np.zeros(0, np.int64)
-        # the source chart's triangles only, and near the edge in 3D too (a UV layout that overlaps
-        # itself, or a chart folded in UV, puts far surface near in UV)
-        R3 = np.array([x[10] for x in seams])
-        MID3 = np.array([x[11] for x in seams])
-        d3 = np.linalg.norm(pos[f[cand]].mean(1) - MID3[sid], axis=1) - size3[cand]
-        same = (chart[cand] == chart[B[sid]]) & (d3 < R3[sid])
-        sid, cand = sid[same], cand[same]
-        w = np.einsum("nij,nkj->nki", M[sid], tri_uv[cand]) + C[sid][:, None, :]  # (n, 3, 2) in A's frame
-        rel = w - A0[sid][:, None, :]
-        dist = np.einsum("nkj,nj->nk", rel, N_hat[sid])
-        along = np.einsum("nkj,nj->nk", rel, T_hat[sid])
-        keep = (dist.max(1) > 0) & (dist.min(1) < band_uv) & (along.max(1) > 0) & (along.min(1) < LA[sid])
-        # the owner's map continued linearly: where it puts the corners, against where they are
-        JAC = np.array([x[12] for x in seams])
-        P0 = np.array([x[13] for x in seams])
-        L3 = np.array([x[14] for x in seams])
-        pred = P0[sid][:, None, :] + np.einsum("nij,nkj->nki", JAC[sid], rel)
-        err = np.linalg.norm(pred - pos[f[cand]], axis=2).max(1)
-        far = np.maximum(np.linalg.norm(pred - MID3[sid][:, None, :], axis=2).max(1), L3[sid])
-        keep &= err <= CONTINUATION_TOL * far
-        sid, cand, w, dist = sid[keep], cand[keep], w[keep], dist[keep]
-        # corner attributes: position, normal, UV in A's frame, own UV, source triangle, owner, depth
-        n = len(cand)
-        at = np.concatenate(
-            [
-                mesh.positions[f[cand]].astype(np.float64),
-                mesh.normals[f[cand]].astype(np.float64),
-                w,
-                tri_uv[cand],
-                np.broadcast_to(cand[:, None, None], (n, 3, 1)).astype(np.float64),
-                np.broadcast_to(A[sid][:, None, None], (n, 3, 1)).astype(np.float64),
-                dist[:, :, None],
-            ],
-            2,
-        )
-        at = clip_triangles(at, dist)  # only past the edge: depth >= 0 and affine
-        owner = np.rint(at[:, 0, 11]).astype(np.int64)
+    seams = directed_seams(mesh, band_uv, edges)
+    at = _extension_corners(mesh, seams, chart, band_uv) if seams else np.zeros((0, 3, 13))
     return SeamExtension(
         band_uv=float(band_uv),
         seam_pairs=pairs,
@@ -385,7 +426,7 @@ def seam_extension(mesh: Mesh, band_uv: float) -> SeamExtension:
         uv=at[:, :, 6:8].astype(np.float32),
         src_uv=at[:, :, 8:10].astype(np.float32),
         depth=np.maximum(at[:, :, -1], 0.0).astype(np.float32),
-        owner=owner,
+        owner=np.rint(at[:, 0, 11]).astype(np.int64),
         source=np.rint(at[:, 0, 10]).astype(np.int64),
         chart=chart,
         border_uv=border[0].astype(np.float32),

@@ -69,6 +69,27 @@ def test_the_cut_plane_unfolds_exactly(cut):
         assert not inside.any(), k
 
 
+@pytest.mark.parametrize("cut", ["rotate", "mirror"])
+def test_directed_seams_map_the_source_edge_onto_the_owners(cut):
+    """Each seam edge of the cut plane is continued from both sides (the layout is rigid: no scale jump);
+    each side's transform puts the source's edge corners on the owner's, its normal points away from
+    the owner triangle, and its UV length is the owner's edge's."""
+    from skinlab.scene.uv_seams import directed_seams
+
+    n = 8
+    m = plane_mesh(cut, n=n)
+    seams = directed_seams(m, 4.0 / TEXELS)
+    assert len(seams) == 2 * n
+    assert {(s.owner, s.source) for s in seams} == {p for a, b in seam_edges(m)[0] for p in ((a, b), (b, a))}
+    f, uv = m.indices.astype(int), m.uvs.astype(np.float64)
+    for s in seams:
+        centre_owner = uv[f[s.owner]].mean(0)
+        assert (centre_owner - s.a0) @ s.n_hat < 0  # positive depth: away from the owner
+        # the source edge's midpoint lands on the owner's edge midpoint
+        np.testing.assert_allclose(s.m @ s.centre + s.c, s.a0 + 0.5 * s.length * s.t_hat, atol=1e-12)
+        assert s.length == pytest.approx(UV_SCALE * 2.0 / n) and abs(np.linalg.det(s.m)) == pytest.approx(1.0)
+
+
 def test_seam_transform_rotates_or_mirrors_across_the_edge():
     a0, a1, a2 = np.array([0.0, 0.0]), np.array([1.0, 0.0]), np.array([0.5, -1.0])  # A below the edge
     rot = np.array([[0.0, -2.0], [2.0, 0.0]])  # B's chart: A's frame rotated by 90 degrees, x 2
