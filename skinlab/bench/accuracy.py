@@ -50,6 +50,7 @@ import math
 import os
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -58,6 +59,7 @@ from .image_error import image_error, lit_mask
 from .ledger_analysis import error_key, log_slope, pareto_front, recommendations, usable
 from .ledger_csv import NUMERIC_COLUMNS, csv_columns, csv_text
 from .ledger_files import write_ledger
+from .ledger_row import LedgerRow
 from .measure import measure_setting
 from .profile_error import edge_error, edge_response, fit_kernel, model_reference, profile_reference
 from .sweep import (
@@ -117,17 +119,19 @@ def _first_line(exc: BaseException) -> str:
     return text.splitlines()[0][:300] if text else type(exc).__name__
 
 
-def _same_images(scene_rows: dict, digests: dict) -> None:
-    """A row whose compared frame is bit-identical to an earlier row's says so (``same_image_as``)."""
-    first: dict = {}
-    for st, row in scene_rows.items():
-        d = digests.get(st)
-        if d is None:
-            continue
-        if d in first:
-            row["same_image_as"] = first[d]
-        else:
-            first[d] = st.label
+def same_images(rows: list[LedgerRow], digests: dict[str, str]) -> list[LedgerRow]:
+    """The rows, each whose compared frame (digests[setting label]) is bit-identical to an earlier row's
+    saying so (``same_image_as``)."""
+    first: dict[str, str] = {}
+    out = []
+    for r in rows:
+        d = digests.get(r.setting)
+        if d is not None and d in first:
+            r = r.but(same_image_as=first[d])
+        elif d is not None:
+            first[d] = r.setting
+        out.append(r)
+    return out
 
 
 def _digest(a: np.ndarray) -> str:
@@ -136,8 +140,8 @@ def _digest(a: np.ndarray) -> str:
     return hashlib.sha1(np.ascontiguousarray(a).tobytes()).hexdigest()
 
 
-def _same_size_partner(st: Setting, scene_rows: dict, hdrs: dict, ref_tech: str | None):
-    """The image reference's frame whose settings share this setting's shared parameter columns
+def same_size_partner(st: Setting, measured: dict[Setting, LedgerRow], ref_tech: str | None) -> Setting | None:
+    """The image reference's ok setting whose settings share this setting's shared parameter columns
     (e.g. an irradiance size), for a setting of another technique that has such columns."""
     if ref_tech is None or st.technique == ref_tech:
         return None
@@ -148,12 +152,286 @@ def _same_size_partner(st: Setting, scene_rows: dict, hdrs: dict, ref_tech: str 
     if not shared:
         return None
     cells = st.cells()
-    for other, r in scene_rows.items():
-        if other.technique == ref_tech and r["status"] == "ok" and other in hdrs:
+    for other, r in measured.items():
+        if other.technique == ref_tech and r.status == "ok":
             oc = other.cells()
             if all(oc[c] == cells[c] for c in shared):
-                return hdrs[other]
+                return other
     return None
+
+
+def image_reference(settings: list[Setting], measured: dict[Setting, LedgerRow]) -> Setting | None:
+    """The setting the scene's image errors are measured against: the exact reference (the first
+    setting), else the proxy (sweep.proxy_reference), where it rendered; None where neither did."""
+    ref = settings[0] if measured[settings[0]].status == "ok" else proxy_reference(settings)
+    return ref if ref is not None and measured[ref].status == "ok" else None
+
+
+def with_image_errors(
+    measured: dict[Setting, LedgerRow], hdrs: dict[Setting, np.ndarray], ref_st: Setting | None, ref_tech: str | None
+) -> list[LedgerRow]:
+    """The scene's rows with their reference and their image errors against its frame (`hdrs`: the
+    timed frames), and against the reference's frame at the same shared settings
+    (``image_rel_l1_same_size``: the technique's own error without the reference's texture-resolution
+    error)."""
+    ref = hdrs.get(ref_st) if ref_st is not None else None
+    mask = lit_mask(ref) if ref is not None else None
+    out = []
+    for st, row in measured.items():
+        cells: dict = {"reference": ref_st.label if ref_st is not None else ""}
+        if ref is not None and st in hdrs:
+            cells.update(image_error(hdrs[st], ref, mask))
+        partner = same_size_partner(st, measured, ref_tech) if st in hdrs else None
+        if partner is not None and partner in hdrs:
+            cells["image_rel_l1_same_size"] = image_error(hdrs[st], hdrs[partner])["image_rel_l1"]
+        out.append(row.but(**cells))
+    return out
+
+
+TIMED_COLUMNS = ("frames", "frame_ms_median", "frame_ms_p10", "frame_ms_p90", "wall_ms_median", "technique_ms_median",
+                 "clock", "blur_levels")  # fmt: skip
+
+
+@dataclass
+class ProfileReferences:
+    """What one scene's profile errors are measured against: its first scattering material's medium, the
+    Monte Carlo random walk's edge response for it (`mc`) and its own model's (`model`)."""
+
+    node: object = None  # the scene's first mesh node with a scattering material
+    medium: object = None
+    mc: object = None
+    model: object = None
+
+    def errors(self, technique: str, model: str, frame_plan) -> dict:
+        """The profile error columns of a frame (nan where the technique gives no edge response)."""
+        if self.mc is None:
+            return {}
+        fn = edge_response(technique, model, self.medium, frame_plan)
+        return {
+            "profile_err_mc": edge_error(self.mc, fn) if fn is not None else math.nan,
+            "profile_err_model": edge_error(self.model, fn)
+            if (fn is not None and self.model is not None)
+            else math.nan,
+        }
+
+
+class LedgerRun:
+    """One run of the ledger: the renderer, the sweep's conditions, and what the scenes add beside their
+    rows (the truths' notes and figures, the profiles, the error-map sheet)."""
+
+    def __init__(self, sweep: Sweep, out: Path, images: bool, references: bool, progress: bool, status):
+        from skinlab.gl.context import create_headless_context, describe
+        from skinlab.render.renderer import Renderer
+
+        self.sweep, self.out, self.images, self.references, self.progress = sweep, out, images, references, progress
+        self.status = status  # shows what is being done (the progress bar's postfix)
+        self.ctx = create_headless_context()
+        self.gl = describe(self.ctx)
+        self.renderer = Renderer(self.ctx)
+        self.renderer.reuse = False  # each setting's cost is that of a full frame (no pass kept from the last)
+        self.truth_notes: dict[str, str] = {}
+        self.truth_quiet: dict[str, str] = {}  # scenes compared with a quieter reference than the sweep's
+        self.truth_scenes: dict[str, dict] = {}  # per scene: what its truth took, its edge region, what it tests
+        self.profiles: dict[str, dict] = {}  # per scene: {"truth": Profile, "kind": ..., setting label: Profile}
+        self.sheet: dict[str, dict[str, np.ndarray]] = {}
+
+    def profile_references(self, scene, label: str) -> ProfileReferences:
+        """The scene's (first) scattering material as the scene file has it: its medium is what the profile
+        errors are measured for, its own model is the model reference."""
+        from skinlab.scene.optics.material_medium import material_medium
+
+        node = next((n for n in scene.mesh_nodes() if n.material.has_subsurface), None)
+        refs = ProfileReferences(node)
+        if node is None:
+            return refs
+        refs.medium = material_medium(node.material.values)
+        self.status(f"{label}: Monte Carlo reference")
+        try:
+            refs.mc = profile_reference(refs.medium, self.sweep.photons, self.out / "mc_cache")
+            refs.model = model_reference(node.material["sss_model"], refs.medium)
+        except Exception as exc:
+            print(f"profile references for {label} failed: {_first_line(exc)}", file=sys.stderr)
+            refs.mc = refs.model = None
+        return refs
+
+    def load_truth(self, scene, label: str):
+        """The scene's path-traced reference at the sweep's truth size, or None (the reason noted)."""
+        spec = self.sweep.truth
+        if spec is None:
+            return None
+        self.status(f"{label}: path-traced reference")
+        truth = None
+        try:
+            truth = load_truth(scene, spec, render=self.references, progress=self.progress)
+        except Exception as exc:
+            self.truth_notes[label] = f"the path-traced reference failed: {_first_line(exc)}"
+        if truth is not None and truth.meta.get("variant", "scalar_rgb") != "scalar_rgb":
+            self.truth_quiet[label] = (
+                f"compared with a quieter reference rendered elsewhere ({truth.meta.get('spp')} spp, "
+                f"{truth.meta.get('variant')}; `QUIET_REFERENCES`, tools/gpu_reference.py)"
+            )
+        if truth is None and label not in self.truth_notes:
+            self.truth_notes[label] = (
+                f"no cached path-traced reference at {spec.size[0]}x{spec.size[1]}, {spec.spp} spp: "
+                "run with --references"
+            )
+        return truth
+
+    def truth_context(self, scene, label: str, truth):
+        """What the scene's settings are measured against (the plain frame, no scattering, finds the light
+        edges where the scene declares none); notes what the truth took and starts the scene's profiles."""
+        from skinlab.render.settings import RenderSettings
+
+        tw, th = truth.image.shape[1::-1]
+        sw = self.sweep
+        plain_rs = RenderSettings(
+            tw, th, shadow_size=sw.shadow_size, supersample=sw.truth.supersample, sss_model="none"
+        )
+        plain = self.renderer.render(scene, plain_rs, readback=("hdr",)).hdr
+        tctx = truth_context(scene, truth, plain)
+        spec = tctx.spec
+        self.truth_scenes[label] = {
+            "spp": truth.meta.get("spp"),
+            "passes": truth.pass_set.count,
+            "seconds": truth.meta.get("seconds"),
+            "variant": truth.meta.get("variant", "scalar_rgb"),
+            "noise": truth.noise.get("rel_l1"),
+            "noise_block": truth.noise.get("rel_l1_block"),
+            "edge_mm": tctx.edge_mm,
+            "edge_from": tctx.edge_from,
+            "edge_pixels": int(tctx.edge.sum()),
+            "tests": spec.tests if spec is not None else "",
+            "profile": spec.profile if spec is not None else "none",
+        }
+        if tctx.profile is not None:
+            self.profiles[label] = {"truth": tctx.profile, "kind": spec.profile}
+        return tctx
+
+    def against_truth(self, scene, label: str, st: Setting, tctx, on_sheet: bool) -> tuple[dict, str]:
+        """An untimed frame at the truth's size, supersampled like the truth's box-filtered pixels, compared
+        with the truth: (its truth columns, its digest); its error and FLIP maps written."""
+        truth = tctx.truth
+        small_rs = st.render_settings(self.sweep, truth.image.shape[1::-1], self.sweep.truth.supersample)
+        small = self.renderer.render(scene, small_rs, readback=("hdr",)).hdr
+        got = truth_errors(small, tctx)
+        prof = got.pop("profile", None)
+        if prof is not None:
+            self.profiles[label][st.label] = prof
+        safe = st.label.replace(" ", "-")
+        write_error_map(self.out / "error_maps" / f"{label}-{safe}.png", small, truth)
+        write_flip_map(self.out / "flip_maps" / f"{label}-{safe}.png", small, tctx)
+        if on_sheet:
+            from skinlab.truth.metrics import relative_map
+
+            self.sheet.setdefault(label, {})[st.label] = relative_map(small, truth.image)
+        return got, _digest(small)
+
+    def measure(self, scene, label: str, st: Setting, refs: ProfileReferences, tctx, on_sheet: bool):
+        """One setting on one scene: (its row, its timed frame or None, the digest of its compared frame or
+        None). A setting that raises is an ``error`` row with what was measured before."""
+        from skinlab.render.registry import get_technique
+        from skinlab.render.scattering import effective_material
+
+        sw = self.sweep
+        cells: dict = {"scene": label, "setting": st.label, "technique": st.technique, "params": st.cells(),
+                       "width": sw.size[0], "height": sw.size[1]}  # fmt: skip
+        hdr = digest = None
+        try:
+            rs = st.render_settings(sw)
+            node = refs.node
+            scatters = node is not None and get_technique(st.technique).scatters
+            cells["model"] = effective_material(node, rs)["sss_model"] if scatters else "none" if node else ""
+            m = measure_setting(self.renderer, scene, rs, sw.warmup, sw.frames, sw.budget_s)
+            cells.update({k: m[k] for k in TIMED_COLUMNS}, passes_ms=m["passes"])
+            hdr, digest = m["hdr"], _digest(m["hdr"])
+            if tctx is not None:
+                got, digest = self.against_truth(scene, label, st, tctx, on_sheet)
+                cells.update(got)
+            if self.images:
+                from skinlab.image_output import write_image
+
+                write_image(self.out / "images" / f"{label}-{st.label.replace(' ', '-')}.png", m["ldr"])
+            # profile error against Monte Carlo and against the material's own model profile
+            cells.update(refs.errors(st.technique, cells["model"], m["frame_plan"]))
+        except Exception as exc:  # a failing technique is a row, not the end of the sweep
+            cells.update(status="error", error=_first_line(exc))
+        return LedgerRow(**cells), hdr, digest
+
+    def scene_rows(
+        self, sname: str, path, settings: list[Setting], ref_tech: str | None, peers, bar
+    ) -> list[LedgerRow]:
+        """Every setting's row on one scene (and the peers'), against its image reference and its truth."""
+        from skinlab.scene.scenefile import load_scene
+
+        label = scene_label(sname)
+        scene = load_scene(path)
+        refs = self.profile_references(scene, label)
+        truth = self.load_truth(scene, label)
+        tctx = self.truth_context(scene, label, truth) if truth is not None else None
+        on_sheet = set(sheet_settings(settings))
+        measured: dict[Setting, LedgerRow] = {}
+        hdrs: dict[Setting, np.ndarray] = {}
+        digests: dict[str, str] = {}
+        for st in settings:
+            self.status(f"{label}: {st.label}")
+            row, hdr, digest = self.measure(scene, label, st, refs, tctx, st in on_sheet)
+            measured[st] = row
+            if hdr is not None:
+                hdrs[st] = hdr
+            if digest is not None:
+                digests[st.label] = digest
+            bar.update(1)
+        ref_st = image_reference(settings, measured)
+        rows = same_images(with_image_errors(measured, hdrs, ref_st, ref_tech), digests)
+        if peers is not None:  # Blender's rows, against the same truth and image reference
+            ref = hdrs.get(ref_st) if ref_st is not None else None
+            mask = lit_mask(ref) if ref is not None else None
+            prows, pmaps = peers.scene_rows(scene, label, self.sweep, truth, tctx, self.out, self.renderer, ref, mask,
+                                            self.profiles.get(label), progress=self.status)  # fmt: skip
+            rows += prows
+            if pmaps:
+                self.sheet.setdefault(label, {}).update(pmaps)
+        return rows
+
+    def meta(self, scenes, peer_res, peers, t_start: float, sweep_s: float, load_start, command) -> dict:
+        """ledger.json's and ledger.md's run metadata."""
+        sw = self.sweep
+        truth = None
+        if sw.truth is not None:
+            truth = {"size": list(sw.truth.size), "spp": sw.truth.spp, "passes": sw.truth.passes,
+                     "supersample": sw.truth.supersample, "missing": self.truth_notes, "quiet": self.truth_quiet,
+                     "scenes": self.truth_scenes}  # fmt: skip
+        return {
+            "sweep": sw.name,
+            "gl": self.gl,
+            "cpus": os.cpu_count(),
+            "size": list(sw.size),
+            "shadow_size": sw.shadow_size,
+            "warmup": sw.warmup,
+            "frames": sw.frames,
+            "budget_s": sw.budget_s,
+            "photons": sw.photons,
+            "scenes": [scene_label(s) for s in scenes],
+            "truth": truth,
+            "sweep_s": sweep_s,
+            "total_s": time.perf_counter() - t_start,
+            "peer": peer_res,
+            "blender": None if peers is None else peers.meta,
+            "loadavg_start": load_start,
+            "loadavg_end": _loadavg(),
+            "command": command,
+            "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
+        }
+
+
+def pyrender_peer(sweep: Sweep) -> dict:
+    """The pyrender peer's frame times at the sweep's size (or why it failed)."""
+    try:
+        from skinlab.bench.peer import peer_bench
+
+        return peer_bench(sweep.size, sweep.peer_frames)
+    except Exception as exc:
+        return {"error": _first_line(exc)}
 
 
 def run_sweep(
@@ -174,15 +452,6 @@ def run_sweep(
     (skinlab/bench/blender_peer.py; True: the sweep's PEER_SETTINGS, or a tuple of PeerSetting)."""
     from tqdm import tqdm
 
-    from skinlab.gl.context import create_headless_context, describe
-    from skinlab.render.registry import get_technique
-    from skinlab.render.renderer import Renderer
-    from skinlab.render.scattering import effective_material
-    from skinlab.render.settings import RenderSettings
-    from skinlab.scene.optics.material_medium import material_medium
-    from skinlab.scene.scenefile import load_scene
-    from skinlab.truth.metrics import relative_map
-
     from .sweep import reference_technique
 
     out = Path(out)
@@ -190,241 +459,31 @@ def run_sweep(
     scenes = tuple(scenes or sweep.scenes)
     paths = {s: resolve_scene(s) for s in scenes}
     settings = sweep_settings(sweep)
-    ref_tech = reference_technique()
-    t_start = time.perf_counter()
-    load_start = _loadavg()
-    ctx = create_headless_context()
-    gl = describe(ctx)
-    renderer = Renderer(ctx)
-    renderer.reuse = False  # each setting's cost is that of a full frame (no pass kept from the last)
+    t_start, load_start = time.perf_counter(), _loadavg()
+    bar = tqdm(total=len(settings) * len(scenes), file=sys.stderr, unit="setting", disable=not progress,
+               desc="ledger", dynamic_ncols=True)  # fmt: skip
+    run = LedgerRun(sweep, out, images, references, progress, bar.set_postfix_str)
     peers = None
     if blender:
         from .blender_peer import LedgerPeers
 
         peers = LedgerPeers(sweep.name, None if blender is True else tuple(blender))
-    rows: list[dict] = []
-    truth_notes: dict[str, str] = {}
-    truth_quiet: dict[str, str] = {}  # scenes compared with a quieter reference than the sweep's
-    truth_scenes: dict[str, dict] = {}  # per scene: what its truth took, its edge region, what it tests
-    profiles: dict[str, dict] = {}  # per scene: {"truth": Profile, setting label: Profile}
-    sheet: dict[str, dict[str, np.ndarray]] = {}
-    on_sheet = set(sheet_settings(settings))
-    bar = tqdm(
-        total=len(settings) * len(scenes),
-        file=sys.stderr,
-        unit="setting",
-        disable=not progress,
-        desc="ledger",
-        dynamic_ncols=True,
-    )
+    rows: list[LedgerRow] = []
     try:
         for sname in scenes:
-            label = scene_label(sname)
-            scene = load_scene(paths[sname])
-            # the scene's (first) scattering material, as the scene file has it: its medium is what the
-            # profile errors are measured for, its own model is the model reference
-            base_node = next((n for n in scene.mesh_nodes() if n.material.has_subsurface), None)
-            base_mat = base_node.material if base_node is not None else None
-            pref = mref = base_medium = None
-            if base_mat is not None:
-                base_medium = material_medium(base_mat.values)
-                bar.set_postfix_str(f"{label}: Monte Carlo reference")
-                try:
-                    pref = profile_reference(base_medium, sweep.photons, out / "mc_cache")
-                    mref = model_reference(base_mat["sss_model"], base_medium)
-                except Exception as exc:
-                    print(f"profile references for {label} failed: {_first_line(exc)}", file=sys.stderr)
-                    base_mat = None
-            truth = tctx = None
-            if sweep.truth is not None:
-                bar.set_postfix_str(f"{label}: path-traced reference")
-                try:
-                    truth = load_truth(scene, sweep.truth, render=references, progress=progress)
-                except Exception as exc:
-                    truth_notes[label] = f"the path-traced reference failed: {_first_line(exc)}"
-                if truth is not None and truth.meta.get("variant", "scalar_rgb") != "scalar_rgb":
-                    truth_quiet[label] = (
-                        f"compared with a quieter reference rendered elsewhere ({truth.meta.get('spp')} spp, "
-                        f"{truth.meta.get('variant')}; `QUIET_REFERENCES`, tools/gpu_reference.py)"
-                    )
-                if truth is None and label not in truth_notes:
-                    truth_notes[label] = (
-                        "no cached path-traced reference at "
-                        f"{sweep.truth.size[0]}x{sweep.truth.size[1]}, {sweep.truth.spp} spp: run with --references"
-                    )
-            if truth is not None:
-                # the plain frame (no scattering) finds the light edges where the scene declares none
-                tw, th = truth.image.shape[1::-1]
-                plain_rs = RenderSettings(
-                    tw, th, shadow_size=sweep.shadow_size, supersample=sweep.truth.supersample, sss_model="none"
-                )
-                plain = renderer.render(scene, plain_rs, readback=("hdr",)).hdr
-                tctx = truth_context(scene, truth, plain)
-                spec = tctx.spec
-                truth_scenes[label] = {
-                    "spp": truth.meta.get("spp"),
-                    "passes": truth.pass_set.count,
-                    "seconds": truth.meta.get("seconds"),
-                    "variant": truth.meta.get("variant", "scalar_rgb"),
-                    "noise": truth.noise.get("rel_l1"),
-                    "noise_block": truth.noise.get("rel_l1_block"),
-                    "edge_mm": tctx.edge_mm,
-                    "edge_from": tctx.edge_from,
-                    "edge_pixels": int(tctx.edge.sum()),
-                    "tests": spec.tests if spec is not None else "",
-                    "profile": spec.profile if spec is not None else "none",
-                }
-                if tctx.profile is not None:
-                    profiles[label] = {"truth": tctx.profile, "kind": spec.profile}
-            hdrs: dict[Setting, np.ndarray] = {}
-            digests: dict[Setting, str] = {}
-            scene_rows: dict[Setting, dict] = {}
-            for st in settings:
-                bar.set_postfix_str(f"{label}: {st.label}")
-                row = {
-                    "scene": label,
-                    "setting": st.label,
-                    "technique": st.technique,
-                    **st.cells(),
-                    "width": sweep.size[0],
-                    "height": sweep.size[1],
-                    "status": "ok",
-                    "error": "",
-                }
-                try:
-                    rs = st.render_settings(sweep)
-                    row["model"] = (
-                        effective_material(base_node, rs)["sss_model"]
-                        if base_node is not None and get_technique(st.technique).scatters
-                        else "none"
-                        if base_node is not None
-                        else ""
-                    )
-                    m = measure_setting(renderer, scene, rs, sweep.warmup, sweep.frames, sweep.budget_s)
-                    row.update(
-                        {
-                            k: m[k]
-                            for k in (
-                                "frames",
-                                "frame_ms_median",
-                                "frame_ms_p10",
-                                "frame_ms_p90",
-                                "wall_ms_median",
-                                "technique_ms_median",
-                                "clock",
-                                "blur_levels",
-                            )
-                        }
-                    )
-                    row["passes"] = m["passes"]
-                    hdrs[st] = m["hdr"]
-                    digests[st] = _digest(m["hdr"])
-                    if tctx is not None:
-                        # an untimed frame at the reference's size, supersampled like the truth's
-                        # box-filtered pixels, compared with the truth
-                        small_rs = st.render_settings(sweep, truth.image.shape[1::-1], sweep.truth.supersample)
-                        small = renderer.render(scene, small_rs, readback=("hdr",)).hdr
-                        got = truth_errors(small, tctx)
-                        prof = got.pop("profile", None)
-                        row.update(got)
-                        if prof is not None:
-                            profiles[label][st.label] = prof
-                        digests[st] = _digest(small)
-                        safe = st.label.replace(" ", "-")
-                        write_error_map(out / "error_maps" / f"{label}-{safe}.png", small, truth)
-                        write_flip_map(out / "flip_maps" / f"{label}-{safe}.png", small, tctx)
-                        if st in on_sheet:
-                            sheet.setdefault(label, {})[st.label] = relative_map(small, truth.image)
-                    if images:
-                        from skinlab.image_output import write_image
-
-                        safe = st.label.replace(" ", "-")
-                        write_image(out / "images" / f"{label}-{safe}.png", m["ldr"])
-                    # profile error against Monte Carlo and against the material's own model profile
-                    if base_mat is not None:
-                        fn = edge_response(st.technique, row["model"], base_medium, m["frame_plan"])
-                        row["profile_err_mc"] = edge_error(pref, fn) if fn is not None else math.nan
-                        row["profile_err_model"] = (
-                            edge_error(mref, fn) if (fn is not None and mref is not None) else math.nan
-                        )
-                except Exception as exc:  # a failing technique is a row, not the end of the sweep
-                    row["status"] = "error"
-                    row["error"] = _first_line(exc)
-                scene_rows[st] = row
-                rows.append(row)
-                bar.update(1)
-            _same_images(scene_rows, digests)
-            # image errors against the reference (the exact one, else the proxy)
-            ref_st = settings[0] if scene_rows[settings[0]]["status"] == "ok" else proxy_reference(settings)
-            if ref_st is not None and scene_rows[ref_st]["status"] != "ok":
-                ref_st = None
-            ref = hdrs.get(ref_st) if ref_st is not None else None
-            mask = lit_mask(ref) if ref is not None else None
-            for st, row in scene_rows.items():
-                row["reference"] = ref_st.label if ref_st is not None else ""
-                if ref is not None and st in hdrs:
-                    row.update(image_error(hdrs[st], ref, mask))
-                # against the image reference at the same shared settings (an irradiance size): the
-                # technique's own error without the reference's texture-resolution error
-                same = _same_size_partner(st, scene_rows, hdrs, ref_tech) if st in hdrs else None
-                if same is not None:
-                    row["image_rel_l1_same_size"] = image_error(hdrs[st], same)["image_rel_l1"]
-            del hdrs
-            if peers is not None:  # Blender's rows, against the same truth and image reference
-                prows, pmaps = peers.scene_rows(scene, label, sweep, truth, tctx, out, renderer, ref, mask,
-                                                profiles.get(label), progress=bar.set_postfix_str)  # fmt: skip
-                rows += prows
-                if pmaps:
-                    sheet.setdefault(label, {}).update(pmaps)
+            rows += run.scene_rows(sname, paths[sname], settings, reference_technique(), peers, bar)
     finally:
         bar.close()
-        renderer.release()
+        run.renderer.release()
         if peers is not None:
             peers.close()
     sweep_s = time.perf_counter() - t_start
-    if sheet:
+    if run.sheet:
         error_map_sheet(
-            sheet,
+            run.sheet,
             out / "error_maps.png",
             "signed relative difference against the path-traced truth per pixel (red: brighter, blue: darker)",
         )
-    peer_res = None
-    if peer:
-        try:
-            from skinlab.bench.peer import peer_bench
-
-            peer_res = peer_bench(sweep.size, sweep.peer_frames)
-        except Exception as exc:
-            peer_res = {"error": _first_line(exc)}
-    meta = {
-        "sweep": sweep.name,
-        "gl": gl,
-        "cpus": os.cpu_count(),
-        "size": list(sweep.size),
-        "shadow_size": sweep.shadow_size,
-        "warmup": sweep.warmup,
-        "frames": sweep.frames,
-        "budget_s": sweep.budget_s,
-        "photons": sweep.photons,
-        "scenes": [scene_label(s) for s in scenes],
-        "truth": None
-        if sweep.truth is None
-        else {
-            "size": list(sweep.truth.size),
-            "spp": sweep.truth.spp,
-            "passes": sweep.truth.passes,
-            "supersample": sweep.truth.supersample,
-            "missing": truth_notes,
-            "quiet": truth_quiet,
-            "scenes": truth_scenes,
-        },
-        "sweep_s": sweep_s,
-        "total_s": time.perf_counter() - t_start,
-        "peer": peer_res,
-        "blender": None if peers is None else peers.meta,
-        "loadavg_start": load_start,
-        "loadavg_end": _loadavg(),
-        "command": command,
-        "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
-    }
-    return write_ledger(rows, meta, out, sweep, profiles)
+    peer_res = pyrender_peer(sweep) if peer else None
+    meta = run.meta(scenes, peer_res, peers, t_start, sweep_s, load_start, command)
+    return write_ledger(rows, meta, out, sweep, run.profiles)

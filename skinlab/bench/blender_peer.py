@@ -41,6 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .ledger_row import LedgerRow
+
 CHILD = Path(__file__).with_name("blender_child.py")
 PYTHON_ENV = "SKINLAB_BLENDER_PYTHON"  # the Python with bpy that runs the child
 VENV = ".venv-blender"  # where `make test` / `make bench` install pyproject's [peers] extra
@@ -246,7 +248,7 @@ def peer_rows(
     budget_s: float,
     progress=None,
     profiles: dict | None = None,
-) -> tuple[list[dict], dict[str, np.ndarray], dict]:
+) -> tuple[list[LedgerRow], dict[str, np.ndarray], dict]:
     """The peer rows of one scene: (rows, {setting label: frame at the ledger's size}, error maps
     {label: signed difference against the truth}). The session renders `scene` built at the ledger's
     size; every row has the ledger's truth columns (truth_ledger.truth_errors against `tctx`, the
@@ -254,7 +256,6 @@ def peer_rows(
     from skinlab.truth.metrics import relative_map
 
     from .blender_scene import blender_spec
-    from .sweep import setting_columns
     from .truth_ledger import truth_errors, write_error_map, write_flip_map
 
     w, h = sweep.size
@@ -264,21 +265,8 @@ def peer_rows(
     for st in settings:
         if progress:
             progress(f"{label}: {st.label}")
-        row = {
-            "scene": label,
-            "setting": st.label,
-            "technique": st.technique,
-            "model": "",
-            "width": w,
-            "height": h,
-            "peer": True,
-            "samples": st.spp,
-            "status": "ok",
-            "error": "",
-            "clock": "wall",
-        }
-        for c in setting_columns():
-            row[c] = ""
+        row: dict = {"scene": label, "setting": st.label, "technique": st.technique, "width": w, "height": h,
+                     "peer": True, "samples": st.spp, "clock": "wall"}  # fmt: skip
         try:
             if st.timed:
                 img, rep = session.render(st.engine, st.spp, (w, h), frames=0, method=st.method)
@@ -333,7 +321,7 @@ def peer_rows(
         except Exception as exc:  # a peer that fails is a row, as a technique that fails
             row["status"] = "error"
             row["error"] = f"{type(exc).__name__}: {exc}".splitlines()[0][:300]
-        rows.append(row)
+        rows.append(LedgerRow(**row))
     return rows, frames_at_size, maps
 
 
@@ -369,7 +357,6 @@ def interleaved_ratio(
 
 
 RATIO_ROUNDS = {"tiny": {"rounds": 1, "frames": 1}}  # the tests' sweep: one round of one frame each
-PEER_COLUMNS = ["samples", "first_frame_ms", "truth_frame_ms", "peer_noise", "peer_noise_block"]
 
 
 def default_setting():
@@ -407,10 +394,8 @@ class LedgerPeers:
             self.session, scene, label, sweep, truth, tctx, out, self.settings, sweep.frames, sweep.budget_s * 10,
             progress, profiles,
         )  # fmt: skip
-        for r in rows:
-            if ref is not None and r["setting"] in at_size:
-                r["reference"] = ""
-                r.update(image_error(at_size[r["setting"]], ref, mask))
+        if ref is not None:
+            rows = [r.but(**image_error(at_size[r.setting], ref, mask)) if r.setting in at_size else r for r in rows]
         if any(s.engine == "eevee" and s.spp == 1 for s in self.settings):
             try:
                 rs = default_setting().render_settings(sweep)
@@ -435,7 +420,7 @@ def _ms(v) -> str:
     return "" if not isinstance(v, (int, float)) or not math.isfinite(v) else f"{v:.0f}"
 
 
-def blender_markdown(rows: list[dict], meta: dict) -> list[str]:
+def blender_markdown(rows: list[LedgerRow], meta: dict) -> list[str]:
     """ledger.md's section on the Blender peers: per scene Skinlab's default frame beside EEVEE and
     Cycles against the truth, the frame times and the interleaved ratio."""
     b = meta.get("blender")
@@ -454,18 +439,18 @@ def blender_markdown(rows: list[dict], meta: dict) -> list[str]:
         "",
     ]
     default = default_setting().label
-    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    scenes = list(dict.fromkeys(r.scene for r in rows))
     L.append(
         "| scene | setting | truth 4x4 | truth px | truth energy | own noise 4x4 | truth noise 4x4 | ms | first ms |"
     )
     L.append("|---|---|---|---|---|---|---|---|---|")
     for s in scenes:
-        for r in [r for r in rows if r["scene"] == s and (r.get("peer") or r["setting"] == default)]:
-            status = "" if r.get("status") == "ok" else f" ({r.get('status')}: {r.get('error')})"
+        for r in [r for r in rows if r.scene == s and (r.peer or r.setting == default)]:
+            status = "" if r.status == "ok" else f" ({r.status}: {r.error})"
             cells = [_pct(r.get(k)) for k in ("truth_rel_l1_block", "truth_rel_l1", "truth_energy")]
             cells += [_pct(r.get(k)) for k in ("peer_noise_block", "truth_noise_block")]
             cells += [_ms(r.get(k)) for k in ("frame_ms_median", "first_frame_ms")]
-            L.append(f"| {s} | {r['setting']}{status} | " + " | ".join(cells) + " |")
+            L.append(f"| {s} | {r.setting}{status} | " + " | ".join(cells) + " |")
     ratios = b.get("ratios") or {}
     if ratios:
         L += [

@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 
+from .ledger_row import LedgerRow
+
 RECOMMEND_THRESHOLDS = (0.01, 0.02, 0.05)
 
 
@@ -21,27 +23,27 @@ def _finite(v) -> bool:
     return isinstance(v, (int, float, np.floating)) and bool(np.isfinite(v))
 
 
-def usable(r: dict, key: str = "image_rel_l1") -> bool:
-    return r.get("status") == "ok" and _finite(r.get("frame_ms_median", math.nan)) and _finite(r.get(key, math.nan))
+def usable(r: LedgerRow, key: str = "image_rel_l1") -> bool:
+    return r.status == "ok" and _finite(r.frame_ms_median) and _finite(r[key])
 
 
-def error_key(rows: list[dict]) -> str:
+def error_key(rows: list[LedgerRow]) -> str:
     """The truth where every scene of `rows` has it, else the exact convolution."""
-    scenes = {r["scene"] for r in rows}
-    with_truth = {r["scene"] for r in rows if usable(r, TRUTH_KEY)}
+    scenes = {r.scene for r in rows}
+    with_truth = {r.scene for r in rows if usable(r, TRUTH_KEY)}
     return TRUTH_KEY if scenes and with_truth == scenes else "image_rel_l1"
 
 
 TIE_SIGMAS = 2.0  # two errors differ when their difference is more than this many standard errors
 
 
-def sigma(r: dict, key: str) -> float:
+def sigma(r: LedgerRow, key: str) -> float:
     """The uncertainty of r[key] from the truth's noise (0 for a measure without one)."""
     v = r.get(f"{key}_sigma")
     return float(v) if _finite(v) else 0.0
 
 
-def difference_sigma(a: dict, b: dict, key: str) -> float:
+def difference_sigma(a: LedgerRow, b: LedgerRow, key: str) -> float:
     """The standard error of a[key] - b[key] from the two uncertainties, sqrt(sigma_a^2 + sigma_b^2):
     conservative (both are measured against the same truth, so part of its noise is shared; the
     per-group values, ``jackknife``, give the paired figure, skinlab/truth/metrics.py paired_sigma, which
@@ -50,30 +52,30 @@ def difference_sigma(a: dict, b: dict, key: str) -> float:
     return math.hypot(sigma(a, key), sigma(b, key))
 
 
-def told_apart(a: dict, b: dict, key: str) -> bool:
+def told_apart(a: LedgerRow, b: LedgerRow, key: str) -> bool:
     """Whether the errors of two rows differ by more than TIE_SIGMAS times the noise of their difference
     (identical images never do)."""
     return abs(a[key] - b[key]) > TIE_SIGMAS * difference_sigma(a, b, key)
 
 
-def distinct(rows: list[dict]) -> list[dict]:
+def distinct(rows: list[LedgerRow]) -> list[LedgerRow]:
     """The rows that are not the same image as an earlier row (``same_image_as``)."""
-    return [r for r in rows if not r.get("same_image_as")]
+    return [r for r in rows if not r.same_image_as]
 
 
-def pareto_front(rows: list[dict], key: str = "image_rel_l1") -> list[dict]:
+def pareto_front(rows: list[LedgerRow], key: str = "image_rel_l1") -> list[LedgerRow]:
     """Rows not dominated in (frame_ms_median, key), sorted by time: each is more accurate than every
     cheaper one by more than the noise (told_apart); a row that is the same image as another is not a
     point of its own."""
-    pts = sorted((r for r in distinct(rows) if usable(r, key)), key=lambda r: (r["frame_ms_median"], r[key]))
-    front: list[dict] = []
+    pts = sorted((r for r in distinct(rows) if usable(r, key)), key=lambda r: (r.frame_ms_median, r[key]))
+    front: list[LedgerRow] = []
     for r in pts:
         if not front or (r[key] < front[-1][key] and told_apart(r, front[-1], key)):
             front.append(r)
     return front
 
 
-def best_and_ties(rows: list[dict], key: str) -> tuple[dict | None, list[dict]]:
+def best_and_ties(rows: list[LedgerRow], key: str) -> tuple[LedgerRow | None, list[LedgerRow]]:
     """Of one scene's rows: the smallest error, and the other rows the noise cannot tell from it."""
     ok = [r for r in distinct(rows) if usable(r, key)]
     if not ok:
@@ -82,13 +84,16 @@ def best_and_ties(rows: list[dict], key: str) -> tuple[dict | None, list[dict]]:
     return best, [r for r in ok if r is not best and not told_apart(r, best, key)]
 
 
-def mark_ties(rows: list[dict], key: str) -> None:
-    """Set each row's ``ties_best``: "best", "tie" (within the noise of the best) or ""."""
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        srows = [r for r in rows if r["scene"] == scene]
-        best, ties = best_and_ties(srows, key)
-        for r in srows:
-            r["ties_best"] = "best" if r is best else "tie" if any(r is t for t in ties) else ""
+def mark_ties(rows: list[LedgerRow], key: str) -> list[LedgerRow]:
+    """The rows (in order) with ``ties_best`` set: "best", "tie" (within the noise of the best) or "", per
+    scene among the rows that are not a peer's (peers are drawn beside, never ranked: "")."""
+    rank: dict[int, str] = {}
+    for scene in dict.fromkeys(r.scene for r in rows):
+        best, ties = best_and_ties([r for r in rows if r.scene == scene and not r.peer], key)
+        rank.update({id(t): "tie" for t in ties})
+        if best is not None:
+            rank[id(best)] = "best"
+    return [r.but(ties_best=rank.get(id(r), "")) for r in rows]
 
 
 def log_slope(x, y) -> tuple[float, float, int]:
@@ -101,7 +106,7 @@ def log_slope(x, y) -> tuple[float, float, int]:
     return float(b), float(a), int(ok.sum())
 
 
-def cost_series(rows: list[dict], sweep) -> list[dict]:
+def cost_series(rows: list[LedgerRow], sweep) -> list[dict]:
     """Per scene and per axis a technique declares a cost for (LedgerStyle.cost_axes) and sweeps:
     the rows along that axis (the others at the base), ok, and where the technique declares levels,
     those whose frame blurs at all (a frame that blurs nothing costs a step, not a power law)."""
@@ -110,8 +115,8 @@ def cost_series(rows: list[dict], sweep) -> list[dict]:
     from .sweep import Setting, declared_settings
 
     out = []
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        by_label = {r["setting"]: r for r in rows if r["scene"] == scene and r["status"] == "ok"}
+    for scene in dict.fromkeys(r.scene for r in rows):
+        by_label = {r.setting: r for r in rows if r.scene == scene and r.status == "ok"}
         for t in techniques():
             decl = t.ledger.sweep.get(sweep.name)
             if decl is None or not t.ledger.cost_axes:
@@ -124,7 +129,7 @@ def cost_series(rows: list[dict], sweep) -> list[dict]:
                 for v in decl.axes[field]:
                     st = Setting.of(t.name, **{**dict(base.values), field: v})
                     r = by_label.get(st.label)
-                    if r is None or (t.ledger.levels and not (r.get("blur_levels") or 0) > 0) or v is None:
+                    if r is None or (t.ledger.levels and not (r.blur_levels or 0) > 0) or v is None:
                         continue
                     pts.append((float(v), r))
                 pts.sort(key=lambda p: p[0])
@@ -141,9 +146,9 @@ def slopes(series: list[dict]) -> list[dict]:
             {
                 **{k: s[k] for k in ("scene", "technique", "field", "what", "power")},
                 "values": [v for v, _ in s["points"]],
-                "frame": log_slope(x, [r["frame_ms_median"] for _, r in s["points"]]),
-                "own": log_slope(x, [r.get("technique_ms_median", math.nan) for _, r in s["points"]]),
-                "levels": [r.get("blur_levels") for _, r in s["points"]],
+                "frame": log_slope(x, [r.frame_ms_median for _, r in s["points"]]),
+                "own": log_slope(x, [r.technique_ms_median for _, r in s["points"]]),
+                "levels": [r.blur_levels for _, r in s["points"]],
             }
         )
     return res
@@ -155,7 +160,7 @@ def default_technique() -> str:
     return RenderSettings(8, 8).technique_name
 
 
-def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS, key: str = "image_rel_l1") -> list[dict]:
+def recommendations(rows: list[LedgerRow], thresholds=RECOMMEND_THRESHOLDS, key: str = "image_rel_l1") -> list[dict]:
     """For each error budget tau: the cheapest setting (cost: mean over scenes of the median frame
     time) within it in every scene, overall and among the default technique's settings that blur in
     every scene (where it declares levels). Against the exact convolution the budget is absolute
@@ -165,22 +170,23 @@ def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS, key: str 
     the difference."""
     from skinlab.render.registry import get_technique
 
-    scenes = list(dict.fromkeys(r["scene"] for r in rows))
-    by_label: dict[str, dict] = {}
+    scenes = list(dict.fromkeys(r.scene for r in rows))
+    by_label: dict[str, dict[str, LedgerRow]] = {}
     for r in rows:
-        by_label.setdefault(r["setting"], {})[r["scene"]] = r
-    best = {s: None for s in scenes}
+        by_label.setdefault(r.setting, {})[r.scene] = r
+    best: dict[str, LedgerRow | None] = {s: None for s in scenes}
     if key == TRUTH_KEY:
         for s in scenes:
-            best[s], _ = best_and_ties([r for r in rows if r["scene"] == s], key)
+            best[s], _ = best_and_ties([r for r in rows if r.scene == s], key)
     floor = {s: (best[s][key] if best[s] is not None else (math.inf if key == TRUTH_KEY else 0.0)) for s in scenes}
 
     def within(r, s, tau) -> bool:
         if not usable(r, key):
             return False
-        if best[s] is None:
+        b = best[s]
+        if b is None:
             return r[key] <= floor[s] + tau
-        return r[key] <= floor[s] + tau + TIE_SIGMAS * difference_sigma(r, best[s], key)
+        return r[key] <= floor[s] + tau + TIE_SIGMAS * difference_sigma(r, b, key)
 
     dflt = default_technique()
     levels = get_technique(dflt).ledger.levels
@@ -190,7 +196,7 @@ def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS, key: str 
         for labl, per in by_label.items():
             if len(per) != len(scenes) or not all(within(r, s, tau) for s, r in per.items()):
                 continue
-            cost = float(np.mean([r["frame_ms_median"] for r in per.values()]))
+            cost = float(np.mean([r.frame_ms_median for r in per.values()]))
             ok.append((cost, labl, per))
         ok.sort(key=lambda t: t[0])
         top = ok[0] if ok else None
@@ -198,8 +204,8 @@ def recommendations(rows: list[dict], thresholds=RECOMMEND_THRESHOLDS, key: str 
             (
                 t
                 for t in ok
-                if next(iter(t[2].values()))["technique"] == dflt
-                and (not levels or all((r.get("blur_levels") or 0) > 0 for r in t[2].values()))
+                if next(iter(t[2].values())).technique == dflt
+                and (not levels or all((r.blur_levels or 0) > 0 for r in t[2].values()))
             ),
             None,
         )

@@ -23,9 +23,10 @@ from .ledger_analysis import (
 )
 from .ledger_csv import csv_text
 from .ledger_markdown import markdown
+from .ledger_row import LedgerRow
 
 
-def write_ledger(rows: list[dict], meta: dict, out: Path, sweep=None, profiles: dict | None = None) -> dict:
+def write_ledger(rows: list[LedgerRow], meta: dict, out: Path, sweep=None, profiles: dict | None = None) -> dict:
     from skinlab.bench.ledger_html import html_report
     from skinlab.bench.ledger_plots import cost_plot, pareto_plot, profile_plot
 
@@ -33,12 +34,12 @@ def write_ledger(rows: list[dict], meta: dict, out: Path, sweep=None, profiles: 
 
     sweep = sweep or SWEEPS.get(meta.get("sweep"), SWEEPS["full"])
     out = Path(out)
-    own = [r for r in rows if not r.get("peer")]  # the fronts, ties and defaults are Skinlab's; peers drawn beside
-    key = error_key(own)
-    mark_ties(own, key)
+    key = error_key([r for r in rows if not r.peer])
+    rows = mark_ties(rows, key)
+    own = [r for r in rows if not r.peer]  # the fronts, ties and defaults are Skinlab's; peers drawn beside
     fronts = {}
-    for scene in dict.fromkeys(r["scene"] for r in own):
-        fronts[scene] = pareto_front([r for r in own if r["scene"] == scene], key)
+    for scene in dict.fromkeys(r.scene for r in own):
+        fronts[scene] = pareto_front([r for r in own if r.scene == scene], key)
     series = cost_series(own, sweep)
     sl = slopes(series)
     recs = recommendations(own, key=key)
@@ -75,9 +76,9 @@ def write_ledger(rows: list[dict], meta: dict, out: Path, sweep=None, profiles: 
     ]
     doc = {
         "meta": meta,
-        "rows": rows,
+        "rows": [r.as_dict() for r in rows],
         "slopes": sl,
-        "pareto": {s: [r["setting"] for r in f] for s, f in fronts.items()},
+        "pareto": {s: [r.setting for r in f] for s, f in fronts.items()},
         "recommendations": rec_json,
         "error_axis": key,
     }

@@ -11,6 +11,7 @@ import math
 from pathlib import Path
 
 from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, error_key
+from .ledger_row import Column, LedgerRow, columns
 
 CSS = """
 body { font: 14px/1.45 system-ui, sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
@@ -38,7 +39,7 @@ def _finite(v) -> bool:
     return isinstance(v, (int, float)) and math.isfinite(v)
 
 
-def _pm(r: dict, key: str, pct: bool = True) -> str:
+def _pm(r: LedgerRow, key: str, pct: bool = True) -> str:
     v, s = r.get(key), r.get(f"{key}_sigma")
     if not _finite(v):
         return ""
@@ -55,107 +56,132 @@ def _table(head: list[str], rows: list[list[str]], classes: list[str] | None = N
     return "\n".join(out) + "</table>"
 
 
-def html_report(rows: list[dict], meta: dict, sl: list[dict], recs: list[dict], fronts: dict, out: Path) -> str:
-    from .ledger_plots import pareto_plot
-    from .sweep import sheet_settings_of_rows
+RANKS = {"best": "best", "tie": "tie (within noise)"}
 
-    out = Path(out)
-    key = error_key(rows)
-    t = meta.get("truth") or {}
+
+def table_cell(r: LedgerRow, c: Column) -> str:
+    """How ledger.html's per-scene table shows column `c` of row `r` (its declared ``show``; the setting
+    with its status where it is not ok)."""
     esc = html.escape
-    P = [f"<!doctype html><html><head><meta charset='utf-8'><title>Accuracy/time ledger ({esc(meta['sweep'])})</title>"
-         f"<style>{CSS}</style></head><body>"]  # fmt: skip
-    P.append(f"<h1>Accuracy/time ledger ({esc(meta['sweep'])} sweep)</h1>")
+    v = r.param(c.name) if c.kind == "params" else getattr(r, c.name)
+    if c.name == "setting":
+        return esc(r.setting) + ("" if r.status == "ok" else f" ({esc(r.status)})")
+    if c.show == "num":
+        return f"{v:.1f}" if _finite(v) else ""
+    if c.show in ("pm", "pm_plain", "pct", "profile"):
+        return _pm(r, c.name, pct=c.show != "pm_plain")
+    if c.show == "rank":
+        return RANKS.get(v, "")
+    return esc(str(v))
+
+
+def scene_table(srows: list[LedgerRow]) -> str:
+    """One scene's table: the columns that declare an HTML header (at most ten), a row per setting."""
+    cols = [c for c in columns(*srows) if c.html]
+    body = [[table_cell(r, c) for c in cols] for r in srows]
+    return _table([c.html for c in cols], body, ["same" if r.same_image_as else r.ties_best for r in srows])
+
+
+def column_table(rows: list[LedgerRow]) -> str:
+    """Every column of ledger.csv with its unit and what it holds (the LedgerRow declaration)."""
+    esc = html.escape
+    return _table(["column", "unit", "holds"], [[f"<code>{esc(c.name)}</code>", esc(c.unit), esc(c.doc)]
+                                                for c in columns(*rows)])  # fmt: skip
+
+
+def conditions(meta: dict, key: str) -> list[str]:
+    """The title, how the run was measured, which scenes lack their truth."""
+    esc = html.escape
+    P = [f"<h1>Accuracy/time ledger ({esc(meta['sweep'])} sweep)</h1>"]
     P.append(
         f"<p class='note'>GL: {esc(str(meta['gl']))}; {meta['cpus']} CPU(s); {esc(meta['date'])}; image "
         f"{meta['size'][0]}x{meta['size'][1]}; load average {meta.get('loadavg_start')} &rarr; "
         f"{meta.get('loadavg_end')}; command <code>{esc(meta.get('command') or '')}</code>. Error axis: "
         f"{esc(ERROR_LABELS[key])}. The full tables are in ledger.md.</p>"
     )
-    for scene, why in (t.get("missing") or {}).items():
+    for scene, why in ((meta.get("truth") or {}).get("missing") or {}).items():
         P.append(f"<p><b>{esc(scene)}</b>: {esc(why)}</p>")
     if key != TRUTH_KEY:
         P.append(
             "<p><b>Not measured against the path-traced truth</b> (no cached reference for every scene): the errors "
             "are against the exact convolution.</p>"
         )
-    per_scene = t.get("scenes") or {}
-    maps = sheet_settings_of_rows(rows)
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        srows = [r for r in rows if r["scene"] == scene]
-        P.append(f"<h2>{esc(scene)}</h2>")
-        d = per_scene.get(scene)
-        if d:
-            nb, npx, sec = 100 * (d.get("noise_block") or 0), 100 * (d.get("noise") or 0), d.get("seconds") or 0
-            P.append(
-                f"<p>{esc(d.get('tests') or '')} Truth: {d.get('spp')} spp in {d.get('passes')} passes "
-                f"({sec:.0f} s of path tracing), noise floor {nb:.2f} % on 4x4 blocks, {npx:.2f} % per pixel; edge "
-                f"region: {d.get('edge_pixels')} px within {d.get('edge_mm', 0):.1f} mm of the "
-                f"{esc(d.get('edge_from') or '')} edges.</p>"
-            )
-        fig = out / "html" / f"pareto-{scene}.png"
-        pareto_plot(srows, {scene: fronts.get(scene, [])}, fig, key=key, label=ERROR_LABELS[key])
-        P.append(_img(fig, alt=f"Pareto front of {scene}"))
-        head = ["setting", "ms", "truth 4x4", "truth px", "FLIP", "edge px", "profile", "rank", "same image as"]
-        body, cls = [], []
-        for r in srows:
-            ms = r.get("frame_ms_median")
-            rank = {"best": "best", "tie": "tie (within noise)"}.get(r.get("ties_best", ""), "")
-            body.append(
-                [
-                    esc(r["setting"]) + ("" if r["status"] == "ok" else f" ({esc(r['status'])})"),
-                    f"{ms:.1f}" if _finite(ms) else "",
-                    _pm(r, "truth_rel_l1_block"),
-                    _pm(r, "truth_rel_l1"),
-                    _pm(r, "truth_flip", pct=False),
-                    _pm(r, "truth_edge_rel_l1"),
-                    _pm(r, "truth_profile_err"),
-                    rank,
-                    esc(r.get("same_image_as", "")),
-                ]
-            )
-            cls.append("same" if r.get("same_image_as") else r.get("ties_best", ""))
-        P.append(_table(head, body, cls))
-        figs = []
-        for labl in maps.get(scene, []):
-            safe = labl.replace(" ", "-")
-            em, fm = out / "error_maps" / f"{scene}-{safe}.png", out / "flip_maps" / f"{scene}-{safe}.png"
-            if em.is_file():
-                figs.append(f"<figure>{_img(em, 'map', labl)}{_img(fm, 'map', labl)}<figcaption>{esc(labl)}"
-                            "</figcaption></figure>")  # fmt: skip
-        if figs:
-            P.append(
-                "<p class='note'>Per pixel, at the truth's size: (frame - truth) / truth of luminance (red brighter, "
-                "blue darker, full colour at &plusmn;50 %), and the FLIP map (magma, 0 to 1).</p>"
-            )
-            P.append("<div class='maps'>" + "".join(figs) + "</div>")
+    return P
+
+
+def scene_section(scene: str, rows: list[LedgerRow], meta: dict, fronts: dict, key: str, out: Path) -> list[str]:
+    """One scene: what it tests and its truth, its Pareto figure, its table, its error and FLIP maps."""
+    from .ledger_plots import pareto_plot
+    from .sweep import sheet_settings_of_rows
+
+    esc = html.escape
+    srows = [r for r in rows if r.scene == scene]
+    P = [f"<h2>{esc(scene)}</h2>"]
+    d = ((meta.get("truth") or {}).get("scenes") or {}).get(scene)
+    if d:
+        nb, npx, sec = 100 * (d.get("noise_block") or 0), 100 * (d.get("noise") or 0), d.get("seconds") or 0
+        P.append(
+            f"<p>{esc(d.get('tests') or '')} Truth: {d.get('spp')} spp in {d.get('passes')} passes "
+            f"({sec:.0f} s of path tracing), noise floor {nb:.2f} % on 4x4 blocks, {npx:.2f} % per pixel; edge "
+            f"region: {d.get('edge_pixels')} px within {d.get('edge_mm', 0):.1f} mm of the "
+            f"{esc(d.get('edge_from') or '')} edges.</p>"
+        )
+    fig = out / "html" / f"pareto-{scene}.png"
+    pareto_plot(srows, {scene: fronts.get(scene, [])}, fig, key=key, label=ERROR_LABELS[key])
+    P.append(_img(fig, alt=f"Pareto front of {scene}"))
+    P.append(scene_table(srows))
+    figs = []
+    for labl in sheet_settings_of_rows(rows).get(scene, []):
+        safe = labl.replace(" ", "-")
+        em, fm = out / "error_maps" / f"{scene}-{safe}.png", out / "flip_maps" / f"{scene}-{safe}.png"
+        if em.is_file():
+            figs.append(f"<figure>{_img(em, 'map', labl)}{_img(fm, 'map', labl)}<figcaption>{esc(labl)}"
+                        "</figcaption></figure>")  # fmt: skip
+    if figs:
+        P.append(
+            "<p class='note'>Per pixel, at the truth's size: (frame - truth) / truth of luminance (red brighter, "
+            "blue darker, full colour at &plusmn;50 %), and the FLIP map (magma, 0 to 1).</p>"
+        )
+        P.append("<div class='maps'>" + "".join(figs) + "</div>")
+    return P
+
+
+def recommendations_and_slopes(recs: list[dict], sl: list[dict], out: Path) -> list[str]:
+    esc = html.escape
+    P = ["<h2>Recommended defaults</h2>"]
+    dflt = recs[0]["default"] if recs else ""
+
+    def cell(t):
+        return ["none qualifies", ""] if t is None else [f"<code>{esc(t[1])}</code>", f"{t[0]:.1f}"]
+
+    rec_rows = [[f"{100 * rec['threshold']:g} %", *cell(rec["best"]), *cell(rec["best_default"])] for rec in recs]
+    P.append(_table(["budget", "cheapest setting", "mean ms", f"cheapest {esc(dflt)}", "mean ms"], rec_rows))
+    P.append("<h2>Cost slopes</h2>")
+
+    def f(t):
+        return "n/a" if math.isnan(t[0]) else f"{t[0]:.3f}"
+
+    slope_rows = [[esc(s["scene"]), f"{esc(s['technique'])} vs {esc(s['what'])}", f(s["frame"]), f(s["own"]),
+                   ", ".join(f"{v:g}" for v in s["values"])] for s in sl]  # fmt: skip
+    P.append(_table(["scene", "series", "frame", "technique passes", "values"], slope_rows))
+    P.append(_img(out / "cost.png", alt="cost"))
+    return P
+
+
+def html_report(rows: list[LedgerRow], meta: dict, sl: list[dict], recs: list[dict], fronts: dict, out: Path) -> str:
+    out = Path(out)
+    key = error_key(rows)
+    esc = html.escape
+    P = [f"<!doctype html><html><head><meta charset='utf-8'><title>Accuracy/time ledger ({esc(meta['sweep'])})</title>"
+         f"<style>{CSS}</style></head><body>"]  # fmt: skip
+    P += conditions(meta, key)
+    for scene in dict.fromkeys(r.scene for r in rows):
+        P += scene_section(scene, rows, meta, fronts, key, out)
     if (out / "profiles.png").is_file():
         P.append("<h2>Profiles across the declared lines and edges</h2>")
         P.append(_img(out / "profiles.png", alt="profiles"))
-    P.append("<h2>Recommended defaults</h2>")
-    dflt = recs[0]["default"] if recs else ""
-    rec_rows = []
-    for rec in recs:
-        cell = lambda t: ["none qualifies", ""] if t is None else [f"<code>{esc(t[1])}</code>", f"{t[0]:.1f}"]
-        rec_rows.append([f"{100 * rec['threshold']:g} %", *cell(rec["best"]), *cell(rec["best_default"])])
-    P.append(_table(["budget", "cheapest setting", "mean ms", f"cheapest {esc(dflt)}", "mean ms"], rec_rows))
-    P.append("<h2>Cost slopes</h2>")
-    f = lambda t: "n/a" if math.isnan(t[0]) else f"{t[0]:.3f}"
-    P.append(
-        _table(
-            ["scene", "series", "frame", "technique passes", "values"],
-            [
-                [
-                    esc(s["scene"]),
-                    f"{esc(s['technique'])} vs {esc(s['what'])}",
-                    f(s["frame"]),
-                    f(s["own"]),
-                    ", ".join(f"{v:g}" for v in s["values"]),
-                ]
-                for s in sl
-            ],  # fmt: skip
-        )
-    )
-    P.append(_img(out / "cost.png", alt="cost"))
+    P += recommendations_and_slopes(recs, sl, out)
+    P += ["<h2>Columns</h2>", "<p class='note'>The columns of ledger.csv (skinlab/bench/ledger_row.py).</p>",
+          column_table(rows)]  # fmt: skip
     P.append("</body></html>")
     return "\n".join(P)

@@ -1,5 +1,6 @@
-"""The ledger as Markdown (ledger.md): the measurement conditions, one table per scene, the Pareto
-fronts, the cost slopes, the pyrender peer and the recommended defaults."""
+"""The ledger as Markdown (ledger.md): the measurement conditions, the tables against the truth, one table
+per scene (its columns from the LedgerRow declaration, skinlab/bench/ledger_row.py), the Pareto fronts,
+the cost slopes, the peers, the recommended defaults and the columns with their units."""
 
 from __future__ import annotations
 
@@ -9,11 +10,11 @@ from .blender_peer import blender_markdown
 from .image_error import LUM_FRACTION
 from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, error_key
 from .ledger_csv import fmt_cell
-from .sweep import setting_columns
+from .ledger_row import Column, LedgerRow, columns
 from .truth_ledger import truth_markdown
 
 
-def pm(r: dict, key: str, percent: bool = True) -> str:
+def pm(r: LedgerRow, key: str, percent: bool = True) -> str:
     """'value +- sigma' (percent or as is), '' where not measured."""
     v, s = r.get(key), r.get(f"{key}_sigma")
     if not isinstance(v, (int, float)) or not math.isfinite(v):
@@ -25,17 +26,56 @@ def pm(r: dict, key: str, percent: bool = True) -> str:
     return f"{k * v:.2f}{unit}" if percent else f"{v:.4f}"
 
 
-def profile_cell(r: dict, key: str) -> str:
+def profile_cell(r: LedgerRow, key: str) -> str:
     """A profile error; n/a where the technique moves no light (a step: exactly 100 %, says nothing)."""
     v = r.get(key)
     if not isinstance(v, (int, float)) or not math.isfinite(v):
         return ""
-    if r.get("technique") and r.get("model") == "none" or abs(v - 1.0) < 1e-12:
+    if r.technique and r.model == "none" or abs(v - 1.0) < 1e-12:
         return "n/a (no profile)"
     return f"{100 * v:.2f} %"
 
 
-def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: dict) -> str:
+def _pct(v) -> str:
+    return "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100 * v:.2f} %"
+
+
+def table_cell(r: LedgerRow, c: Column) -> str:
+    """How ledger.md's per-scene table shows column `c` of row `r` (its declared ``show``)."""
+    v = r.param(c.name) if c.kind == "params" else getattr(r, c.name)
+    if c.show == "num":
+        return "" if isinstance(v, float) and math.isnan(v) else fmt_cell(v, 4)
+    if c.show == "pct":
+        return _pct(v)
+    if c.show in ("pm", "pm_plain"):
+        return pm(r, c.name, percent=c.show == "pm")
+    if c.show == "profile":
+        return profile_cell(r, c.name)
+    if c.show == "status":
+        return (r.status + (f": {r.error}" if r.error else "")).replace("|", "/")
+    if c.show == "params":
+        return fmt_cell(v)
+    return str(v)
+
+
+def scene_table(srows: list[LedgerRow]) -> list[str]:
+    """One scene's table: a row per setting, the columns that declare a Markdown header, in order."""
+    cols = [c for c in columns(*srows) if c.md]
+    L = ["| " + " | ".join(c.md for c in cols) + " |", "|---" * len(cols) + "|"]
+    L += ["| " + " | ".join(table_cell(r, c) for c in cols) + " |" for r in srows]
+    return L
+
+
+def column_lines(rows: list[LedgerRow]) -> list[str]:
+    """Every column of ledger.csv with its unit and what it holds (the LedgerRow declaration)."""
+    L = ["## Columns", "", "The columns of ledger.csv (and ledger.json's rows; skinlab/bench/ledger_row.py):", "",
+         "| column | unit | holds |", "|---|---|---|"]  # fmt: skip
+    L += [f"| `{c.name}` | {c.unit} | {c.doc} |" for c in columns(*rows)]
+    return [*L, ""]
+
+
+def conditions_lines(rows: list[LedgerRow], meta: dict) -> list[str]:
+    """The title and how the run was measured: GL, image and shadow sizes, frames, clock, time, load."""
     L = [f"# Accuracy/time ledger ({meta['sweep']} sweep)", ""]
     L.append(f"- GL: {meta['gl']}; {meta['cpus']} CPU(s); {meta['date']}")
     L.append(
@@ -44,7 +84,7 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         f"of `render(readback=False)` per setting (fewer, at least 3, where they would take over "
         f"{meta['budget_s']:g} s); Monte Carlo {meta['photons']:,} photons per channel"
     )
-    clocks = sorted({r.get("clock") for r in rows if r.get("clock")})
+    clocks = sorted({r.clock for r in rows if r.clock})
     L.append(
         f"- clock: {', '.join(clocks) or 'n/a'} (cpu-synchronised: wall time with glFinish after each "
         "pass, Mesa llvmpipe's GPU timer queries see only command submission; gpu-timer: GL timer queries)"
@@ -57,129 +97,93 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         )
     if meta.get("command"):
         L.append(f"- command: `{meta['command']}`")
-    L += [
-        "",
-        "image error: against the scene's reference image (the `reference` column) on linear HDR over "
-        f"lit surface pixels (coverage > 0, luminance > {LUM_FRACTION:.0%} of the 99th percentile); "
-        "rel-L1 = sum|img - ref| / sum ref; max/p95: per-pixel sum_c|img - ref| / sum_c ref. "
-        "`rel-L1 vs exact same size`: a tsd setting against the exact convolution at its own irradiance "
-        "size (the fit/blur error without the texture-resolution error). "
-        "profile error: relative L1 of the edge response against the Monte Carlo random walk, "
-        "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1); `vs model`: the same against the "
-        "material's own model profile (the technique's approximation alone).",
-        "`truth 4x4` / `truth px`: relative L1 against the path-traced truth on 4x4 blocks / per pixel, "
-        "`truth FLIP`: the mean FLIP of the tone-mapped frames, `truth edge px`: relative L1 per pixel within "
-        "the edge region, each +- its standard error from the truth's passes (jackknife); the truth's noise "
-        "floor (4x4) and the largest per-channel energy difference beside them. `n/a (no profile)`: the "
-        "technique moves no light, its profile is a step.",
-        "",
-        *truth_markdown(rows, meta),
-    ]
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        srows = [r for r in rows if r["scene"] == scene]
-        ref = next((r["reference"] for r in srows if r.get("reference")), "")
-        proxy = bool(ref) and not ref.startswith("exact")
-        L.append(f"## {scene}")
-        L.append("")
-        if not ref:
-            L.append(
-                "**No reference image**: neither the exact convolution nor a tsd proxy rendered; "
-                "image errors are empty."
-            )
-        elif proxy:
-            L.append(
-                f"**Proxy reference**: the exact technique did not render (see its row), so `{ref}` "
-                "stands in as the image reference; image errors are relative to it, not to the exact "
-                "profile."
-            )
-        else:
-            L.append(f"Reference image: `{ref}`.")
-        ref_size = next((r.get("tsd_size") for r in srows if r["setting"] == ref), None)
-        finer = [
-            r["setting"] for r in srows if ref_size and r.get("tsd_size") not in ("", None) and r["tsd_size"] > ref_size
+    return L
+
+
+MEASURES = [
+    "image error: against the scene's reference image (the `reference` column) on linear HDR over "
+    f"lit surface pixels (coverage > 0, luminance > {LUM_FRACTION:.0%} of the 99th percentile); "
+    "rel-L1 = sum|img - ref| / sum ref; max/p95: per-pixel sum_c|img - ref| / sum_c ref. "
+    "`rel-L1 vs exact same size`: a tsd setting against the exact convolution at its own irradiance "
+    "size (the fit/blur error without the texture-resolution error). "
+    "profile error: relative L1 of the edge response against the Monte Carlo random walk, "
+    "int|E - E_mc| dx / int|step - E_mc| dx (no scattering = 1); `vs model`: the same against the "
+    "material's own model profile (the technique's approximation alone).",
+    "`truth 4x4` / `truth px`: relative L1 against the path-traced truth on 4x4 blocks / per pixel, "
+    "`truth FLIP`: the mean FLIP of the tone-mapped frames, `truth edge px`: relative L1 per pixel within "
+    "the edge region, each +- its standard error from the truth's passes (jackknife); the truth's noise "
+    "floor (4x4) and the largest per-channel energy difference beside them. `n/a (no profile)`: the "
+    "technique moves no light, its profile is a step.",
+]
+
+
+def reference_lines(srows: list[LedgerRow]) -> list[str]:
+    """What one scene's image errors are measured against (the exact convolution, a proxy, nothing), and
+    which settings are compared with a coarser image than their own."""
+    ref = next((r.reference for r in srows if r.reference), "")
+    if not ref:
+        L = ["**No reference image**: neither the exact convolution nor a tsd proxy rendered; image errors are empty."]
+    elif not ref.startswith("exact"):
+        L = [
+            f"**Proxy reference**: the exact technique did not render (see its row), so `{ref}` "
+            "stands in as the image reference; image errors are relative to it, not to the exact "
+            "profile."
         ]
-        if finer:
-            L.append(
-                f"Settings with a finer irradiance texture than the reference's {ref_size} texels "
-                f"({', '.join(finer)}) are compared with a coarser image: their error includes the "
-                "reference's own texture-resolution error (compare the exact rows at smaller sizes)."
-            )
-        L.append("")
-        cols = setting_columns()
-        head = [
-            "setting", "technique", "model", *cols, "blur levels", "frames", "frame ms median", "p10", "p90",
-            "technique ms", "image rel-L1", "image max", "image p95", "rel-L1 vs exact same size", "profile err vs MC",
-            "profile err vs model", "truth 4x4", "truth px", "truth FLIP", "truth edge px", "truth noise 4x4",
-            "truth energy", "same image as", "status",
-        ]  # fmt: skip
-        L.append("| " + " | ".join(head) + " |")
-        L.append("|---" * len(head) + "|")
-        for r in srows:
-            status = r["status"] + (f": {r['error']}" if r.get("error") else "")
-            pct = lambda v: "" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{100 * v:.2f} %"
-            L.append(
-                "| "
-                + " | ".join(
-                    [
-                        r["setting"],
-                        r["technique"],
-                        r.get("model", ""),
-                        *(fmt_cell(r.get(c)) for c in cols),
-                        fmt_cell(r.get("blur_levels", "")),
-                        fmt_cell(r.get("frames", "")),
-                        fmt_cell(r.get("frame_ms_median"), 4),
-                        fmt_cell(r.get("frame_ms_p10"), 4),
-                        fmt_cell(r.get("frame_ms_p90"), 4),
-                        fmt_cell(r.get("technique_ms_median"), 4),
-                        pct(r.get("image_rel_l1")),
-                        pct(r.get("image_max_rel")),
-                        pct(r.get("image_p95_rel")),
-                        pct(r.get("image_rel_l1_same_size")),
-                        profile_cell(r, "profile_err_mc"),
-                        profile_cell(r, "profile_err_model"),
-                        pm(r, "truth_rel_l1_block"),
-                        pm(r, "truth_rel_l1"),
-                        pm(r, "truth_flip", percent=False),
-                        pm(r, "truth_edge_rel_l1"),
-                        pct(r.get("truth_noise_block")),
-                        pct(r.get("truth_energy")),
-                        r.get("same_image_as", ""),
-                        status.replace("|", "/"),
-                    ]
-                )
-                + " |"
-            )
-        L.append("")
-        fr = fronts.get(scene, [])
-        if fr:
-            key = error_key(rows)
-            L.append(
-                f"Pareto front (time, {ERROR_LABELS[key]}): "
-                + " -> ".join(f"`{r['setting']}` ({r['frame_ms_median']:.1f} ms, {100 * r[key]:.2f} %)" for r in fr)
-                + " (each point more accurate than the cheaper ones by more than twice the noise of the difference)"
-            )
-            L.append("")
-        same = [r for r in srows if r.get("same_image_as")]
-        if same:
-            L.append(
-                "Same image (bit-identical frames, one point in the Pareto front and the ranks): "
-                + "; ".join(f"`{r['setting']}` = `{r['same_image_as']}`" for r in same)
-            )
-            L.append("")
-        key = error_key(rows)
-        best = next((r for r in srows if r.get("ties_best") == "best"), None)
-        if best is not None and key == TRUTH_KEY:
-            ties = [r["setting"] for r in srows if r.get("ties_best") == "tie"]
-            L.append(
-                f"Best against the truth: `{best['setting']}`; "
-                + (
-                    f"the truth's noise cannot tell it from {', '.join(f'`{t}`' for t in ties)}."
-                    if ties
-                    else "every other setting is worse by more than the noise."
-                )
-            )
-            L.append("")
-    L += [
+    else:
+        L = [f"Reference image: `{ref}`."]
+    ref_size = next((r.param("tsd_size") for r in srows if r.setting == ref), None)
+    finer = [r.setting for r in srows if ref_size and r.param("tsd_size") != "" and r.param("tsd_size") > ref_size]
+    if finer:
+        L.append(
+            f"Settings with a finer irradiance texture than the reference's {ref_size} texels "
+            f"({', '.join(finer)}) are compared with a coarser image: their error includes the "
+            "reference's own texture-resolution error (compare the exact rows at smaller sizes)."
+        )
+    return L
+
+
+def ranking_lines(srows: list[LedgerRow], front: list[LedgerRow], key: str) -> list[str]:
+    """Below one scene's table: its Pareto front, its same-image rows, its best and the ties with it."""
+    L = []
+    if front:
+        L += [
+            f"Pareto front (time, {ERROR_LABELS[key]}): "
+            + " -> ".join(f"`{r.setting}` ({r.frame_ms_median:.1f} ms, {100 * r[key]:.2f} %)" for r in front)
+            + " (each point more accurate than the cheaper ones by more than twice the noise of the difference)",
+            "",
+        ]
+    same = [r for r in srows if r.same_image_as]
+    if same:
+        L += [
+            "Same image (bit-identical frames, one point in the Pareto front and the ranks): "
+            + "; ".join(f"`{r.setting}` = `{r.same_image_as}`" for r in same),
+            "",
+        ]
+    best = next((r for r in srows if r.ties_best == "best"), None)
+    if best is not None and key == TRUTH_KEY:
+        ties = [r.setting for r in srows if r.ties_best == "tie"]
+        L += [
+            f"Best against the truth: `{best.setting}`; "
+            + (
+                f"the truth's noise cannot tell it from {', '.join(f'`{t}`' for t in ties)}."
+                if ties
+                else "every other setting is worse by more than the noise."
+            ),
+            "",
+        ]
+    return L
+
+
+def scene_lines(scene: str, rows: list[LedgerRow], fronts: dict) -> list[str]:
+    """One scene's section: its reference, its table, its ranks."""
+    srows = [r for r in rows if r.scene == scene]
+    return [f"## {scene}", "", *reference_lines(srows), "", *scene_table(srows), "",
+            *ranking_lines(srows, fronts.get(scene, []), error_key(rows))]  # fmt: skip
+
+
+def cost_slope_lines(sl: list[dict]) -> list[str]:
+    """The cost slopes along every axis a technique declares a cost for."""
+    L = [
         "## Cost slopes",
         "",
         "Least-squares slopes of log(time) against log(the cost variable) along each axis a technique declares a "
@@ -191,8 +195,11 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         "| scene | series | frame vs it | technique passes vs it | values | blur levels |",
         "|---|---|---|---|---|---|",
     ]
+
+    def f(t):
+        return "n/a" if math.isnan(t[0]) else f"{t[0]:.3f}"
+
     for s in sl:
-        f = lambda t: "n/a" if math.isnan(t[0]) else f"{t[0]:.3f}"
         power = "" if s["power"] == 1 else f" = {s['field']}^{s['power']:g}"
         L.append(
             f"| {s['scene']} | {s['technique']} vs {s['what']}{power} | {f(s['frame'])} | {f(s['own'])} | "
@@ -200,33 +207,40 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         )
     if not sl:
         L.append("| (no cost series measured) | | | | | |")
-    L.append("")
-    L += ["## Peer: pyrender", ""]
+    return [*L, ""]
+
+
+def pyrender_lines(meta: dict) -> list[str]:
+    """The pyrender peer's frame times beside Skinlab's (or why it was not run)."""
+    L = ["## Peer: pyrender", ""]
     p = meta.get("peer")
     if p is None:
         L.append("Not run (--no-peer).")
     elif "error" in p:
         L.append(f"The pyrender peer failed: {p['error']}")
     else:
-        L.append(
+        L += [
             f"`skinlab bench peer --size {p['size'][0]}x{p['size'][1]} --frames {p['frames']}` "
             f"({p['gl']}): the head, shadows off, colour+depth read back on both sides, median of "
             f"{p['frames']} whole frames (no glFinish between passes); pyrender's frame is plain PBR, "
             "Skinlab's plain-PBR frame has sss_model none, its default frame the default "
-            "RenderSettings (texture-space diffusion on the skin)."
-        )
-        L.append("")
-        L.append("| renderer | ms/frame | / pyrender |")
-        L.append("|---|---|---|")
-        L.append(f"| skinlab, plain PBR | {p['skinlab_ms']:.2f} | {p['ratio_skinlab_over_pyrender']:.2f} |")
+            "RenderSettings (texture-space diffusion on the skin).",
+            "",
+            "| renderer | ms/frame | / pyrender |",
+            "|---|---|---|",
+            f"| skinlab, plain PBR | {p['skinlab_ms']:.2f} | {p['ratio_skinlab_over_pyrender']:.2f} |",
+        ]
         if p.get("skinlab_default_ms") is not None:
             L.append(
                 f"| skinlab, default settings (tsd) | {p['skinlab_default_ms']:.2f} | "
                 f"{p['ratio_default_over_pyrender']:.2f} |"
             )
         L.append(f"| pyrender | {p['pyrender_ms']:.2f} | 1 |")
-    L.append("")
-    L += blender_markdown(rows, meta)
+    return [*L, ""]
+
+
+def recommendation_lines(rows: list[LedgerRow], recs: list[dict]) -> list[str]:
+    """The rule and, per error budget, the cheapest setting overall and of the default technique."""
     key = recs[0]["key"] if recs else "image_rel_l1"
     dflt = recs[0]["default"] if recs else "the default technique"
     rule = (
@@ -238,7 +252,7 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         else "whose image rel-L1 against the reference is <= tau in *every* scene; the reference itself "
         "qualifies trivially"
     )
-    L += [
+    L = [
         "## Recommended defaults",
         "",
         f"Rule: for each error budget tau, the cheapest setting (mean over the scenes of its median frame time) "
@@ -250,26 +264,33 @@ def markdown(rows: list[dict], meta: dict, sl: dict, recs: list[dict], fronts: d
         f"| cheapest {dflt} setting | mean ms | errors per scene |",
         "|---|---|---|---|---|---|---|",
     ]
+
+    def cell(t):
+        if t is None:
+            return ["none qualifies", "", ""]
+        cost, labl, per = t
+        return [f"`{labl}`", f"{cost:.1f}", ", ".join(f"{s} {100 * r[key]:.2f} %" for s, r in per.items())]
+
     for rec in recs:
-
-        def cell(t):
-            if t is None:
-                return ["none qualifies", "", ""]
-            cost, labl, per = t
-            return [
-                f"`{labl}`",
-                f"{cost:.1f}",
-                ", ".join(f"{s} {100 * r[key]:.2f} %" for s, r in per.items()),
-            ]
-
         L.append(
             f"| {100 * rec['threshold']:g} % | " + " | ".join(cell(rec["best"]) + cell(rec["best_default"])) + " |"
         )
-    if any(r.get("reference") and not r["reference"].startswith("exact") for r in rows):
+    if any(r.reference and not r.reference.startswith("exact") for r in rows):
         L += [
             "",
             "These recommendations are relative to a proxy reference (see above), not to the exact "
             "convolution: re-run once the exact technique renders.",
         ]
-    L.append("")
+    return [*L, ""]
+
+
+def markdown(rows: list[LedgerRow], meta: dict, sl: list[dict], recs: list[dict], fronts: dict) -> str:
+    L = [*conditions_lines(rows, meta), "", *MEASURES, "", *truth_markdown(rows, meta)]
+    for scene in dict.fromkeys(r.scene for r in rows):
+        L += scene_lines(scene, rows, fronts)
+    L += cost_slope_lines(sl)
+    L += pyrender_lines(meta)
+    L += blender_markdown(rows, meta)
+    L += recommendation_lines(rows, recs)
+    L += column_lines(rows)
     return "\n".join(L)

@@ -15,6 +15,7 @@ from skinlab.render.registry import techniques
 
 from .blender_peer import PEER_STYLES
 from .ledger_analysis import usable
+from .ledger_row import LedgerRow
 
 
 def _floor(pts, key: str = "image_rel_l1") -> float:
@@ -67,24 +68,24 @@ def technique_styles() -> dict[str, tuple[str, str]]:
 
 
 def pareto_plot(
-    rows: list[dict], fronts: dict, path: Path, key: str = "image_rel_l1", label: str = "image rel-L1"
+    rows: list[LedgerRow], fronts: dict, path: Path, key: str = "image_rel_l1", label: str = "image rel-L1"
 ) -> Path:
     from .ledger_analysis import sigma
 
     plt = _plt()
     styles = technique_styles()
-    scenes = list(dict.fromkeys(r["scene"] for r in rows)) or ["(none)"]
+    scenes = list(dict.fromkeys(r.scene for r in rows)) or ["(none)"]
     fig, axes = plt.subplots(1, len(scenes), figsize=(6.4 * len(scenes), 4.8), squeeze=False)
     for ax, scene in zip(axes[0], scenes):
-        pts = [r for r in rows if r["scene"] == scene and usable(r, key) and not r.get("same_image_as")]
+        pts = [r for r in rows if r.scene == scene and usable(r, key) and not r.same_image_as]
         floor = _floor(pts, key)
         # each technique's marker and colour; the Blender peers' (skinlab/bench/blender_peer.py) from PEER_STYLES
         for name in [*(t.name for t in techniques()), *PEER_STYLES]:
-            sel = [r for r in pts if r["technique"] == name]
+            sel = [r for r in pts if r.technique == name]
             if not sel:
                 continue
             marker, colour = styles[name] if name in styles else PEER_STYLES[name]
-            x = [r["frame_ms_median"] for r in sel]
+            x = [r.frame_ms_median for r in sel]
             y = [max(r[key], floor) for r in sel]
             err = [2 * sigma(r, key) for r in sel]  # TIE_SIGMAS standard errors: the noise the ranks allow
             if any(e > 0 for e in err):
@@ -94,25 +95,23 @@ def pareto_plot(
                 zorder=3,
             )  # fmt: skip
             for r, xi, yi in zip(sel, x, y) if name in PEER_STYLES else ():
-                ax.annotate(
-                    r["setting"], (xi, yi), textcoords="offset points", xytext=(5, -9), fontsize=6, color=colour
-                )
+                ax.annotate(r.setting, (xi, yi), textcoords="offset points", xytext=(5, -9), fontsize=6, color=colour)
         fr = fronts.get(scene, [])
         if fr:
-            x = [r["frame_ms_median"] for r in fr]
+            x = [r.frame_ms_median for r in fr]
             y = [max(r[key], floor) for r in fr]
             ax.step(x, y, where="post", color="grey", lw=1, ls="--", zorder=2, label="Pareto front (beyond noise)")
             ax.scatter(x, y, s=140, facecolors="none", edgecolors="grey", zorder=4)
             for r, xi, yi in zip(fr, x, y):
-                text = r["setting"] + (" (reference: 0)" if r[key] == 0 else "")
+                text = r.setting + (" (reference: 0)" if r[key] == 0 else "")
                 ax.annotate(text, (xi, yi), textcoords="offset points", xytext=(5, 4), fontsize=7)
         notes = []
-        bad = [r for r in rows if r["scene"] == scene and not usable(r, key)]
+        bad = [r for r in rows if r.scene == scene and not usable(r, key)]
         if bad:
-            notes.append("not plotted: " + ", ".join(f"{r['setting']} ({r['status']})" for r in bad))
-        same = [r for r in rows if r["scene"] == scene and r.get("same_image_as") and usable(r, key)]
+            notes.append("not plotted: " + ", ".join(f"{r.setting} ({r.status})" for r in bad))
+        same = [r for r in rows if r.scene == scene and r.same_image_as and usable(r, key)]
         if same:
-            notes.append("same image as another: " + ", ".join(f"{r['setting']} = {r['same_image_as']}" for r in same))
+            notes.append("same image as another: " + ", ".join(f"{r.setting} = {r.same_image_as}" for r in same))
         if notes:
             ax.text(0.01, 0.01, "\n".join(notes), transform=ax.transAxes, fontsize=6, va="bottom", wrap=True)
         ax.set_xscale("log")
@@ -121,11 +120,11 @@ def pareto_plot(
         if pts and any(r[key] > 0 for r in pts):
             ax.set_yscale("log")
         if key == "image_rel_l1":
-            ref = next((r["reference"] for r in rows if r["scene"] == scene and r.get("reference")), "")
+            ref = next((r.reference for r in rows if r.scene == scene and r.reference), "")
             ax.set_title(f"{scene}: error vs time (reference: {ref or 'none'})", fontsize=9)
             ax.set_ylabel(f"{label} (the reference drawn at {floor:g})")
         else:
-            noise = next((r.get("truth_noise_block") for r in pts if r.get("truth_noise_block") is not None), None)
+            noise = next((r.truth_noise_block for r in pts if np.isfinite(r.truth_noise_block)), None)
             if noise is not None and np.isfinite(noise):
                 ax.axhline(noise, color="grey", lw=0.8, ls=":", label="truth noise floor (4x4)")
             ax.set_title(f"{scene}: error against the path-traced truth vs time (bars: 2 sigma)", fontsize=9)
@@ -176,7 +175,7 @@ def cost_plot(series: list[dict], slopes: list[dict], path: Path) -> Path:
     return _save(fig, Path(path))
 
 
-def profile_plot(profiles: dict, rows: list[dict], path: Path) -> Path:
+def profile_plot(profiles: dict, rows: list[LedgerRow], path: Path) -> Path:
     """Per scene with a declared line or edge: the luminance profile across it of the truth and of each
     technique's setting (its default where swept, else its first), log axis, normalised to the truth's
     peak."""
@@ -196,15 +195,15 @@ def profile_plot(profiles: dict, rows: list[dict], path: Path) -> Path:
         ax.plot(truth.x_mm, lum(truth) / peak, color="black", lw=2.2, label="path-traced truth", zorder=5)
         by_tech: dict[str, str] = {}
         for r in rows:
-            if r["scene"] != scene or r["setting"] not in p or r.get("same_image_as"):
+            if r.scene != scene or r.setting not in p or r.same_image_as:
                 continue
-            if r.get("peer"):  # each peer row its own line (skinlab/bench/blender_peer.py)
-                by_tech[r["setting"]] = r["setting"]
+            if r.peer:  # each peer row its own line (skinlab/bench/blender_peer.py)
+                by_tech[r.setting] = r.setting
                 continue
-            default = Setting.of(r["technique"]).label
-            if r["technique"] not in by_tech or r["setting"] == default:
-                by_tech[r["technique"]] = r["setting"]
-        peer_tech = {r["setting"]: r["technique"] for r in rows if r.get("peer")}
+            default = Setting.of(r.technique).label
+            if r.technique not in by_tech or r.setting == default:
+                by_tech[r.technique] = r.setting
+        peer_tech = {r.setting: r.technique for r in rows if r.peer}
         for tech, labl in by_tech.items():
             marker, colour = styles.get(tech) or PEER_STYLES.get(peer_tech.get(tech), ("o", "grey"))
             pr = p[labl]

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from skinlab.resources import scenes_root
 
+from .ledger_row import LedgerRow
 from .truth_ledger import REFERENCE_SCENES, TruthSpec, reference_scene_names
 
 ASSETS = scenes_root()
@@ -212,16 +213,16 @@ def sheet_settings(settings: list[Setting]) -> list[Setting]:
     return out
 
 
-def sheet_settings_of_rows(rows: list[dict]) -> dict[str, list[str]]:
+def sheet_settings_of_rows(rows: list[LedgerRow]) -> dict[str, list[str]]:
     """Per scene, the labels of one ok row per technique (as sheet_settings picks them); every row of a
     peer (a renderer that is not a registered technique: skinlab/bench/blender_peer.py)."""
     out: dict[str, list[str]] = {}
-    for scene in dict.fromkeys(r["scene"] for r in rows):
-        srows = [r for r in rows if r["scene"] == scene and r.get("status") == "ok"]
+    for scene in dict.fromkeys(r.scene for r in rows):
+        srows = [r for r in rows if r.scene == scene and r.status == "ok"]
         labels = []
-        for tech in dict.fromkeys(r["technique"] for r in srows):
-            cands = [r["setting"] for r in srows if r["technique"] == tech]
-            if any(r.get("peer") for r in srows if r["technique"] == tech):
+        for tech in dict.fromkeys(r.technique for r in srows):
+            cands = [r.setting for r in srows if r.technique == tech]
+            if any(r.peer for r in srows if r.technique == tech):
                 labels += cands
                 continue
             default = Setting.of(tech).label

@@ -41,31 +41,9 @@ from skinlab.truth.compare import (
     judged_blocks,
 )
 
+from .ledger_row import LedgerRow
+
 REFERENCE_SCENES = scenes_root() / "reference"
-TRUTH_COLUMNS = [
-    "truth_rel_l1",
-    "truth_rel_l1_sigma",
-    "truth_rel_l1_block",
-    "truth_rel_l1_block_sigma",
-    "truth_flip",
-    "truth_flip_sigma",
-    "truth_edge_rel_l1",
-    "truth_edge_rel_l1_sigma",
-    "truth_edge_pixels",
-    "truth_profile_err",
-    "truth_profile_err_sigma",
-    "truth_energy",
-    "truth_energy_r",
-    "truth_energy_g",
-    "truth_energy_b",
-    "truth_noise",
-    "truth_noise_block",
-    "truth_spp",
-    "truth_passes",
-    "truth_blocks8_over",
-    "truth_blocks8_judged",
-    "truth_blocks8_over_frac",
-]
 # the errors measured with their uncertainty (the jackknife over the truth's passes, skinlab/truth/metrics.py)
 JACKKNIFED = ("truth_rel_l1", "truth_rel_l1_block", "truth_flip", "truth_edge_rel_l1", "truth_profile_err")
 
@@ -304,24 +282,24 @@ def _finite(v) -> bool:
     return isinstance(v, (int, float)) and math.isfinite(v)
 
 
-def _pm(r: dict, key: str, pct: bool) -> str:
+def _pm(r: LedgerRow, key: str, pct: bool) -> str:
     v, s = r.get(key), r.get(f"{key}_sigma")
     if not _finite(v):
         return ""
-    mark = "= " if r.get("ties_best") in ("best", "tie") and key == r.get("_rank_key", TRUTH_BLOCK_KEY) else ""
+    mark = "= " if r.ties_best in ("best", "tie") and key == TRUTH_BLOCK_KEY else ""
     if pct:
         return mark + f"{100 * v:.1f}" + (f" +- {100 * s:.1f}" if _finite(s) else "") + " %"
     return mark + f"{v:.3f}" + (f" +- {s:.3f}" if _finite(s) else "")
 
 
-def _blocks(r: dict) -> str:
-    over, judged = r.get("truth_blocks8_over"), r.get("truth_blocks8_judged")
+def _blocks(r: LedgerRow) -> str:
+    over, judged = r.truth_blocks8_over, r.truth_blocks8_judged
     if not isinstance(over, int) or not isinstance(judged, int):
         return ""
     return f"{over} / {judged}"
 
 
-def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
+def truth_markdown(rows: list[LedgerRow], meta: dict) -> list[str]:
     """The ledger's section against the truth: a table of settings x scenes (error on 4x4 blocks,
     the reference's noise floor beside it), what is missing, and the error maps."""
     t = meta.get("truth")
@@ -353,7 +331,7 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
         L.append(f"- **{scene}**: {what}")
     if t.get("missing") or t.get("quiet"):
         L.append("")
-    scenes = [s for s in dict.fromkeys(r["scene"] for r in rows) if s not in (t.get("missing") or {})]
+    scenes = [s for s in dict.fromkeys(r.scene for r in rows) if s not in (t.get("missing") or {})]
     if not scenes:
         return [*L, ""]
     per_scene = t.get("scenes") or {}
@@ -380,7 +358,7 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
         L.append("")
     by_label: dict[str, dict] = {}
     for r in rows:
-        by_label.setdefault(r["setting"], {})[r["scene"]] = r
+        by_label.setdefault(r.setting, {})[r.scene] = r
     for key, what, pct in (
         ("truth_rel_l1_block", "relative L1 on 4x4 blocks", True),
         ("truth_rel_l1", "relative L1 per pixel", True),
@@ -388,12 +366,11 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
         ("truth_edge_rel_l1", "relative L1 per pixel within the edge region", True),
         ("truth_profile_err", "relative L1 of the profile across the declared line or edge", True),
     ):
-        have = [s for s in scenes if any(_finite(r.get(key)) for r in rows if r["scene"] == s)]
+        have = [s for s in scenes if any(_finite(r[key]) for r in rows if r.scene == s)]
         if not have:
             continue
         noise = {
-            s: next((r.get("truth_noise_block") for r in rows if r["scene"] == s and r.get("truth_noise_block")), None)
-            for s in have
+            s: next((r.truth_noise_block for r in rows if r.scene == s and r.truth_noise_block), None) for s in have
         }
         L.append(f"**{what}** (+- its standard error from the truth's passes; `=` marks the best and the settings "
                  "the noise cannot tell from it):")  # fmt: skip
@@ -404,7 +381,7 @@ def truth_markdown(rows: list[dict], meta: dict) -> list[str]:
         L.append("|---|" + "---|" * (len(have) + 1))
         for labl, per in by_label.items():
             cells = [_pm(per[s], key, pct) if s in per else "" for s in have]
-            ms = [per[s].get("frame_ms_median") for s in have if s in per]
+            ms = [per[s].frame_ms_median for s in have if s in per]
             ms = [m for m in ms if isinstance(m, (int, float)) and math.isfinite(m)]
             mean_ms = f"{sum(ms) / len(ms):.1f}" if ms else ""
             L.append(f"| {labl} | " + " | ".join(cells) + f" | {mean_ms} |")

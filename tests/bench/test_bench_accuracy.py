@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from skinlab.bench import accuracy as acc
+from skinlab.bench.ledger_row import LedgerRow
 from skinlab.scene.optics import edges
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -89,6 +90,36 @@ def test_csv_structure(tiny):
             frac = float(r["truth_blocks8_over_frac"])
             assert (judged == 0 and frac != frac) or frac == pytest.approx(over / judged)
     assert len({r["truth_noise_block"] for r in rows}) == 1  # one reference per scene
+
+
+def test_the_written_rows_read_back_and_every_column_is_listed(tiny):
+    """ledger.csv reads back into the rows ledger.json holds (and writes the same file again); every
+    column of its header, as the LedgerRow declaration has it, is listed in ledger.md and ledger.html."""
+    import html
+
+    from skinlab.bench.ledger_csv import csv_text, read_csv
+    from skinlab.bench.ledger_row import columns
+
+    out, _ = tiny
+    rows = read_csv(out / "ledger.csv")
+    assert csv_text(rows) == (out / "ledger.csv").read_text()
+    doc = json.loads((out / "ledger.json").read_text())
+
+    def plain(v):  # ledger.json writes nan as null
+        if isinstance(v, dict):
+            return {k: plain(x) for k, x in v.items()}
+        if isinstance(v, list):
+            return [plain(x) for x in v]
+        return None if isinstance(v, float) and math.isnan(v) else v
+
+    assert [plain(r.as_dict()) for r in rows] == doc["rows"]
+    md, page = (out / "ledger.md").read_text(), (out / "ledger.html").read_text()
+    for c in columns(*rows):
+        assert f"| `{c.name}` | {c.unit} | {c.doc} |" in md, c.name
+        assert (
+            f"<tr><td><code>{c.name}</code></td><td>{html.escape(c.unit)}</td><td>{html.escape(c.doc)}</td></tr>"
+            in page
+        )
 
 
 def test_markdown_json_and_figures(tiny):
@@ -167,7 +198,7 @@ def test_rows_carry_uncertainties_and_ranks(tiny):
 def test_truth_section_says_how_the_compared_frames_were_sampled():
     from skinlab.bench.truth_ledger import truth_markdown
 
-    rows = [{"scene": "a", "setting": "none", "truth_rel_l1_block": 0.1, "frame_ms_median": 2.0}]
+    rows = [LedgerRow(scene="a", setting="none", truth_rel_l1_block=0.1, frame_ms_median=2.0)]
     meta = {"truth": {"size": [32, 32], "spp": 16, "passes": 2, "missing": {}}}
     for n, says in ((1, "one sample at each pixel's centre"), (2, "2 x 2 samples per pixel, box-filtered")):
         text = "\n".join(truth_markdown(rows, {"truth": {**meta["truth"], "supersample": n}}))
@@ -211,14 +242,7 @@ def test_bad_scene_is_one_line():
 
 def test_pareto_front_and_recommendation_rule():
     def row(scene, label, ms, err, tech="tsd"):
-        return {
-            "scene": scene,
-            "setting": label,
-            "technique": tech,
-            "status": "ok",
-            "frame_ms_median": ms,
-            "image_rel_l1": err,
-        }
+        return LedgerRow(scene=scene, setting=label, technique=tech, frame_ms_median=ms, image_rel_l1=err)
 
     rows = [
         row("a", "ref", 100.0, 0.0, "exact"),
@@ -231,19 +255,18 @@ def test_pareto_front_and_recommendation_rule():
         row("b", "z", 28.0, 0.008),
     ]
     front = acc.pareto_front([r for r in rows if r["scene"] == "a"])
-    assert [r["setting"] for r in front] == ["x", "z", "ref"]  # y is dominated by x
+    assert [r.setting for r in front] == ["x", "z", "ref"]  # y is dominated by x
     recs = {r["threshold"]: r for r in acc.recommendations(rows, (0.01, 0.05, 0.001))}
     assert recs[0.01]["best"][1] == "z"  # y fails in scene a; z is within 1 % in both
     assert recs[0.05]["best"][1] == "x"
     assert recs[0.001]["best"][1] == "ref" and recs[0.001]["best_default"] is None
     # against the truth the budget counts from each scene's best setting
-    for r in rows:
-        r["truth_rel_l1_block"] = r["image_rel_l1"] + (0.12 if r["scene"] == "a" else 0.10)
+    rows = [r.but(truth_rel_l1_block=r.image_rel_l1 + (0.12 if r.scene == "a" else 0.10)) for r in rows]
     assert acc.error_key(rows) == "truth_rel_l1_block"
     recs = {r["threshold"]: r for r in acc.recommendations(rows, (0.01, 0.05), key="truth_rel_l1_block")}
     assert recs[0.01]["best"][1] == "z" and recs[0.05]["best"][1] == "x"
     front = acc.pareto_front([r for r in rows if r["scene"] == "b"], "truth_rel_l1_block")
-    assert [r["setting"] for r in front] == ["x", "y", "ref"]  # ref (0.100) beats y (0.102)
+    assert [r.setting for r in front] == ["x", "y", "ref"]  # ref (0.100) beats y (0.102)
 
 
 def test_log_slope_and_image_error():
@@ -311,8 +334,8 @@ def test_ranks_tell_apart_only_differences_larger_than_the_noise():
     key = "truth_rel_l1_block"
 
     def row(label, ms, err, sigma, tech="tsd", **kw):
-        return {"scene": "s", "setting": label, "technique": tech, "status": "ok", "frame_ms_median": ms,
-                key: err, f"{key}_sigma": sigma, **kw}  # fmt: skip
+        return LedgerRow(scene="s", setting=label, technique=tech, frame_ms_median=ms,
+                         **{key: err, f"{key}_sigma": sigma}, **kw)  # fmt: skip
 
     cheap = row("cheap", 1.0, 0.100, 0.003)
     # 0.4 % better, but the noise of the difference (0.0042) is larger: a tie
@@ -323,9 +346,10 @@ def test_ranks_tell_apart_only_differences_larger_than_the_noise():
     rows = [cheap, close, far, same]
     assert not told_apart(cheap, close, key) and told_apart(cheap, far, key)
     assert not told_apart(far, same, key)  # identical errors never differ
-    assert [r["setting"] for r in acc.pareto_front(rows, key)] == ["cheap", "far"]
-    mark_ties(rows, key)
-    assert far["ties_best"] == "best" and cheap["ties_best"] == "" and same["ties_best"] == ""
+    assert [r.setting for r in acc.pareto_front(rows, key)] == ["cheap", "far"]
+    assert [r.ties_best for r in mark_ties(rows, key)] == ["", "", "best", ""]
+    peer = row("peer", 0.5, 0.01, 0.001, peer=True)  # a peer is drawn beside, never ranked
+    assert [r.ties_best for r in mark_ties([*rows, peer], key)] == ["", "", "best", "", ""]
     recs = {r["threshold"]: r for r in acc.recommendations(rows, (0.0, 0.02, 0.03), key=key)}
     assert recs[0.0]["best"][1] == "far"
     assert recs[0.02]["best"][1] == "close"  # within 2 % of the best once the noise is allowed
