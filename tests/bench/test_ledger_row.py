@@ -84,3 +84,60 @@ def test_an_older_ledger_reads_and_a_wrong_file_says_so(tmp_path):
     bad.write_text("scene,setting,technique,status,frames\nhead,none,none,ok,three\n")
     with pytest.raises(ValueError, match=r"other\.csv: line 2, column frames: "):
         read_csv(bad)
+
+
+def test_the_run_loops_pieces_on_made_up_frames():
+    """The image reference is the exact setting where it rendered, else the proxy; every row gets its
+    reference and its image error against that frame, a tsd setting also against the exact frame of its own
+    irradiance size; bit-identical frames are one image (``same_image_as``)."""
+    from skinlab.bench.accuracy import image_reference, same_images, with_image_errors
+    from skinlab.bench.sweep import Setting
+
+    exact, exact512 = Setting.of("exact", size=256), Setting.of("exact", size=512)
+    tsd, tsd512, none = Setting.of("tsd", size=256), Setting.of("tsd", size=512, gaussians=6), Setting.of("none")
+    settings = [exact, exact512, tsd, tsd512, none]
+    frame = np.zeros((8, 8, 4), np.float32)
+    frame[2:6, 2:6] = 1.0
+    hdrs = {st: frame * (1.0 + 0.01 * i) for i, st in enumerate(settings)}
+    for st in (exact, exact512):
+        hdrs[st][..., 3] = 1.0
+    measured = {st: LedgerRow(scene="s", setting=st.label, technique=st.technique) for st in settings}
+    assert image_reference(settings, measured) == exact
+    rows = with_image_errors(measured, hdrs, exact, "exact")
+    by = {r.setting: r for r in rows}
+    assert all(r.reference == exact.label for r in rows) and by[exact.label].image_rel_l1 == 0.0
+    assert by[tsd.label].image_rel_l1 == pytest.approx(0.02, rel=1e-5)  # 1.02 against 1.00
+    assert by[tsd.label].image_rel_l1_same_size == pytest.approx(0.02, rel=1e-5)  # against exact 256 itself
+    assert by[tsd512.label].image_rel_l1_same_size == pytest.approx(0.02 / 1.01, rel=1e-5)  # against exact 512
+    assert math.isnan(by[none.label].image_rel_l1_same_size)  # none shows no irradiance size
+    failed = {**measured, exact: measured[exact].but(status="error")}
+    assert image_reference(settings, failed) == tsd512  # the proxy: largest size and K
+    gone = {st: r.but(status="error") for st, r in measured.items()}
+    assert image_reference(settings, gone) is None
+    same = same_images(rows, {exact.label: "a", tsd.label: "b", none.label: "a", tsd512.label: "b"})
+    assert [r.same_image_as for r in same] == ["", "", "", tsd.label, exact.label]
+
+
+def test_the_markdown_sections_say_what_the_scene_was_measured_against():
+    from skinlab.bench.ledger_markdown import ranking_lines, reference_lines, scene_table
+
+    exact = LedgerRow(
+        scene="s", setting="exact 256", technique="exact", params={"tsd_size": 256}, reference="exact 256"
+    )
+    fine = LedgerRow(scene="s", setting="tsd K6 512 auto", technique="tsd", params={"tsd_size": 512},
+                     reference="exact 256", frame_ms_median=2.0, truth_rel_l1_block=0.1, ties_best="best")  # fmt: skip
+    tie = fine.but(setting="tsd K6 1024 auto", same_image_as="tsd K6 512 auto", ties_best="tie")
+    text = "\n".join(reference_lines([exact, fine]))
+    assert "Reference image: `exact 256`." in text and "finer irradiance texture than the reference's 256" in text
+    proxy = [fine.but(reference="tsd K6 512 auto")]
+    assert "**Proxy reference**" in reference_lines(proxy)[0]
+    assert "**No reference image**" in reference_lines([fine.but(reference="")])[0]
+    ranks = "\n".join(ranking_lines([fine, tie], [fine], "truth_rel_l1_block"))
+    assert "Pareto front (time, error vs path-traced truth" in ranks and "`tsd K6 512 auto` (2.0 ms, 10.00 %)" in ranks
+    assert "`tsd K6 1024 auto` = `tsd K6 512 auto`" in ranks and "cannot tell it from `tsd K6 1024 auto`" in ranks
+    table = scene_table([exact, fine.but(status="error", error="a | b")])
+    header = [h.strip() for h in table[0].strip("|").split("|")]
+    assert header == [c.md for c in columns() if c.md] and len(table) == 4
+    cells = [c.strip() for c in table[3].strip("|").split("|")]
+    assert cells[0] == "tsd K6 512 auto" and cells[header.index("tsd_size")] == "512"
+    assert cells[header.index("truth 4x4")] == "10.00 %" and cells[-1] == "error: a / b"
