@@ -6,7 +6,7 @@ and the plots read the columns from here.
 
 A row is immutable: the run loop builds it and changes it with ``dataclasses.replace`` (``row.but(...)``).
 Its settings parameters (``params``) are one column each per parameter a registered technique shows
-(``LedgerStyle.columns``; skinlab/bench/sweep.py ``setting_columns``), empty where they do not apply.
+(``LedgerStyle.columns``; ``setting_columns``), empty where they do not apply.
 ``row[name]`` reads a column by name (the error axis is a name: ``row[key]``).
 """
 
@@ -156,8 +156,6 @@ class LedgerRow:
         """A column by name: a field, or a settings parameter column."""
         if name in _FIELD_NAMES and name != "params":
             return getattr(self, name)
-        from .sweep import setting_columns
-
         if name in setting_columns() or name in dict(self.params):
             return self.param(name)
         raise KeyError(f"ledger rows have no column {name!r}")
@@ -214,16 +212,21 @@ def row_columns() -> tuple[Column, ...]:
     return tuple(Column(f.name, **f.metadata) for f in fields(LedgerRow))
 
 
+def setting_columns() -> list[str]:
+    """The ledger's parameter columns: every registered technique's LedgerStyle.columns, in registry order."""
+    from skinlab.render.registry import techniques
+
+    return list(dict.fromkeys(c for t in techniques() for c in t.ledger.columns))
+
+
 def param_columns(*rows: LedgerRow) -> list[str]:
     """The settings parameter columns: every registered technique's, then any other the rows carry."""
-    from .sweep import setting_columns
-
     return list(dict.fromkeys([*setting_columns(), *(k for r in rows for k, _ in r.params)]))
 
 
 def columns(*rows: LedgerRow) -> list[Column]:
     """Every column in the CSV's order: the fields, ``params`` expanded into one column per settings
-    parameter (skinlab/bench/sweep.py setting_columns), each with its technique's field's doc."""
+    parameter (setting_columns), each with its technique's field's doc."""
     proto = next(c for c in row_columns() if c.kind == "params")
     docs = _param_docs()
     out = []

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from skinlab.resources import scenes_root
 
-from .ledger_row import LedgerRow
+from .ledger_row import LedgerRow, setting_columns
 from .truth_ledger import REFERENCE_SCENES, TruthSpec, reference_scene_names
 
 ASSETS = scenes_root()
@@ -147,13 +147,6 @@ class Setting:
         """The fields in which this setting differs from `base` (same technique)."""
         b = dict(base.values)
         return [f for f, v in self.values if b.get(f) != v]
-
-
-def setting_columns() -> list[str]:
-    """The ledger's parameter columns: every registered technique's LedgerStyle.columns, in registry order."""
-    from skinlab.render.registry import techniques
-
-    return list(dict.fromkeys(c for t in techniques() for c in t.ledger.columns))
 
 
 def declared_settings(technique: str, sweep: Sweep) -> list[Setting]:
