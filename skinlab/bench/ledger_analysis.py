@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from .ledger_row import LedgerRow
+from .ledger_row import LedgerRow, finite
 
 RECOMMEND_THRESHOLDS = (0.01, 0.02, 0.05)
 
@@ -19,12 +19,8 @@ ERROR_LABELS = {
 }
 
 
-def _finite(v) -> bool:
-    return isinstance(v, (int, float, np.floating)) and bool(np.isfinite(v))
-
-
 def usable(r: LedgerRow, key: str = "image_rel_l1") -> bool:
-    return r.status == "ok" and _finite(r.frame_ms_median) and _finite(r[key])
+    return r.status == "ok" and finite(r.frame_ms_median) and finite(r[key])
 
 
 def error_key(rows: list[LedgerRow]) -> str:
@@ -40,7 +36,7 @@ TIE_SIGMAS = 2.0  # two errors differ when their difference is more than this ma
 def sigma(r: LedgerRow, key: str) -> float:
     """The uncertainty of r[key] from the truth's noise (0 for a measure without one)."""
     v = r.get(f"{key}_sigma")
-    return float(v) if _finite(v) else 0.0
+    return float(v) if finite(v) else 0.0
 
 
 def difference_sigma(a: LedgerRow, b: LedgerRow, key: str) -> float:

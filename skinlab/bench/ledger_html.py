@@ -11,7 +11,7 @@ import math
 from pathlib import Path
 
 from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, error_key
-from .ledger_row import Column, LedgerRow, columns
+from .ledger_row import Column, LedgerRow, columns, finite
 
 CSS = """
 body { font: 14px/1.45 system-ui, sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
@@ -35,17 +35,13 @@ def _img(path: Path, cls: str = "fig", alt: str = "") -> str:
     return f'<img class="{cls}" src="{_uri(path)}" alt="{html.escape(alt)}">'
 
 
-def _finite(v) -> bool:
-    return isinstance(v, (int, float)) and math.isfinite(v)
-
-
 def _pm(r: LedgerRow, key: str, pct: bool = True) -> str:
     v, s = r.get(key), r.get(f"{key}_sigma")
-    if not _finite(v):
+    if not finite(v):
         return ""
     if pct:
-        return f"{100 * v:.2f}" + (f" &plusmn; {100 * s:.2f}" if _finite(s) else "") + " %"
-    return f"{v:.4f}" + (f" &plusmn; {s:.4f}" if _finite(s) else "")
+        return f"{100 * v:.2f}" + (f" &plusmn; {100 * s:.2f}" if finite(s) else "") + " %"
+    return f"{v:.4f}" + (f" &plusmn; {s:.4f}" if finite(s) else "")
 
 
 def _table(head: list[str], rows: list[list[str]], classes: list[str] | None = None) -> str:
@@ -67,7 +63,7 @@ def table_cell(r: LedgerRow, c: Column) -> str:
     if c.name == "setting":
         return esc(r.setting) + ("" if r.status == "ok" else f" ({esc(r.status)})")
     if c.show == "num":
-        return f"{v:.1f}" if _finite(v) else ""
+        return f"{v:.1f}" if finite(v) else ""
     if c.show in ("pm", "pm_plain", "pct", "profile"):
         return _pm(r, c.name, pct=c.show != "pm_plain")
     if c.show == "rank":

@@ -182,6 +182,11 @@ class LedgerRow:
         return out
 
 
+def finite(v) -> bool:
+    """A measured number (not nan, not inf, not empty)."""
+    return isinstance(v, (int, float)) and math.isfinite(v)
+
+
 def _float(v) -> float:
     if v is None or v == "":
         return NAN

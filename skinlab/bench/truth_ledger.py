@@ -41,7 +41,7 @@ from skinlab.truth.compare import (
     judged_blocks,
 )
 
-from .ledger_row import LedgerRow
+from .ledger_row import LedgerRow, finite
 
 REFERENCE_SCENES = scenes_root() / "reference"
 # the errors measured with their uncertainty (the jackknife over the truth's passes, skinlab/truth/metrics.py)
@@ -278,18 +278,14 @@ def _pct(v) -> str:
 TRUTH_BLOCK_KEY = "truth_rel_l1_block"
 
 
-def _finite(v) -> bool:
-    return isinstance(v, (int, float)) and math.isfinite(v)
-
-
 def _pm(r: LedgerRow, key: str, pct: bool) -> str:
     v, s = r.get(key), r.get(f"{key}_sigma")
-    if not _finite(v):
+    if not finite(v):
         return ""
     mark = "= " if r.ties_best in ("best", "tie") and key == TRUTH_BLOCK_KEY else ""
     if pct:
-        return mark + f"{100 * v:.1f}" + (f" +- {100 * s:.1f}" if _finite(s) else "") + " %"
-    return mark + f"{v:.3f}" + (f" +- {s:.3f}" if _finite(s) else "")
+        return mark + f"{100 * v:.1f}" + (f" +- {100 * s:.1f}" if finite(s) else "") + " %"
+    return mark + f"{v:.3f}" + (f" +- {s:.3f}" if finite(s) else "")
 
 
 def _blocks(r: LedgerRow) -> str:
@@ -366,7 +362,7 @@ def truth_markdown(rows: list[LedgerRow], meta: dict) -> list[str]:
         ("truth_edge_rel_l1", "relative L1 per pixel within the edge region", True),
         ("truth_profile_err", "relative L1 of the profile across the declared line or edge", True),
     ):
-        have = [s for s in scenes if any(_finite(r[key]) for r in rows if r.scene == s)]
+        have = [s for s in scenes if any(finite(r[key]) for r in rows if r.scene == s)]
         if not have:
             continue
         noise = {
