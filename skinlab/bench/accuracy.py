@@ -219,12 +219,12 @@ class LedgerRun:
     """One run of the ledger: the renderer, the sweep's conditions, and what the scenes add beside their
     rows (the truths' notes and figures, the profiles, the error-map sheet)."""
 
-    def __init__(self, sweep: Sweep, out: Path, images: bool, references: bool, progress: bool, status):
+    def __init__(self, sweep: Sweep, out: Path, images: bool, references: bool, progress: bool, say):
         from skinlab.gl.context import create_headless_context, describe
         from skinlab.render.renderer import Renderer
 
         self.sweep, self.out, self.images, self.references, self.progress = sweep, out, images, references, progress
-        self.status = status  # shows what is being done (the progress bar's postfix)
+        self.say = say  # shows what is being done (the progress bar's postfix)
         self.ctx = create_headless_context()
         self.gl = describe(self.ctx)
         self.renderer = Renderer(self.ctx)
@@ -245,7 +245,7 @@ class LedgerRun:
         if node is None:
             return refs
         refs.medium = material_medium(node.material.values)
-        self.status(f"{label}: Monte Carlo reference")
+        self.say(f"{label}: Monte Carlo reference")
         try:
             refs.mc = profile_reference(refs.medium, self.sweep.photons, self.out / "mc_cache")
             refs.model = model_reference(node.material["sss_model"], refs.medium)
@@ -259,7 +259,7 @@ class LedgerRun:
         spec = self.sweep.truth
         if spec is None:
             return None
-        self.status(f"{label}: path-traced reference")
+        self.say(f"{label}: path-traced reference")
         truth = None
         try:
             truth = load_truth(scene, spec, render=self.references, progress=self.progress)
@@ -373,7 +373,7 @@ class LedgerRun:
         hdrs: dict[Setting, np.ndarray] = {}
         digests: dict[str, str] = {}
         for st in settings:
-            self.status(f"{label}: {st.label}")
+            self.say(f"{label}: {st.label}")
             row, hdr, digest = self.measure(scene, label, st, refs, tctx, st in on_sheet)
             measured[st] = row
             if hdr is not None:
@@ -387,7 +387,7 @@ class LedgerRun:
             ref = hdrs.get(ref_st) if ref_st is not None else None
             mask = lit_mask(ref) if ref is not None else None
             prows, pmaps = peers.scene_rows(scene, label, self.sweep, truth, tctx, self.out, self.renderer, ref, mask,
-                                            self.profiles.get(label), progress=self.status)  # fmt: skip
+                                            self.profiles.get(label), progress=self.say)  # fmt: skip
             rows += prows
             if pmaps:
                 self.sheet.setdefault(label, {}).update(pmaps)
