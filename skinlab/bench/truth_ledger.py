@@ -295,12 +295,18 @@ def _blocks(r: LedgerRow) -> str:
     return f"{over} / {judged}"
 
 
-def truth_markdown(rows: list[LedgerRow], meta: dict) -> list[str]:
-    """The ledger's section against the truth: a table of settings x scenes (error on 4x4 blocks,
-    the reference's noise floor beside it), what is missing, and the error maps."""
-    t = meta.get("truth")
-    if not t:
-        return []
+TRUTH_TABLES = (  # ledger.md's tables against the truth: column, what it measures, shown in per cent
+    ("truth_rel_l1_block", "relative L1 on 4x4 blocks", True),
+    ("truth_rel_l1", "relative L1 per pixel", True),
+    ("truth_flip", "FLIP mean (tone-mapped)", False),
+    ("truth_edge_rel_l1", "relative L1 per pixel within the edge region", True),
+    ("truth_profile_err", "relative L1 of the profile across the declared line or edge", True),
+)
+
+
+def _intro_lines(t: dict) -> list[str]:
+    """How the compared frames were rendered and the truths measured; which scenes lack one (and why),
+    which were compared with a quieter one."""
     L = [
         "## Against the path-traced truth",
         "",
@@ -327,62 +333,62 @@ def truth_markdown(rows: list[LedgerRow], meta: dict) -> list[str]:
         L.append(f"- **{scene}**: {what}")
     if t.get("missing") or t.get("quiet"):
         L.append("")
-    scenes = [s for s in dict.fromkeys(r.scene for r in rows) if s not in (t.get("missing") or {})]
-    if not scenes:
-        return [*L, ""]
-    per_scene = t.get("scenes") or {}
-    if per_scene:
-        L += [
-            "The truths (each the mean of its passes; spp and path-tracing time are what the cached reference took, "
-            "summed over the runs that rendered its passes; the edge region is where the edge errors are measured):",
-            "",
-            "| scene | tests | spp | passes | path tracing s | noise px | noise 4x4 | edge region |",
-            "|---|---|---|---|---|---|---|---|",
-        ]
-        for sc, d in per_scene.items():
-            edge = (
-                f"{d['edge_pixels']} px within {d['edge_mm']:.1f} mm of the {d['edge_from']} edges"
-                if d.get("edge_pixels")
-                else "none found"
-            )
-            sec = d.get("seconds")
-            L.append(
-                f"| {sc} | {d.get('tests') or ''} | {d.get('spp')} | {d.get('passes')} | "
-                f"{'' if sec is None else f'{sec:.0f}'} | {_pct(d.get('noise'))} | {_pct(d.get('noise_block'))} | "
-                f"{edge} |"
-            )
-        L.append("")
-    by_label: dict[str, dict] = {}
-    for r in rows:
-        by_label.setdefault(r.setting, {})[r.scene] = r
-    for key, what, pct in (
-        ("truth_rel_l1_block", "relative L1 on 4x4 blocks", True),
-        ("truth_rel_l1", "relative L1 per pixel", True),
-        ("truth_flip", "FLIP mean (tone-mapped)", False),
-        ("truth_edge_rel_l1", "relative L1 per pixel within the edge region", True),
-        ("truth_profile_err", "relative L1 of the profile across the declared line or edge", True),
-    ):
-        have = [s for s in scenes if any(finite(r[key]) for r in rows if r.scene == s)]
-        if not have:
-            continue
-        noise = {
-            s: next((r.truth_noise_block for r in rows if r.scene == s and r.truth_noise_block), None) for s in have
-        }
-        L.append(f"**{what}** (+- its standard error from the truth's passes; `=` marks the best and the settings "
-                 "the noise cannot tell from it):")  # fmt: skip
-        L.append("")
-        head = " | ".join(f"{s} (noise {_pct(noise[s])})" if key == TRUTH_BLOCK_KEY else s for s in have)
-        # the time is the timed frames' (at the ledger's size, as users render them: no supersampling)
-        L.append("| setting | " + head + " | mean ms (timed, 1 spp) |")
-        L.append("|---|" + "---|" * (len(have) + 1))
-        for labl, per in by_label.items():
-            cells = [_pm(per[s], key, pct) if s in per else "" for s in have]
-            ms = [per[s].frame_ms_median for s in have if s in per]
-            ms = [m for m in ms if isinstance(m, (int, float)) and math.isfinite(m)]
-            mean_ms = f"{sum(ms) / len(ms):.1f}" if ms else ""
-            L.append(f"| {labl} | " + " | ".join(cells) + f" | {mean_ms} |")
-        L.append("")
-    L += [
+    return L
+
+
+def _truths_table(per_scene: dict) -> list[str]:
+    """Per scene what its truth took (spp, passes, time), its noise and its edge region."""
+    if not per_scene:
+        return []
+    L = [
+        "The truths (each the mean of its passes; spp and path-tracing time are what the cached reference took, "
+        "summed over the runs that rendered its passes; the edge region is where the edge errors are measured):",
+        "",
+        "| scene | tests | spp | passes | path tracing s | noise px | noise 4x4 | edge region |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for sc, d in per_scene.items():
+        edge = (
+            f"{d['edge_pixels']} px within {d['edge_mm']:.1f} mm of the {d['edge_from']} edges"
+            if d.get("edge_pixels")
+            else "none found"
+        )
+        sec = d.get("seconds")
+        L.append(
+            f"| {sc} | {d.get('tests') or ''} | {d.get('spp')} | {d.get('passes')} | "
+            f"{'' if sec is None else f'{sec:.0f}'} | {_pct(d.get('noise'))} | {_pct(d.get('noise_block'))} | "
+            f"{edge} |"
+        )
+    return [*L, ""]
+
+
+def _error_table(rows: list[LedgerRow], scenes: list[str], key: str, what: str, pct: bool) -> list[str]:
+    """Settings x scenes of one error against the truth (each +- its standard error, the best and its ties
+    marked), with the mean timed frame; nothing where no scene measured it."""
+    have = [s for s in scenes if any(finite(r[key]) for r in rows if r.scene == s)]
+    if not have:
+        return []
+    noise = {
+        s: next((r.truth_noise_block for r in rows if r.scene == s and finite(r.truth_noise_block)), None) for s in have
+    }
+    L = [f"**{what}** (+- its standard error from the truth's passes; `=` marks the best and the settings "
+         "the noise cannot tell from it):", ""]  # fmt: skip
+    head = " | ".join(f"{s} (noise {_pct(noise[s])})" if key == TRUTH_BLOCK_KEY else s for s in have)
+    # the time is the timed frames' (at the ledger's size, as users render them: no supersampling)
+    L.append("| setting | " + head + " | mean ms (timed, 1 spp) |")
+    L.append("|---|" + "---|" * (len(have) + 1))
+    for labl, per in _by_label(rows).items():
+        cells = [_pm(per[s], key, pct) if s in per else "" for s in have]
+        ms = [per[s].frame_ms_median for s in have if s in per]
+        ms = [m for m in ms if finite(m)]
+        mean_ms = f"{sum(ms) / len(ms):.1f}" if ms else ""
+        L.append(f"| {labl} | " + " | ".join(cells) + f" | {mean_ms} |")
+    return [*L, ""]
+
+
+def _blocks_table(rows: list[LedgerRow], scenes: list[str]) -> list[str]:
+    """Issue 12's block target per setting and scene: 8x8 blocks off the truth, of those judged."""
+    L = [
         f"{JUDGE_BLOCK}x{JUDGE_BLOCK}-pixel blocks more than {100 * JUDGE_TOL:.0f} % off the truth (luminance) of "
         f"those its noise allows to judge (half-to-half block noise below {100 * JUDGE_NOISE:.0f} %, not dark): "
         "over / judged.",
@@ -390,16 +396,41 @@ def truth_markdown(rows: list[LedgerRow], meta: dict) -> list[str]:
         "| setting | " + " | ".join(scenes) + " |",
         "|---|" + "---|" * len(scenes),
     ]
-    for labl, per in by_label.items():
+    for labl, per in _by_label(rows).items():
         cells = [_blocks(per[s]) if s in per else "" for s in scenes]
         L.append(f"| {labl} | " + " | ".join(cells) + " |")
-    L += [
-        "",
-        "Error maps: `error_maps/SCENE-SETTING.png` for every setting, `error_maps.png` for one setting per "
-        "technique: (frame - truth) / truth of luminance per pixel (at the truth's size; the truth floored at 1 % "
-        "of its 99th percentile), red brighter, blue darker, full colour at +-50 %; `flip_maps/SCENE-SETTING.png`: "
-        "the FLIP map of the tone-mapped frames (magma, 0 to 1). Per-pixel errors include the truth's own "
-        "per-pixel noise (about half the `noise px` between the halves): a bias the jackknife does not remove.",
-        "",
-    ]
     return L
+
+
+def _by_label(rows: list[LedgerRow]) -> dict[str, dict[str, LedgerRow]]:
+    """Setting label -> scene -> row (in the rows' order)."""
+    by_label: dict[str, dict[str, LedgerRow]] = {}
+    for r in rows:
+        by_label.setdefault(r.setting, {})[r.scene] = r
+    return by_label
+
+
+ERROR_MAPS = (
+    "Error maps: `error_maps/SCENE-SETTING.png` for every setting, `error_maps.png` for one setting per "
+    "technique: (frame - truth) / truth of luminance per pixel (at the truth's size; the truth floored at 1 % "
+    "of its 99th percentile), red brighter, blue darker, full colour at +-50 %; `flip_maps/SCENE-SETTING.png`: "
+    "the FLIP map of the tone-mapped frames (magma, 0 to 1). Per-pixel errors include the truth's own "
+    "per-pixel noise (about half the `noise px` between the halves): a bias the jackknife does not remove."
+)
+
+
+def truth_markdown(rows: list[LedgerRow], meta: dict) -> list[str]:
+    """The ledger's section against the truth: what the truths took, a table of settings x scenes per
+    error (4x4 blocks with the reference's noise floor beside it, per pixel, FLIP, the edge region, the
+    profile), the block target, what is missing, and the error maps."""
+    t = meta.get("truth")
+    if not t:
+        return []
+    L = _intro_lines(t)
+    scenes = [s for s in dict.fromkeys(r.scene for r in rows) if s not in (t.get("missing") or {})]
+    if not scenes:
+        return [*L, ""]
+    L += _truths_table(t.get("scenes") or {})
+    for key, what, pct in TRUTH_TABLES:
+        L += _error_table(rows, scenes, key, what, pct)
+    return [*L, *_blocks_table(rows, scenes), "", ERROR_MAPS, ""]
