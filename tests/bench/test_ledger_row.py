@@ -141,3 +141,17 @@ def test_the_markdown_sections_say_what_the_scene_was_measured_against():
     cells = [c.strip() for c in table[3].strip("|").split("|")]
     assert cells[0] == "tsd K6 512 auto" and cells[header.index("tsd_size")] == "512"
     assert cells[header.index("truth 4x4")] == "10.00 %" and cells[-1] == "error: a / b"
+
+
+def test_the_truth_tables_skip_rows_without_a_truth():
+    """A setting that failed before its truth was measured (nan) neither gives the scene's noise floor nor
+    a cell; the block target table counts over / judged."""
+    from skinlab.bench.truth_ledger import truth_markdown
+
+    failed = LedgerRow(scene="a", setting="ssss 4", technique="ssss", status="error")
+    ok = LedgerRow(scene="a", setting="none", technique="none", truth_rel_l1_block=0.1, truth_rel_l1_block_sigma=0.01,
+                   truth_noise_block=0.02, frame_ms_median=2.0, ties_best="best", truth_blocks8_over=1,
+                   truth_blocks8_judged=4)  # fmt: skip
+    text = "\n".join(truth_markdown([failed, ok], {"truth": {"size": [32, 32], "spp": 16, "passes": 2}}))
+    assert "| setting | a (noise 2.0 %) | mean ms (timed, 1 spp) |" in text
+    assert "| ssss 4 |  |  |" in text and "| none | = 10.0 +- 1.0 % | 2.0 |" in text and "| none | 1 / 4 |" in text
