@@ -1,0 +1,163 @@
+"""Light through thin parts against the truth, per pixel: which of two local slab models of the
+thickness follows the path-traced truth (a one-off analysis for docs/ground-truth.md, "The back-lit
+ear"; not a feature).
+
+For every pixel of the scene's view the visible point, its normal and the light's direction are found
+by casting rays through the mesh (Embree, through trimesh), and the light through it is predicted by
+the exact slab transmittance (skinlab/scene/optics/slab.py slab_through) under two readings of the
+thickness:
+
+- ``chord``: the renderer's (lib/sss_translucency.glsl): the matter the light crosses on its way to
+  the point (every entry and exit along the ray to the light), times the cosine of the point's normal
+  with the light, lit at that cosine;
+- ``normal``: the distance through the mesh along the inward normal to the far face, lit at the far
+  face's own cosine where that face sees the light.
+
+Each prediction is scaled per channel to the truth (the median ratio: only the pattern and the colour
+balance are judged) and its relative L1 printed, with the frame's own against the truth; the scales'
+ratios between channels say how far each model's colour is from the truth's.
+
+    .venv/bin/python -m tools.translucency_check SCENE TRUTH.exr FRAME.exr [--out DIR]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+
+def _camera_rays(scene, w: int, h: int):
+    inv = np.linalg.inv(scene.camera.projection_matrix(w / h) @ scene.camera.view_matrix())
+    ys, xs = np.mgrid[0:h, 0:w]
+    ndc = np.stack([(xs + 0.5) / w * 2 - 1, 1 - (ys + 0.5) / h * 2], -1).reshape(-1, 2)
+    ends = []
+    for z in (-1.0, 1.0):
+        q = (inv @ np.c_[ndc, np.full(len(ndc), z), np.ones(len(ndc))].T).T
+        ends.append(q[:, :3] / q[:, 3:])
+    d = ends[1] - ends[0]
+    return ends[0], d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
+    """(h * w, 3) predicted light through per unit irradiance for each model, and the visible mask."""
+    import trimesh
+    from trimesh.ray.ray_pyembree import RayMeshIntersector
+
+    from skinlab.scene.interreflection import world_geometry
+    from skinlab.scene.optics.material_medium import material_medium
+    from skinlab.scene.optics.slab import slab_table, slab_through
+
+    node = scene.mesh_nodes()[0]
+    p, n = world_geometry(node)
+    f = node.mesh.indices.astype(np.int64)
+    tm = trimesh.Trimesh(p, f, process=False)
+    ray = RayMeshIntersector(tm)
+
+    def normal_at(tri, loc):
+        bary = trimesh.triangles.points_to_barycentric(p[f[tri]], loc)
+        q = (n[f[tri]] * bary[:, :, None]).sum(1)
+        return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+    origins, dirs = _camera_rays(scene, w, h)
+    tri, idx, loc = ray.intersects_id(origins, dirs, multiple_hits=False, return_locations=True)
+    seen = np.zeros(h * w, bool)
+    seen[idx] = True
+    pos, nrm = loc, normal_at(tri, loc)
+    lights = [l for l in scene.lights() if l.kind == "directional"]
+    if not lights:
+        raise ValueError("translucency_check: the scene needs a directional light")
+    to_light = -np.asarray(lights[0].direction, np.float64)
+    to_light /= np.linalg.norm(to_light)
+    mm = scene.mm_per_unit
+    med = material_medium(node.material.values)
+    table = slab_table(med.alpha_arr, node.material.values["subsurface_color"])
+    k = len(pos)
+
+    # chord: the matter along the ray to the light (inside from the point to the first hit, then alternating)
+    o = pos + to_light * 1e-4
+    _, r2, l2 = ray.intersects_id(o, np.tile(to_light, (k, 1)), multiple_hits=True, return_locations=True)
+    dist = np.linalg.norm(l2 - o[r2], axis=1)
+    order = np.lexsort((dist, r2))
+    r2, dist = r2[order], dist[order]
+    rank = np.arange(len(r2)) - np.searchsorted(r2, r2)  # the hit's place along its ray
+    prev = np.where(rank > 0, np.concatenate([[0.0], dist[:-1]]), 0.0)
+    chord = np.bincount(r2, np.where(rank % 2 == 0, dist - prev, 0.0), minlength=k)
+    back = np.clip(-(nrm @ to_light), 0.0, 1.0)  # the light reaches the point from behind its surface
+    through_chord = back[:, None] * slab_through(back, chord * back * mm, table, med.mfp_arr, med.alpha_arr, 1.0)
+
+    # normal: the far face along the inward normal, lit at its own cosine where it sees the light
+    o2 = pos - nrm * 1e-4
+    tri3, r3, l3 = ray.intersects_id(o2, -nrm, multiple_hits=False, return_locations=True)
+    d_n = np.full(k, np.nan)
+    d_n[r3] = np.linalg.norm(l3 - o2[r3], axis=1)
+    cos_far = np.zeros(k)
+    cos_far[r3] = np.clip(normal_at(tri3, l3) @ to_light, 0.0, 1.0)
+    far = o2 - nrm * np.nan_to_num(d_n)[:, None]
+    lit = ~np.isnan(d_n) & (cos_far > 0) & ~ray.intersects_any(far + to_light * 1e-3, np.tile(to_light, (k, 1)))
+    t_n = slab_through(cos_far, np.nan_to_num(d_n) * mm, table, med.mfp_arr, med.alpha_arr, 1.0)
+    through_normal = np.where(lit[:, None], cos_far[:, None] * t_n, 0.0)
+
+    out = {"seen": seen}
+    for name, v in (("chord", through_chord), ("normal", through_normal)):
+        full = np.zeros((h * w, 3))
+        full[seen] = v
+        out[name] = full
+    return out
+
+
+def _scale(pred: np.ndarray, truth: np.ndarray) -> float:
+    m = (pred > 1e-6) & (truth > 1e-6)
+    return float(np.median(truth[m] / pred[m])) if m.any() else 0.0
+
+
+def _rel_l1(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.abs(a - b).sum() / max(b.sum(), 1e-30))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m tools.translucency_check", description=__doc__.split("\n\n")[0])
+    ap.add_argument("scene", help="scene file (a back-lit one: light through thin parts)")
+    ap.add_argument("truth", help="the path-traced truth (EXR, as `skinlab reference` writes it)")
+    ap.add_argument("frame", help="Skinlab's frame of the same view and size (EXR)")
+    ap.add_argument("--out", help="folder for truth | chord | normal images (tone mapped PNG)")
+    args = ap.parse_args(argv)
+    from skinlab.image_output import read_image, write_image
+    from skinlab.scene.scenefile import load_scene
+
+    truth, frame = read_image(args.truth)[..., :3], read_image(args.frame)[..., :3]
+    if truth.shape != frame.shape:
+        raise SystemExit(
+            f"translucency_check: the truth is {truth.shape[1]}x{truth.shape[0]}, the frame "
+            f"{frame.shape[1]}x{frame.shape[0]}: render them at one size"
+        )
+    h, w = truth.shape[:2]
+    pred = predictions(load_scene(args.scene), w, h)
+    seen = pred["seen"]
+    t, fr = truth.reshape(-1, 3)[seen], frame.reshape(-1, 3)[seen]
+    print(f"{args.scene}: {seen.sum()} pixels; relative L1 per channel R G B against the truth")
+    print("  frame          " + "  ".join(f"{_rel_l1(fr[:, c], t[:, c]):6.3f}" for c in range(3)))
+    images = [truth]
+    for name in ("chord", "normal"):
+        v = pred[name][seen]
+        k = np.array([_scale(v[:, c], t[:, c]) for c in range(3)])
+        errs = "  ".join(f"{_rel_l1(k[c] * v[:, c], t[:, c]):6.3f}" for c in range(3))
+        bal = k / k[0] if k[0] > 0 else k
+        colour = f"(scale per channel over red's: {bal[1]:.3f} {bal[2]:.3f}; 1 1 = the truth's colour)"
+        print(f"  {name:6s} model  {errs}   {colour}")
+        full = np.zeros((h * w, 3))
+        full[seen] = v * k
+        images.append(full.reshape(h, w, 3))
+    if args.out:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        for name, img in zip(("truth", "chord", "normal"), images):
+            ldr = (np.clip(1.0 - np.exp(-6.0 * img), 0.0, 1.0) ** (1 / 2.2) * 255).astype(np.uint8)
+            print(f"wrote {write_image(out / f'{name}.png', ldr)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
