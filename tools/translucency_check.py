@@ -13,9 +13,11 @@ thickness:
 - ``normal``: the distance through the mesh along the inward normal to the far face, lit at the far
   face's own cosine where that face sees the light.
 
-Each prediction is scaled per channel to the truth (the median ratio: only the pattern and the colour
-balance are judged) and its relative L1 printed, with the frame's own against the truth; the scales'
-ratios between channels say how far each model's colour is from the truth's.
+Each prediction is radiance (the light's colour and intensity, the base colour, 1/pi and the exit
+factor of light that came through, as the renderer shades it), then scaled per channel to the truth
+(the median ratio) so that its relative L1 judges the pattern alone; the frame's own against the truth
+is printed beside. The scales say how far each model's level and colour are from the truth's (1 1 1:
+the same).
 
     .venv/bin/python -m tools.translucency_check SCENE TRUTH.exr FRAME.exr [--out DIR]
 """
@@ -48,7 +50,7 @@ def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
 
     from skinlab.scene.interreflection import world_geometry
     from skinlab.scene.optics.material_medium import material_medium
-    from skinlab.scene.optics.slab import slab_table, slab_through
+    from skinlab.scene.optics.slab import slab_exit, slab_exit_tables, slab_table, slab_through
 
     node = scene.mesh_nodes()[0]
     p, n = world_geometry(node)
@@ -66,15 +68,26 @@ def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
     seen = np.zeros(h * w, bool)
     seen[idx] = True
     pos, nrm = loc, normal_at(tri, loc)
+    view = np.clip(-(nrm * dirs[idx]).sum(1), 0.0, 1.0)  # the cosine toward the camera
     lights = [l for l in scene.lights() if l.kind == "directional"]
     if not lights:
         raise ValueError("translucency_check: the scene needs a directional light")
     to_light = -np.asarray(lights[0].direction, np.float64)
     to_light /= np.linalg.norm(to_light)
     mm = scene.mm_per_unit
-    med = material_medium(node.material.values)
-    table = slab_table(med.alpha_arr, node.material.values["subsurface_color"])
+    values = node.material.values
+    med = material_medium(values)
+    table = slab_table(med.alpha_arr, values["subsurface_color"])
+    exits = slab_exit_tables(med.alpha_arr, table, 1.0)
+    # radiance per unit of the prediction's light through: the light's colour and intensity, the base
+    # colour (the table is per unit of it), 1 / pi, and the exit factor of light that came through
+    scale = np.asarray(lights[0].color, np.float64) * float(lights[0].intensity) * np.asarray(values["base_color"])
+    scale = scale / np.pi
     k = len(pos)
+
+    def radiance(cos_in, d_mm, through):
+        ex = np.array([slab_exit(m, c, d, table, exits, med.mfp_arr, 1.0) for m, c, d in zip(view, cos_in, d_mm)])
+        return through * ex * scale
 
     # chord: the matter along the ray to the light (inside from the point to the first hit, then alternating)
     o = pos + to_light * 1e-4
@@ -86,7 +99,9 @@ def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
     prev = np.where(rank > 0, np.concatenate([[0.0], dist[:-1]]), 0.0)
     chord = np.bincount(r2, np.where(rank % 2 == 0, dist - prev, 0.0), minlength=k)
     back = np.clip(-(nrm @ to_light), 0.0, 1.0)  # the light reaches the point from behind its surface
-    through_chord = back[:, None] * slab_through(back, chord * back * mm, table, med.mfp_arr, med.alpha_arr, 1.0)
+    d_chord = chord * back * mm
+    through_chord = back[:, None] * slab_through(back, d_chord, table, med.mfp_arr, med.alpha_arr, 1.0)
+    through_chord = radiance(back, d_chord, through_chord)
 
     # normal: the far face along the inward normal, lit at its own cosine where it sees the light
     o2 = pos - nrm * 1e-4
@@ -98,7 +113,7 @@ def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
     far = o2 - nrm * np.nan_to_num(d_n)[:, None]
     lit = ~np.isnan(d_n) & (cos_far > 0) & ~ray.intersects_any(far + to_light * 1e-3, np.tile(to_light, (k, 1)))
     t_n = slab_through(cos_far, np.nan_to_num(d_n) * mm, table, med.mfp_arr, med.alpha_arr, 1.0)
-    through_normal = np.where(lit[:, None], cos_far[:, None] * t_n, 0.0)
+    through_normal = radiance(cos_far, np.nan_to_num(d_n) * mm, np.where(lit[:, None], cos_far[:, None] * t_n, 0.0))
 
     out = {"seen": seen}
     for name, v in (("chord", through_chord), ("normal", through_normal)):
@@ -144,9 +159,7 @@ def main(argv: list[str] | None = None) -> int:
         v = pred[name][seen]
         k = np.array([_scale(v[:, c], t[:, c]) for c in range(3)])
         errs = "  ".join(f"{_rel_l1(k[c] * v[:, c], t[:, c]):6.3f}" for c in range(3))
-        bal = k / k[0] if k[0] > 0 else k
-        colour = f"(scale per channel over red's: {bal[1]:.3f} {bal[2]:.3f}; 1 1 = the truth's colour)"
-        print(f"  {name:6s} model  {errs}   {colour}")
+        print(f"  {name:6s} model  {errs}   (times {k[0]:.3f} {k[1]:.3f} {k[2]:.3f} to the truth's level)")
         full = np.zeros((h * w, 3))
         full[seen] = v * k
         images.append(full.reshape(h, w, 3))
