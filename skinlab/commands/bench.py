@@ -19,7 +19,9 @@ from skinlab.bench.orbit import SCENES as ORBIT_SCENES
 from skinlab.bench.orbit import orbit_bench
 from skinlab.bench.peer import peer_bench
 from skinlab.bench.reload import reload_bench
-from skinlab.render.settings import parse_size
+from skinlab.render.settings import RenderSettings, parse_size
+
+RELOAD_SHADOW_SIZE = 512  # `skinlab bench reload --shadow-size`: its own default, stated in its help
 
 
 def register(sub) -> None:
@@ -103,7 +105,15 @@ def register(sub) -> None:
         default=0.05,
         help="ShaderWatcher settle time in seconds (default 0.05, as skinlab view)",
     )
-    rel.add_argument("--shadow-size", type=int, default=512, help="shadow map texels per side (default 512)")
+    shadow = RenderSettings.fields()["shadow_size"]  # the render setting this benchmark's frames use
+    rel.add_argument(
+        "--shadow-size",
+        type=int,
+        default=RELOAD_SHADOW_SIZE,
+        help=f"the timed frames' {shadow.doc}: this benchmark's own default, smaller than a render's "
+        f"{shadow.default} so that a frame after an edit is quick; {shadow.expected()} "
+        f"(default: {RELOAD_SHADOW_SIZE} {shadow.unit})",
+    )
     rel.add_argument("--tsd-size", type=int, default=256, help="texture-space diffusion texels per side (default 256)")
     rel.add_argument(
         "--mode",

@@ -9,6 +9,7 @@ import json
 import sys
 from pathlib import Path
 
+from skinlab.commands.field_options import add_command_options
 from skinlab.commands.scene_options import (
     add_scene_edit_options,
     add_scene_look_options,
@@ -16,7 +17,36 @@ from skinlab.commands.scene_options import (
     scene_look_from_args,
 )
 from skinlab.commands.technique_options import add_frame_options, render_settings_from_args
+from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings, parse_size
+
+# the command's own options (the frame's and the scene's come from their declarations elsewhere)
+RENDER_OPTIONS = (
+    Field(
+        "out",
+        "string",
+        "out/render.png",
+        doc="output image: .png (tone mapped, 8-bit sRGB) or .exr (linear radiance, 32-bit float, with alpha)",
+    ),
+    Field("size", "string", "640x640", doc="image size WIDTHxHEIGHT in pixels"),
+    Field("json", "bool", False, doc="print outputs, timings and the frame plan as JSON"),
+    Field("explain", "bool", False, doc="print the frame plan (passes and why each runs)"),
+    Field(
+        "time",
+        "bool",
+        False,
+        doc="render a warm-up frame first and write and time the second, so that the per-pass times leave "
+        "out shader compiles and texture uploads. Default: one frame, its times include them",
+    ),
+    Field(
+        "reuse",
+        "bool",
+        False,
+        doc="implies --time; the timed frame reuses the warm-up frame's results whose inputs did not change "
+        "(shadow maps, texture-space irradiance and blurs: what the viewer does while only the camera moves); "
+        "--explain lists them as 'reused: inputs unchanged since frame 1'. Default: every pass runs",
+    ),
+)
 
 
 def register(sub) -> None:
@@ -27,39 +57,11 @@ def register(sub) -> None:
         help="scene file (TOML) or a mesh file (.glb .gltf .obj .ply .stl .off: default camera, two lights "
         "and a plain grey material); default: the Lee Perry-Smith head",
     )
-    p.add_argument(
-        "--out",
-        default="out/render.png",
-        help="output image: .png (tone mapped, 8-bit sRGB) or .exr (linear radiance, 32-bit float, with alpha) "
-        "(default out/render.png)",
-    )
-    p.add_argument("--size", default="640x640", help="image size WIDTHxHEIGHT in pixels (default 640x640)")
-    p.add_argument(
-        "--camera-orbit",
-        type=float,
-        default=0.0,
-        metavar="DEG",
-        help="swing the scene's camera DEG degrees about the vertical axis through the meshes' centre "
-        "(positive: the camera moves to its right; default 0)",
-    )
-    add_scene_look_options(p)  # --exposure, --environment MAP and its rotation, intensity, --background
+    add_command_options(p, RENDER_OPTIONS[:2])  # --out, --size
+    add_scene_look_options(p)  # --exposure, --environment MAP and its rotation, intensity, --background, --camera-orbit
     add_frame_options(p)  # --shadow-size, --supersample, --bounces, ..., --sss, --technique and its options
     add_scene_edit_options(p)  # --preset, --set KEY=VALUE, --mm-per-unit
-    p.add_argument("--json", action="store_true", help="print outputs, timings and the frame plan as JSON")
-    p.add_argument("--explain", action="store_true", help="print the frame plan (passes and why each runs)")
-    p.add_argument(
-        "--time",
-        action="store_true",
-        help="render a warm-up frame first and write and time the second, so that the per-pass times leave "
-        "out shader compiles and texture uploads. Default: one frame, its times include them",
-    )
-    p.add_argument(
-        "--reuse",
-        action="store_true",
-        help="implies --time; the timed frame reuses the warm-up frame's results whose inputs did not change "
-        "(shadow maps, texture-space irradiance and blurs: what the viewer does while only the camera moves); "
-        "--explain lists them as 'reused: inputs unchanged since frame 1'. Default: every pass runs",
-    )
+    add_command_options(p, RENDER_OPTIONS[2:])  # --json, --explain, --time, --reuse
     p.set_defaults(func=run)
 
 
@@ -135,18 +137,10 @@ def run(args) -> int:
     w, h = parse_size(args.size)
     settings = settings_from_args(args, w, h)
     edits = scene_edits_from_args(args)
-    look = scene_look_from_args(args)  # --exposure, --environment ...
-    if args.camera_orbit != args.camera_orbit or abs(args.camera_orbit) == float("inf"):
-        raise ValueError(f"--camera-orbit: expected a finite angle in degrees, got {args.camera_orbit}")
-
-    def prepare(scene):
-        look(scene)
-        if args.camera_orbit:
-            scene.orbit_camera(args.camera_orbit)
-
+    look = scene_look_from_args(args)  # --exposure, --environment ..., --camera-orbit
     timed = args.time or args.reuse
     scene, result, written, ctx = render_to_files(
-        args.scene, [Path(args.out)], settings, prepare, args.reuse, edits, timed=timed
+        args.scene, [Path(args.out)], settings, look, args.reuse, edits, timed=timed
     )
     for warning in result.plan.warnings:
         print(f"warning: {warning}", file=sys.stderr)

@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import argparse
 
+from skinlab.commands.field_options import add_setting_option, option_flags, setting_value
+from skinlab.declare import Field
 from skinlab.render.options import TechniqueSettings
 from skinlab.render.registry import DEFAULT_TECHNIQUE, get_technique, techniques
 
 
-def _flags(technique: str, field: str, extra: tuple[str, ...]) -> list[str]:
-    flags = [f"--{technique}-{field.replace('_', '-')}"]
-    return flags + [f for f in extra if f not in flags]
+def _flags(technique: str, field: Field) -> list[str]:
+    return option_flags(field, prefix=f"{technique}_")
 
 
 def _dest(technique: str, field: str) -> str:
@@ -32,16 +33,8 @@ def add_technique_options(parser: argparse.ArgumentParser) -> None:
         if not opts:
             continue
         group = parser.add_argument_group(f"technique {t.name} ({t.description})")
-        defaults = t.settings_type.defaults()
         for name, o in opts.items():
-            flags = _flags(t.name, name, o.flags)
-            kw = dict(dest=_dest(t.name, name), default=None, help=o.help(defaults[name]))
-            if o.kind == "bool":
-                group.add_argument(*flags, action=argparse.BooleanOptionalAction, **kw)
-            elif o.kind == "choice":
-                group.add_argument(*flags, choices=o.choices, **kw)
-            else:
-                group.add_argument(*flags, type=str, metavar="N" if o.kind == "int" else "X", **kw)
+            add_setting_option(group, o, _dest(t.name, name), _flags(t.name, o))
 
 
 def technique_from_args(args) -> TechniqueSettings:
@@ -54,20 +47,11 @@ def technique_from_args(args) -> TechniqueSettings:
             raw = getattr(args, _dest(t.name, name), None)
             if raw is None:
                 continue
-            flag = _flags(t.name, name, o.flags)[0]
+            flag = _flags(t.name, o)[0]
             if t is not chosen:
                 raise ValueError(f"{flag}: a setting of technique {t.name}, but --technique is {chosen.name}")
-            values[name] = o.check(_parse(raw, o.kind, flag, o), flag)
+            values[name] = setting_value(o, raw, flag)
     return chosen.settings_type(**values)
-
-
-def _parse(raw, kind: str, flag: str, o):
-    if kind in ("bool", "choice") or not isinstance(raw, str):
-        return raw
-    try:
-        return int(raw) if kind == "int" else float(raw)
-    except ValueError:
-        raise ValueError(f"{flag}: expected {o.expected()}, got {raw!r}") from None
 
 
 def _render_dest(field: str) -> str:
@@ -75,20 +59,12 @@ def _render_dest(field: str) -> str:
 
 
 def add_render_options(parser: argparse.ArgumentParser) -> None:
-    """One option per render setting declared with ``option`` (RenderSettings.options():
-    ``--supersample N``), help and checks from the declaration."""
+    """One option per render setting declared for the command line (RenderSettings.options():
+    ``--shadow-size N``, ``--supersample N``, ``--sss MODEL``, ...), help and checks from the declaration."""
     from skinlab.render.settings import RenderSettings
 
     for name, o in RenderSettings.options().items():
-        flag = "--" + name.replace("_", "-")
-        default = RenderSettings.__dataclass_fields__[name].default
-        kw = dict(dest=_render_dest(name), default=None, help=o.help(default))
-        if o.kind == "bool":
-            parser.add_argument(flag, action=argparse.BooleanOptionalAction, **kw)
-        elif o.kind == "choice":
-            parser.add_argument(flag, choices=o.choices, **kw)
-        else:
-            parser.add_argument(flag, type=str, metavar="N" if o.kind == "int" else "X", **kw)
+        add_setting_option(parser, o, _render_dest(name))
 
 
 def render_options_from_args(args) -> dict:
@@ -100,27 +76,15 @@ def render_options_from_args(args) -> dict:
     for name, o in RenderSettings.options().items():
         raw = getattr(args, _render_dest(name), None)
         if raw is not None:
-            flag = "--" + name.replace("_", "-")
-            values[name] = o.check(_parse(raw, o.kind, flag, o), flag)
+            values[name] = setting_value(o, raw, option_flags(o)[0])
     return values
 
 
 def add_frame_options(parser: argparse.ArgumentParser) -> None:
-    """The frame's settings that `skinlab render` and `skinlab view` share, each declared once here or
-    in RenderSettings: --shadow-size, the declared render settings (:func:`add_render_options`:
-    --supersample, --bounces, ...), --sss and the technique's options (:func:`add_technique_options`)."""
-    from skinlab.scene.materials import SSS_MODELS
-
-    parser.add_argument(
-        "--shadow-size", type=int, default=2048, help="shadow map texels per side, 1-16384 (default 2048)"
-    )
-    add_render_options(parser)  # --supersample N, --bounces N, ... from RenderSettings' declarations
-    parser.add_argument(
-        "--sss",
-        choices=SSS_MODELS,
-        default=None,
-        help="subsurface model for every material (default: each material's own sss_model)",
-    )
+    """The frame's settings that `skinlab render` and `skinlab view` share, each declared once in
+    RenderSettings (:func:`add_render_options`: --shadow-size, --sss, --supersample, --bounces, ...) or
+    a technique's settings (:func:`add_technique_options`: --technique and its options)."""
+    add_render_options(parser)
     add_technique_options(parser)  # an option of another technique than --technique is an error naming it
 
 
@@ -128,11 +92,4 @@ def render_settings_from_args(args, w: int, h: int):
     """RenderSettings from the options of :func:`add_frame_options` (errors name the option)."""
     from skinlab.render.settings import RenderSettings
 
-    return RenderSettings(
-        w,
-        h,
-        shadow_size=args.shadow_size,
-        sss_model=args.sss,
-        technique=technique_from_args(args),
-        **render_options_from_args(args),
-    )
+    return RenderSettings(w, h, technique=technique_from_args(args), **render_options_from_args(args))

@@ -4,8 +4,10 @@ hot reload of shaders, scene and presets). See docs/viewer.md."""
 from __future__ import annotations
 
 import logging
+import math
 import sys
 
+from skinlab.commands.field_options import add_command_options, check_command_options
 from skinlab.commands.scene_options import (
     add_scene_edit_options,
     add_scene_look_options,
@@ -13,7 +15,28 @@ from skinlab.commands.scene_options import (
     scene_look_from_args,
 )
 from skinlab.commands.technique_options import add_frame_options, render_settings_from_args
+from skinlab.declare import Field
 from skinlab.render.settings import parse_size
+
+# the viewer's own options (the frame's and the scene's come from their declarations elsewhere)
+VIEW_OPTIONS = (
+    Field("size", "string", "960x720", doc="window size WIDTHxHEIGHT"),
+    Field("watch", "bool", True, doc="reload shaders, the scene file and presets when they change"),
+    Field(
+        "settle",
+        "float",
+        0.05,
+        (0.0, 10.0),
+        unit="seconds",
+        doc="how long a changed file must stay unchanged before it is reloaded",
+    ),
+    Field("shader_dir", "string", shown="the project's shaders/", doc="shader folder"),
+    Field("screenshot_dir", "string", "out/screenshots", doc="where S (PNG) and shift+S (EXR) save screenshots"),
+    Field("frames", "int", None, (1, math.inf), doc="render this many frames, then exit (for tests and scripts)"),
+    Field("screenshot", "string", doc="with --frames: save the last frame here (.png or .exr) before exiting"),
+    Field("continuous", "bool", False, doc="render every loop iteration, not only on changes"),
+    Field("no_ui", "bool", False, doc="start with the panel and overlay hidden (H toggles)"),
+)
 
 
 def register(sub) -> None:
@@ -26,38 +49,15 @@ def register(sub) -> None:
         help="scene file (TOML) or a mesh file (.glb .gltf .obj .ply .stl .off: default camera, two lights and "
         "a plain grey material); default: the Lee Perry-Smith head",
     )
-    p.add_argument("--size", default="960x720", help="window size WIDTHxHEIGHT (default 960x720)")
+    add_command_options(p, VIEW_OPTIONS[:1])  # --size
     # the frame and the scene as `skinlab render` takes them, from the same declarations: --shadow-size,
-    # --supersample, --bounces, ..., --sss, --technique (T cycles) and its settings; --exposure and the
-    # environment map; --preset, --set KEY=VALUE, --mm-per-unit (applied again on every scene reload)
+    # --supersample, --bounces, ..., --sss, --technique (T cycles) and its settings; --exposure, the
+    # environment map, --camera-orbit; --preset, --set KEY=VALUE, --mm-per-unit (applied again on every
+    # scene reload)
     add_frame_options(p)
     add_scene_look_options(p)
     add_scene_edit_options(p)
-    w = p.add_mutually_exclusive_group()
-    w.add_argument(
-        "--watch",
-        dest="watch",
-        action="store_true",
-        default=True,
-        help="reload shaders, the scene file and presets when they change (default)",
-    )
-    w.add_argument("--no-watch", dest="watch", action="store_false", help="do not watch files")
-    p.add_argument(
-        "--settle",
-        type=float,
-        default=0.05,
-        help="seconds a changed file must stay unchanged before it is reloaded (default 0.05)",
-    )
-    p.add_argument("--shader-dir", help="shader folder (default: the project's shaders/)")
-    p.add_argument(
-        "--screenshot-dir",
-        default="out/screenshots",
-        help="where S (PNG) and shift+S (EXR) save screenshots (default out/screenshots)",
-    )
-    p.add_argument("--frames", type=int, help="render this many frames, then exit (for tests and scripts)")
-    p.add_argument("--screenshot", help="with --frames: save the last frame here (.png or .exr) before exiting")
-    p.add_argument("--continuous", action="store_true", help="render every loop iteration, not only on changes")
-    p.add_argument("--no-ui", action="store_true", help="start with the panel and overlay hidden (H toggles)")
+    add_command_options(p, VIEW_OPTIONS[1:])
     p.set_defaults(func=run)
 
 
@@ -76,14 +76,11 @@ def run(args) -> int:
     from skinlab.image_output import image_format
 
     size = parse_size(args.size)
-    if args.frames is not None and args.frames < 1:
-        raise ValueError(f"--frames: expected an integer >= 1, got {args.frames}")
+    check_command_options(args, VIEW_OPTIONS)  # --frames >= 1, --settle in [0, 10] seconds
     if args.screenshot:
         if args.frames is None:
             raise ValueError("--screenshot: needs --frames N (interactive screenshots: press S)")
         image_format(args.screenshot)  # fail before opening a window
-    if not (0.0 <= args.settle <= 10.0):
-        raise ValueError(f"--settle: expected seconds in [0, 10], got {args.settle}")
     start = view_start(args, size)  # errors name the option, before a window opens
     if not logging.getLogger().handlers:
         logging.basicConfig(level=logging.INFO, stream=sys.stderr, format="skinlab view: %(message)s")

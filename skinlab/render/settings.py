@@ -6,29 +6,74 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
+from skinlab.declare import Field, declared_fields, option
+from skinlab.scene.materials import SSS_MODELS
+
 from .compute import COMPUTE_CHOICES
-from .options import Option, TechniqueSettings, option, technique_settings
+from .options import TechniqueSettings, technique_settings
 from .techniques import DEFAULT_TECHNIQUE
+
+MAX_SIZE = 16384  # pixels or texels per side of any target
 
 
 @dataclass
 class RenderSettings:
     """What a render is asked to do beyond the scene. The subsurface technique and its own settings
     are one value: ``technique`` is a technique's settings object (``TsdSettings(size=256)``), or a
-    registered name for that technique's defaults (``"ssss"``); see :meth:`for_technique`."""
+    registered name for that technique's defaults (``"ssss"``); see :meth:`for_technique`.
+    Every other field is declared with :func:`option` (:meth:`fields`); those with ``cli`` are the
+    options of `skinlab render` and `skinlab view` (:meth:`options`), those with ``panel`` the viewer's
+    widgets (:meth:`panel_options`)."""
 
-    width: int = 640
-    height: int = 640
-    shadow_size: int = 2048
-    background: tuple[float, float, float] = (0.045, 0.045, 0.05)  # linear
-    max_lights: int = 4
-    # None: each material's own sss_model; else one of skinlab.scene.materials.SSS_MODELS for every material
-    sss_model: str | None = None
+    # the output's size: `--size WIDTHxHEIGHT` (parse_size), the viewer's window
+    width: int = option(640, "output image width", "int", range=(1, MAX_SIZE), unit="pixels", cli=False, panel=False)
+    height: int = option(640, "output image height", "int", range=(1, MAX_SIZE), unit="pixels", cli=False, panel=False)
+    shadow_size: int = option(
+        2048,
+        "shadow map texels per side (each shadow-casting light's depth map, and its distance map)",
+        "int",
+        range=(1, MAX_SIZE),
+        unit="texels",
+        panel=False,  # a slider over 1-16384 texels helps no one; the command line sets it
+    )
+    background: tuple[float, float, float] = option(
+        (0.045, 0.045, 0.05),
+        "the colour behind the meshes where no environment map is drawn",
+        "color",
+        range=(0.0, 1.0e4),
+        unit="linear RGB",
+        cli=False,
+        panel=False,
+    )
+    max_lights: int = option(
+        4,
+        "lights shaded per frame: the scene's first ones",
+        "int",
+        range=(1, 64),
+        unit="lights",
+        cli=False,
+        panel=False,
+    )
+    # the viewer's M key cycles it (its own key, not a panel widget)
+    sss_model: str | None = option(
+        None,
+        "subsurface model for every material",
+        "choice",
+        choices=SSS_MODELS,
+        none="each material's own sss_model",
+        flags=("--sss",),
+        panel=False,
+    )
     # how subsurface scattering is rendered: a registered technique's settings (skinlab/render/registry.py),
     # or its name for its defaults (a settings object after construction: `technique_options`)
     technique: TechniqueSettings | str = DEFAULT_TECHNIQUE
-    # draw depth first, then shade each visible pixel once (skinlab/render/passes/forward.py)
-    depth_prepass: bool = True
+    depth_prepass: bool = option(
+        True,
+        "draw depth first, then shade each visible pixel once (skinlab/render/passes/forward.py)",
+        "bool",
+        cli=False,
+        panel=False,
+    )
     # antialiasing by supersampling: the screen-space targets are N x the output size and each
     # output pixel is the box filter (mean) of its N x N samples of linear radiance, tone-mapped after
     # filtering (skinlab/shaders/passes/tonemap_supersample.frag); what the path-traced truth's box pixel filter does
@@ -76,24 +121,13 @@ class RenderSettings:
     )
 
     def __post_init__(self) -> None:
-        for name in ("width", "height", "shadow_size"):
-            v = getattr(self, name)
-            if not isinstance(v, int) or isinstance(v, bool) or v < 1 or v > 16384:
-                raise ValueError(f"render setting {name}: expected an integer in [1, 16384], got {v!r}")
-        for name, opt in self.options().items():
-            setattr(self, name, opt.check(getattr(self, name), f"render setting {name}"))
-        if max(self.width, self.height) * self.supersample > 16384:
+        for name, decl in self.fields().items():
+            setattr(self, name, decl.check(getattr(self, name), f"render setting {name}"))
+        if max(self.width, self.height) * self.supersample > MAX_SIZE:
             raise ValueError(
                 f"render setting supersample: {self.width}x{self.height} at {self.supersample} x "
-                f"{self.supersample} samples per pixel exceeds 16384 samples per side"
+                f"{self.supersample} samples per pixel exceeds {MAX_SIZE} samples per side"
             )
-        if self.sss_model is not None:
-            from skinlab.scene.materials import SSS_MODELS
-
-            if self.sss_model not in SSS_MODELS:
-                raise ValueError(
-                    f"render setting sss_model: expected one of {', '.join(SSS_MODELS)}, got {self.sss_model!r}"
-                )
         if isinstance(self.technique, str):
             self.technique = technique_settings(self.technique)()
         elif not isinstance(self.technique, TechniqueSettings):
@@ -118,10 +152,21 @@ class RenderSettings:
         return cls(width, height, **base, technique=st(**opts))
 
     @classmethod
-    def options(cls) -> dict[str, Option]:
-        """The render settings declared with :func:`option` (meaning, unit, default, range): the
-        `skinlab render` options come from these."""
-        return {f.name: f.metadata["option"] for f in dataclasses.fields(cls) if "option" in f.metadata}
+    def fields(cls) -> dict[str, Field]:
+        """Every render setting but the technique, as declared with :func:`option` (meaning, unit,
+        default, range): construction checks each."""
+        return declared_fields(cls)
+
+    @classmethod
+    def options(cls) -> dict[str, Field]:
+        """The settings `skinlab render` and `skinlab view` take as options (``--shadow-size``,
+        ``--supersample``, ``--sss``, ...: skinlab/commands/field_options.py)."""
+        return {name: f for name, f in cls.fields().items() if f.cli}
+
+    @classmethod
+    def panel_options(cls) -> dict[str, Field]:
+        """The settings the viewer's panel offers as widgets (skinlab/viewer/panel.py)."""
+        return {name: f for name, f in cls.fields().items() if f.panel}
 
     @property
     def technique_options(self) -> TechniqueSettings:
@@ -149,6 +194,6 @@ def parse_size(text: str) -> tuple[int, int]:
         w, h = (int(x) for x in text.lower().split("x"))
     except ValueError:
         raise ValueError(f"--size: expected WIDTHxHEIGHT such as 640x480, got {text!r}") from None
-    if not (1 <= w <= 16384 and 1 <= h <= 16384):
-        raise ValueError(f"--size: width and height must be in [1, 16384], got {text!r}")
+    if not (1 <= w <= MAX_SIZE and 1 <= h <= MAX_SIZE):
+        raise ValueError(f"--size: width and height must be in [1, {MAX_SIZE}], got {text!r}")
     return w, h

@@ -1,6 +1,6 @@
 """Materials declare their parameters once; uniforms, shader variants and UI derive from that.
 
-A :class:`Param` has a name, a kind, a default and a valid range. Kinds:
+A parameter is a :class:`skinlab.declare.Field` (name, kind, default, range, unit, meaning). Kinds:
 - ``float`` / ``color`` / ``vec3`` / ``vec2``: plain values, uploaded as uniforms ``u_<name>``;
 - ``texture``: a file path; when set it selects a shader variant (``HAS_<NAME>``) and binds a sampler;
 - ``choice``: an option the renderer reads on the CPU (the SSS model picks the profile a technique
@@ -20,95 +20,16 @@ from typing import Any
 
 import numpy as np
 
+from skinlab.declare import NUMERIC_KINDS, Field
+
 SSS_MODELS = ("none", "dipole", "burley", "blender-burley", "gaussians", "pbd")
 ALPHA_MODES = ("opaque", "mask", "blend")
-NUMERIC_KINDS = ("float", "color", "vec3", "vec2")  # uploaded as uniforms
-
-
-@dataclass(frozen=True)
-class Param:
-    name: str
-    kind: str  # float | color | vec3 | vec2 | texture | choice
-    default: Any
-    range: tuple[float, float] | None = None
-    choices: tuple[str, ...] = ()
-    colorspace: str = "linear"  # for textures: "srgb" colour data or "linear" data
-    doc: str = ""
-    unit: str = ""
-
-    @property
-    def limits(self) -> tuple[float, float]:
-        """The range of a numeric parameter (declared for every one)."""
-        if self.range is None:
-            raise TypeError(f"material parameter {self.name}: a {self.kind} has no range")
-        return self.range
-
-    @property
-    def uniform(self) -> str:
-        return f"u_{self.name}"
-
-    @property
-    def define(self) -> str:
-        return f"HAS_{self.name.upper()}"
-
-    def _numbers(self, value: Any, label: str) -> np.ndarray:
-        """A float, colour/vec3 or vec2 value as an array (1, 3 or 2 numbers; a scalar fills them all)."""
-        if self.kind == "float":
-            try:
-                return np.array([float(value)])
-            except (TypeError, ValueError, OverflowError):  # OverflowError: an int beyond float range
-                raise ValueError(
-                    f"{label}: expected a number in [{self.limits[0]}, {self.limits[1]}], got {value!r}"
-                ) from None
-        n = 2 if self.kind == "vec2" else 3
-        try:
-            arr = np.asarray(value, dtype=np.float64).reshape(-1)
-        except (TypeError, ValueError, OverflowError):
-            raise ValueError(f"{label}: expected {n} numbers, got {value!r}") from None
-        if arr.size == 1:
-            arr = np.repeat(arr, n)
-        if arr.size != n:
-            what = "(u, v)" if n == 2 else "(R, G, B)"
-            raise ValueError(f"{label}: expected {n} numbers {what}, got {arr.size}")
-        return arr
-
-    def _canonical(self, arr: np.ndarray):
-        return float(arr[0]) if self.kind == "float" else tuple(float(x) for x in arr)
-
-    def validate(self, value: Any, where: str = "") -> Any:
-        """Return the value in canonical form or raise ValueError naming the parameter."""
-        label = f"{where}{self.name}"
-        if self.kind == "texture":
-            if value is None or value == "":
-                return None
-            if not isinstance(value, str | Path):
-                raise ValueError(f"{label}: expected a file path (string), got {value!r}")
-            return Path(value)
-        if self.kind == "choice":
-            if not isinstance(value, str) or value not in self.choices:
-                raise ValueError(f"{label}: expected one of {', '.join(self.choices)}; got {value!r}")
-            return value
-        arr = self._numbers(value, label)
-        lo, hi = self.limits
-        if not np.isfinite(arr).all() or (arr < lo).any() or (arr > hi).any():
-            unit = f" {self.unit}" if self.unit else ""
-            raise ValueError(f"{label}: value {value!r} outside the valid range [{lo}, {hi}]{unit}")
-        return self._canonical(arr)
-
-    def clamp(self, value: Any) -> Any:
-        """Like validate, but numbers out of range are clamped into it and NaN becomes the default
-        (for UI widgets); malformed values and unknown choices still raise, naming the parameter."""
-        if self.kind not in NUMERIC_KINDS:
-            return self.validate(value)
-        arr = self._numbers(value, self.name)
-        arr = np.where(np.isnan(arr), np.asarray(self._numbers(self.default, self.name)), arr)
-        return self._canonical(np.clip(arr, *self.limits))
 
 
 # One meaning per parameter, stated here once: the panel's tooltips, the docs (docs/scenes.md, generated
 # from this table by `python -m skinlab.scene.scene_docs`) and errors all read it.
-PRINCIPLED_PARAMS: tuple[Param, ...] = (
-    Param(
+PRINCIPLED_PARAMS: tuple[Field, ...] = (
+    Field(
         "base_color",
         "color",
         (0.8, 0.8, 0.8),
@@ -116,7 +37,7 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         unit="linear RGB",
         doc="albedo of the plain diffuse part (weight 1 - subsurface) and a metal's F0; x the colour map",
     ),
-    Param(
+    Field(
         "base_color_map",
         "texture",
         None,
@@ -124,14 +45,14 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         doc="colour map (sRGB file): multiplies base_color and subsurface_color per texel; its mean colour "
         "also goes into the medium's albedo (the colour rule above)",
     ),
-    Param("roughness", "float", 0.5, (0.0, 1.0), doc="perceptual roughness; GGX alpha = roughness^2"),
-    Param("roughness_map", "texture", None, doc="roughness map (R channel, linear); multiplies roughness"),
-    Param("metallic", "float", 0.0, (0.0, 1.0), doc="0 dielectric, 1 metal (base_color becomes the specular F0)"),
-    Param("specular", "float", 0.5, (0.0, 1.0), doc="dielectric F0 = 0.08 * specular (0.5 -> 4 %, index 1.5)"),
-    Param("normal_map", "texture", None, doc="tangent-space normal map (linear, OpenGL +Y)"),
-    Param("normal_scale", "float", 1.0, (0.0, 4.0), doc="strength of the normal map (0: off)"),
-    Param("occlusion_map", "texture", None, doc="ambient occlusion (R channel, linear); multiplies the ambient light"),
-    Param(
+    Field("roughness", "float", 0.5, (0.0, 1.0), doc="perceptual roughness; GGX alpha = roughness^2"),
+    Field("roughness_map", "texture", None, doc="roughness map (R channel, linear); multiplies roughness"),
+    Field("metallic", "float", 0.0, (0.0, 1.0), doc="0 dielectric, 1 metal (base_color becomes the specular F0)"),
+    Field("specular", "float", 0.5, (0.0, 1.0), doc="dielectric F0 = 0.08 * specular (0.5 -> 4 %, index 1.5)"),
+    Field("normal_map", "texture", None, doc="tangent-space normal map (linear, OpenGL +Y)"),
+    Field("normal_scale", "float", 1.0, (0.0, 4.0), doc="strength of the normal map (0: off)"),
+    Field("occlusion_map", "texture", None, doc="ambient occlusion (R channel, linear); multiplies the ambient light"),
+    Field(
         "occlusion_strength",
         "float",
         1.0,
@@ -139,8 +60,8 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         doc="how much of the occlusion map applies: ambient x (1 + strength (map - 1)) "
         "(glTF occlusionTexture.strength)",
     ),
-    Param("metallic_map", "texture", None, doc="metalness map (R channel, linear); multiplies metallic"),
-    Param(
+    Field("metallic_map", "texture", None, doc="metalness map (R channel, linear); multiplies metallic"),
+    Field(
         "emissive",
         "color",
         (0.0, 0.0, 0.0),
@@ -149,8 +70,8 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         doc="light the surface emits (added to what it reflects; glTF emissiveFactor x emissive_strength); "
         "lights nothing else",
     ),
-    Param("emissive_map", "texture", None, colorspace="srgb", doc="emission map (sRGB file); multiplies emissive"),
-    Param(
+    Field("emissive_map", "texture", None, colorspace="srgb", doc="emission map (sRGB file); multiplies emissive"),
+    Field(
         "alpha",
         "float",
         1.0,
@@ -158,7 +79,7 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         doc="opacity x the colour map's alpha channel x the vertex colour's alpha (glTF baseColorFactor[3]); "
         "read only when alpha_mode is mask or blend",
     ),
-    Param(
+    Field(
         "alpha_mode",
         "choice",
         "opaque",
@@ -167,8 +88,8 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         "path-traced truth); blend: drawn after the opaque meshes, far to near, over them, casting no shadow "
         "(glTF alphaMode)",
     ),
-    Param("alpha_cutoff", "float", 0.5, (0.0, 1.0), doc="the alpha below which a masked surface is cut away"),
-    Param(
+    Field("alpha_cutoff", "float", 0.5, (0.0, 1.0), doc="the alpha below which a masked surface is cut away"),
+    Field(
         "uv_offset",
         "vec2",
         (0.0, 0.0),
@@ -177,8 +98,8 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         "every map is read at uv_offset + R(uv_rotation) diag(uv_scale) uv; texture-space diffusion's layout keeps "
         "the mesh's own UVs",
     ),
-    Param("uv_scale", "vec2", (1.0, 1.0), (-1000.0, 1000.0), doc="the texture transform's scale (see uv_offset)"),
-    Param(
+    Field("uv_scale", "vec2", (1.0, 1.0), (-1000.0, 1000.0), doc="the texture transform's scale (see uv_offset)"),
+    Field(
         "uv_rotation",
         "float",
         0.0,
@@ -186,7 +107,7 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         unit="radians",
         doc="the texture transform's rotation of the UVs, counter-clockwise (see uv_offset)",
     ),
-    Param(
+    Field(
         "diffuse_transmission",
         "float",
         0.0,
@@ -194,7 +115,7 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         doc="the share of the plain diffuse part sent through a thin surface to the other side, Lambertian "
         "(glTF KHR_materials_diffuse_transmission: leaves, paper, lash cards); light from behind shows through",
     ),
-    Param(
+    Field(
         "diffuse_transmission_color",
         "color",
         (1.0, 1.0, 1.0),
@@ -202,14 +123,14 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         unit="linear RGB",
         doc="the colour of the light diffuse_transmission lets through",
     ),
-    Param(
+    Field(
         "subsurface",
         "float",
         0.0,
         (0.0, 1.0),
         doc="weight of subsurface scattering against plain diffuse (Blender: Subsurface Weight)",
     ),
-    Param(
+    Field(
         "subsurface_radius",
         "vec3",
         (1.0, 0.2, 0.1),
@@ -218,13 +139,13 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         doc="artist radius R = 4 pi l per channel (l: mean free path), millimetres; Blender's Subsurface Radius "
         "x Subsurface Scale in mm",
     ),
-    Param(
+    Field(
         "subsurface_map",
         "texture",
         None,
         doc="subsurface weight map (R channel, linear); multiplies subsurface per texel (every technique)",
     ),
-    Param(
+    Field(
         "subsurface_radius_map",
         "texture",
         None,
@@ -232,7 +153,7 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         "it; ears and nostrils scatter further than the forehead); honoured by disk (per-pixel sample radius), "
         "tsd and exact (through the stretch map); ssss, tint and preintegrated keep one radius per material",
     ),
-    Param(
+    Field(
         "subsurface_color",
         "color",
         (0.8, 0.4, 0.3),
@@ -242,7 +163,7 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         "scattering part shows from afar), x the colour map per texel; the medium's single-scattering albedo is "
         "inverted from it x the map's mean by photon beam diffusion at the material's index",
     ),
-    Param(
+    Field(
         "subsurface_scatter_anisotropy",
         "float",
         0.0,
@@ -251,7 +172,7 @@ PRINCIPLED_PARAMS: tuple[Param, ...] = (
         "subsurface_radius give the reduced (similarity) medium the diffusion uses, so g changes the "
         "single-scattering term (Jensen's phase) and the path-traced truth's phase and coefficients",
     ),
-    Param(
+    Field(
         "sss_model",
         "choice",
         "burley",
@@ -292,15 +213,15 @@ class Material:
 
     name: str = "default"
     values: dict[str, Any] = field(default_factory=dict)
-    params: tuple[Param, ...] = PRINCIPLED_PARAMS
+    params: tuple[Field, ...] = PRINCIPLED_PARAMS
 
     def __post_init__(self) -> None:
         given = dict(self.values)
-        self.values = {p.name: p.validate(p.default) if p.default is not None else None for p in self.params}
+        self.values = {p.name: p.check(p.default) if p.default is not None else None for p in self.params}
         self.update(given)
 
     @property
-    def param_map(self) -> dict[str, Param]:
+    def param_map(self) -> dict[str, Field]:
         return {p.name: p for p in self.params}
 
     def update(self, values: Mapping[str, Any]) -> Material:
@@ -314,7 +235,7 @@ class Material:
         for k, v in values.items():
             if k not in pm:
                 raise ValueError(f"material {self.name!r}: unknown parameter {k!r}; known: {', '.join(pm)}")
-            self.values[k] = pm[k].validate(v, where=f"material {self.name!r}: ")
+            self.values[k] = pm[k].check(v, f"material {self.name!r}: {k}")
         return self
 
     def apply_preset(self, name: str) -> Material:
@@ -372,7 +293,7 @@ class Material:
 _GLSL_TYPES = {"float": "float", "color": "vec3", "vec3": "vec3", "vec2": "vec2"}
 
 
-def glsl_material_uniforms(params: tuple[Param, ...] = PRINCIPLED_PARAMS) -> str:
+def glsl_material_uniforms(params: tuple[Field, ...] = PRINCIPLED_PARAMS) -> str:
     """The material uniform and sampler declarations (the virtual include ``skinlab/material.glsl``):
     ``uniform <type> u_<name>;`` per plain value and ``uniform sampler2D u_<map>;`` inside
     ``#ifdef HAS_<MAP>`` per texture. Choices are read on the CPU and declare nothing."""

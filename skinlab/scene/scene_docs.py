@@ -7,11 +7,14 @@ parameters in skinlab.scene.materials) so that the reference cannot drift from t
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
+from skinlab.declare import Field
+
 from .gltf_materials import GLTF_MAPPING
-from .materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
+from .materials import PRINCIPLED_PARAMS, SSS_MODELS
 from .scenefile import SCENE_FILE_KEYS
 
 DOC_PATH = Path(__file__).resolve().parents[2] / "docs" / "scenes.md"  # the checkout's docs (a developer tool)
@@ -176,23 +179,40 @@ technique.
 """
 
 
-def _fmt_default(p: Param) -> str:
-    if p.default is None:
-        return "none"
-    if isinstance(p.default, tuple):
-        return "[" + ", ".join(f"{x:g}" for x in p.default) + "]"
-    if isinstance(p.default, str):
-        return f'"{p.default}"'
-    return f"{p.default:g}"
-
-
-def _fmt_range(p: Param) -> str:
+def _fmt_range(p: Field) -> str:
     if p.kind == "choice":
         return ", ".join(f'"{c}"' for c in p.choices)
     if p.kind == "texture":
         return "sRGB image" if p.colorspace == "srgb" else "linear image"
     lo, hi = p.limits
     return f"[{lo:g}, {hi:g}]"
+
+
+_KEY_KIND = {
+    "string": "string",
+    "choice": "string",
+    "bool": "boolean",
+    "int": "integer",
+    "float": "number",
+    "vec3": "3 numbers",
+    "color": "1 or 3 numbers",
+    "vec4": "4 numbers",
+    "table": "table",
+    "tables": "table of tables",
+}
+
+
+def _key_type(k: Field) -> str:
+    """A scene-file key's type in words, from its kind and range (or its declared words)."""
+    if k.type_text:
+        return k.type_text
+    base = _KEY_KIND[k.kind]
+    lo, hi = k.range if k.range is not None else (-math.inf, math.inf)
+    if lo == -math.inf and hi == math.inf:
+        return base
+    if hi == math.inf:
+        return f"{base} {'>' if k.lo_open else '>='} {lo:g}"
+    return f"{base} in {'(' if k.lo_open else '['}{lo:g}, {hi:g}]"
 
 
 def _cell(text: str) -> str:
@@ -205,10 +225,11 @@ def scenes_markdown() -> str:
         out.append(f"## `{section}`\n")
         if section == "[materials.NAME]":
             out.append("A material is a table of the parameters in the next section, plus:\n")
-        out.append("| key | type | default | meaning |")
-        out.append("|---|---|---|---|")
+        out.append("| key | type | default | unit | meaning |")
+        out.append("|---|---|---|---|---|")
         for k in keys:
-            out.append(f"| `{k.name}` | {_cell(k.type)} | {_cell(k.default)} | {_cell(k.doc)} |")
+            cells = (_key_type(k), k.default_text(), k.unit or "-", k.doc)
+            out.append(f"| `{k.name}` | " + " | ".join(_cell(c) for c in cells) + " |")
         out.append("")
     out.append("## Material parameters\n")
     out.append(
@@ -218,9 +239,8 @@ def scenes_markdown() -> str:
     out.append("| parameter | type | default | range | unit | meaning |")
     out.append("|---|---|---|---|---|---|")
     for p in PRINCIPLED_PARAMS:
-        out.append(
-            f"| `{p.name}` | {_KIND[p.kind]} | {_fmt_default(p)} | {_fmt_range(p)} | {p.unit or '-'} | {_cell(p.doc)} |"
-        )
+        cells = (_KIND[p.kind], p.default_text(), _fmt_range(p), p.unit or "-", _cell(p.doc))
+        out.append(f"| `{p.name}` | " + " | ".join(cells) + " |")
     out.append("")
     out.append(f"Subsurface models (`sss_model`): {', '.join(f'`{m}`' for m in SSS_MODELS)}; see docs/tsd.md.\n")
     out.append(_COLOUR_RULE)

@@ -48,14 +48,16 @@ cast_shadow = true
 
 from __future__ import annotations
 
+import math
 import sys
 import tomllib
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from skinlab.declare import Field
 from skinlab.resources import assets_root, bundled_scenes, scene_by_name
 
 from . import transform as tf
@@ -74,216 +76,341 @@ class SceneFileError(ValueError):
     pass
 
 
-@dataclass(frozen=True)
-class Key:
-    """One scene-file key: its TOML type, default, range or unit, and meaning (docs/scenes.md)."""
-
-    name: str
-    type: str
-    default: str
-    doc: str
+INF = math.inf
 
 
-# Every key of every table, declared once: validation rejects anything else and docs/scenes.md is
-# generated from this (skinlab/scene/scene_docs.py). Material parameters come from skinlab.scene.materials.
-SCENE_FILE_KEYS: dict[str, tuple[Key, ...]] = {
+def _key(name: str, kind: str, default: Any = None, range=None, doc: str = "", **kw: Any) -> Field:
+    """A scene-file key: a Field that is neither a command-line option nor a panel widget of its own."""
+    return Field(name, kind, default, range, doc=doc, cli=False, panel=False, **kw)
+
+
+# Every key of every table, declared once with its typed default: reading (_read), validation (unknown
+# keys are rejected) and docs/scenes.md (skinlab/scene/scene_docs.py) come from this. `shown` is the
+# default in words where it is computed; `type_text` the type in words where a relation bounds it.
+# Material parameters come from skinlab.scene.materials.
+SCENE_FILE_KEYS: dict[str, tuple[Field, ...]] = {
     "[scene]": (
-        Key("name", "string", "the file's stem", "shown in the viewer's title and output names"),
-        Key(
+        _key("name", "string", shown="the file's stem", doc="shown in the viewer's title and output names"),
+        _key(
             "mm_per_unit",
-            "number >= 1e-12",
-            "1.0",
-            "millimetres per scene unit: the physical scale that subsurface_radius (mm) is measured against",
+            "float",
+            1.0,
+            (1e-12, INF),
+            doc="millimetres per scene unit: the physical scale that subsurface_radius (mm) is measured against",
         ),
     ),
     "[environment]": (
-        Key(
+        _key(
             "ambient",
-            "3 numbers >= 0",
-            "[0.03, 0.03, 0.035]; 0 with a map",
-            "uniform ambient radiance, linear RGB (unshadowed; added to the map's light)",
+            "color",
+            (0.03, 0.03, 0.035),
+            (0.0, INF),
+            shown="[0.03, 0.03, 0.035]; 0 with a map",
+            doc="uniform ambient radiance, linear RGB (unshadowed; added to the map's light)",
         ),
-        Key("exposure", "number > 0", "1.0", "linear multiplier on radiance before tone mapping (PNG only)"),
-        Key(
+        _key(
+            "exposure",
+            "float",
+            1.0,
+            (0.0, INF),
+            lo_open=True,
+            doc="linear multiplier on radiance before tone mapping (PNG only; EXR output is radiance, unaffected)",
+        ),
+        _key(
             "map",
             "string",
-            "none",
-            "an HDR environment map lighting the scene: an equirectangular (2:1) linear .exr or .hdr, relative "
+            doc="an HDR environment map lighting the scene: an equirectangular (2:1) linear .exr or .hdr, relative "
             "to the scene file, or a bundled map by name (studio, city, courtyard, interior; skinlab/assets/hdri/). "
             "Mitsuba's axes: +Y up, the image's centre toward +Z; bright small sources become directional "
             "lights with shadows (docs/environment.md)",
         ),
-        Key(
+        _key(
             "rotation_deg",
-            "number",
-            "0",
-            "turns the map about +Y, counter-clockwise seen from above (degrees; needs map)",
+            "float",
+            0.0,
+            (-INF, INF),
+            unit="degrees",
+            doc="turns the map about +Y, counter-clockwise seen from above (needs map)",
         ),
-        Key("intensity", "number >= 0", "1.0", "multiplier on the map's radiance (needs map)"),
-        Key(
+        _key("intensity", "float", 1.0, (0.0, INF), doc="multiplier on the map's radiance (needs map)"),
+        _key(
             "show_background",
-            "boolean",
-            "false",
-            "draw the map behind the scene (the image's alpha stays the meshes' coverage; needs map)",
+            "bool",
+            False,
+            doc="draw the map behind the scene (the image's alpha stays the meshes' coverage; needs map)",
         ),
     ),
     "[camera]": (
-        Key("position", "3 numbers", "[0, 0, 10]", "eye position, scene units"),
-        Key("target", "3 numbers", "[0, 0, 0]", "point looked at; must differ from position"),
-        Key("up", "3 numbers", "[0, 1, 0]", "up direction (non-zero)"),
-        Key("yfov_deg", "number in (0, 179]", "30", "vertical field of view, degrees"),
-        Key("znear", "number > 0", "0.1", "near clipping distance, scene units"),
-        Key("zfar", "number > znear", "1000", "far clipping distance, scene units"),
+        _key("position", "vec3", (0.0, 0.0, 10.0), unit="scene units", doc="eye position"),
+        _key("target", "vec3", (0.0, 0.0, 0.0), unit="scene units", doc="point looked at; must differ from position"),
+        _key("up", "vec3", (0.0, 1.0, 0.0), type_text="3 numbers, non-zero", doc="up direction"),
+        _key("yfov_deg", "float", 30.0, (0.0, 179.0), lo_open=True, unit="degrees", doc="vertical field of view"),
+        _key("znear", "float", 0.1, (0.0, INF), lo_open=True, unit="scene units", doc="near clipping distance"),
+        _key(
+            "zfar",
+            "float",
+            1000.0,
+            (0.0, INF),
+            lo_open=True,
+            unit="scene units",
+            type_text="number > znear",
+            doc="far clipping distance",
+        ),
     ),
     "[materials.NAME]": (
-        Key(
+        _key(
             "preset",
             "string",
-            "none",
-            "a Jensen et al. 2001 medium (assets/presets/): sets base_color, subsurface_color, subsurface_radius, "
+            doc="a Jensen et al. 2001 medium (assets/presets/): sets base_color, subsurface_color, subsurface_radius, "
             "subsurface = 1 and specular first; the table's other keys then override",
         ),
-        Key(
+        _key(
             "openpbr",
             "table",
-            "{}",
-            "OpenPBR Surface's subsurface parameters with OpenPBR's meanings, applied after the table's other keys "
-            "([materials.NAME.openpbr] below)",
+            shown="{}",
+            doc="OpenPBR Surface's subsurface parameters with OpenPBR's meanings, applied after the table's other "
+            "keys ([materials.NAME.openpbr] below)",
         ),
-        Key("subsurface_weight", "number in [0, 1]", "0", "an exact alias of subsurface (OpenPBR's name)"),
+        _key("subsurface_weight", "float", 0.0, (0.0, 1.0), doc="an exact alias of subsurface (OpenPBR's name)"),
     ),
+    # read by skinlab/scene/openpbr.py, which converts them
     "[materials.NAME.openpbr]": (
-        Key("subsurface_weight", "number in [0, 1]", "the material's subsurface", "weight of subsurface scattering"),
-        Key(
+        _key(
+            "subsurface_weight",
+            "float",
+            None,
+            (0.0, 1.0),
+            shown="the material's subsurface",
+            doc="weight of subsurface scattering",
+        ),
+        _key(
             "subsurface_color",
-            "3 numbers in [0, 1]",
-            "the material's",
-            "the multiple-scattering albedo (Skinlab's subsurface_color, the same meaning)",
+            "color",
+            None,
+            (0.0, 1.0),
+            type_text="3 numbers in [0, 1]",
+            shown="the material's",
+            doc="the multiple-scattering albedo (Skinlab's subsurface_color, the same meaning)",
         ),
-        Key(
+        _key(
             "subsurface_radius",
-            "number >= 0",
-            "1 (with subsurface_radius_scale)",
-            "length scale of the mean free path, scene units",
+            "float",
+            1.0,
+            (0.0, INF),
+            shown="1 (with subsurface_radius_scale)",
+            unit="scene units",
+            doc="length scale of the mean free path",
         ),
-        Key(
+        _key(
             "subsurface_radius_scale",
-            "1 or 3 numbers >= 0",
-            "[1, 0.5, 0.25] (with subsurface_radius)",
-            "per-channel multiplier: radius x scale is the real mean free path 1/sigma_t per channel",
+            "color",
+            (1.0, 0.5, 0.25),
+            (0.0, INF),
+            shown="[1, 0.5, 0.25] (with subsurface_radius)",
+            doc="per-channel multiplier: radius x scale is the real mean free path 1/sigma_t per channel",
         ),
-        Key(
+        _key(
             "subsurface_scatter_anisotropy",
-            "number in [-0.95, 0.95]",
-            "the material's",
-            "Henyey-Greenstein g (Skinlab's parameter of the same name)",
+            "float",
+            None,
+            (-0.95, 0.95),
+            shown="the material's",
+            doc="Henyey-Greenstein g (Skinlab's parameter of the same name)",
         ),
-    ),
+    ),  # fmt: skip
     "[[meshes]]": (
-        Key("file", "string (required)", "-", "mesh file (.glb .gltf .obj .ply .stl .off), relative to the scene file"),
-        Key("name", "string", "the file's stem", "name of the node that holds the file's nodes"),
-        Key("material", "string", "a default material", "name of a [materials.NAME] table"),
-        Key("overrides", "table", "{}", "material parameters for this mesh only, e.g. { roughness = 0.4 }"),
-        Key("nodes", "table of tables", "{}", "per node of the file, by name: material, overrides, visible"),
-        Key("translation", "3 numbers", "[0, 0, 0]", "scene units"),
-        Key("rotation", "4 numbers", "[0, 0, 0, 1]", "quaternion x, y, z, w (not with rotation_deg)"),
-        Key("rotation_deg", "3 numbers", "[0, 0, 0]", "Euler angles about X, Y, Z in degrees (not with rotation)"),
-        Key(
+        _key(
+            "file",
+            "string",
+            shown="-",
+            type_text="string (required)",
+            doc="mesh file (.glb .gltf .obj .ply .stl .off), relative to the scene file",
+        ),
+        _key("name", "string", shown="the file's stem", doc="name of the node that holds the file's nodes"),
+        _key("material", "string", shown="a default material", doc="name of a [materials.NAME] table"),
+        _key("overrides", "table", shown="{}", doc="material parameters for this mesh only, e.g. { roughness = 0.4 }"),
+        _key("nodes", "tables", shown="{}", doc="per node of the file, by name: material, overrides, visible"),
+        _key("translation", "vec3", (0.0, 0.0, 0.0), unit="scene units", doc="the entry's translation"),
+        _key("rotation", "vec4", (0.0, 0.0, 0.0, 1.0), doc="quaternion x, y, z, w (not with rotation_deg)"),
+        _key(
+            "rotation_deg",
+            "vec3",
+            (0.0, 0.0, 0.0),
+            unit="degrees",
+            doc="Euler angles about X, Y, Z (not with rotation)",
+        ),
+        _key(
             "scale",
-            "1 or 3 numbers, magnitude 1e-12 to 1e12",
-            "1",
-            "scale factor(s); with the file's own node transforms a mesh's world transform must scale by 1e-12 "
+            "scale",
+            1.0,
+            type_text="1 or 3 numbers, magnitude 1e-12 to 1e12",
+            doc="scale factor(s); with the file's own node transforms a mesh's world transform must scale by 1e-12 "
             "to 1e12 and move by at most 1e12 (errors name the node)",
         ),
-        Key("visible", "boolean", "true", "false hides the mesh and all its nodes"),
-        Key("flip_v", "boolean", "false", "v -> 1 - v: for files whose UV origin is the image's top-left"),
-        Key(
+        _key("visible", "bool", True, doc="false hides the mesh and all its nodes"),
+        _key("flip_v", "bool", False, doc="v -> 1 - v: for files whose UV origin is the image's top-left"),
+        _key(
             "generate_uvs",
-            "boolean",
-            "false",
-            "make an xatlas UV atlas where the file has none (cached by mesh content in ~/.cache/skinlab)",
+            "bool",
+            False,
+            doc="make an xatlas UV atlas where the file has none (cached by mesh content in ~/.cache/skinlab)",
         ),
     ),
     "[meshes.nodes.NAME]": (
-        Key("material", "string", "the mesh's material", "name of a [materials.NAME] table"),
-        Key("overrides", "table", "{}", "material parameters for this node (on top of the mesh's overrides)"),
-        Key("visible", "boolean", "true", "false hides this node"),
+        _key("material", "string", shown="the mesh's material", doc="name of a [materials.NAME] table"),
+        _key(
+            "overrides", "table", shown="{}", doc="material parameters for this node (on top of the mesh's overrides)"
+        ),
+        _key("visible", "bool", True, doc="false hides this node"),
     ),
     "[[lights]]": (
-        Key("name", "string", "lightN", "the viewer's key light is the one named 'key'"),
-        Key(
+        _key("name", "string", shown="lightN", doc="the viewer's key light is the one named 'key'"),
+        _key(
             "type",
-            "string",
-            '"directional"',
-            '"directional" (uses direction), "point" (position), "spot" (position, direction, inner_deg, '
+            "choice",
+            "directional",
+            choices=LightNode.KINDS,
+            type_text="string",
+            doc='"directional" (uses direction), "point" (position), "spot" (position, direction, inner_deg, '
             'outer_deg), "rect" (position, direction, width, height) or "sphere" (position, radius)',
         ),
-        Key("direction", "3 numbers, non-zero", "[0, 0, -1]", "the way a directional, spot or rect light shines"),
-        Key("position", "3 numbers", "(required but for directional)", "the light's position (centre), scene units"),
-        Key("color", "1 or 3 numbers >= 0", "[1, 1, 1]", "linear RGB"),
-        Key(
+        _key(
+            "direction",
+            "vec3",
+            (0.0, 0.0, -1.0),
+            type_text="3 numbers, non-zero",
+            doc="the way a directional, spot or rect light shines",
+        ),
+        _key(
+            "position",
+            "vec3",
+            shown="(required but for directional)",
+            unit="scene units",
+            doc="the light's position (centre)",
+        ),
+        _key("color", "color", (1.0, 1.0, 1.0), (0.0, INF), unit="linear RGB", doc="the light's colour"),
+        _key(
             "intensity",
-            "number >= 0",
-            "1.0",
-            "multiplier on color: irradiance (directional), intensity (point, spot: falls off with the inverse "
+            "float",
+            1.0,
+            (0.0, INF),
+            doc="multiplier on color: irradiance (directional), intensity (point, spot: falls off with the inverse "
             "square of the distance in metres) or emitted radiance (rect, sphere)",
         ),
-        Key("cast_shadow", "boolean", "false", "render a shadow map (at most 2 lights; needed for translucency)"),
-        Key("visible", "boolean", "true", "false: the light is off, kept in the scene (the viewer's Ctrl+S writes it)"),
-        Key("inner_deg", "number in [0, outer_deg]", "30", "spot: half-angle of the full beam, degrees"),
-        Key(
+        _key("cast_shadow", "bool", False, doc="render a shadow map (at most 2 lights; needed for translucency)"),
+        _key("visible", "bool", True, doc="false: the light is off, kept in the scene (the viewer's Ctrl+S writes it)"),
+        _key(
+            "inner_deg",
+            "float",
+            30.0,
+            (0.0, 90.0),
+            unit="degrees",
+            type_text="number in [0, outer_deg]",
+            doc="spot: half-angle of the full beam",
+        ),
+        _key(
             "outer_deg",
-            "number in (0, 90]",
-            "45",
-            "spot: half-angle past which it is dark; between the two the light fades linearly in angle",
+            "float",
+            45.0,
+            (0.0, 90.0),
+            lo_open=True,
+            unit="degrees",
+            doc="spot: half-angle past which it is dark; between the two the light fades linearly in angle",
         ),
-        Key(
+        _key(
             "width",
-            "number > 0",
-            "1",
-            "rect: extent across (horizontal when the light does not point straight up or down), scene units; "
-            "one-sided, shining along direction",
+            "float",
+            1.0,
+            (0.0, INF),
+            lo_open=True,
+            unit="scene units",
+            doc="rect: extent across (horizontal when the light does not point straight up or down); one-sided, "
+            "shining along direction",
         ),
-        Key("height", "number > 0", "1", "rect: extent along its other side, scene units"),
-        Key("radius", "number > 0", "0.5", "sphere: radius, scene units"),
+        _key(
+            "height",
+            "float",
+            1.0,
+            (0.0, INF),
+            lo_open=True,
+            unit="scene units",
+            doc="rect: extent along its other side",
+        ),
+        _key("radius", "float", 0.5, (0.0, INF), lo_open=True, unit="scene units", doc="sphere: radius"),
     ),
-    # what the scene tests, for the accuracy ledger (skinlab/scene/measure.py, docs/ledger.md "Edges and profiles")
+    # what the scene tests, for the accuracy ledger (read by skinlab/scene/measure.py parse_measure;
+    # docs/ledger.md "Edges and profiles")
     "[measure]": (
-        Key("tests", "string", '""', "what the scene tests, in a sentence (shown in the ledger)"),
-        Key(
+        _key("tests", "string", "", doc="what the scene tests, in a sentence (shown in the ledger)"),
+        _key(
             "profile",
-            "string",
-            '"none"',
-            '"line": a slit or stripe of light (the ledger plots the line spread function), "edge": a shadow or '
+            "choice",
+            "none",
+            choices=("none", "line", "edge"),
+            type_text="string",
+            doc='"line": a slit or stripe of light (the ledger plots the line spread function), "edge": a shadow or '
             'light edge (edge spread function), "none"',
         ),
-        Key("profile_origin", "3 numbers", "(required for a profile)", "a point on the line's centre or the edge"),
-        Key(
-            "profile_axis",
-            "3 numbers, non-zero",
-            "(required for a profile)",
-            "the direction across the line or edge: the profile's coordinate; pixels are averaged along the line",
+        _key(
+            "profile_origin", "vec3", shown="(required for a profile)", doc="a point on the line's centre or the edge"
         ),
-        Key("profile_range_mm", "number > 0", "30", "the profile spans +-this many mm across the line or edge"),
-        Key("profile_band_mm", "number > 0", "all", "only pixels within this many mm of the origin along the line"),
-        Key("line_width_mm", "number >= 0", "0", "the line's (slit's) width, for its edge region"),
-        Key(
+        _key(
+            "profile_axis",
+            "vec3",
+            shown="(required for a profile)",
+            type_text="3 numbers, non-zero",
+            doc="the direction across the line or edge: the profile's coordinate; pixels are averaged along the line",
+        ),
+        _key(
+            "profile_range_mm",
+            "float",
+            30.0,
+            (0.0, INF),
+            lo_open=True,
+            unit="mm",
+            doc="the profile spans +-this many mm across the line or edge",
+        ),
+        _key(
+            "profile_band_mm",
+            "float",
+            None,
+            (0.0, INF),
+            lo_open=True,
+            unit="mm",
+            shown="all",
+            doc="only pixels within this many mm of the origin along the line",
+        ),
+        _key(
+            "line_width_mm", "float", 0.0, (0.0, INF), unit="mm", doc="the line's (slit's) width, for its edge region"
+        ),
+        _key(
             "edge_mm",
-            "number >= 0",
-            "3 diffusion lengths",
-            "the edge region (errors within it are reported apart): within this many mm of the declared edge or "
+            "float",
+            None,
+            (0.0, INF),
+            unit="mm",
+            shown="3 diffusion lengths",
+            doc="the edge region (errors within it are reported apart): within this many mm of the declared edge or "
             "the line's sides, else of the plain frame's light edges; default 3 x 1/sigma_tr of the scene's most "
             "diffuse channel",
         ),
-        Key(
+        _key(
             "ledger",
-            "boolean",
-            "true",
-            "false: left out of the ledger's default scene list (a scene whose truth needs its own frame shape or "
+            "bool",
+            True,
+            doc="false: left out of the ledger's default scene list (a scene whose truth needs its own frame shape or "
             "path depth, such as the 16:1 slits; `--scenes` still takes it)",
         ),
-    ),
+    ),  # fmt: skip
 }
+
+
+def scene_key(section: str, name: str) -> Field:
+    """The declaration of one scene-file key (KeyError naming the section and key)."""
+    for f in SCENE_FILE_KEYS[section]:
+        if f.name == name:
+            return f
+    raise KeyError(f"{section}: no key {name!r}")
 
 
 def _keys(section: str) -> set[str]:
@@ -457,9 +584,9 @@ def _material_values(where: str, material: Material, values: dict) -> Material:
             n = {"float": "a number", "vec2": "2 numbers"}.get(pm[k].kind, "3 numbers")
             raise SceneFileError(f"{where}.{k}: expected {n}, got {_kind(v)} {_show(v)}")
         if pm[k].kind == "choice" and not isinstance(v, str):
-            raise SceneFileError(f"{where}.{k}: expected one of {', '.join(pm[k].choices)}; got {_show(v)}")
+            raise SceneFileError(f"{where}.{k}: expected one of {', '.join(pm[k].choices)}, got {_show(v)}")
         try:
-            material.values[k] = pm[k].validate(v)
+            material.values[k] = pm[k].check(v)
         except ValueError as exc:
             raise SceneFileError(f"{where}.{exc}") from None
     return material
@@ -586,150 +713,211 @@ def read_scene_data(path: Path) -> dict:
     return data
 
 
+TOP_LEVEL = ("scene", "environment", "camera", "materials", "meshes", "lights", "measure")
+
+
 def _build(path: Path, data: dict) -> Scene:
+    """A Scene from a scene file's data: each table read by the function named after it."""
     base = path.parent
-    _known("top level", data, {"scene", "environment", "camera", "materials", "meshes", "lights", "measure"})
-    sc = _table("[scene]", data.get("scene", {}))
-    _known("[scene]", sc, _keys("[scene]"))
-    name = _str("[scene].name", sc["name"]) if "name" in sc else path.stem
-    mm = _num("[scene].mm_per_unit", sc["mm_per_unit"], 1e-12) if "mm_per_unit" in sc else 1.0
-    scene = Scene(name, mm)
-    scene.source = path
-
-    env = _table("[environment]", data.get("environment", {}))
-    _known("[environment]", env, _keys("[environment]"))
-    if "exposure" in env:
-        scene.environment.exposure = _num("[environment].exposure", env["exposure"], 0.0, lo_open=True)
-    _environment_map(env, base, scene)
-    if "ambient" in env:
-        scene.environment.ambient = _vec("[environment].ambient", env["ambient"], lo=0.0)
-
-    materials: dict[str, Material] = {}
-    for name, values in _table("[materials]", data.get("materials", {})).items():
-        where = f"[materials.{name}]"
-        materials[name] = _material_table(where, Material(name), _table(where, values), base, mm)
-
-    file_materials: dict[tuple[str, int], Material] = {}
-
-    def material_for(where: str, name: Any, overrides: Any, own=None, mfile: Path | None = None) -> Material:
-        """The named [materials.NAME] table; without a name the file's own material `own` (glTF,
-        one Material per file and material), else the default; `overrides` on top (a copy)."""
-        if name is None and own is not None:
-            key = (str(mfile), own.index)
-            if key not in file_materials:
-                file_materials[key] = _file_material(f"{where} ({Path(str(mfile)).name})", own, mm)
-            mat = file_materials[key]
-        elif name is None:
-            mat = Material("default")
-        elif _str(f"{where}.material", name) not in materials:
-            raise SceneFileError(
-                f"{where}.material: no material named {name!r} (defined: {', '.join(materials) or 'none'})"
-            )
-        else:
-            mat = materials[name]
-        if overrides:
-            ow = f"{where}.overrides"
-            mat = Material(f"{mat.name}+overrides", dict(mat.values), mat.params)
-            _material_table(ow, mat, _table(ow, overrides), base, mm)
-        return mat
-
+    _known("top level", data, set(TOP_LEVEL))
+    scene = _scene_table(path, _table("[scene]", data.get("scene", {})))
+    _environment_table(_table("[environment]", data.get("environment", {})), base, scene)
+    materials = SceneMaterials(_material_tables(data.get("materials", {}), base, scene.mm_per_unit), base, scene)
     for i, entry in enumerate(_tables("[meshes]", data.get("meshes", []))):
-        where = f"[[meshes]] #{i + 1}"
-        _known(where, entry, _keys("[[meshes]]"))
-        if "file" not in entry:
-            raise SceneFileError(f"{where}: missing 'file'")
-        mpath = Path(_str(f"{where}.file", entry["file"]))
-        mpath = mpath if mpath.is_absolute() else base / mpath
-        top = Node(_str(f"{where}.name", entry.get("name", mpath.stem)), **_trs(where, entry))
-        top.visible = _bool(f"{where}.visible", entry.get("visible", True))
-        top.file_info = {
-            "file": mpath,
-            "flip_v": bool(entry.get("flip_v", False)),
-            "generate_uvs": bool(entry.get("generate_uvs", False)),
-        }
-        scene.add(top)
-        mesh_overrides = _table(f"{where}.overrides", entry.get("overrides", {}))
-        node_cfg = _table(f"{where}.nodes", entry.get("nodes", {}))
-        try:
-            loaded = load_mesh_file(mpath, scene.warnings)
-        except (ValueError, FileNotFoundError) as exc:
-            raise SceneFileError(f"{where}.file: {exc}") from None
-        names = {n.name for n in loaded}
-        for nname, cfg in node_cfg.items():
-            _table(f"{where}.nodes.{nname}", cfg)
-            if nname not in names:
-                raise SceneFileError(
-                    f"{where}.nodes.{nname}: {mpath.name} has no node named {nname!r} "
-                    f"(it has: {', '.join(sorted(names))})"
-                )
-        if _bool(f"{where}.flip_v", entry.get("flip_v", False)):
-            loaded = [replace(ln, mesh=flip_v(ln.mesh)) for ln in loaded]
-        if _bool(f"{where}.generate_uvs", entry.get("generate_uvs", False)):  # an xatlas atlas where none
-            loaded = [replace(ln, mesh=ln.mesh and with_atlas(ln.mesh)) for ln in loaded]
-        entry_mats: dict = {}  # the entry's material (with its overrides) per file material
-        created: dict[str, Node] = {}
-        for ln in loaded:
-            nwhere = f"{where}.nodes.{ln.name}"
-            cfg = node_cfg.get(ln.name, {})
-            _known(nwhere, cfg, _keys("[meshes.nodes.NAME]"))
-            if ln.mesh is not None:
-                own = ln.material if "material" not in entry else None  # a named material wins
-                key = own.index if own is not None else None
-                if key not in entry_mats:
-                    entry_mats[key] = material_for(where, entry.get("material"), mesh_overrides, own, mpath)
-                mat = entry_mats[key]
-                if "material" in cfg or "overrides" in cfg:
-                    mat = material_for(
-                        nwhere,
-                        cfg.get("material", entry.get("material")),
-                        {**mesh_overrides, **_table(f"{nwhere}.overrides", cfg.get("overrides", {}))},
-                        ln.material if "material" not in cfg and "material" not in entry else None,
-                        mpath,
-                    )
-                node: Node = MeshNode(ln.name, ln.mesh, mat)
-            else:
-                node = Node(ln.name)
-            node.set_matrix(ln.matrix)
-            node.visible = _bool(f"{nwhere}.visible", cfg.get("visible", True))
-            (created[ln.parent] if ln.parent else top).add(node)
-            created[ln.name] = node
-        _check_world_transforms(where, top)
-
+        _mesh_entry(f"[[meshes]] #{i + 1}", entry, scene, materials)
     for i, entry in enumerate(_tables("[lights]", data.get("lights", []))):
         scene.add(_light(f"[[lights]] #{i + 1}", entry, i))
-
     if "camera" in data:
-        cam = _table("[camera]", data["camera"])
-        _known("[camera]", cam, _keys("[camera]"))
-        znear = _num("[camera].znear", cam.get("znear", 0.1), 0.0, lo_open=True)
-        zfar = _num("[camera].zfar", cam.get("zfar", 1000.0), 0.0, lo_open=True)
-        if zfar <= znear:
-            raise SceneFileError(f"[camera].zfar: must be greater than znear ({znear}), got {zfar}")
-        yfov = _num("[camera].yfov_deg", cam.get("yfov_deg", 30.0), 0.0, 179.0, lo_open=True)
-        c = CameraNode("camera", np.radians(yfov), znear, zfar)
-        eye = _vec("[camera].position", cam.get("position", [0, 0, 10]))
-        target = _vec("[camera].target", cam.get("target", [0, 0, 0]))
-        up = _vec("[camera].up", cam.get("up", [0, 1, 0]))
-        if np.allclose(eye, target):
-            raise SceneFileError(f"[camera].target: the camera looks at its own position {eye.tolist()}")
-        if np.linalg.norm(up) == 0:
-            raise SceneFileError("[camera].up: must be non-zero")
-        c.look_at(eye, target, up)
-        scene.add(c)
+        scene.add(_camera_table(_table("[camera]", data["camera"])))
     if "measure" in data:
-        from .measure import parse_measure
-
-        table = _table("[measure]", data["measure"])
-        _known("[measure]", table, _keys("[measure]"))
-        try:
-            scene.measure = parse_measure(table, _num, _vec, _str, _bool)
-        except ValueError as exc:
-            raise SceneFileError(str(exc)) from None
+        scene.measure = _measure_table(_table("[measure]", data["measure"]))
     if not scene.mesh_nodes(visible_only=False):
         raise SceneFileError("the scene has no meshes (add a [[meshes]] entry with a file)")
     if scene.camera is None:
         scene.add(default_camera(scene))
     return scene
+
+
+def _read(where: str, table: dict, section: str, name: str) -> Any:
+    """Key `name` of `table` (called `where` in errors), read as its declaration in SCENE_FILE_KEYS
+    [section] says; the declared default where the table does not have it."""
+    f = scene_key(section, name)
+    if name not in table:
+        if f.kind == "table":
+            return {}  # an empty table (shown "{}")
+        return np.asarray(f.default, np.float64) if f.kind in _VECTOR_KEYS and f.default is not None else f.default
+    value, w = table[name], f"{where}.{name}"
+    lo, hi = f.range if f.range is not None else (-math.inf, math.inf)
+    if f.kind == "string":
+        return _str(w, value)
+    if f.kind == "bool":
+        return _bool(w, value)
+    if f.kind == "choice":
+        if _str(w, value) not in f.choices:
+            raise SceneFileError(f"{w}: expected one of {', '.join(f.choices)}, got {value!r}")
+        return value
+    if f.kind == "float":
+        return _num(w, value, None if lo == -math.inf else lo, None if hi == math.inf else hi, f.lo_open)
+    if f.kind in _VECTOR_KEYS:
+        return _vec(w, value, _VECTOR_KEYS[f.kind], lo=None if lo == -math.inf else lo)
+    if f.kind == "table":
+        return _table(w, value)
+    raise TypeError(f"{w}: a {f.kind} key is read where it is used")
+
+
+_VECTOR_KEYS = {"vec3": 3, "color": 3, "vec4": 4}
+
+
+def _scene_table(path: Path, sc: dict) -> Scene:
+    """[scene]: the name (default the file's stem) and the physical scale."""
+    _known("[scene]", sc, _keys("[scene]"))
+    name = _read("[scene]", sc, "[scene]", "name") if "name" in sc else path.stem
+    scene = Scene(name, _read("[scene]", sc, "[scene]", "mm_per_unit"))
+    scene.source = path
+    return scene
+
+
+def _environment_table(env: dict, base: Path, scene: Scene) -> None:
+    """[environment]: exposure, the uniform ambient and the environment map with its settings."""
+    _known("[environment]", env, _keys("[environment]"))
+    scene.environment.exposure = _read("[environment]", env, "[environment]", "exposure")
+    scene.environment.ambient = _read("[environment]", env, "[environment]", "ambient")
+    _environment_map(env, base, scene)
+    if "ambient" in env:  # given beside a map, it stays
+        scene.environment.ambient = _read("[environment]", env, "[environment]", "ambient")
+
+
+def _material_tables(tables: Any, base: Path, mm_per_unit: float) -> dict[str, Material]:
+    """[materials.NAME] tables, by name."""
+    materials: dict[str, Material] = {}
+    for name, values in _table("[materials]", tables).items():
+        where = f"[materials.{name}]"
+        materials[name] = _material_table(where, Material(name), _table(where, values), base, mm_per_unit)
+    return materials
+
+
+class SceneMaterials:
+    """The material a mesh node gets: a named [materials.NAME] table, else the mesh file's own (glTF:
+    one Material per file and material), else the default; the entry's and node's overrides on top."""
+
+    def __init__(self, named: dict[str, Material], base: Path, scene: Scene) -> None:
+        self.named, self.base, self.mm_per_unit = named, base, scene.mm_per_unit
+        self.from_files: dict[tuple[str, int], Material] = {}
+
+    def choose(self, where: str, name: Any, overrides: Any, own=None, mfile: Path | None = None) -> Material:
+        if name is None and own is not None:
+            key = (str(mfile), own.index)
+            if key not in self.from_files:
+                self.from_files[key] = _file_material(f"{where} ({Path(str(mfile)).name})", own, self.mm_per_unit)
+            mat = self.from_files[key]
+        elif name is None:
+            mat = Material("default")
+        elif _str(f"{where}.material", name) not in self.named:
+            raise SceneFileError(
+                f"{where}.material: no material named {name!r} (defined: {', '.join(self.named) or 'none'})"
+            )
+        else:
+            mat = self.named[name]
+        if overrides:
+            ow = f"{where}.overrides"
+            mat = Material(f"{mat.name}+overrides", dict(mat.values), mat.params)
+            _material_table(ow, mat, _table(ow, overrides), self.base, self.mm_per_unit)
+        return mat
+
+
+def _mesh_entry(where: str, entry: dict, scene: Scene, materials: SceneMaterials) -> Node:
+    """One [[meshes]] entry: a node holding the file's nodes, with the entry's transform, materials,
+    overrides and per-node settings."""
+    sec = "[[meshes]]"
+    _known(where, entry, _keys(sec))
+    if "file" not in entry:
+        raise SceneFileError(f"{where}: missing 'file'")
+    mpath = Path(_read(where, entry, sec, "file"))
+    mpath = mpath if mpath.is_absolute() else materials.base / mpath
+    flip, atlas = _read(where, entry, sec, "flip_v"), _read(where, entry, sec, "generate_uvs")
+    top = Node(_read(where, entry, sec, "name") if "name" in entry else mpath.stem, **_trs(where, entry))
+    top.visible = _read(where, entry, sec, "visible")
+    top.file_info = {"file": mpath, "flip_v": flip, "generate_uvs": atlas}
+    scene.add(top)
+    node_cfg = _table(f"{where}.nodes", entry.get("nodes", {}))
+    try:
+        loaded = load_mesh_file(mpath, scene.warnings)
+    except (ValueError, FileNotFoundError) as exc:
+        raise SceneFileError(f"{where}.file: {exc}") from None
+    names = {n.name for n in loaded}
+    for nname, cfg in node_cfg.items():
+        _table(f"{where}.nodes.{nname}", cfg)
+        if nname not in names:
+            raise SceneFileError(
+                f"{where}.nodes.{nname}: {mpath.name} has no node named {nname!r} (it has: {', '.join(sorted(names))})"
+            )
+    if flip:
+        loaded = [replace(ln, mesh=flip_v(ln.mesh)) for ln in loaded]
+    if atlas:  # an xatlas atlas where none
+        loaded = [replace(ln, mesh=ln.mesh and with_atlas(ln.mesh)) for ln in loaded]
+    _file_nodes(where, entry, top, loaded, node_cfg, mpath, materials)
+    _check_world_transforms(where, top)
+    return top
+
+
+def _file_nodes(where, entry: dict, top: Node, loaded, node_cfg: dict, mpath: Path, materials: SceneMaterials):
+    """The mesh file's nodes under `top`, each with its material (the entry's, or its node table's)."""
+    mesh_overrides = _read(where, entry, "[[meshes]]", "overrides")
+    entry_mats: dict = {}  # the entry's material (with its overrides) per file material
+    created: dict[str, Node] = {}
+    for ln in loaded:
+        nwhere = f"{where}.nodes.{ln.name}"
+        cfg = node_cfg.get(ln.name, {})
+        _known(nwhere, cfg, _keys("[meshes.nodes.NAME]"))
+        if ln.mesh is not None:
+            own = ln.material if "material" not in entry else None  # a named material wins
+            key = own.index if own is not None else None
+            if key not in entry_mats:
+                entry_mats[key] = materials.choose(where, entry.get("material"), mesh_overrides, own, mpath)
+            mat = entry_mats[key]
+            if "material" in cfg or "overrides" in cfg:
+                mat = materials.choose(
+                    nwhere,
+                    cfg.get("material", entry.get("material")),
+                    {**mesh_overrides, **_read(nwhere, cfg, "[meshes.nodes.NAME]", "overrides")},
+                    ln.material if "material" not in cfg and "material" not in entry else None,
+                    mpath,
+                )
+            node: Node = MeshNode(ln.name, ln.mesh, mat)
+        else:
+            node = Node(ln.name)
+        node.set_matrix(ln.matrix)
+        node.visible = _read(nwhere, cfg, "[meshes.nodes.NAME]", "visible")
+        (created[ln.parent] if ln.parent else top).add(node)
+        created[ln.name] = node
+
+
+def _camera_table(cam: dict) -> CameraNode:
+    """[camera]: where it is, what it looks at, its field of view and clipping distances."""
+    _known("[camera]", cam, _keys("[camera]"))
+    key = lambda name: _read("[camera]", cam, "[camera]", name)  # noqa: E731
+    znear, zfar = key("znear"), key("zfar")
+    if zfar <= znear:
+        raise SceneFileError(f"[camera].zfar: must be greater than znear ({znear}), got {zfar}")
+    c = CameraNode("camera", np.radians(key("yfov_deg")), znear, zfar)
+    eye, target, up = key("position"), key("target"), key("up")
+    if np.allclose(eye, target):
+        raise SceneFileError(f"[camera].target: the camera looks at its own position {eye.tolist()}")
+    if np.linalg.norm(up) == 0:
+        raise SceneFileError("[camera].up: must be non-zero")
+    c.look_at(eye, target, up)
+    return c
+
+
+def _measure_table(table: dict):
+    """[measure]: what the scene tests, for the accuracy ledger (skinlab/scene/measure.py)."""
+    from .measure import parse_measure
+
+    _known("[measure]", table, _keys("[measure]"))
+    try:
+        return parse_measure(table, _num, _vec, _str, _bool)
+    except ValueError as exc:
+        raise SceneFileError(str(exc)) from None
 
 
 def _check_world_transforms(where: str, top: Node) -> None:
@@ -754,41 +942,38 @@ _LIGHT_KEYS = {
 
 
 def _light(where: str, entry: dict, i: int) -> LightNode:
-    _known(where, entry, _keys("[[lights]]"))
-    kind = _str(f"{where}.type", entry.get("type", "directional"))
-    if kind not in LightNode.KINDS:
-        raise SceneFileError(f"{where}.type: expected one of {', '.join(LightNode.KINDS)}, got {kind!r}")
+    """One [[lights]] entry: its kind, the keys that kind has (the others are errors), colour and power."""
+    sec = "[[lights]]"
+    _known(where, entry, _keys(sec))
+    key = lambda name: _read(where, entry, sec, name)  # noqa: E731
+    kind = key("type")
     own = _LIGHT_KEYS[kind]
-    for key in ("direction", "position", "inner_deg", "outer_deg", "width", "height", "radius"):
-        if key in entry and key not in own:
+    for name in ("direction", "position", "inner_deg", "outer_deg", "width", "height", "radius"):
+        if name in entry and name not in own:
             hint = {
                 "position": " (use direction)",
                 "direction": " (it shines every way: remove direction)" if kind in ("point", "sphere") else "",
-            }.get(key, "")
-            raise SceneFileError(f"{where}.{key}: a {kind} light has no {key}{hint}")
-    shape = {}
-    for key, lo, hi in (("inner_deg", 0.0, 90.0), ("outer_deg", 0.0, 90.0), ("width", 0.0, None), ("height", 0.0, None),
-                        ("radius", 0.0, None)):  # fmt: skip
-        if key in entry:
-            shape[key] = _num(f"{where}.{key}", entry[key], lo, hi, lo_open=key != "inner_deg")
+            }.get(name, "")
+            raise SceneFileError(f"{where}.{name}: a {kind} light has no {name}{hint}")
+    shape = {name: key(name) for name in own if name not in ("position", "direction")}
     try:
         light = LightNode(
-            _str(f"{where}.name", entry.get("name", f"light{i + 1}")),
+            key("name") if "name" in entry else f"light{i + 1}",
             kind,
-            _vec(f"{where}.color", entry.get("color", 1.0), lo=0.0),
-            _num(f"{where}.intensity", entry.get("intensity", 1.0), 0.0),
-            _bool(f"{where}.cast_shadow", entry.get("cast_shadow", False)),
+            key("color"),
+            key("intensity"),
+            key("cast_shadow"),
             **shape,
         )
     except ValueError as exc:
         raise SceneFileError(f"{where}: {exc}") from None
-    light.visible = _bool(f"{where}.visible", entry.get("visible", True))
+    light.visible = key("visible")
     if "position" in own:
         if "position" not in entry:
             raise SceneFileError(f"{where}: a {kind} light needs 'position'")
-        light.translation = _vec(f"{where}.position", entry["position"])
+        light.translation = key("position")
     if "direction" in own:
-        d = _vec(f"{where}.direction", entry.get("direction", [0, 0, -1]))
+        d = key("direction")
         if np.linalg.norm(d) == 0:
             raise SceneFileError(f"{where}.direction: must be non-zero")
         light.rotation = tf.look_at_rotation(np.zeros(3), d)

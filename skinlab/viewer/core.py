@@ -192,9 +192,9 @@ class ViewerCore:
         return getattr(self.settings.technique, name)
 
     def set_render_option(self, name: str, value) -> object:
-        """Change one declared render setting (RenderSettings.options(): supersample, bounces, ...),
-        checked against its declaration."""
-        opts = self.settings.options()
+        """Change one render setting the panel offers (RenderSettings.panel_options(): supersample,
+        bounces, ...), checked against its declaration."""
+        opts = self.settings.panel_options()
         if name not in opts:
             raise ValueError(f"render setting {name!r}: unknown; the declared ones: {', '.join(opts)}")
         self.settings = dataclasses.replace(self.settings, **{name: value})  # validated again

@@ -1,10 +1,12 @@
 """The parameter panel's logic, independent of any GUI toolkit (unit-tested without a window).
 
-Widgets are derived from the material parameter declarations (``skinlab.scene.materials.Param``), so a
-new parameter appears in the panel without GUI code: ``float`` -> slider over its range,
-``color`` -> colour editor, ``vec3`` -> three draggable numbers within the range, ``texture`` ->
-file path, ``choice`` -> combo box. Edits are clamped into the declared range and then applied
-through ``Material.update`` (which validates again and names the parameter on error).
+Widgets are derived from the declarations (``skinlab.declare.Field``: material parameters, render and
+technique settings alike) through one table, :data:`WIDGETS`, so a new parameter or setting appears in
+the panel without GUI code: ``float`` -> slider over its range, ``int`` -> integer slider, ``bool`` ->
+checkbox, ``color`` -> colour editor, ``vec3`` / ``vec2`` -> draggable numbers within the range,
+``texture`` -> file path, ``choice`` -> combo box; a field that may be None (automatic) adds an "auto"
+checkbox (``<widget>_or_auto``). Edits are clamped into the declared range (``Field.clamp``) and then
+applied through ``Material.update`` or the settings (which validate again and name the field on error).
 
 Presets map a Jensen et al. 2001 medium onto the principled parameters as a scene file's ``preset``
 does (skinlab.scene.materials.medium_values): base and ``subsurface_color`` the medium's diffuse surface
@@ -23,13 +25,17 @@ from typing import Any
 
 import numpy as np
 
+from skinlab.declare import Field, declared_fields
 from skinlab.scene import transform as tf
 from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Node, Scene
-from skinlab.scene.materials import Material, Param
+from skinlab.scene.materials import Material
 
-# Param.kind -> widget kind
+# Field.kind -> widget kind, for every declaration the panel shows; a field that may be None
+# (automatic) gets "<widget>_or_auto"
 WIDGETS = {
     "float": "slider_float",
+    "int": "slider_int",
+    "bool": "checkbox",
     "color": "color_edit3",
     "vec3": "drag_float3",
     "vec2": "drag_float2",
@@ -52,16 +58,20 @@ class Widget:
     logarithmic: bool = False  # sliders over ranges spanning decades (e.g. radius 0-1000 mm)
 
 
-def widget_for(param: Param, value: Any = None) -> Widget:
-    kind = WIDGETS.get(param.kind)
+def widget_for(decl: Field, value: Any = None) -> Widget:
+    """The widget of one declaration showing `value` (None: the default, or automatic where the field
+    allows None); its tooltip is the declaration's help (meaning, values, default with its unit)."""
+    kind = WIDGETS.get(decl.kind)
     if kind is None:
         raise ValueError(
-            f"parameter {param.name!r}: no panel widget for kind {param.kind!r} (known kinds: {', '.join(WIDGETS)})"
+            f"parameter {decl.name!r}: no panel widget for kind {decl.kind!r} (known kinds: {', '.join(WIDGETS)})"
         )
-    value = param.default if value is None and param.kind != "texture" else value
-    rng = tuple(float(x) for x in param.range) if param.range is not None else None
-    log = bool(rng and rng[0] >= 0 and rng[1] >= 1000 * max(rng[0], 1e-3))
-    return Widget(param.name, kind, value, rng, tuple(param.choices), param.unit, param.doc, log)
+    if value is None and decl.kind != "texture" and not decl.none:
+        value = decl.default
+    rng = tuple(float(x) for x in decl.range) if decl.range is not None else None
+    log = bool(decl.kind != "int" and rng and rng[0] >= 0 and rng[1] >= 1000 * max(rng[0], 1e-3))
+    kind += "_or_auto" if decl.none else ""
+    return Widget(decl.name, kind, value, rng, tuple(decl.choices), decl.unit, decl.help(), log)
 
 
 def widget_label(w: Widget) -> str:
@@ -97,7 +107,7 @@ def sss_override_note(material: Material, override: str | None) -> str | None:
     return f"sss_model: M forces '{override}' on every material; this one's own '{own}' is not used"
 
 
-def clamp_value(param: Param, value: Any) -> Any:
+def clamp_value(param: Field, value: Any) -> Any:
     """The value a widget hands back, made valid for ``param``: numbers are clamped into the
     range (NaN -> the default), colours/vec3 element-wise; choices must be one of the options;
     textures must name an existing file (or be empty: no map). Errors name the parameter."""
@@ -512,48 +522,22 @@ INTENSITY_DOC = {
 }
 
 
-# -- the current technique's settings (skinlab/render/options.py declarations) --------------------------------
-
-# Option.kind -> widget kind; an option that may be None (automatic) gets "<kind>_or_auto"
-TECHNIQUE_WIDGETS = {"bool": "checkbox", "int": "slider_int", "float": "slider_float", "choice": "combo"}
+# -- the current technique's and the render settings (declared with skinlab.declare.option) --------------------
 
 
 def technique_widgets(settings) -> list[Widget]:
     """One widget per field of a technique's settings, from its declaration (range, meaning, default)."""
-    return option_widgets(settings, settings.defaults())
+    return [widget_for(f, getattr(settings, name)) for name, f in settings.options().items()]
 
 
 def render_widgets(settings) -> list[Widget]:
-    """One widget per declared render setting (RenderSettings.options(): supersampling,
-    interreflection), from its declaration like a technique's."""
-    import dataclasses
-
-    fields = {f.name: f.default for f in dataclasses.fields(settings)}
-    return option_widgets(settings, {name: fields[name] for name in settings.options()})
-
-
-def option_widgets(settings, defaults: dict) -> list[Widget]:
-    out = []
-    for name, o in settings.options().items():
-        kind = TECHNIQUE_WIDGETS[o.kind] + ("_or_auto" if o.none else "")
-        rng = tuple(float(x) for x in o.range) if o.range is not None else None
-        out.append(Widget(name, kind, getattr(settings, name), rng, o.choices, unit=o.unit, doc=o.help(defaults[name])))
-    return out
+    """One widget per render setting the panel offers (RenderSettings.panel_options(): supersampling,
+    interreflection, compute shaders), from its declaration like a technique's."""
+    return [widget_for(f, getattr(settings, name)) for name, f in settings.panel_options().items()]
 
 
 def technique_value(settings, name: str, value: Any) -> Any:
-    """A widget's value made valid for the field: numbers clamped into the declared range, integers
-    rounded (odd counts to the nearest odd one inside the range); None (automatic), booleans and
-    choices as given (the settings check them)."""
-    o = settings.options()[name]
-    if value is None or o.kind in ("bool", "choice"):
-        return value
-    v = float(value)
-    if o.range is not None:
-        v = min(max(v, o.range[0]), o.range[1])
-    if o.kind == "float":
-        return v
-    n = int(round(v))
-    if o.odd and n % 2 == 0:
-        n = n + 1 if o.range is None or n + 1 <= o.range[1] else n - 1
-    return n
+    """A widget's value made valid for the field (``Field.clamp``): numbers clamped into the declared
+    range, integers rounded (odd counts to the nearest odd one inside the range); None (automatic)
+    where the field allows it."""
+    return declared_fields(type(settings))[name].clamp(value)

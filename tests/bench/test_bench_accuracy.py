@@ -360,8 +360,9 @@ def test_sweep_settings_come_from_the_techniques_declarations():
     """A technique joins the ledger through its LedgerStyle alone: its declared base and axes, or its
     defaults once; the ledger columns come from the registry."""
     from skinlab.bench.sweep import Setting, declared_settings, setting_columns, sweep_settings
+    from skinlab.declare import option
     from skinlab.render import registry
-    from skinlab.render.options import TechniqueSettings, option
+    from skinlab.render.options import TechniqueSettings
     from skinlab.render.technique import LedgerStyle, LedgerSweep, Technique
 
     full = sweep_settings(acc.SWEEPS["full"])

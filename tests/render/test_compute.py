@@ -187,11 +187,11 @@ def test_a_context_without_compute_renders_the_fragment_path(renderer):
 
 
 def test_compute_setting_is_declared_checked_and_offered(tmp_path):
-    from skinlab.render.options import Option
+    from skinlab.declare import Field
     from skinlab.viewer.panel import render_widgets, technique_value
 
     opt = RenderSettings.options()["compute"]
-    assert isinstance(opt, Option) and opt.kind == "choice" and opt.choices == ("auto", "on", "off")
+    assert isinstance(opt, Field) and opt.kind == "choice" and opt.choices == ("auto", "on", "off")
     assert RenderSettings().compute == "auto"
     with pytest.raises(ValueError, match=r"render setting compute: expected one of auto, on, off, got 'fast'"):
         RenderSettings(compute="fast")

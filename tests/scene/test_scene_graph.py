@@ -62,9 +62,9 @@ def test_material_declaration_drives_uniforms_defines_and_validation():
     assert u["u_roughness"] == 0.3 and u["u_subsurface_radius"] == (1.0, 0.2, 0.1)
     assert "u_base_color_map" not in u and m.textures()["u_base_color_map"][1] == "srgb"
     assert m.defines() == {"HAS_BASE_COLOR_MAP": "1"}
-    with pytest.raises(ValueError, match=r"material 'skin': roughness: value 1.5 outside the valid range \[0.0, 1.0\]"):
+    with pytest.raises(ValueError, match=r"material 'skin': roughness: expected a number in \[0, 1\], got 1.5"):
         m.update({"roughness": 1.5})
-    with pytest.raises(ValueError, match="subsurface_radius: value .* outside .* mm"):
+    with pytest.raises(ValueError, match=r"subsurface_radius: expected 3 numbers in \[0, 1000\], got"):
         m.update({"subsurface_radius": [1, -1, 1]})
     with pytest.raises(ValueError, match="unknown parameter 'roughnes'"):
         m.update({"roughnes": 0.2})

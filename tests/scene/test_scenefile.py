@@ -62,7 +62,7 @@ def test_overrides_and_default_camera(tmp_path):
             r"s.toml: \[\[meshes\]\] #1.file: mesh file not found: .*nope.glb",
         ),
         ("[[meshes]]\nfil='x'\n", r"s.toml: \[\[meshes\]\] #1: unknown key\(s\) fil"),
-        ("[materials.m]\nroughness = 2\n", r"s.toml: \[materials.m\].roughness: value 2 outside the valid range"),
+        ("[materials.m]\nroughness = 2\n", r"s.toml: \[materials.m\].roughness: expected a number in \[0, 1\], got 2"),
         (
             "[materials.m]\nbase_color_map = 'missing.png'\n",
             r"\[materials.m\].base_color_map: texture file not found: .*missing.png",

@@ -71,7 +71,7 @@ def test_panel_has_exposure_and_every_light(core, ui):
     for l in lights:
         assert f"light{l.uid}/intensity" in layout and f"light{l.uid}/color (linear)" in layout
     # every declared render and technique setting has a row (its label whole in its column)
-    for name in core.settings.options():
+    for name in core.settings.panel_options():
         assert any(k.startswith(f"render/{name}") for k in layout), name
 
 

@@ -61,11 +61,11 @@ def test_view_options_build_the_settings_and_edits_render_would():
     [
         (["--bounces", "9"], "--bounces: expected an integer in [0, 8], got 9"),
         (["--supersample", "x"], "--supersample: expected"),
-        (["--exposure", "0"], "--exposure: expected a finite multiplier > 0, got 0.0"),
+        (["--exposure", "0"], "--exposure: expected a number > 0, got 0.0"),
         (["--preset", "jam"], "--preset: unknown material 'jam'"),
         (["--mm-per-unit", "-1"], "--mm-per-unit: expected millimetres per scene unit > 0"),
         (["--set", "glow=1"], "glow: not a material parameter"),
-        (["--environment-intensity", "-1"], "--environment-intensity: expected a finite number >= 0"),
+        (["--environment-intensity", "-1"], "--environment-intensity: expected a number >= 0, got -1.0"),
     ],
 )
 def test_bad_view_options_fail_before_a_window_opens(argv, msg):

@@ -12,10 +12,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings
 from skinlab.render.techniques.tsd import TsdSettings
 from skinlab.scene import transform as tf
-from skinlab.scene.materials import PRINCIPLED_PARAMS, SSS_MODELS, Param
+from skinlab.scene.materials import PRINCIPLED_PARAMS, SSS_MODELS
 from skinlab.scene.scenefile import ASSETS, DEFAULT_SCENE
 from skinlab.viewer.camera import PITCH_LIMIT, OrbitCamera
 from skinlab.viewer.core import SSS_CYCLE, ViewerCore, next_sss_model
@@ -205,19 +206,26 @@ def test_orbit_from_scene_camera_looks_the_same_way():
 # -- panel model -------------------------------------------------------------------------------------
 
 
-def test_every_param_kind_has_a_widget():
-    kinds = {p.kind for p in PRINCIPLED_PARAMS}
-    assert kinds == set(WIDGETS)  # the declarations use every kind the panel knows
-    for p in PRINCIPLED_PARAMS:
+def test_every_declared_kind_has_a_widget_from_one_table():
+    """Material parameters, render settings and every technique's settings get their widgets from the
+    one table WIDGETS, and together use every kind it knows."""
+    from skinlab.render.registry import techniques
+    from skinlab.render.settings import RenderSettings
+
+    declared = [*PRINCIPLED_PARAMS, *RenderSettings.panel_options().values()]
+    declared += [f for t in techniques() for f in t.settings_type.options().values()]
+    assert {p.kind for p in declared} == set(WIDGETS)  # the declarations use every kind the panel knows
+    for p in declared:
         w = widget_for(p)
-        assert w.widget == WIDGETS[p.kind] and w.param == p.name
+        assert w.widget == WIDGETS[p.kind] + ("_or_auto" if p.none else "") and w.param == p.name
+        assert w.doc == p.help() and p.doc in w.doc  # the tooltip: the one meaning, values and default
         if p.kind in ("float", "color", "vec3", "vec2"):
             assert w.range == tuple(p.range)
         if p.kind == "choice":
             assert w.choices == p.choices and len(w.choices) > 1
-    assert widget_for(Param("subsurface_radius", "vec3", (1, 1, 1), (0.0, 1000.0))).logarithmic
+    assert widget_for(Field("subsurface_radius", "vec3", (1, 1, 1), (0.0, 1000.0))).logarithmic
     with pytest.raises(ValueError, match="weird.*no panel widget for kind 'matrix'"):
-        widget_for(Param("weird", "matrix", None))
+        widget_for(Field("weird", "matrix", None))
 
 
 def test_clamping_per_kind(tmp_path):
@@ -587,7 +595,7 @@ def test_render_settings_widgets_come_from_the_declaration(core):
 
     c, _ = core
     ws = {w.param: w for w in render_widgets(c.settings)}
-    assert list(ws) == list(RenderSettings.options())
+    assert list(ws) == list(RenderSettings.panel_options())
     assert ws["bounces"].widget == "slider_int" and ws["bounces"].range == (0.0, 8.0)
     assert "default: 2 bounces" in ws["bounces"].doc and "rays per vertex" in ws["bounce_rays"].doc
     assert c.set_render_option("bounces", technique_value(c.settings, "bounces", 0)) == 0

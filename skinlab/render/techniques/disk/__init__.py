@@ -12,9 +12,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from skinlab.declare import option
 from skinlab.gl.uniforms import set_uniform
 from skinlab.render.frame_plan import FramePlan, PlannedPass
-from skinlab.render.options import TechniqueSettings, option
+from skinlab.render.options import TechniqueSettings
 from skinlab.render.profile_table import plan_profile_table
 from skinlab.render.technique import ForwardHook, LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading

@@ -7,8 +7,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from skinlab.declare import option
 from skinlab.render.frame_plan import FramePlan
-from skinlab.render.options import TechniqueSettings, option
+from skinlab.render.options import TechniqueSettings
 from skinlab.render.technique import LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.render.techniques.tsd import PASSES as TSD_PASSES
 from skinlab.render.techniques.tsd.forward import TsdForward

@@ -13,8 +13,9 @@ from dataclasses import dataclass, field
 import moderngl
 import numpy as np
 
+from skinlab.declare import option
 from skinlab.gl.uniforms import set_uniforms
-from skinlab.render.options import TechniqueSettings, option
+from skinlab.render.options import TechniqueSettings
 from skinlab.render.scattering import scattering_material
 from skinlab.render.technique import (
     ForwardHook,

@@ -10,9 +10,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from skinlab.declare import option
 from skinlab.gl.uniforms import set_uniform
 from skinlab.render.frame_plan import FramePlan, PlannedPass
-from skinlab.render.options import TechniqueSettings, option
+from skinlab.render.options import TechniqueSettings
 from skinlab.render.technique import ForwardHook, LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
 from skinlab.scene.optics.edges import separable_edge

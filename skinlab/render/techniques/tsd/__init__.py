@@ -7,8 +7,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from skinlab.declare import option
 from skinlab.render.frame_plan import FramePlan
-from skinlab.render.options import TechniqueSettings, option
+from skinlab.render.options import TechniqueSettings
 from skinlab.render.technique import LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
 from skinlab.scene.optics.edges import gaussians_edge, step_edge
 

@@ -1,0 +1,88 @@
+"""Command-line options made from declarations (skinlab/declare.py ``Field``): the option's spelling,
+help (meaning, values, default with its unit) and choices come from the Field, and so do the checks of
+the value given (an error naming the option and what was expected).
+
+Two uses: a *setting* (a render or technique setting, a scene-file key) is None when not given, so
+that the declaration's own default (or the scene's value) holds: :func:`add_setting_option` and
+:func:`setting_value`; a command's *own* option (``--out``, ``--frames``) has its declared default on
+the parsed arguments: :func:`add_command_options`, checked by :func:`check_command_options`."""
+
+from __future__ import annotations
+
+import argparse
+from collections.abc import Iterable
+from typing import Any
+
+from skinlab.declare import Field
+
+_METAVAR = {"int": "N", "float": "X"}
+
+
+def option_flags(f: Field, prefix: str = "") -> list[str]:
+    """``--<prefix><name>`` (underscores as dashes) and the other spellings the field declares."""
+    main = "--" + (prefix + f.name).replace("_", "-")
+    return [main, *(x for x in f.flags if x != main)]
+
+
+def _help(text: str) -> str:
+    return text.replace("%", "%%")  # argparse formats help with %
+
+
+def add_setting_option(
+    parser, f: Field, dest: str, flags: list[str] | None = None, help: str | None = None, metavar: str | None = None
+) -> None:
+    """One option for a declared setting; its value is None unless given (:func:`setting_value`)."""
+    flags = flags or option_flags(f)
+    kw: dict[str, Any] = dict(dest=dest, default=None, help=_help(help or f.help()))
+    if f.kind == "bool":
+        parser.add_argument(*flags, action=argparse.BooleanOptionalAction, **kw)
+    elif f.kind == "choice":
+        parser.add_argument(*flags, choices=f.choices, **kw)
+    else:
+        parser.add_argument(*flags, type=str, metavar=metavar or _METAVAR.get(f.kind, f.name.upper()), **kw)
+
+
+def setting_value(f: Field, raw: Any, flag: str) -> Any:
+    """A given option's value, checked against its declaration (errors name the option); None: not given."""
+    if raw is None:
+        return None
+    if isinstance(raw, str) and f.kind in ("int", "float"):
+        try:
+            raw = int(raw) if f.kind == "int" else float(raw)
+        except ValueError:
+            raise ValueError(f"{flag}: expected {f.expected()}, got {raw!r}") from None
+    return f.check(raw, flag)
+
+
+def add_command_options(parser, fields: Iterable[Field]) -> None:
+    """A command's own options, each from its declaration: a bool is a switch (off unless given), the
+    others take a value with the declared default (check them with :func:`check_command_options`)."""
+    for f in fields:
+        flags = option_flags(f)
+        kw: dict[str, Any] = dict(dest=f.name, default=f.default, help=_help(_command_help(f)))
+        if f.kind == "bool":  # a switch; one that is on by default also has its --no- spelling
+            parser.add_argument(*flags, action=argparse.BooleanOptionalAction if f.default else "store_true", **kw)
+        elif f.kind == "choice":
+            parser.add_argument(*flags, choices=f.choices, **kw)
+        else:
+            meta = f.unit.upper() if f.unit and " " not in f.unit else _METAVAR.get(f.kind, f.name.upper())
+            kind = {"int": int, "float": float}.get(f.kind, str)
+            parser.add_argument(*flags, type=kind, metavar=meta, **kw)
+
+
+def _command_help(f: Field) -> str:
+    if f.kind == "bool":
+        return f"{f.doc} (default: {f.default})" if f.default else f.doc
+    if f.default is None:
+        return f"{f.doc} (default: {f.shown or f.none or 'none'})"
+    values = f"; {f.expected(with_none=False)}" if f.kind in ("int", "float") and f.range else ""
+    unit = f" {f.unit}" if f.unit else ""
+    return f"{f.doc}{values} (default: {f.shown or f'{f.default}{unit}'})"
+
+
+def check_command_options(args, fields: Iterable[Field]) -> None:
+    """Every declared option of a command given a value outside its declaration: an error naming it."""
+    for f in fields:
+        value = getattr(args, f.name, None)
+        if value is not None and f.kind in ("int", "float"):
+            f.check(value, option_flags(f)[0])
