@@ -239,8 +239,8 @@ def scenes_markdown() -> str:
     out.append("| parameter | type | default | range | unit | meaning |")
     out.append("|---|---|---|---|---|---|")
     for p in PRINCIPLED_PARAMS:
-        cells = (_KIND[p.kind], p.default_text(), _fmt_range(p), p.unit or "-", _cell(p.doc))
-        out.append(f"| `{p.name}` | " + " | ".join(cells) + " |")
+        row = (_KIND[p.kind], p.default_text(), _fmt_range(p), p.unit or "-", _cell(p.doc))
+        out.append(f"| `{p.name}` | " + " | ".join(row) + " |")
     out.append("")
     out.append(f"Subsurface models (`sss_model`): {', '.join(f'`{m}`' for m in SSS_MODELS)}; see docs/tsd.md.\n")
     out.append(_COLOUR_RULE)

@@ -450,13 +450,14 @@ class Gui:
 
     def _light_rows(self, rows: Rows, light) -> None:
         panel = self.core.panel
-        rows.row("intensity", "irradiance (directional) or intensity (point) multiplier on the colour")
+        declared = {w.param: w for w in light_widgets(light)}  # tooltips: the [[lights]] keys' meanings
+        rows.row("intensity", declared["intensity"].doc)
         ch, v = imgui.slider_float(
             f"##intensity{light.uid}", float(light.intensity), *LIGHT_INTENSITY, "%.3g", imgui.SliderFlags_.logarithmic
         )
         if ch:
             panel.set_light_intensity(light, v)
-        rows.row("color (linear)")
+        rows.row("color (linear)", declared["color"].doc)
         rgb = [float(x) for x in np.asarray(light.color, np.float64).reshape(-1)[:3]]
         flags = imgui.ColorEditFlags_.float | imgui.ColorEditFlags_.hdr
         ch, v = imgui.color_edit3(f"##color{light.uid}", rgb, flags)

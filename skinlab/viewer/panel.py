@@ -17,6 +17,7 @@ its artist radius ``R = 4 pi l`` in mm (``Medium.artist_radius_mm``; Cycles' con
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -482,44 +483,46 @@ LIGHT_COLOR_MAX = 10.0  # a light's colour channels in the panel (linear, may ex
 ENV_NONE = "(none)"
 
 
+# a light's angular radius (soft shadows of a directional light): the viewer's own setting (a scene
+# file's directional lights are points at infinity; an environment map's sources get theirs from the map)
+LIGHT_ANGULAR_RADIUS = Field(
+    "angular_radius_deg",
+    "float",
+    0.0,
+    (0.0, 10.0),
+    unit="deg",
+    doc="the light's angular radius: soft shadows (0: a point at infinity)",
+)
+
+
+def _light_widget(name: str, value: Any, rng: tuple[float, float] | None = None) -> Widget:
+    """A light's widget from its [[lights]] scene-key declaration; `rng` the slider's reach where the
+    declared range is open-ended (intensity, sizes)."""
+    from skinlab.scene.scenefile import scene_key
+
+    decl = scene_key("[[lights]]", name)
+    return widget_for(decl if rng is None else dataclasses.replace(decl, range=rng), value)
+
+
 def light_widgets(light: LightNode) -> list[Widget]:
     """The panel's widgets for a light: its colour, intensity and shadow, and what its kind has (a
-    spot's cone, an area light's size, a directional light's angular radius: soft shadows)."""
+    spot's cone, an area light's size, a directional light's angular radius: soft shadows), each from
+    its declaration (the scene file's [[lights]] keys; LIGHT_ANGULAR_RADIUS)."""
     top = max(10.0, 2.0 * light.intensity)
     out = [
-        Widget("color", "color_edit3", tuple(float(x) for x in light.color), doc="linear RGB"),
-        Widget("intensity", "slider_float", light.intensity, (0.0, top), doc=INTENSITY_DOC[light.kind]),
-        Widget("cast_shadow", "checkbox", light.cast_shadow, doc="a shadow map (at most 2 lights)"),
+        _light_widget("color", tuple(float(x) for x in light.color), (0.0, LIGHT_COLOR_MAX)),
+        _light_widget("intensity", light.intensity, (0.0, top)),
+        _light_widget("cast_shadow", light.cast_shadow),
     ]
     if light.kind == "spot":
-        out += [
-            Widget("inner_deg", "slider_float", light.inner_deg, (0.0, 90.0), unit="deg", doc="full beam half-angle"),
-            Widget("outer_deg", "slider_float", light.outer_deg, (0.1, 90.0), unit="deg", doc="dark past this"),
-        ]
+        out += [_light_widget("inner_deg", light.inner_deg), _light_widget("outer_deg", light.outer_deg, (0.1, 90.0))]
     elif light.kind in ("rect", "sphere"):
         scale = 4.0 * max(light.width, light.height, light.radius)
         names = ("width", "height") if light.kind == "rect" else ("radius",)
-        out += [
-            Widget(n, "slider_float", getattr(light, n), (1e-3 * scale, scale), unit="scene units", doc="soft shadows")
-            for n in names
-        ]
+        out += [_light_widget(n, getattr(light, n), (1e-3 * scale, scale)) for n in names]
     elif light.kind == "directional":
-        out.append(
-            Widget(
-                "angular_radius_deg", "slider_float", math.degrees(light.angular_radius), (0.0, 10.0), unit="deg",
-                doc="the light's angular radius: soft shadows (0: a point at infinity)",
-            )
-        )  # fmt: skip
+        out.append(widget_for(LIGHT_ANGULAR_RADIUS, math.degrees(light.angular_radius)))
     return out
-
-
-INTENSITY_DOC = {
-    "directional": "irradiance multiplier on colour",
-    "point": "intensity multiplier (inverse square of the distance in metres)",
-    "spot": "intensity multiplier (inverse square of the distance in metres)",
-    "rect": "emitted radiance multiplier",
-    "sphere": "emitted radiance multiplier",
-}
 
 
 # -- the current technique's and the render settings (declared with skinlab.declare.option) --------------------

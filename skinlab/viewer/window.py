@@ -60,8 +60,8 @@ class ViewerWindow:
         watch: bool = True,
         screenshot_dir="out/screenshots",
         shader_root=None,
-        shadow_size: int = 2048,
-        technique="tsd",
+        shadow_size: int | None = None,
+        technique: str | None = None,
         settle_s: float = 0.05,
         continuous: bool = False,
         show_ui: bool = True,
@@ -69,7 +69,8 @@ class ViewerWindow:
         edits=None,
         prepare=None,
     ):
-        """``settings`` (its size follows the window) replaces ``shadow_size`` and ``technique`` when given;
+        """``settings`` (its size follows the window) replaces ``shadow_size`` and ``technique`` when given
+        (without either: RenderSettings' declared defaults);
         ``edits`` and ``prepare``: the command line's scene options (skinlab/viewer/core.py ViewerCore)."""
         if sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
             raise ViewerError(
@@ -99,7 +100,8 @@ class ViewerWindow:
 
         fw, fh = self.window.get_framebuffer_size()
         if settings is None:
-            settings = RenderSettings(shadow_size=shadow_size, technique=technique)
+            given = {"shadow_size": shadow_size, "technique": technique}
+            settings = RenderSettings(**{k: v for k, v in given.items() if v is not None})
         settings = dataclasses.replace(settings, width=max(fw, 1), height=max(fh, 1))
         try:
             self.core = ViewerCore(

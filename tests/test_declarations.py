@@ -1,0 +1,171 @@
+"""Every setting is declared once (skinlab/declare.py Field): each option of `skinlab render` and `skinlab view`,
+each viewer widget and each scene-file key comes from a declaration, its default stated there alone."""
+
+import argparse
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from skinlab.cli import build_parser
+from skinlab.commands.render import RENDER_OPTIONS, settings_from_args
+from skinlab.commands.scene_options import CAMERA_ORBIT, SET_OPTION
+from skinlab.commands.view import VIEW_OPTIONS
+from skinlab.declare import Field
+from skinlab.render.registry import techniques
+from skinlab.render.settings import RenderSettings
+from skinlab.scene.graph import LightNode
+from skinlab.scene.materials import PRINCIPLED_PARAMS, Material
+from skinlab.scene.scenefile import SCENE_FILE_KEYS, SceneFileError, load_scene, scene_key
+from skinlab.viewer.panel import (
+    LIGHT_ANGULAR_RADIUS,
+    WIDGETS,
+    light_widgets,
+    material_widgets,
+    render_widgets,
+    technique_widgets,
+)
+
+ROOT = Path(__file__).resolve().parents[1]
+BUNNY = ROOT / "skinlab/assets/stanford-bunny/bunny.ply"
+
+
+def declarations() -> list[Field]:
+    out = [*PRINCIPLED_PARAMS, *RenderSettings.fields().values(), *RENDER_OPTIONS, *VIEW_OPTIONS]
+    out += [CAMERA_ORBIT, SET_OPTION, LIGHT_ANGULAR_RADIUS]
+    out += [f for t in techniques() for f in t.settings_type.options().values()]
+    return out + [f for keys in SCENE_FILE_KEYS.values() for f in keys]
+
+
+def command_options(command: str) -> dict[str, argparse.Action]:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return {flag: a for a in sub.choices[command]._actions for flag in a.option_strings}
+
+
+@pytest.mark.parametrize("command", ["render", "view"])
+def test_every_option_of_render_and_view_comes_from_a_declaration(command):
+    docs = [f.doc.replace("%", "%%") for f in declarations() if f.doc]
+    options = command_options(command)
+    assert len(options) > 40  # the parser is real: frame, technique, scene and own options
+    for flag, action in options.items():
+        if flag in ("-h", "--help", "--technique"):  # argparse's own; the registry's descriptions
+            continue
+        assert any(doc in action.help for doc in docs), f"{command} {flag}: help from no declaration"
+
+
+def test_render_settings_are_options_of_both_commands_with_their_declared_help():
+    render, view = command_options("render"), command_options("view")
+    for name, f in RenderSettings.fields().items():
+        flag = "--" + name.replace("_", "-")
+        if not f.cli:  # width, height (--size), background, ...: no option of theirs
+            # (--background is the [environment] show_background key's, another meaning)
+            assert all(flag not in o or f.doc not in o[flag].help for o in (render, view)), flag
+            continue
+        for options in (render, view):
+            a = options[flag]
+            assert a.help == f.help() and a.default is None, flag  # None: the declaration's default holds
+            assert all(options[extra] is a for extra in f.flags)  # --sss: the same option as --sss-model
+    assert {"--shadow-size", "--sss", "--bounces", "--supersample", "--exposure", "--camera-orbit"} <= set(view)
+
+
+def test_shadow_size_has_one_default_stated_in_its_declaration():
+    decl = RenderSettings.fields()["shadow_size"]
+    assert decl.default == RenderSettings().shadow_size == 2048 and decl.unit == "texels"
+    st = settings_from_args(build_parser().parse_args(["render"]), 8, 8)
+    assert (
+        st.shadow_size == decl.default and "(default: 2048 texels)" in command_options("render")["--shadow-size"].help
+    )
+    # no module but the declaration writes a shadow-size default: a line naming a shadow size with 2048
+    for path in (ROOT / "skinlab").rglob("*.py"):
+        if path.name == "settings.py" and path.parent.name == "render":
+            continue
+        for line in path.read_text(encoding="utf-8").splitlines():
+            assert not re.search(r"shadow.?size\W.*\b2048\b", line), (path, line)
+    # `skinlab bench reload --shadow-size` is a distinct option (its own default), and its help says so
+    bench = build_parser()._actions
+    sub = next(a for a in bench if isinstance(a, argparse._SubParsersAction)).choices["bench"]
+    reload_cmd = next(a for a in sub._actions if isinstance(a, argparse._SubParsersAction)).choices["reload"]
+    a = next(a for a in reload_cmd._actions if "--shadow-size" in a.option_strings)
+    assert a.default == 512 and "this benchmark's own default" in a.help and "render's 2048" in a.help
+    assert decl.doc in a.help
+
+
+def test_every_viewer_widget_comes_from_a_declaration():
+    st = RenderSettings()
+    assert [w.param for w in render_widgets(st)] == list(RenderSettings.panel_options())
+    for w in render_widgets(st):
+        assert w.doc == RenderSettings.fields()[w.param].help()
+    for t in techniques():
+        s = t.settings_type()
+        ws = technique_widgets(s)
+        assert [w.param for w in ws] == list(s.options())
+        assert all(w.doc == s.options()[w.param].help() for w in ws)
+    ws = material_widgets(Material("m"))
+    assert [w.param for w in ws] == [p.name for p in PRINCIPLED_PARAMS]
+    assert all(w.doc == p.help() for w, p in zip(ws, PRINCIPLED_PARAMS, strict=True))
+    kinds = ("directional", "point", "spot", "rect", "sphere")
+    for kind in kinds:
+        for w in light_widgets(LightNode("l", kind)):
+            decl = LIGHT_ANGULAR_RADIUS if w.param == LIGHT_ANGULAR_RADIUS.name else scene_key("[[lights]]", w.param)
+            assert decl.doc in w.doc and w.widget.startswith(WIDGETS[decl.kind]), (kind, w.param)
+
+
+def test_every_declared_default_is_a_valid_value_of_its_declaration():
+    checked = 0
+    for f in declarations():
+        if f.default is None or f.kind in ("table", "tables", "vec4", "scale", "texture"):
+            continue
+        value = f.check(f.default)
+        assert np.allclose(value, f.default) if f.kind in ("float", "color", "vec3", "vec2") else value == f.default
+        checked += 1
+    assert checked > 60
+
+
+def test_scene_keys_are_read_with_their_declared_defaults(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(
+        f'[[meshes]]\nfile = "{BUNNY}"\n[camera]\nposition = [0, 0, 5]\n'
+        '[[lights]]\ntype = "spot"\nposition = [0, 0, 3]\n[[lights]]\ntype = "rect"\nposition = [0, 1, 3]\n'
+        '[[lights]]\ntype = "sphere"\nposition = [1, 0, 3]\n',
+        encoding="utf-8",
+    )
+    scene = load_scene(path)
+    key = lambda section, name: scene_key(section, name).default  # noqa: E731
+    cam = scene.camera
+    assert (cam.znear, cam.zfar) == (key("[camera]", "znear"), key("[camera]", "zfar"))
+    assert np.isclose(np.degrees(cam.yfov), key("[camera]", "yfov_deg"))
+    assert scene.environment.exposure == key("[environment]", "exposure")
+    assert np.allclose(scene.environment.ambient, key("[environment]", "ambient"))
+    spot, rect, sphere = scene.lights()
+    assert (spot.inner_deg, spot.outer_deg) == (key("[[lights]]", "inner_deg"), key("[[lights]]", "outer_deg"))
+    assert (rect.width, rect.height, sphere.radius) == tuple(
+        key("[[lights]]", n) for n in ("width", "height", "radius")
+    )
+    assert spot.intensity == key("[[lights]]", "intensity") and spot.cast_shadow is key("[[lights]]", "cast_shadow")
+    assert np.allclose(spot.color, key("[[lights]]", "color")) and spot.name == "light1"
+    # the API's own defaults (LightNode, CameraNode) are the scene file's
+    api = LightNode("x", "spot")
+    assert (api.inner_deg, api.outer_deg, api.intensity) == (spot.inner_deg, spot.outer_deg, spot.intensity)
+
+
+def test_unknown_scene_keys_are_refused_naming_every_declared_one(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(f'[[meshes]]\nfile = "{BUNNY}"\n[camera]\nfov = 30\n', encoding="utf-8")
+    with pytest.raises(SceneFileError) as exc:
+        load_scene(path)
+    msg = str(exc.value)
+    assert "[camera]: unknown key(s) fov; expected some of" in msg
+    assert all(k.name in msg for k in SCENE_FILE_KEYS["[camera]"])
+
+
+def test_a_bad_value_is_one_line_naming_it_and_what_was_expected():
+    f = RenderSettings.fields()["bounces"]
+    with pytest.raises(ValueError, match=r"^render setting bounces: expected an integer in \[0, 8\], got 9$"):
+        RenderSettings(bounces=9)
+    with pytest.raises(ValueError, match=r"^material 'm': roughness: expected a number in \[0, 1\], got 2$"):
+        Material("m", {"roughness": 2})
+    assert f.clamp(9.6) == 8 and f.clamp(float("nan")) == f.default
+    with pytest.raises(ValueError, match=r"^exposure: expected a number > 0, got 0$"):
+        scene_key("[environment]", "exposure").check(0)
