@@ -5,7 +5,30 @@ maps (skinlab/truth/metrics.py has the definitions)."""
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
+
+from skinlab.commands.field_options import add_command_options, check_command_options
+from skinlab.declare import Field
+
+COMPARE_OPTIONS = (
+    Field(
+        "out",
+        "string",
+        doc="write the signed relative-difference map here (PNG: red brighter than B, blue darker, full colour at "
+        "+-50 %) and the FLIP map beside it (NAME-flip.png)",
+        shown="none",
+    ),
+    Field(
+        "exposure",
+        "float",
+        1.0,
+        (0.0, math.inf),
+        lo_open=True,
+        doc="linear multiplier on both images' radiance before tone mapping, for FLIP",
+    ),
+    Field("json", "bool", False, doc="print the result as JSON"),
+)
 
 
 def register(sub) -> None:
@@ -21,12 +44,7 @@ def register(sub) -> None:
     )
     p.add_argument("a", help="the image to judge (.exr linear, or .png/.jpg sRGB)")
     p.add_argument("b", help="the reference image, of the same size")
-    p.add_argument(
-        "--out", default=None, help="write the signed relative-difference map here (PNG: red brighter than B, blue "
-        "darker, full colour at +-50 %%) and the FLIP map beside it (NAME-flip.png)",
-    )  # fmt: skip
-    p.add_argument("--exposure", type=float, default=1.0, help="exposure before tone mapping for FLIP (default 1)")
-    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    add_command_options(p, COMPARE_OPTIONS)
     p.set_defaults(func=run)
 
 
@@ -121,13 +139,10 @@ def finite_json(v):
 
 
 def run(args) -> int:
-    import math
-
     from skinlab.image_output import check_output_path, write_image
     from skinlab.truth.compare import error_map_rgb, magma_rgb
 
-    if not (args.exposure > 0 and math.isfinite(args.exposure)):
-        raise ValueError(f"--exposure: expected a number > 0, got {args.exposure}")
+    check_command_options(args, COMPARE_OPTIONS)  # --exposure > 0
     out = check_output_path(args.out, "--out") if args.out else None
     a, lin_a = load_for_compare(args.a, "A")
     b, lin_b = load_for_compare(args.b, "B")

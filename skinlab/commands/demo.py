@@ -8,24 +8,32 @@ import sys
 from pathlib import Path
 
 from skinlab.atomic_write import write_text_atomic
+from skinlab.commands.field_options import add_command_options
+from skinlab.commands.render import RENDER_OPTIONS
+from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings, parse_size
 from skinlab.resources import scenes_root
 
 ASSETS = scenes_root()
 BUNNIES = ("marble", "skimmilk", "ketchup")
 
+DEMO_OPTIONS = (
+    Field("out", "string", "out", doc="output folder"),
+    next(f for f in RENDER_OPTIONS if f.name == "size"),  # the image size, as `skinlab render --size`
+    Field(
+        "gallery",
+        "bool",
+        False,
+        doc="also render the head with each SSS model and the bunny presets into OUT/gallery "
+        "(one PNG each, gallery.md and the labelled contact sheet gallery.png)",
+    ),
+    Field("no_progress", "bool", False, doc="no progress bar for --gallery"),
+)
+
 
 def register(sub) -> None:
     p = sub.add_parser("demo", help="render the default head scene into OUT (PNG + EXR)")
-    p.add_argument("--out", default="out", help="output folder (default out/)")
-    p.add_argument("--size", default="640x640", help="image size WIDTHxHEIGHT in pixels (default 640x640)")
-    p.add_argument(
-        "--gallery",
-        action="store_true",
-        help="also render the head with each SSS model and the bunny presets into OUT/gallery "
-        "(one PNG each, gallery.md and the labelled contact sheet gallery.png)",
-    )
-    p.add_argument("--no-progress", action="store_true", help="no progress bar for --gallery")
+    add_command_options(p, DEMO_OPTIONS)
     p.set_defaults(func=run)
 
 

@@ -7,13 +7,17 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from skinlab.commands.field_options import add_command_options
 from skinlab.commands.scene_options import add_scene_edit_options, scene_edits_from_args
+from skinlab.declare import Field
+
+EXPORT_OPTIONS = (Field("out", "string", "out/scene.glb", doc="output .glb or .gltf"),)
 
 
 def register(sub) -> None:
     p = sub.add_parser("export", help="write a scene as glTF 2.0 (.glb or .gltf) with its materials, lights and camera")
     p.add_argument("scene", nargs="?", help="scene file (TOML) or a mesh file; default: the Lee Perry-Smith head")
-    p.add_argument("--out", default="out/scene.glb", help="output .glb or .gltf (default out/scene.glb)")
+    add_command_options(p, EXPORT_OPTIONS)
     add_scene_edit_options(p)
     p.set_defaults(func=run)
 

@@ -5,10 +5,15 @@ from __future__ import annotations
 
 import json
 
+from skinlab.commands.field_options import add_command_options
+from skinlab.declare import Field
+
+SCENES_OPTIONS = (Field("json", "bool", False, doc="print name, file and summary of each as JSON"),)
+
 
 def register(sub) -> None:
     p = sub.add_parser("scenes", help="list the bundled scenes (names for render, view, reference and skinlab.load)")
-    p.add_argument("--json", action="store_true", help="print name, file and summary of each as JSON")
+    add_command_options(p, SCENES_OPTIONS)
     p.set_defaults(func=run)
 
 
