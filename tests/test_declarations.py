@@ -151,9 +151,18 @@ def test_scene_keys_are_read_with_their_declared_defaults(tmp_path):
     )
     assert spot.intensity == key("[[lights]]", "intensity") and spot.cast_shadow is key("[[lights]]", "cast_shadow")
     assert np.allclose(spot.color, key("[[lights]]", "color")) and spot.name == "light1"
-    # the API's own defaults (LightNode, CameraNode) are the scene file's
+    # the API's own defaults (LightNode, Environment, MeasureSpec: what parse_measure builds) are the scene file's
+    from skinlab.scene.graph import Environment
+    from skinlab.scene.measure import MeasureSpec
+
     api = LightNode("x", "spot")
     assert (api.inner_deg, api.outer_deg, api.intensity) == (spot.inner_deg, spot.outer_deg, spot.intensity)
+    env = Environment()
+    for f in SCENE_FILE_KEYS["[environment]"]:
+        if f.default is not None:
+            assert np.allclose(getattr(env, f.name), f.default), f.name
+    spec = MeasureSpec()
+    assert all(getattr(spec, f.name) == f.default for f in SCENE_FILE_KEYS["[measure]"])
 
 
 def test_unknown_scene_keys_are_refused_naming_every_declared_one(tmp_path):
