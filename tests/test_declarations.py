@@ -21,7 +21,8 @@ from skinlab.render.registry import techniques
 from skinlab.render.settings import RenderSettings
 from skinlab.scene.graph import LightNode
 from skinlab.scene.materials import PRINCIPLED_PARAMS, Material
-from skinlab.scene.scenefile import SCENE_FILE_KEYS, SceneFileError, load_scene, scene_key
+from skinlab.scene.scene_keys import SCENE_FILE_KEYS, scene_key
+from skinlab.scene.scenefile import SceneFileError, load_scene
 from skinlab.viewer.panel import (
     LIGHT_ANGULAR_RADIUS,
     WIDGETS,

@@ -8,8 +8,7 @@ import sys
 from pathlib import Path
 
 from skinlab.atomic_write import write_text_atomic
-from skinlab.commands.field_options import add_command_options
-from skinlab.commands.render import RENDER_OPTIONS
+from skinlab.commands.field_options import IMAGE_SIZE, add_command_options
 from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings, parse_size
 from skinlab.resources import scenes_root
@@ -19,7 +18,7 @@ BUNNIES = ("marble", "skimmilk", "ketchup")
 
 DEMO_OPTIONS = (
     Field("out", "string", "out", doc="output folder"),
-    next(f for f in RENDER_OPTIONS if f.name == "size"),  # the image size, as `skinlab render --size`
+    IMAGE_SIZE,  # as `skinlab render --size`
     Field(
         "gallery",
         "bool",

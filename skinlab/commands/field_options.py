@@ -17,6 +17,9 @@ from skinlab.declare import Field
 
 _METAVAR = {"int": "N", "float": "X"}
 
+# an option two commands share with one meaning (`skinlab render --size`, `skinlab demo --size`)
+IMAGE_SIZE = Field("size", "string", "640x640", doc="image size WIDTHxHEIGHT in pixels")
+
 
 def option_flags(f: Field, prefix: str = "") -> list[str]:
     """``--<prefix><name>`` (underscores as dashes) and the other spellings the field declares."""

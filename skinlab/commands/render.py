@@ -9,7 +9,7 @@ import json
 import sys
 from pathlib import Path
 
-from skinlab.commands.field_options import add_command_options
+from skinlab.commands.field_options import IMAGE_SIZE, add_command_options
 from skinlab.commands.scene_options import (
     add_scene_edit_options,
     add_scene_look_options,
@@ -28,7 +28,7 @@ RENDER_OPTIONS = (
         "out/render.png",
         doc="output image: .png (tone mapped, 8-bit sRGB) or .exr (linear radiance, 32-bit float, with alpha)",
     ),
-    Field("size", "string", "640x640", doc="image size WIDTHxHEIGHT in pixels"),
+    IMAGE_SIZE,
     Field("json", "bool", False, doc="print outputs, timings and the frame plan as JSON"),
     Field("explain", "bool", False, doc="print the frame plan (passes and why each runs)"),
     Field(

@@ -26,7 +26,7 @@ SET_OPTION = Field(
 def add_scene_edit_options(p) -> None:
     """--preset, --set and --mm-per-unit: edits of the scene file's data, validated as the keys they
     edit ([materials.NAME] preset on every material, any key, [scene] mm_per_unit)."""
-    from skinlab.scene.scenefile import scene_key
+    from skinlab.scene.scene_keys import scene_key
 
     preset = scene_key("[materials.NAME]", "preset")
     p.add_argument(
@@ -96,7 +96,7 @@ def add_scene_look_options(p) -> None:
     --camera-orbit: how the built scene is lit, exposed and seen (`skinlab render` and `skinlab view`), each from the
     [environment] key of the same meaning (skinlab/scene/scenefile.py SCENE_FILE_KEYS)."""
     from skinlab.commands.field_options import add_command_options, add_setting_option
-    from skinlab.scene.scenefile import scene_key
+    from skinlab.scene.scene_keys import scene_key
 
     for flag, key, metavar in LOOK_OPTIONS:
         f = scene_key("[environment]", key)
@@ -114,7 +114,7 @@ def add_scene_look_options(p) -> None:
 def _look_values(args) -> dict:
     """The given --exposure and environment options, checked against their scene keys' declarations."""
     from skinlab.commands.field_options import setting_value
-    from skinlab.scene.scenefile import scene_key
+    from skinlab.scene.scene_keys import scene_key
 
     out = {}
     for flag, key, _ in LOOK_OPTIONS:

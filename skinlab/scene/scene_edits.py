@@ -50,14 +50,14 @@ def make_edits(preset_name=None, mm_per_unit=None, sets=(), option: str = "") ->
     """Checked SceneEdits (None if empty): a preset that exists, mm_per_unit > 0, each set a
     ``KEY=VALUE`` string or a (key, value) pair. Errors name the option (``option="--"``: the command
     line's spelling)."""
-    import math
+    if mm_per_unit is not None:  # checked as the [scene] key it sets
+        from .scene_keys import scene_key
 
-    if mm_per_unit is not None:
-        ok = isinstance(mm_per_unit, int | float) and not isinstance(mm_per_unit, bool)
-        if not ok or not (math.isfinite(mm_per_unit) and 0 < mm_per_unit <= 1e12):
-            raise SceneEditError(f"{option}mm{'-' if option else '_'}per{'-' if option else '_'}unit: expected "
-                                 f"millimetres per scene unit > 0, got {mm_per_unit!r}")  # fmt: skip
-        mm_per_unit = float(mm_per_unit)
+        label = f"{option}mm-per-unit" if option else "mm_per_unit"
+        try:
+            mm_per_unit = float(scene_key("[scene]", "mm_per_unit").check(mm_per_unit, label))
+        except ValueError as exc:
+            raise SceneEditError(str(exc)) from None
     if preset_name is not None:
         from .optics.media import preset
 

@@ -498,7 +498,7 @@ LIGHT_ANGULAR_RADIUS = Field(
 def _light_widget(name: str, value: Any, rng: tuple[float, float] | None = None) -> Widget:
     """A light's widget from its [[lights]] scene-key declaration; `rng` the slider's reach where the
     declared range is open-ended (intensity, sizes)."""
-    from skinlab.scene.scenefile import scene_key
+    from skinlab.scene.scene_keys import scene_key
 
     decl = scene_key("[[lights]]", name)
     return widget_for(decl if rng is None else dataclasses.replace(decl, range=rng), value)

@@ -29,7 +29,7 @@ def test_values_read_as_toml_words_and_comma_lists():
             parse_set(bad)
     with pytest.raises(SceneEditError, match=r"--preset: unknown material 'jam'; choose one of .*marble"):
         make_edits("jam", option="--")
-    with pytest.raises(SceneEditError, match=r"--mm-per-unit: expected millimetres per scene unit > 0, got -1"):
+    with pytest.raises(SceneEditError, match=r"--mm-per-unit: expected a number >= 1e-12, got -1"):
         make_edits(mm_per_unit=-1, option="--")
 
 

@@ -2,7 +2,7 @@
 
 from skinlab.scene.materials import PRINCIPLED_PARAMS
 from skinlab.scene.scene_docs import DOC_PATH, main, scenes_markdown
-from skinlab.scene.scenefile import SCENE_FILE_KEYS
+from skinlab.scene.scene_keys import SCENE_FILE_KEYS
 
 
 def test_docs_scenes_md_is_up_to_date():
@@ -27,10 +27,10 @@ def test_every_key_and_parameter_is_documented_with_its_meaning():
 
 
 def test_a_declared_key_change_makes_the_docs_stale(monkeypatch):
-    from skinlab.scene import scenefile
+    from skinlab.scene import scene_keys
 
     changed = dict(SCENE_FILE_KEYS)
     changed["[scene]"] = changed["[scene]"][:1]
     monkeypatch.setattr("skinlab.scene.scene_docs.SCENE_FILE_KEYS", changed)
     assert scenes_markdown() != DOC_PATH.read_text(encoding="utf-8")
-    assert scenefile.SCENE_FILE_KEYS["[scene]"][1].name == "mm_per_unit"
+    assert scene_keys.SCENE_FILE_KEYS["[scene]"][1].name == "mm_per_unit"

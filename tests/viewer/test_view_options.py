@@ -63,7 +63,7 @@ def test_view_options_build_the_settings_and_edits_render_would():
         (["--supersample", "x"], "--supersample: expected"),
         (["--exposure", "0"], "--exposure: expected a number > 0, got 0.0"),
         (["--preset", "jam"], "--preset: unknown material 'jam'"),
-        (["--mm-per-unit", "-1"], "--mm-per-unit: expected millimetres per scene unit > 0"),
+        (["--mm-per-unit", "-1"], "--mm-per-unit: expected a number >= 1e-12, got -1.0"),
         (["--set", "glow=1"], "glow: not a material parameter"),
         (["--environment-intensity", "-1"], "--environment-intensity: expected a number >= 0, got -1.0"),
     ],
