@@ -226,10 +226,16 @@ def option(default: Any, doc: str, kind: str, **kw: Any) -> Any:
     return dataclasses.field(default=default, metadata={"declared": Field("", kind, default, doc=doc, **kw)})
 
 
-def declared_fields(cls: Any) -> dict[str, Field]:
-    """The fields of a dataclass declared with :func:`option`, by name, in order."""
-    return {
-        f.name: dataclasses.replace(f.metadata["declared"], name=f.name)
-        for f in dataclasses.fields(cls)
-        if "declared" in f.metadata
-    }
+_DECLARED: dict[type, dict[str, Field]] = {}  # per dataclass, made once
+
+
+def declared_fields(cls: type) -> dict[str, Field]:
+    """The fields of a dataclass declared with :func:`option`, by name, in order (made once per class;
+    the dict is shared: do not change it)."""
+    if cls not in _DECLARED:
+        _DECLARED[cls] = {
+            f.name: dataclasses.replace(f.metadata["declared"], name=f.name)
+            for f in dataclasses.fields(cls)
+            if "declared" in f.metadata
+        }
+    return _DECLARED[cls]

@@ -19,7 +19,7 @@ from skinlab.commands.view import VIEW_OPTIONS
 from skinlab.declare import Field
 from skinlab.render.registry import techniques
 from skinlab.render.settings import RenderSettings
-from skinlab.scene.graph import LightNode
+from skinlab.scene.graph import CameraNode, LightNode
 from skinlab.scene.materials import PRINCIPLED_PARAMS, Material
 from skinlab.scene.scene_keys import SCENE_FILE_KEYS, scene_key
 from skinlab.scene.scenefile import SceneFileError, load_scene
@@ -158,6 +158,10 @@ def test_scene_keys_are_read_with_their_declared_defaults(tmp_path):
 
     api = LightNode("x", "spot")
     assert (api.inner_deg, api.outer_deg, api.intensity) == (spot.inner_deg, spot.outer_deg, spot.intensity)
+    api_cam = CameraNode()
+    assert (api_cam.znear, api_cam.zfar, api_cam.yfov) == (cam.znear, cam.zfar, cam.yfov)
+    framed = load_scene(BUNNY).camera  # a mesh file's camera frames it with the declared field of view
+    assert np.isclose(np.degrees(framed.yfov), key("[camera]", "yfov_deg"))
     env = Environment()
     for f in SCENE_FILE_KEYS["[environment]"]:
         if f.default is not None:

@@ -712,8 +712,9 @@ def flip_v(mesh: Mesh | None) -> Mesh | None:
     return _FLIPPED[mesh.uid]
 
 
-def default_camera(scene: Scene, yfov_deg: float = 30.0) -> CameraNode:
-    """A camera on +Z framing the scene's bounds."""
+def default_camera(scene: Scene, yfov_deg: float | None = None) -> CameraNode:
+    """A camera on +Z framing the scene's bounds (field of view: [camera] yfov_deg's declared default)."""
+    yfov_deg = scene_key("[camera]", "yfov_deg").default if yfov_deg is None else yfov_deg
     lo, hi = scene.world_bounds()
     centre = (lo + hi) / 2
     radius = max(np.linalg.norm(hi - lo) / 2, 1e-6)
