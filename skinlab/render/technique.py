@@ -121,7 +121,7 @@ class NodeShading:
     material: Any
     hook: str = PLAIN_HOOK
     defines: dict[str, object] = field(default_factory=dict)
-    bind: Callable[[moderngl.Program, TextureUnits], None] | None = None
+    bind: Callable[[moderngl.Program, TextureUnits], object] | None = None  # its result is not used
     # the mesh scatters below its surface: the forward pass binds its medium's entry/exit factors
     # and single scattering (skinlab/render/boundary.py); False for a hook that shades it without
     subsurface: bool = True

@@ -57,20 +57,21 @@ def test_screen_space_sss_follows_its_separable_kernel(renderer, multiple_only):
         res = renderer.render(scene, st)
         assert [p.kind for p in res.plan.passes] == ["shadow", "forward", "ssss_blur", "tonemap"]
         plan = res.plan.passes[2].params.ssss
-        assert len(plan.offsets_mm) == taps
+        kernel = plan.kernels[0]  # the frame's one scattering material
+        assert plan.taps == len(kernel.offsets_mm) == taps
         row, lit = edge_row(res, n)
         x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
             scene, 2 * scene.mm_per_unit / n
         )  # where the light entered
-        own = ssss.separable_edge_response(-x_mm, plan.offsets_mm, plan.weights)
+        own = ssss.separable_edge_response(-x_mm, kernel.offsets_mm, kernel.weights)
         err = np.abs(row / lit - own)
         assert err.max() < 0.02 + 1.0 / taps, (taps, err.max(axis=0))
-        medium = material_medium(plan.material.values)
+        medium = material_medium(kernel.material.values)
         exact = tsd.edge_response(-x_mm, exact_profile("burley", medium), "profile")
         assert np.abs(row / lit - exact).max() < 0.06 + 1.0 / taps
     # the kernel itself: weights sum to 1 per channel, symmetric offsets
-    np.testing.assert_allclose(plan.weights.sum(axis=0), 1.0)
-    np.testing.assert_allclose(plan.offsets_mm, -plan.offsets_mm[::-1])
+    np.testing.assert_allclose(kernel.weights.sum(axis=0), 1.0)
+    np.testing.assert_allclose(kernel.offsets_mm, -kernel.offsets_mm[::-1])
 
 
 def test_screen_space_sss_does_not_bleed_across_depth_discontinuities(renderer):

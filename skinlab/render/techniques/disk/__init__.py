@@ -47,9 +47,8 @@ class DiskForward(ForwardHook):
 
     outputs = (DIFFUSE_TARGET,)
 
-    @property
-    def reason(self) -> str:
-        return (
+    def __post_init__(self) -> None:
+        self.reason = (
             "; subsurface diffuse"
             + (f" and {REASON}" if self.translucency else "")
             + (" and profile index to a second target for the disk pass")

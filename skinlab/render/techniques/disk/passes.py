@@ -8,9 +8,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import moderngl
 import numpy as np
 
-from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
+from skinlab.gl.uniforms import Shader, set_array, set_uniform, set_uniforms
 from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
 from skinlab.render.profile_table import MAX_PROFILES
@@ -51,6 +52,7 @@ class DiskPass(RenderPass):
         ffilt, fout = self._gpu.fbos
         cam = frame.scene.camera
         table = self._gpu.table(prm.table())
+        prog: Shader
         if prm.compute:
             prog = self.r.programs.compute("techniques/disk/gather.comp")
         else:
@@ -74,7 +76,7 @@ class DiskPass(RenderPass):
         frame.targets[DIFFUSE_TARGET].use(0)
         frame.targets["depth"].use(1)
         table.use(2)
-        if prm.compute:  # the gather and the composite in one dispatch
+        if isinstance(prog, moderngl.ComputeShader):  # the gather and the composite in one dispatch
             frame.targets["hdr_color"].use(3)
             set_uniform(prog, "u_color", 3)
             bind_images(prog, {"u_dst": filtered, "u_composite": out})

@@ -8,7 +8,7 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from skinlab.gl.uniforms import set_uniforms
+from skinlab.gl.uniforms import Shader, set_uniforms
 from skinlab.render.techniques.tsd.passes import TsdPass, store
 from skinlab.render.techniques.tsd.plan import TsdExactParams
 from skinlab.scene.optics.material_medium import material_medium
@@ -59,6 +59,7 @@ class TsdExactPass(TsdPass):
         t = store(self.r).targets(node, size)
         lut, r_max = self.lut(prm.model, material_medium(prm.material.values))
         dst = t.level(ctx, 0)
+        prog: Shader
         if prm.compute:
             prog = self.r.programs.compute("techniques/exact/gather.comp")
         else:
@@ -79,6 +80,6 @@ class TsdExactPass(TsdPass):
         t.irradiance.use(0)
         t.stretch.use(1)
         lut.use(2)
-        t.draw_into(self.r, prog, dst, prm.compute)
+        t.draw_into(self.r, prog, dst)
         t.irradiance.filter = (moderngl.LINEAR, moderngl.LINEAR)
         self.publish(frame, p)

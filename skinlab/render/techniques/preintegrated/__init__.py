@@ -96,15 +96,13 @@ class PreintegratedForward(ForwardHook):
     state: LutTextures | None = None
     translucency: bool = False  # add the light through thin parts (shadow distance maps) per light
 
-    @property
-    def reason(self) -> str:
-        if not self.nodes:
-            return ""
-        return (
-            "; pre-integrated skin lookup (N.L x curvature)"
-            + (f" and {REASON}" if self.translucency else "")
-            + (f" for {len(self.nodes)}")
-        )
+    def __post_init__(self) -> None:
+        if self.nodes:
+            self.reason = (
+                "; pre-integrated skin lookup (N.L x curvature)"
+                + (f" and {REASON}" if self.translucency else "")
+                + (f" for {len(self.nodes)}")
+            )
 
     def shading(self, node, frame):
         hit = self.nodes.get(node.uid)

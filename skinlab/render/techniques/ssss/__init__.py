@@ -45,9 +45,8 @@ class SsssForward(ForwardHook):
 
     outputs = (DIFFUSE_TARGET,)
 
-    @property
-    def reason(self) -> str:
-        return (
+    def __post_init__(self) -> None:
+        self.reason = (
             "; subsurface diffuse"
             + (f" and {REASON}" if self.translucency else "")
             + (" to a second target for the screen-space blur")
@@ -105,9 +104,7 @@ class SsssTechnique(Technique[SsssSettings]):
                 from skinlab.scene.optics.profile_fit import profile_fit
                 from skinlab.scene.optics.ssss import ssss_kernel
 
-                offsets, weights, _ = ssss_kernel(
-                    profile_fit(model, medium, p.params.gaussians), len(p.params.ssss.offsets_mm)
-                )
+                offsets, weights, _ = ssss_kernel(profile_fit(model, medium, p.params.gaussians), p.params.ssss.taps)
                 return separable_edge(offsets, weights)
         return super().edge_response(model, medium, plan)
 

@@ -8,9 +8,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import moderngl
 import numpy as np
 
-from skinlab.gl.uniforms import set_array, set_uniforms
+from skinlab.gl.uniforms import Shader, set_array, set_uniforms
 from skinlab.render.compute import bind_images, dispatch
 from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
 from skinlab.render.profile_table import MAX_PROFILES
@@ -45,11 +46,12 @@ class SsssBlurPass(RenderPass):
         # pixels per scene unit at view depth 1: rows span 2 tan(yfov/2), columns the same times aspect
         ppu_y = h / (2.0 * math.tan(cam.yfov / 2.0))
         ppu_x = ppu_y  # square pixels (aspect = w / h)
+        prog: Shader
         if p.params.compute:
             prog = self.r.programs.compute("techniques/ssss/blur.comp")
         else:
             prog = self.r.programs.get("passes/fullscreen.vert", "techniques/ssss/blur.frag")
-        n = len(plan.offsets_mm)
+        n = plan.taps
         table = self._gpu.table(plan.table())
         ranges = np.array([k.range_mm for k in plan.kernels], np.float32)
         set_array(prog, "u_range_mm", ranges, MAX_PROFILES)
@@ -70,7 +72,7 @@ class SsssBlurPass(RenderPass):
             (frame.targets["ssss_diffuse"], tmp, ftmp, (1.0 / w, 0.0), ppu_x),
             (tmp, blurred, fblur, (0.0, 1.0 / h), ppu_y),
         )
-        if p.params.compute:  # horizontal, then vertical with the composite
+        if isinstance(prog, moderngl.ComputeShader):  # horizontal, then vertical with the composite
             horizontal = steps[0]
             horizontal[0].use(0)
             set_uniforms(prog, {"u_dir": horizontal[3], "u_pixels_per_unit": horizontal[4]})

@@ -6,6 +6,7 @@ is blurred with its own material's kernel (as HDRP keeps a table of profiles).""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -13,10 +14,13 @@ from skinlab.render.profile_table import plan_profile_table
 from skinlab.scene.optics.profile_fit import profile_fit
 from skinlab.scene.optics.ssss import ssss_kernel
 
+if TYPE_CHECKING:
+    from skinlab.scene.materials import Material
+
 
 @dataclass
 class SsssKernel:
-    material: object  # the first material using this profile (named in the plan)
+    material: Material  # the first material using this profile (named in the plan)
     offsets_mm: np.ndarray  # (n,)
     weights: np.ndarray  # (n, 3)
     range_mm: float
@@ -27,22 +31,14 @@ class SsssPlan:
     kernels: list[SsssKernel]  # by profile index
     profile: dict = field(default_factory=dict)  # node uid -> profile index (nodes whose diffuse is blurred)
 
-    # the first profile's kernel (a frame with one scattering material has only that one)
     @property
-    def material(self):
-        return self.kernels[0].material
-
-    @property
-    def offsets_mm(self) -> np.ndarray:
-        return self.kernels[0].offsets_mm
-
-    @property
-    def weights(self) -> np.ndarray:
-        return self.kernels[0].weights
+    def taps(self) -> int:
+        """Taps per kernel (every profile's kernel has as many)."""
+        return len(self.kernels[0].offsets_mm)
 
     def table(self) -> np.ndarray:
         """(profiles, taps, 4) float32: rgb weight, a offset mm (the blur's u_table)."""
-        t = np.zeros((len(self.kernels), len(self.offsets_mm), 4), np.float32)
+        t = np.zeros((len(self.kernels), self.taps, 4), np.float32)
         for j, k in enumerate(self.kernels):
             t[j, :, :3] = k.weights
             t[j, :, 3] = k.offsets_mm

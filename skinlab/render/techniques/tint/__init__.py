@@ -33,9 +33,8 @@ class TintSettings(TechniqueSettings):
 class TintForward(ForwardHook):
     tints: dict = field(default_factory=dict)  # node uid -> (effective material, RGB tint)
 
-    @property
-    def reason(self) -> str:
-        return f"; profile tint (no convolution) for {len(self.tints)}" if self.tints else ""
+    def __post_init__(self) -> None:
+        self.reason = f"; profile tint (no convolution) for {len(self.tints)}" if self.tints else ""
 
     def shading(self, node, frame):
         hit = self.tints.get(node.uid)

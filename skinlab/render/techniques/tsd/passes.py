@@ -20,12 +20,13 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import cast
 
 import moderngl
 import numpy as np
 
 from skinlab.gl.state import gl_state
-from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
+from skinlab.gl.uniforms import Shader, set_array, set_uniform, set_uniforms
 from skinlab.render.ambient import ambient_defines, bind_ambient
 from skinlab.render.boundary import bind_boundary
 from skinlab.render.compute import bind_images, dispatch
@@ -92,10 +93,10 @@ class TsdNodeTargets:
             f = self.fbos[key] = ctx.framebuffer([tex, *more], depth)
         return f
 
-    def draw_into(self, renderer, prog, dst: moderngl.Texture, compute: bool) -> None:
+    def draw_into(self, renderer, prog: Shader, dst: moderngl.Texture) -> None:
         """Run `prog` over every texel of `dst` (this node's size): a compute shader writing image
         `u_dst`, or a fullscreen fragment pass into `dst` (the two paths of a blur or a gather)."""
-        if compute:
+        if isinstance(prog, moderngl.ComputeShader):
             bind_images(prog, {"u_dst": dst})
             dispatch(prog, (self.size, self.size))
         else:
@@ -232,7 +233,8 @@ class TsdStore(TechniqueState):
             if t is not None:
                 t.release()
             c = self.ctx
-            t = self.nodes[node.uid] = TsdNodeTargets(size, *(_texture(c, size) for _ in range(4)))
+            irradiance, scratch, stretch, raw = (_texture(c, size) for _ in range(4))
+            t = self.nodes[node.uid] = TsdNodeTargets(size, irradiance, scratch, stretch, raw)
         return t
 
     def retain(self, uids) -> int:
@@ -341,6 +343,10 @@ def dilate_compute(
 class TsdPass(RenderPass):
     """A texture-space pass of one mesh node; ``output`` names the node texture holding its result."""
 
+    def output(self, t: TsdNodeTargets, p) -> moderngl.Texture:
+        """The texture of `t` the pass writes its result into (each kind says which)."""
+        raise NotImplementedError
+
     def node_targets(self, p) -> TsdNodeTargets:
         return store(self.r).targets(p.params.node, p.params.size)
 
@@ -442,7 +448,8 @@ class TsdIrradiancePass(TsdPass):
             slot_light = np.full(2, -1, np.int32)
             for s, light in enumerate(prm.shadow_lights[:2]):
                 slot_light[s] = next(i for i, x in enumerate(prm.lights) if x is light)
-            prog["u_slot_light"].write(slot_light[: max(prog["u_slot_light"].array_length, 1)].tobytes())
+            u = cast(moderngl.Uniform, prog["u_slot_light"])
+            u.write(slot_light[: max(u.array_length, 1)].tobytes())
         if prm.translucency:
             bind_translucency(prog, frame, units, self.r.dummy_texture())
         if prm.deferred:
@@ -576,6 +583,7 @@ class TsdBlurPass(TsdPass):
         # u then v; with seams the v step goes to the scratch texture and the seam fill from there
         # into the level (its gutter across the seams, for the next blur and the gather)
         steps = ((src, dst), (dst, t.scratch)) if seams else ((src, t.scratch), (t.scratch, dst))
+        prog: Shader
         if prm.compute:
             prog = self.r.programs.compute("techniques/tsd/blur.comp")
         else:
@@ -588,7 +596,7 @@ class TsdBlurPass(TsdPass):
         for axis, (a, b) in enumerate(steps):
             a.use(0)
             set_uniform(prog, "u_axis", axis)
-            t.draw_into(self.r, prog, b, prm.compute)
+            t.draw_into(self.r, prog, b)
         if seams:
             seam_fill(self.r, t, t.scratch, dst, prm.compute)
         self.publish(frame, p)

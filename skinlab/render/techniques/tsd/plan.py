@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -37,6 +38,11 @@ from skinlab.scene.optics.tsd import (
 from skinlab.scene.uv_checks import analyse_uvs
 
 from .seams import node_seams, seam_band_texels, seams_summary
+
+if TYPE_CHECKING:
+    from skinlab.scene.graph import MeshNode
+    from skinlab.scene.materials import Material
+    from skinlab.scene.uv_seams import SeamExtension
 
 DILATE_RINGS = 4  # texels of dilation past chart borders (irradiance and stretch)
 # the path `compute = auto` takes on software GL for the dilations and the blurs (skinlab/render/compute.py;
@@ -156,8 +162,8 @@ def subtexel_note(mesh_name: str, fit, p50: float, size: int, mm_per_pixel: floa
     channels = [c for c in range(3) if lost[c] > 0.5]
     if not channels:
         return None
-    names = [CHANNELS[c] for c in channels]
-    names = ", ".join(names[:-1]) + " and " + names[-1] if len(names) > 1 else names[0]
+    lit = [CHANNELS[c] for c in channels]
+    names = ", ".join(lit[:-1]) + " and " + lit[-1] if len(lit) > 1 else lit[0]
     head = (
         f"mesh {mesh_name!r}: {int(sub.sum())} of {int(used.sum())} Gaussians of the profile are narrower than a "
         f"texel ({p50:.2g} mm at {size} texels a side) and not blurred, so most {names} light leaves where it "
@@ -181,11 +187,11 @@ def subtexel_note(mesh_name: str, fit, p50: float, size: int, mm_per_pixel: floa
 
 @dataclass
 class TsdNodePlan:
-    node: object
-    material: object
+    node: MeshNode
+    material: Material
     kernel: DiffusionKernel
     size: int
-    seams: object = None  # the mesh's SeamExtension (skinlab/scene/uv_seams.py), None: no seams or switched off
+    seams: SeamExtension | None = None  # skinlab/scene/uv_seams.py; None: no seams or switched off
     seam_band: int = 0  # texels the extension reaches past each seam
     size_note: str = ""  # why the texture space is smaller than the size setting (fitted_size)
 
@@ -197,12 +203,12 @@ class TsdNodePlan:
 class TsdNodeParams:
     """What every texture-space pass of one mesh node needs."""
 
-    node: object
+    node: MeshNode
     size: int  # texels per side
-    material: object  # the effective material
+    material: Material  # the effective material
     kernel: DiffusionKernel  # the Gaussian chain (and the translucency's Gaussians)
     dilate: int = DILATE_RINGS
-    seams: object = None  # SeamExtension: light crosses UV seams (seams.py); None: not used
+    seams: SeamExtension | None = None  # SeamExtension: light crosses UV seams (seams.py); None: not used
     compute: bool = False  # the pass's compute shader (skinlab/render/compute.py), where it has one
 
 
@@ -221,7 +227,7 @@ class TsdIrradianceParams(TsdNodeParams):
 
 @dataclass
 class TsdBlurParams(TsdNodeParams):
-    step: BlurStep | None = None
+    step: BlurStep = field(kw_only=True)
 
 
 @dataclass

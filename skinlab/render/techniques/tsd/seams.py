@@ -104,9 +104,8 @@ class SeamMap:
         self.texture.repeat_x = self.texture.repeat_y = False
         self.depth = ctx.depth_renderbuffer((size, size))
         self.fbo = ctx.framebuffer([self.texture], self.depth)
-        self.vbo = None
-        self.vao = None
-        self.source = None  # (id of the extension, id of the program) the vertex data is for
+        self.vertices: tuple[moderngl.Buffer, moderngl.VertexArray] | None = None  # the extension's
+        self.source: tuple | None = None  # (id of the extension, id of the program) the vertices are for
 
     def draw(self, prog, ext: SeamExtension, mesh) -> None:
         key = (id(ext), id(prog), mesh.uid, mesh.version)
@@ -126,22 +125,24 @@ class SeamMap:
             data[b, 4] = ext.border_depth.reshape(-1) + BORDER_BIAS * ext.band_uv
             data[n_ext + n_border :, 0:2] = real
             data[n_ext + n_border :, 4] = -1.0  # the real charts: always in front
-            self.vbo = self.ctx.buffer(data.tobytes())
-            self.vao = self.ctx.vertex_array(prog, [(self.vbo, "2f 2f 1f", "in_uv", "in_src", "in_depth")])
-            self.source = key
+            vbo = self.ctx.buffer(data.tobytes())
+            vao = self.ctx.vertex_array(prog, [(vbo, "2f 2f 1f", "in_uv", "in_src", "in_depth")])
+            self.vertices, self.source = (vbo, vao), key
+        assert self.vertices is not None
         size = self.texture.size[0]
         self.fbo.use()
         self.ctx.viewport = (0, 0, size, size)
         self.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         set_uniforms(prog, {"u_depth_range": float(ext.band_uv) * 2.0})
         with gl_state(self.ctx, moderngl.DEPTH_TEST, depth_func="<"):
-            self.vao.render(moderngl.TRIANGLES)
+            self.vertices[1].render(moderngl.TRIANGLES)
 
     def release_vertices(self) -> None:
-        if self.vao is not None:
-            self.vao.release()
-            self.vbo.release()
-        self.vao = self.vbo = self.source = None
+        if self.vertices is not None:
+            vbo, vao = self.vertices
+            vao.release()
+            vbo.release()
+        self.vertices = self.source = None
 
     def release(self) -> None:
         self.release_vertices()
