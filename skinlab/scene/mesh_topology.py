@@ -127,7 +127,7 @@ def _hole_area(p: np.ndarray, f: np.ndarray) -> float:
     t = p[f]
     area = 0.5 * float(np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum())
     try:
-        loops = _boundary_loops(f)
+        loops = boundary_loops(f)
     except ValueError:
         return float("inf")
     holes = 0.0
@@ -247,9 +247,10 @@ def close_mesh(positions: np.ndarray, indices: np.ndarray, unfold_rounds: int = 
     return p[used], renumber[f]
 
 
-def _boundary_loops(f: np.ndarray) -> list[list[int]]:
-    """The boundary's loops, each in the order a cap must run (against its neighbours' winding);
-    ValueError where an open boundary does not close."""
+def boundary_loops(f: np.ndarray) -> list[list[int]]:
+    """The boundary's loops (directed edges whose reverse no triangle has), each in the order a cap
+    must run (against its neighbours' winding): a fan (loop[i], loop[i + 1], centre) closes it wound
+    like the rest. ValueError where an open boundary does not close."""
     directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
     present = {tuple(x) for x in directed.tolist()}
     # a boundary edge a->b has no b->a; the fill runs the other way, b->a
@@ -279,7 +280,7 @@ def _fill_holes(p: np.ndarray, f: np.ndarray, big: np.ndarray) -> tuple[np.ndarr
     holes of BIG_HOLE edges or more) extended to the new triangles."""
     new_p, new_f, new_big = [p], [f], [big]
     n = len(p)
-    for loop in _boundary_loops(f):
+    for loop in boundary_loops(f):
         centre = p[loop].mean(axis=0)
         new_p.append(centre[None])
         new_f.append(np.array([[loop[i], loop[(i + 1) % len(loop)], n] for i in range(len(loop))], np.int64))

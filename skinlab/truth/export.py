@@ -55,7 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from skinlab.scene.graph import LightNode, MeshNode, Scene
-from skinlab.scene.mesh_topology import edge_report, weld
+from skinlab.scene.mesh_topology import boundary_loops, edge_report, weld
 from skinlab.scene.optics.constants import MIN_MFP_MM
 from skinlab.scene.optics.material_medium import eta_from_specular, material_medium
 from skinlab.scene.optics.rough_dielectric import SMOOTH_ALPHA  # below it a smooth dielectric (rough one degenerates)
@@ -135,39 +135,10 @@ def _world_geometry(node: MeshNode, origin: np.ndarray, scale: float) -> tuple[n
     return p.astype(np.float32), n.astype(np.float32)
 
 
-def boundary_loops(faces: np.ndarray) -> list[list[int]]:
-    """Closed loops of boundary edges (edges used by one triangle), each in the direction that
-    continues the triangles' winding (a -> b where the triangle has the edge a -> b)."""
-    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]).astype(np.int64)
-    key = np.sort(e, axis=1)
-    _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    bnd = e[count[inv.ravel()] == 1]
-    nxt: dict[int, list[int]] = {}
-    for a, b in bnd:
-        nxt.setdefault(int(a), []).append(int(b))
-    loops, seen = [], set()
-    for a, b in bnd:
-        a, b = int(a), int(b)
-        if (a, b) in seen:
-            continue
-        loop, cur, prev = [a], b, a
-        seen.add((a, b))
-        while cur != a and len(loop) <= len(bnd):
-            loop.append(cur)
-            cands = [c for c in nxt.get(cur, []) if (cur, c) not in seen]
-            if not cands:
-                break
-            prev, cur = cur, cands[0]
-            seen.add((prev, cur))
-        if cur == a and len(loop) >= 3:
-            loops.append(loop)
-    return loops
-
-
 def close_holes(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray):
     """A watertight copy for the medium: each boundary loop of the welded surface capped by a fan
     around its centroid, wound like the rest of the mesh. Returns (positions, normals, faces, loops
-    closed)."""
+    closed). ValueError where the boundary does not form loops (mesh_topology.boundary_loops)."""
     loops = boundary_loops(weld(positions, faces).first_faces())
     if not loops:
         return positions, normals, faces, 0
@@ -176,13 +147,13 @@ def close_holes(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray):
     for loop in loops:
         ring = positions[loop].astype(np.float64)
         c = ring.mean(axis=0)
-        # the cap's outward normal: the loop runs opposite to the cap's own winding
+        # the cap's outward normal: the loop runs in the cap's own winding
         area = np.cross(ring - c, np.roll(ring, -1, axis=0) - c).sum(axis=0)
-        out = -area / max(np.linalg.norm(area), 1e-30)
+        out = area / max(np.linalg.norm(area), 1e-30)
         pos.append(c[None].astype(np.float32))
         nrm.append(out[None].astype(np.float32))
         a = np.asarray(loop, np.int64)
-        tri.append(np.column_stack([np.roll(a, -1), a, np.full(len(a), n)]).astype(np.uint32))
+        tri.append(np.column_stack([a, np.roll(a, -1), np.full(len(a), n)]).astype(np.uint32))
         n += 1
     return np.concatenate(pos), np.concatenate(nrm), np.concatenate(tri), len(loops)
 
@@ -348,7 +319,11 @@ def describe(
         if scatters:
             interior = medium_dict(values)
             faces = mesh.indices
-            pos, nrm, faces, closed = close_holes(pos, nrm, faces)
+            try:
+                pos, nrm, faces, closed = close_holes(pos, nrm, faces)
+            except ValueError:  # an open boundary that does not close (a fin, a non-manifold edge)
+                closed = 0
+                notes.append(f"{node.name}: the mesh's boundary does not form loops: its holes are left open")
             if closed:
                 notes.append(f"{node.name}: {closed} hole(s) in the mesh capped so that the medium is closed")
                 uv = None

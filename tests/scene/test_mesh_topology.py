@@ -8,7 +8,15 @@ import pytest
 from skinlab.render.plan import plan_frame
 from skinlab.render.settings import RenderSettings
 from skinlab.scene.mesh import Mesh
-from skinlab.scene.mesh_topology import close_mesh, edge_report, folded_triangles, open_mesh_warning, weld, welded_mesh
+from skinlab.scene.mesh_topology import (
+    boundary_loops,
+    close_mesh,
+    edge_report,
+    folded_triangles,
+    open_mesh_warning,
+    weld,
+    welded_mesh,
+)
 from skinlab.scene.scenefile import load_scene
 from tests.tsd_scenes import light_from, quad_mesh, slab_scene
 
@@ -48,7 +56,6 @@ def test_one_weld_one_answer_to_is_it_closed():
     mesh_topology.weld: exactly equal float32 positions (-0.0 and 0.0 one), nothing merely near."""
     from skinlab.scene.mesh_thickness import is_closed
     from skinlab.scene.uv_seams import seam_edges
-    from skinlab.truth.export import boundary_loops
 
     w = weld(np.array([[0, 0, 0], [-0.0, 0, 0], [1e-7, 0, 0], [1, 0, 0]], np.float32), np.array([[0, 2, 3]]))
     assert w.ids[0] == w.ids[1] != w.ids[2] and len(w.positions) == 3 and w.first_faces().tolist() == [[0, 2, 3]]

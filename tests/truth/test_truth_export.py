@@ -10,7 +10,7 @@ import pytest
 
 from skinlab.scene.graph import CameraNode, LightNode, MeshNode, Scene
 from skinlab.scene.materials import Material
-from skinlab.scene.mesh_topology import weld
+from skinlab.scene.mesh_topology import boundary_loops, weld
 from skinlab.scene.optics.material_medium import eta_from_specular, material_medium
 from skinlab.scene.optics.media import preset
 from skinlab.scene.primitives import box_mesh
@@ -160,12 +160,12 @@ def test_open_mesh_is_closed_for_the_medium_and_wound_outward():
     keep = np.ones(len(box.indices), bool)
     keep[:2] = False  # drop the top face: a hole of four edges
     faces = box.indices[keep]
-    assert len(ex.boundary_loops(weld(box.positions, faces).first_faces())) == 1
+    assert len(boundary_loops(weld(box.positions, faces).first_faces())) == 1
     p, n, f, closed = ex.close_holes(box.positions, box.normals, faces)
-    assert closed == 1 and ex.boundary_loops(weld(p, f).first_faces()) == []
+    assert closed == 1 and boundary_loops(weld(p, f).first_faces()) == []
     assert ex.signed_volume(p, f) == pytest.approx(48.0, rel=1e-5)
     # UV seams (vertices repeated per face) are not holes
-    assert ex.boundary_loops(weld(box.positions, box.indices).first_faces()) == []
+    assert boundary_loops(weld(box.positions, box.indices).first_faces()) == []
 
 
 def test_inward_wound_mesh_is_turned_outward():
