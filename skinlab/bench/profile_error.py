@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from skinlab.atomic_write import write_bytes_atomic
-from skinlab.scene.optics.edges import model_edge, scattering_channels, step, step_edge
+from skinlab.scene.optics.edges import model_edge, step, step_edge
 
 EDGE_RANGE_MFP = 50.0  # the edge-response integral spans +-50 mean free paths per channel
 MC_SEED = 1
@@ -60,7 +60,7 @@ def _edge_grid(mfp: float) -> np.ndarray:
 
 def _reference(medium, edge_of_channel, photons: int = 0) -> ProfileReference:
     """Edge responses of a reference per scattering channel: edge_of_channel(c, x_mm) -> (N,)."""
-    scatter = scattering_channels(medium)
+    scatter = medium.scattering
     xs, es, dens = [], [], []
     for c in range(3):
         if not scatter[c]:
@@ -74,7 +74,7 @@ def _reference(medium, edge_of_channel, photons: int = 0) -> ProfileReference:
 
 def profile_reference(medium, photons: int, cache_dir: Path | None) -> ProfileReference:
     """The Monte Carlo edge responses of `medium` (one random walk per scattering channel)."""
-    from skinlab.scene.optics.tsd import edge_response
+    from skinlab.scene.optics.edges import edge_response
 
     def edge(c, x):
         mfp = float(medium.mfp_arr[c])

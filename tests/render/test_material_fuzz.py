@@ -82,9 +82,9 @@ def test_a_channel_without_energy_plans_as_no_scattering_in_it():
     beyond 1e-5 mm, too (a dipole's tail reaches further: sub-picometre Gaussians, which the blur folds
     into the identity as sub-texel)."""
     from skinlab.scene.optics.disk import disk_kernel
+    from skinlab.scene.optics.exact_profile import exact_profile_lut
     from skinlab.scene.optics.material_medium import material_medium
     from skinlab.scene.optics.profile_fit import profile_fit
-    from skinlab.scene.optics.tsd import exact_profile_lut
 
     medium = material_medium(Material("m", ISSUE_26).values)
     for model in ("burley", "blender-burley", "dipole", "pbd"):

@@ -29,7 +29,7 @@ import numpy as np
 from skinlab.cache import table
 
 from .burley import burley_sample_golubev
-from .constants import MIN_MFP_MM, PI
+from .constants import PI
 from .media import Medium
 
 GOLDEN_ANGLE = PI * (3.0 - math.sqrt(5.0))  # radians, 2.39996...
@@ -55,10 +55,6 @@ def burley_radial_pdf(r, d):
     return (np.exp(-r / d) + np.exp(-r / (3.0 * d))) / (4.0 * d)
 
 
-def _scatter(medium: Medium) -> np.ndarray:
-    return (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
-
-
 @table(disk=True, maxsize=256)
 def disk_kernel(model: str, medium: Medium, samples: int) -> DiskKernel:
     """The disk samples for a material's sss_model and medium (cached per medium and count)."""
@@ -72,7 +68,7 @@ def disk_kernel(model: str, medium: Medium, samples: int) -> DiskKernel:
         )
     if not (isinstance(samples, int) and 1 <= samples <= MAX_DISK_SAMPLES):
         raise ValueError(f"disk_samples: expected an integer in [1, {MAX_DISK_SAMPLES}], got {samples!r}")
-    scatter = _scatter(medium)
+    scatter = medium.scattering
     if not scatter.any():
         return DiskKernel(np.zeros(samples), np.zeros((samples, 3)), 0.0, 0.0)
     prof = get_profile(MODEL_PROFILES[model])

@@ -29,7 +29,7 @@ import numpy as np
 from skinlab.cache import parallel_map, table
 from skinlab.resources import asset_path
 
-from .constants import PI
+from .constants import MIN_MFP_MM, PI
 from .dipole import dipole_total
 from .pbd import pbd_total
 
@@ -231,6 +231,12 @@ class Medium:
     @property
     def mfp_arr(self) -> np.ndarray:
         return np.array(self.mfp_mm)
+
+    @property
+    def scattering(self) -> np.ndarray:
+        """(3,) bool: the channels that scatter at all, a mean free path of at least MIN_MFP_MM (a
+        shorter one is no scattering for every profile) and an albedo above 0."""
+        return (self.mfp_arr >= MIN_MFP_MM) & (self.alpha_arr > 0)
 
     @property
     def sigma_s(self) -> np.ndarray:

@@ -12,7 +12,7 @@ import numpy as np
 
 from skinlab.cache import table
 
-from .constants import MIN_MFP_MM, SKIN6_VARIANCES, SKIN6_WEIGHTS
+from .constants import SKIN6_VARIANCES, SKIN6_WEIGHTS
 from .gaussians import NoEnergy, fit_gaussians
 from .media import Medium
 from .profiles import get_profile
@@ -54,7 +54,7 @@ def profile_fit(model: str, medium: Medium, K: int = 6) -> ProfileFit:
         raise ValueError(f"gaussians: expected an integer in [1, {MAX_FIT_GAUSSIANS}], got {K!r}")
     # channels that scatter at all (mean free paths below MIN_MFP_MM are "no scattering" for every
     # profile); the others keep the unblurred irradiance
-    scatter = (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
+    scatter = medium.scattering
     if model == "gaussians":
         radius = np.where(scatter, medium.artist_radius_mm, 0.0)
         scale = float(radius[scatter].mean() / np.mean(SKIN6_RADIUS_MM)) if scatter.any() else 0.0

@@ -35,21 +35,16 @@ from skinlab.cache import table
 
 from .constants import (
     COVERAGE_EPS,
-    MIN_MFP_MM,
     TSD_MAX_STEP_TEXELS,
     TSD_MIN_MM_PER_TEXEL,
     TSD_TAP_RANGE,
 )
-from .media import Medium
-from .profile_fit import MODEL_PROFILES, ProfileFit
-from .profiles import get_profile
+from .profile_fit import ProfileFit
 
 TSD_MIN_TAPS = 7  # d'Eon & Luebke's 7-tap kernel is the smallest
 TSD_MAX_TAPS = 31
 TSD_SUBTEXEL_SIGMA = 0.35  # a Gaussian whose sigma is below this many texels is the identity
 NEGLIGIBLE_WEIGHT = 1e-3  # a Gaussian below this weight in every channel is skipped
-
-EXACT_ENERGY = 0.999  # the exact convolution's support: the radius holding this of every channel's energy
 
 
 @dataclass(frozen=True)
@@ -226,120 +221,6 @@ def gather_reference(irradiance, levels, kernel: DiffusionKernel) -> np.ndarray:
     for s, lv in zip(kernel.steps, levels):
         out = out + unpremultiply(lv) * np.asarray(s.weight)[None, None, :]
     return out
-
-
-def exact_profile_convolution(
-    irradiance: np.ndarray, mm_per_texel: tuple[float, float], profile_fn, radius_mm: float | None = None
-) -> np.ndarray:
-    """Brute-force convolution of an irradiance texture (uniform stretch mm_per_texel = (u, v)) with
-    a radial profile normalised to sum 1 per channel over the texel grid (profile_fn(r_mm) -> (N, 3)).
-    The kernel is evaluated at texel centres with 4x4 supersampling; normalised convolution by coverage.
-    For the reference comparisons (fit error); O(texels x kernel) — use small textures."""
-    from scipy.signal import fftconvolve
-
-    irr = np.asarray(irradiance, np.float64)
-    mu, mv = float(mm_per_texel[0]), float(mm_per_texel[1])
-    if radius_mm is None:
-        radius_mm = 0.5 * min(irr.shape[1] * mu, irr.shape[0] * mv)
-    nu, nv = int(math.ceil(radius_mm / mu)), int(math.ceil(radius_mm / mv))
-    ss = 4
-    off = (np.arange(ss) + 0.5) / ss - 0.5
-    ys, xs = np.mgrid[-nv : nv + 1, -nu : nu + 1]
-    # the radial profile tabulated once (log-spaced; some profiles cost ~0.1 ms per radius) and
-    # interpolated at the 4x4 sub-samples of every kernel texel
-    r_tab = np.concatenate([[0.0], np.geomspace(1e-6, max(2.0 * radius_mm, 1e-3), 4000)])
-    R_tab = np.asarray(profile_fn(r_tab), np.float64).reshape(len(r_tab), -1)
-    ker = np.zeros(ys.shape + (3,))
-    for oy in off:
-        for ox in off:
-            r = np.hypot((xs + ox) * mu, (ys + oy) * mv)
-            ker += np.stack([np.interp(r, r_tab, R_tab[:, c]) for c in range(3)], axis=-1)
-    ker = np.maximum(ker, 0.0)
-    ker /= np.maximum(ker.sum(axis=(0, 1)), 1e-300)
-    a = irr[..., 3]
-    out = np.zeros(irr.shape[:2] + (3,))
-    for c in range(3):
-        num = fftconvolve(irr[..., c], ker[..., c], mode="same")
-        den = fftconvolve(a, ker[..., c], mode="same")
-        out[..., c] = np.where(den > 1e-9, num / np.maximum(den, 1e-9), 0.0)
-    return out
-
-
-def edge_response(x_mm: np.ndarray, fit_or_profile, kind: str = "gaussians") -> np.ndarray:
-    """Fraction of a half-plane's irradiance (lit for x < 0) that leaves at distance x (mm) past the edge,
-    per channel, for a normalised kernel: sum_k W_k Phi(-x / sigma_k) (+ identity step) for a Gaussian
-    fit; for a radial profile (kind='profile', fit_or_profile = profile_fn(r_mm) -> (N, C)), the
-    integral of R over the half-plane, by quadrature, divided by its integral over the plane."""
-    x = np.atleast_1d(np.asarray(x_mm, np.float64))
-    if kind == "gaussians":
-        k: DiffusionKernel = fit_or_profile
-        out = np.outer(np.where(x < 0, 1.0, np.where(x == 0, 0.5, 0.0)), k.identity)
-        for s in k.steps:
-            sig = math.sqrt(s.variance_mm2)
-            phi = 0.5 * (1.0 + np.vectorize(math.erf)(-x / (sig * math.sqrt(2.0))))
-            out += np.outer(phi, s.weight)
-        return out
-    fn = fit_or_profile
-    # L(d) = int R(sqrt(d^2 + y^2)) dy: the light leaving at distance d from a line source; the
-    # fraction beyond distance |x| from the edge is int_{|x|}^inf L / int_{-inf}^inf L.
-    d = np.concatenate([[0.0], np.geomspace(1e-6, 400.0, 1500)])
-    ys = np.concatenate([[0.0], np.geomspace(1e-6, 400.0, 1500)])
-    r_tab = np.concatenate([[0.0], np.geomspace(1e-6, 600.0, 4000)])
-    R_tab = np.asarray(fn(r_tab), np.float64).reshape(len(r_tab), -1)
-    rr = np.hypot(d[:, None], ys[None, :])
-    prof = np.stack([np.interp(rr, r_tab, R_tab[:, c]) for c in range(R_tab.shape[1])], axis=-1)
-    line = 2.0 * np.trapezoid(prof, ys, axis=1)  # (nd, C)
-    seg = 0.5 * (line[1:] + line[:-1]) * np.diff(d)[:, None]
-    tail = np.concatenate([np.cumsum(seg[::-1], axis=0)[::-1], np.zeros((1, line.shape[1]))])  # int_d^inf
-    half = tail[0]
-    res = np.zeros((len(x), line.shape[1]))
-    for c in range(line.shape[1]):
-        far = np.interp(np.abs(x), d, tail[:, c]) / (2.0 * half[c]) if half[c] > 0 else np.where(x < 0, 0.5, 0.5)
-        res[:, c] = np.where(x > 0, far, 1.0 - far)
-    return res
-
-
-def profile_tint(model: str, medium: Medium) -> np.ndarray:
-    """The per-pixel tint baseline (no convolution): the exact profile evaluated at one radius, the
-    mean free path averaged over the scattering channels, scaled so the brightest channel is 1.
-    Kept only as the baseline it is: it shifts colour but moves no light."""
-    scatter = (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
-    if model not in MODEL_PROFILES or not scatter.any():
-        return np.ones(3)
-    r0 = float(medium.mfp_arr[scatter].mean())
-    R = np.asarray(get_profile(MODEL_PROFILES[model]).evaluate(np.array([r0]), medium), np.float64)[0]
-    R = np.where(scatter, np.maximum(R, 0.0), R.max() if R.max() > 0 else 1.0)
-    return R / R.max() if R.max() > 0 else np.ones(3)
-
-
-def exact_profile_lut(model: str, medium: Medium, n: int = 512, energy: float | None = None):
-    """Tables for the brute-force texture-space convolution (skinlab/shaders/techniques/exact/gather.frag):
-    r_max (mm, the radius holding `energy` (default EXACT_ENERGY) of every scattering channel's light), R(r) at
-    r_i = i r_max / (n - 1) normalised so its integral over the disc r <= r_max is 1 per channel, and
-    the cumulative energy E(r_i) = int_0^r_i R 2 pi r dr (for the centre texel). Channels that do not
-    scatter get R = 0 and E = 1 (a delta)."""
-    scatter = (medium.mfp_arr >= MIN_MFP_MM) & (medium.alpha_arr > 0)
-    prof = get_profile(MODEL_PROFILES[model])
-    fn = lambda r: np.asarray(prof.evaluate(np.asarray(r, np.float64), medium), np.float64) * scatter[None, :]
-    if not scatter.any():
-        return 1e-3, np.zeros((n, 3)), np.ones((n, 3))
-    from .gaussians import NoEnergy, _energy_radius
-
-    try:
-        r_max = _energy_radius(fn, EXACT_ENERGY if energy is None else energy)
-    except NoEnergy:  # the light spreads less than 1e-5 mm: a delta in every channel
-        return 1e-3, np.zeros((n, 3)), np.ones((n, 3))
-    r = np.linspace(0.0, r_max, n)
-    # fine quadrature of the cumulative energy (the profile may be singular at 0: Burley ~ 1/r)
-    rf = np.concatenate([[0.0], np.geomspace(r_max * 1e-7, r_max, 20000)])
-    Rf = fn(np.maximum(rf, r_max * 1e-9))
-    seg = 0.5 * (Rf[1:] * rf[1:, None] + Rf[:-1] * rf[:-1, None]) * np.diff(rf)[:, None] * 2 * math.pi
-    cum = np.concatenate([np.zeros((1, 3)), np.cumsum(seg, axis=0)])
-    tot = np.where(cum[-1] > 0, cum[-1], 1.0)
-    E = np.stack([np.interp(r, rf, cum[:, c] / tot[c]) for c in range(3)], axis=1)
-    R = fn(np.maximum(r, r_max * 1e-9)) / tot[None, :]
-    E = np.where(scatter[None, :], E, 1.0)
-    return float(r_max), R, E
 
 
 def dilate_reference(img: np.ndarray, rings: int) -> np.ndarray:

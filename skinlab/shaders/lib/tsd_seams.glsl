@@ -1,7 +1,7 @@
 // UV seams in texture-space diffusion (skinlab/render/techniques/tsd/seams.py): a gutter texel that the
 // seam map marks (a = 1) stands for the surface across a seam, whose value is read at the seam map's
 // UV (rg, in the other chart). Bilinear by hand (four texelFetch, clamped), so the NumPy twin
-// (skinlab/scene/optics/tsd.py seam_lookup_reference) agrees to fp32 rounding. Premultiplied values.
+// (skinlab/scene/optics/tsd.py seam_bilinear_reference) agrees to fp32 rounding. Premultiplied values.
 vec4 seam_bilinear(sampler2D src, vec2 uv) {
     ivec2 last = textureSize(src, 0) - 1;
     vec2 x = uv * vec2(textureSize(src, 0)) - 0.5;

@@ -9,7 +9,8 @@ from skinlab.gl.glsl_eval import assert_close_fp32
 from skinlab.render.settings import RenderSettings
 from skinlab.render.techniques.disk import DiskSettings
 from skinlab.scene.graph import MeshNode
-from skinlab.scene.optics import burley, disk, tsd
+from skinlab.scene.optics import burley, disk
+from skinlab.scene.optics.edges import edge_response
 from skinlab.scene.optics.material_medium import material_medium
 from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
@@ -56,7 +57,7 @@ def test_kernel_hard_cases():
 def test_edge_response_approaches_the_exact_profile_edge_with_more_samples():
     m = medium()
     x = np.linspace(-20, 20, 161)
-    exact = tsd.edge_response(x, exact_profile("burley", m), "profile")
+    exact = edge_response(x, exact_profile("burley", m), "profile")
     errs = [np.abs(disk.disk_edge_response(x, disk.disk_kernel("burley", m, n)) - exact).max() for n in (8, 64)]
     assert errs[1] < errs[0] and errs[1] < 0.03, errs
 

@@ -9,7 +9,9 @@ from skinlab.render.techniques.exact import ExactSettings
 from skinlab.render.techniques.ssss import SsssSettings
 from skinlab.render.techniques.tsd import TsdSettings
 from skinlab.render.techniques.tsd.passes import frame_nodes, read_texture
-from skinlab.scene.optics import ssss, tsd
+from skinlab.scene.optics import ssss
+from skinlab.scene.optics.edges import edge_response
+from skinlab.scene.optics.exact_profile import exact_profile_convolution
 from skinlab.scene.optics.material_medium import material_medium
 from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, skin, slab_scene
 
@@ -32,13 +34,13 @@ def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer
     x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
         scene, 2 * scene.mm_per_unit / n
     )  # where the light entered
-    edge = tsd.edge_response(-x_mm, exact_profile(model, medium), "profile")
+    edge = edge_response(-x_mm, exact_profile(model, medium), "profile")
     err = np.abs(row / lit - edge)
     assert err.max() < 0.03, (err.max(axis=0), int(err.argmax()) // 3)
     # texture level against the NumPy brute-force convolution of the same irradiance
     irr, stretch = read_texture(t.targets.irradiance), read_texture(t.targets.stretch)
     gpu = read_texture(t.targets.levels[0])[..., :3]
-    ref = tsd.exact_profile_convolution(
+    ref = exact_profile_convolution(
         irr, (stretch[n // 2, n // 2, 0], stretch[n // 2, n // 2, 1]), exact_profile(model, medium)
     )
     core = (slice(16, -16), slice(16, -16))
@@ -67,7 +69,7 @@ def test_screen_space_sss_follows_its_separable_kernel(renderer, multiple_only):
         err = np.abs(row / lit - own)
         assert err.max() < 0.02 + 1.0 / taps, (taps, err.max(axis=0))
         medium = material_medium(kernel.material.values)
-        exact = tsd.edge_response(-x_mm, exact_profile("burley", medium), "profile")
+        exact = edge_response(-x_mm, exact_profile("burley", medium), "profile")
         assert np.abs(row / lit - exact).max() < 0.06 + 1.0 / taps
     # the kernel itself: weights sum to 1 per channel, symmetric offsets
     np.testing.assert_allclose(kernel.weights.sum(axis=0), 1.0)

@@ -9,6 +9,8 @@ from skinlab.render.techniques.tsd.passes import frame_nodes, read_texture, stor
 from skinlab.scene.mesh import Mesh
 from skinlab.scene.optics import tsd
 from skinlab.scene.optics.boundary import boundary_tables, table_lookup
+from skinlab.scene.optics.edges import edge_response
+from skinlab.scene.optics.exact_profile import exact_profile_convolution
 from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.single_scattering import single_scatter_brdf
 from skinlab.scene.optics.slab import slab_table, slab_through
@@ -77,7 +79,7 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
     cov = stretch[..., 3] > 0
     np.testing.assert_allclose(stretch[cov, :2], 2 * 20.0 / 128, rtol=1e-5)
     _, diffused = tsd.diffuse_reference(irr, stretch, t.kernel)
-    exact = tsd.exact_profile_convolution(
+    exact = exact_profile_convolution(
         irr, (stretch[64, 64, 0], stretch[64, 64, 1]), exact_profile("burley", material_medium(t.material.values))
     )
     rel_l1 = np.abs(diffused - exact).sum(axis=(0, 1)) / np.abs(exact).sum(axis=(0, 1))
@@ -99,7 +101,7 @@ def test_shadow_edge_follows_the_profile_edge_response(renderer, model, multiple
     x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
         scene, 2 * scene.mm_per_unit / n
     )  # where the light entered
-    edge = tsd.edge_response(-x_mm, exact_profile(model, material_medium(t.material.values)), "profile")
+    edge = edge_response(-x_mm, exact_profile(model, material_medium(t.material.values)), "profile")
     err = np.abs(row / lit - edge)
     assert np.all(np.isfinite(err))
     assert err.max() < 0.02, (model, err.max(axis=0), int(err.argmax()) // 3)

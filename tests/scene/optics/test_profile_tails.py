@@ -7,9 +7,9 @@ import pytest
 
 from skinlab.scene.optics import gaussians
 from skinlab.scene.optics.disk import SAMPLE_ENERGY, disk_kernel
+from skinlab.scene.optics.exact_profile import EXACT_ENERGY, exact_profile_lut
 from skinlab.scene.optics.media import Medium, preset
 from skinlab.scene.optics.profiles import get_profile
-from skinlab.scene.optics.tsd import EXACT_ENERGY, exact_profile_lut
 
 
 def burley(name):

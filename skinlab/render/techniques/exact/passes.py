@@ -11,8 +11,8 @@ import numpy as np
 from skinlab.gl.uniforms import Shader, set_uniforms
 from skinlab.render.techniques.tsd.passes import TsdPass, store
 from skinlab.render.techniques.tsd.plan import TsdExactParams
+from skinlab.scene.optics.exact_profile import exact_profile_lut
 from skinlab.scene.optics.material_medium import material_medium
-from skinlab.scene.optics.tsd import exact_profile_lut
 
 EXACT_INNER_HALF = 24  # brute force: texels summed one by one within 24 texels of the centre...
 EXACT_RING_RATIO = 1.15  # ...then annuli r -> 1.15 r out to r_max, cells read from the mip pyramid

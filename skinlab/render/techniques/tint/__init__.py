@@ -1,6 +1,6 @@
 """Technique "tint": the per-pixel profile tint, no convolution (the original study's baseline).
 The subsurface part of each scattering material's diffuse term is tinted by its profile at one
-radius (skinlab/scene/optics/tsd.py profile_tint); no light moves across the surface."""
+radius (skinlab/scene/optics/profile_tint.py); no light moves across the surface."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from skinlab.render.technique import (
     TechniquePlan,
 )
 from skinlab.scene.optics.material_medium import material_medium
-from skinlab.scene.optics.tsd import profile_tint
+from skinlab.scene.optics.profile_tint import profile_tint
 
 HOOK = "techniques/tint/forward.glsl"
 

@@ -4,7 +4,7 @@
 // R(r) x its area; the centre cell contributes the profile's energy inside its own area (the
 // cumulative table E, so a profile singular at r = 0 is integrated, not sampled). Distances use this
 // texel's stretch (mm per texel along u, v). Coverage-normalised like the Gaussian blurs.
-// Tables: skinlab/scene/optics/tsd.py exact_profile_lut; NumPy counterpart: exact_profile_convolution.
+// Tables: skinlab/scene/optics/exact_profile.py exact_profile_lut; NumPy counterpart: exact_profile_convolution there.
 #include "skinlab/constants.glsl"
 uniform sampler2D u_src;         // premultiplied irradiance (rgb E a, a), with mipmaps
 uniform sampler2D u_stretch;
