@@ -1,6 +1,6 @@
-"""Every technique (default settings) on the close-up reference scenes against their cached
-path-traced truth (issue 21; docs/ground-truth.md, "Close-ups"): relative L1 on 4x4 blocks and per
-pixel, per-channel energy, and per scene what it was made to measure, each with the truth's own
+"""A one-off analysis, not a feature: every technique (default settings) on the close-up reference
+scenes against their cached path-traced truth (issue 21; docs/ground-truth.md, "Close-ups"): relative
+L1 on 4x4 blocks and per pixel, per-channel energy, and per scene what it was made to measure, each with the truth's own
 noise (the same measure between the halves of its passes):
 
 * slit scenes: the line profile (the image averaged along the slit, per channel): its relative L1
@@ -14,17 +14,21 @@ noise (the same measure between the halves of its passes):
 Nothing is path-traced here: the references must be cached (the commands are in CLOSEUPS and
 docs/ground-truth.md). Frames are supersampled like the truth's pixels (TRUTH_SUPERSAMPLE).
 
-    python -m tools.closeup_table [SCENES] [TECHNIQUES] [--profiles OUT.npz]   # comma-separated; default all
+    python -m tools.closeup_table [SCENES] [TECHNIQUES] [--profiles OUT.npz] [--bounces N]
+        [--sss-model MODEL] [--no-translucency] [--size WxH --spp N]
 
-SKINLAB_BOUNCES=N and SKINLAB_SSS_MODEL=<model> as in tools/truth_table.py; SKINLAB_TRANSLUCENCY=0
-renders with every technique's translucency off."""
+SCENES and TECHNIQUES are comma-separated ("" or left out: all). --bounces and --sss-model as in
+tools/truth_table.py; --no-translucency renders with every technique's translucency off; --size and
+--spp compare against other (cached) truths of every scene than CLOSEUPS' (a slit's millimetres per
+column scaled to the width)."""
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -41,6 +45,13 @@ class Closeup:
     rr_depth: int = 64
     kind: str = ""  # "slit" | "shadow" | "slabs" | ""
     mm_per_px: float = 0.0  # slit scenes: along the profile axis (the image's columns)
+
+    def at(self, size: tuple[int, int] | None, spp: int | None) -> Closeup:
+        """The same close-up against a truth of another size or spp (a slit's mm per column scaled)."""
+        spec = self if spp is None else replace(self, spp=spp)
+        if size is None:
+            return spec
+        return replace(spec, size=size, mm_per_px=self.mm_per_px * self.size[0] / size[0])
 
     def command(self, scene: str) -> str:
         rr = f" --rr-depth {self.rr_depth}" if self.rr_depth != 64 else ""
@@ -201,28 +212,47 @@ def shadow_regions(scene, size):
     return deep, lit_far, edge
 
 
-def main(argv: list[str]) -> int:
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT, got {text!r}") from None
+    return w, h
+
+
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m tools.closeup_table", description=__doc__.split("\n\n")[0])
+    ap.add_argument("scenes", nargs="?", default="", help=f"comma-separated (default: {','.join(CLOSEUPS)})")
+    ap.add_argument("techniques", nargs="?", default="", help=f"comma-separated (default: {','.join(TECHNIQUES)})")
+    ap.add_argument("--profiles", default=None, help="write the slits' line profiles to this .npz")
+    ap.add_argument("--bounces", type=int, default=None, help="orders of interreflection (0: off)")
+    ap.add_argument("--sss-model", default=None, help="override every material's sss_model")
+    ap.add_argument("--no-translucency", action="store_true", help="every technique's translucency off")
+    ap.add_argument("--size", type=_size, default=None, help="WxH of the truths instead of CLOSEUPS'")
+    ap.add_argument("--spp", type=int, default=None, help="samples per pixel of the truths instead of CLOSEUPS'")
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parser().parse_args(argv)
     from skinlab.gl.context import create_headless_context
     from skinlab.render.renderer import Renderer
     from skinlab.render.settings import RenderSettings
     from skinlab.scene.scenefile import load_scene
 
-    out = None
-    if "--profiles" in argv:
-        k = argv.index("--profiles")
-        out = argv[k + 1]
-        argv = argv[:k] + argv[k + 2 :]
-    scenes = argv[0].split(",") if argv and argv[0] else list(CLOSEUPS)
-    techs = argv[1].split(",") if len(argv) > 1 and argv[1] else TECHNIQUES
-    extra = {}
-    if os.environ.get("SKINLAB_BOUNCES"):
-        extra["bounces"] = int(os.environ["SKINLAB_BOUNCES"])
-    model = os.environ.get("SKINLAB_SSS_MODEL") or None
+    out = args.profiles
+    scenes = args.scenes.split(",") if args.scenes else list(CLOSEUPS)
+    unknown = [s for s in scenes if s not in CLOSEUPS]
+    if unknown:
+        raise SystemExit(f"closeup_table: no close-up {', '.join(unknown)}; expected some of {', '.join(CLOSEUPS)}")
+    techs = args.techniques.split(",") if args.techniques else TECHNIQUES
+    extra = {} if args.bounces is None else {"bounces": args.bounces}
+    model = args.sss_model
     r = Renderer(create_headless_context())
     saved = {}
     print("load average at start: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
     for s in scenes:
-        spec = CLOSEUPS[s]
+        spec = CLOSEUPS[s].at(args.size, args.spp)
         scene = load_scene(REFERENCE_SCENES / f"{s}.toml")
         truth = load_closeup_truth(scene, spec)
         if truth is None:
@@ -265,7 +295,7 @@ def main(argv: list[str]) -> int:
         print(head, flush=True)
         for t in techs:
             own = {}
-            if os.environ.get("SKINLAB_TRANSLUCENCY") == "0" and t not in ("none", "tint"):
+            if args.no_translucency and t not in ("none", "tint"):
                 own["translucency"] = False
             rs = RenderSettings.for_technique(
                 t, spec.size[0], spec.size[1], supersample=TRUTH_SUPERSAMPLE, sss_model=model, **extra, **own
@@ -300,10 +330,11 @@ def main(argv: list[str]) -> int:
                 )
             print(line, flush=True)
     print("load average at end: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
+    r.release()
     if out:
         np.savez(out, **saved)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())
