@@ -1,92 +1,84 @@
-"""Where the plain frame's time goes (the frame `skinlab bench peer` times against pyrender): the head
-with sss_model none and no shadow-casting light, rendered with one part of
-skinlab/shaders/passes/forward.frag taken out or one texture setting changed, the variants interleaved
-round by round so that a change of machine load hits all alike. Whole frames with the colour+depth
-read-back, as the peer bench times them. The variants are measurements only (copies of shaders/
-under a temporary folder); none of them is what the renderer runs.
+"""A one-off analysis, not a feature: where the plain frame's time goes (the frame `skinlab bench peer`
+times against pyrender): the head with sss_model none and no shadow-casting light, rendered with one
+part of skinlab/shaders/passes/forward.frag taken out or one texture setting changed, the variants
+interleaved round by round so that a change of machine load hits all alike. Whole frames with the
+colour+depth read-back, as the peer bench times them. Each variant is declared where it lives: a
+render setting, the scene's materials, or a measurement define the shader reads (``MEASURE_...``,
+set through ShaderLibrary.defines in a renderer of its own); none of them is what the renderer runs.
 
-    .venv/bin/python -m tools.forward_cost [--size 640] [--rounds 7]
+    .venv/bin/python -m tools.forward_cost [--size 640] [--rounds 7] [--scene SCENE]
 
-Variants: base (as shipped), aniso1 (the maps filtered without anisotropy), no_maps (no colour or
-normal map fetches), no_prepass (RenderSettings.depth_prepass off), raster_only (the interpolated
-inputs written out: rasterising, the pre-pass, tone mapping and the read-back), and the
-differences of aniso1 from base in the HDR image.
+Variants: base (as shipped), aniso1 (the maps filtered without anisotropy), no_maps (the materials
+without their colour, normal and occlusion maps), no_prepass (RenderSettings.depth_prepass off),
+raster_only (forward.frag's MEASURE_RASTER_ONLY: the interpolated inputs written out: rasterising,
+the pre-pass, tone mapping and the read-back), and the differences of aniso1 from base in the HDR
+image.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import shutil
 import statistics
 import sys
-import tempfile
 import time
-from pathlib import Path
 
 import numpy as np
 
 FWD = "passes/forward.frag"
-EDITS = {
-    "no_maps": [
-        (FWD, "#ifdef HAS_NORMAL_MAP\n    n = perturb", "#if 0\n    n = perturb"),
-        (FWD, "#ifdef HAS_BASE_COLOR_MAP\n    base *=", "#if 0\n    base *="),
-    ],
-    "raster_only": [
-        (
-            FWD,
-            "void main() {",
-            "void main() { f_color = vec4(v_world + v_normal + v_tangent.xyz + vec3(v_uv, 0.0), 1.0); return;",
-        )
-    ],
-}
+MAPS = ("base_color_map", "normal_map")
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m tools.forward_cost", description=__doc__.split("\n\n")[0])
     ap.add_argument("--size", type=int, default=640, help="frame width and height (default 640)")
     ap.add_argument("--rounds", type=int, default=7, help="timed rounds (default 7)")
+    ap.add_argument("--scene", default=None, help="scene name or file (default: the head)")
     args = ap.parse_args(argv)
-    from skinlab.bench.shader_variants import edited_shader_root
     from skinlab.gl.context import create_headless_context, describe
     from skinlab.gl.shader_source import ShaderLibrary
     from skinlab.render.renderer import Renderer
     from skinlab.render.settings import RenderSettings
     from skinlab.scene.scenefile import load_scene
 
+    from .cost_variants import measure_library, without_maps
+
+    def scene_without_shadows(maps=True):
+        scene = load_scene(args.scene)
+        for light in scene.lights():
+            light.cast_shadow = False  # as the peer bench
+        return scene if maps else without_maps(scene, MAPS)
+
     ctx = create_headless_context()
-    scene = load_scene(None)
-    for light in scene.lights():
-        light.cast_shadow = False  # as the peer bench
+    scene = scene_without_shadows()
     n = args.size
     plain = RenderSettings(n, n, sss_model="none")
-    tmp = Path(tempfile.mkdtemp(prefix="skinlab-forward-cost-"))
     runs = {}
 
-    def renderer(name, edits=()):
-        r = Renderer(ctx, ShaderLibrary(root=edited_shader_root(tmp / name, name, edits)))
+    def renderer(measure: dict | None = None) -> Renderer:
+        r = Renderer(ctx, measure_library(FWD, measure) if measure else ShaderLibrary())
         r.reuse = False
         r.timer.sync = False
         return r
 
     try:
-        runs["base"] = (renderer("base"), plain)
-        r = renderer("aniso1")
+        runs["base"] = (renderer(), plain, scene)
+        r = renderer()
         r.render(scene, plain, readback=False)
         for t in r.resources.textures.values():
             t.anisotropy = 1.0
-        runs["aniso1"] = (r, plain)
-        runs["no_maps"] = (renderer("no_maps", EDITS["no_maps"]), plain)
-        runs["no_prepass"] = (renderer("no_prepass"), RenderSettings(n, n, sss_model="none", depth_prepass=False))
-        runs["raster_only"] = (renderer("raster_only", EDITS["raster_only"]), plain)
-        hdr = {k: r.render(scene, st, readback=("hdr",)).hdr for k, (r, st) in runs.items()}
+        runs["aniso1"] = (r, plain, scene)
+        runs["no_maps"] = (renderer(), plain, scene_without_shadows(maps=False))
+        runs["no_prepass"] = (renderer(), RenderSettings(n, n, sss_model="none", depth_prepass=False), scene)
+        runs["raster_only"] = (renderer({"MEASURE_RASTER_ONLY": 1}), plain, scene)
+        hdr = {k: r.render(sc, st, readback=("hdr",)).hdr for k, (r, st, sc) in runs.items()}
         load0 = os.getloadavg()
-        times = {k: [] for k in runs}
+        times: dict[str, list[float]] = {k: [] for k in runs}
         for _ in range(args.rounds):
-            for name, (r, st) in runs.items():
+            for name, (r, st, sc) in runs.items():
                 ctx.finish()
                 t0 = time.perf_counter()
-                r.render(scene, st, readback=("ldr", "depth"))
+                r.render(sc, st, readback=("ldr", "depth"))
                 times[name].append((time.perf_counter() - t0) * 1e3)
         print(f"{describe(ctx)}; plain frame {n}x{n} (sss_model none, no shadows), median of {args.rounds}")
         print(f"load average {tuple(round(x, 2) for x in load0)} -> {tuple(round(x, 2) for x in os.getloadavg())}")
@@ -100,9 +92,8 @@ def main(argv=None) -> int:
             f"(frame max {hdr['base'].max():.3f})"
         )
     finally:
-        for r, _ in runs.values():
+        for r, *_ in runs.values():
             r.release()
-        shutil.rmtree(tmp, ignore_errors=True)
     return 0
 
 

@@ -100,10 +100,14 @@ class ExpandedSource:
 
 @dataclass
 class ShaderLibrary:
-    """Resolves shader files under ``root`` plus generated virtual files (e.g. constants)."""
+    """Resolves shader files under ``root`` plus generated virtual files (e.g. constants). ``defines``
+    adds, per pass file, defines to every variant expanded from it: the measurement variants a
+    shader declares with ``#ifdef MEASURE_...`` (tools/forward_cost.py, tools/irradiance_cost.py time a
+    pass with one part taken out, in a renderer of its own), never set by the renderer."""
 
     root: Path = SHADER_ROOT
     virtual: Mapping[str, Callable[[], str]] = field(default_factory=dict)
+    defines: Mapping[str, Mapping[str, object]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.root = Path(self.root)
@@ -146,6 +150,7 @@ class ShaderLibrary:
         map an include name to a file under the root for this expansion only: the forward pass's
         ``#include "skinlab/sss_hook.glsl"`` names the technique's hook file this way."""
         aliases = dict(aliases or {})
+        defines = {**self.defines.get(name, {}), **(defines or {})}
         files: list[str] = []
         paths: list[Path | None] = []
         out: list[str] = []
@@ -176,7 +181,7 @@ class ShaderLibrary:
                 if lines and _VERSION.match(lines[0]):
                     emit(lines[0], idx, 1)
                     first = 1
-                for k, v in (defines or {}).items():
+                for k, v in defines.items():
                     emit(f"#define {k} {'' if v is True else v}".rstrip(), idx, 0)
             out.append(f"#line {first + 1} {idx}")
             in_comment = False  # inside a /* */ comment at the start of the line

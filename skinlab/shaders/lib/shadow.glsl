@@ -34,10 +34,14 @@ float shadow_pcf(sampler2DShadow map, mat4 shadow_matrix, vec3 world, float NoL)
     if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0)))) return 1.0;
     vec2 size = vec2(textureSize(map, 0));
     float bias = shadow_bias(shadow_matrix, p, size, NoL);
+#ifdef MEASURE_PCF_1TAP  // a measurement variant (tools/irradiance_cost.py): one compare, no filter
+    return texture(map, vec3(c.xy, c.z - bias));
+#else
     vec2 texel = 1.0 / size;
     float sum = 0.0;
     for (int y = -1; y <= 1; ++y)
         for (int x = -1; x <= 1; ++x)
             sum += texture(map, vec3(c.xy + vec2(x, y) * texel, c.z - bias));
     return sum / 9.0;
+#endif
 }

@@ -40,6 +40,10 @@ layout(location = 0) out vec4 f_color;
 #include "skinlab/sss_hook.glsl"
 
 void main() {
+#ifdef MEASURE_RASTER_ONLY  // a measurement variant (tools/forward_cost.py): the interpolated inputs alone
+    f_color = vec4(v_world + v_normal + v_tangent.xyz + vec3(v_uv, 0.0), 1.0);
+    return;
+#endif
     // the surface inputs, once: normals, view direction, the material's maps, the subsurface weight
     Surface s = surface_inputs(v_world, v_normal, v_uv, v_tangent, v_color, u_camera_pos, gl_FrontFacing);
 #ifdef ALPHA_MASK

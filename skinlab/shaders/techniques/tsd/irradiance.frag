@@ -84,6 +84,10 @@ void main() {
 #ifdef DEFERRED_SURFACE
     if (!load_surface()) discard;
 #endif
+#ifdef MEASURE_RASTER_ONLY  // a measurement variant (tools/irradiance_cost.py): the inputs alone
+    f_irradiance = vec4(v_world + v_normal + v_tangent.xyz + vec3(v_uv, 0.0), 1.0);
+    return;
+#endif
     MaterialSample m = material_sample(v_uv, v_color);  // the material's maps, as the forward pass reads them
     vec3 ng = normalize(v_normal);
     vec3 n = ng;

@@ -1,0 +1,59 @@
+"""The cost tools at a tiny size: their variants are declared (measurement defines the shaders read,
+a technique option, materials without maps), not patched into copies of the shaders."""
+
+import numpy as np
+import pytest
+
+from skinlab.gl.shader_source import ShaderLibrary
+from skinlab.render.renderer import Renderer
+from skinlab.render.settings import RenderSettings
+from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK
+from skinlab.scene.scenefile import load_scene
+from tools import forward_cost, irradiance_cost
+from tools.cost_variants import measure_library, without_maps
+
+HOOK = {HOOK_INCLUDE: PLAIN_HOOK}
+
+
+def test_a_measure_define_reaches_its_pass_only_and_must_be_read():
+    lib = measure_library(irradiance_cost.IRR, irradiance_cost.MEASURES["pcf_1tap"])
+    assert "#define MEASURE_PCF_1TAP" in lib.expand(irradiance_cost.IRR).text
+    assert "#define MEASURE_PCF_1TAP" not in lib.expand(forward_cost.FWD, aliases=HOOK).text  # shadow.glsl too
+    assert "#define MEASURE_" not in ShaderLibrary().expand(irradiance_cost.IRR).text  # never set otherwise
+    with pytest.raises(SystemExit, match="passes/forward.frag: no shader of the pass reads MEASURE_NOTHING"):
+        measure_library(forward_cost.FWD, {"MEASURE_NOTHING": 1})
+
+
+def test_the_variants_change_what_they_say(ctx):
+    scene = load_scene(None)
+    st = RenderSettings(24, 24, sss_model="none")
+    base = Renderer(ctx)
+    raster = Renderer(ctx, measure_library(forward_cost.FWD, {"MEASURE_RASTER_ONLY": 1}))
+    a = base.render(scene, st, readback=("hdr",)).hdr
+    b = raster.render(scene, st, readback=("hdr",)).hdr
+    assert not np.allclose(a, b)  # the forward pass wrote its inputs, not the shading
+    bare = without_maps(load_scene(None), forward_cost.MAPS)
+    assert all(n.material["normal_map"] is None and n.material["base_color_map"] is None for n in bare.mesh_nodes())
+    assert any(n.material["normal_map"] is not None for n in scene.mesh_nodes())  # the head has maps to take out
+    base.release()
+    raster.release()
+
+
+def test_forward_cost_runs_tiny(capsys):
+    assert forward_cost.main(["--size", "16", "--rounds", "1"]) == 0
+    out = capsys.readouterr().out
+    for name in ("base", "aniso1", "no_maps", "no_prepass", "raster_only"):
+        assert f"  {name:<12}" in out
+    assert "aniso1 vs base, HDR" in out
+
+
+def test_irradiance_cost_runs_tiny(capsys):
+    argv = ["--size", "16", "--tsd-size", "64", "--rounds", "1", "--scene", "reference/slab-thin-backlit-skin1"]
+    assert irradiance_cost.main(argv) == 0
+    out = capsys.readouterr().out
+    for name in ("base", "pcf_1tap", "no_translucency", "no_maps", "raster_only"):
+        assert f"  {name:<16}" in out
+    assert "light-through record's fill" in out  # the thin slab lets light through: the fill is timed
+    assert irradiance_cost.main(["--coverage", "--tsd-size", "128", "--rounds", "1"]) == 0
+    shares = [float(line.split("%")[0].split()[-1]) for line in capsys.readouterr().out.splitlines() if "UVs x" in line]
+    assert len(shares) == 4 and shares == sorted(shares, reverse=True) and shares[-1] < shares[0] / 10

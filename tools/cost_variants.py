@@ -1,0 +1,31 @@
+"""Measurement variants of a pass for the cost tools (tools/forward_cost.py, tools/irradiance_cost.py),
+each declared where it lives: a shader library whose expansions of one pass file carry defines its
+shaders declare for measuring only (``#ifdef MEASURE_...``: a part of the pass taken out), checked to
+be read, so that a variant cannot silently time the pass as shipped after the shader changed; a
+scene whose materials lack their maps (the passes then compile without them)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from skinlab.gl.shader_source import ShaderLibrary
+from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK
+
+
+def measure_library(pass_file: str, defines: Mapping[str, object]) -> ShaderLibrary:
+    """A ShaderLibrary adding `defines` to every expansion of `pass_file` (ShaderLibrary.defines);
+    SystemExit naming the file and the define when the pass (its includes too) does not read one."""
+    library = ShaderLibrary(defines={pass_file: dict(defines)})
+    flat = ShaderLibrary().expand(pass_file, aliases={HOOK_INCLUDE: PLAIN_HOOK}).flat  # (the forward pass's hook)
+    for name in defines:
+        if name not in flat:
+            raise SystemExit(f"{pass_file}: no shader of the pass reads {name} any more; update this tool")
+    return library
+
+
+def without_maps(scene, maps: tuple[str, ...]):
+    """`scene` (a freshly loaded one: changed in place) with `maps` taken out of its materials (the
+    passes then compile without HAS_BASE_COLOR_MAP, HAS_NORMAL_MAP, ... and fetch none of them)."""
+    for node in scene.mesh_nodes():
+        node.material = node.material.with_overrides({k: None for k in maps})
+    return scene
