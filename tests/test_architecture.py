@@ -428,3 +428,8 @@ def test_tools_run_as_modules_of_the_repository_without_editing_sys_path():
     assert "if args.code:" in (tools / "full_over_plain.py").read_text(encoding="utf-8")
     docs = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
     assert not [d.name for d in docs if "python tools/" in d.read_text(encoding="utf-8")]
+    # neither the package nor the tools import the tests; the package does not import the tools
+    pattern = re.compile(r"^\s*(?:from|import)\s+(tests|tools)\b", re.M)
+    for f in [*sorted((ROOT / "skinlab").rglob("*.py")), *sorted(tools.glob("*.py"))]:
+        found = {m.group(1) for m in pattern.finditer(f.read_text(encoding="utf-8"))}
+        assert "tests" not in found and (f.parent == tools or "tools" not in found), f

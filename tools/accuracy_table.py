@@ -1,5 +1,5 @@
-"""Regenerate the accuracy table of docs/accuracy.md: every profile model against the Monte Carlo
-reference (skinlab/scene/optics/montecarlo.py) for reduced albedos 0.1 .. 0.99.
+"""Documentation, not a feature: regenerate the accuracy table of docs/accuracy.md: every profile model
+against the Monte Carlo reference (skinlab/scene/optics/montecarlo.py) for reduced albedos 0.1 .. 0.99.
 
     .venv/bin/python -m tools.accuracy_table [--photons 200000] [--eta 1.3] [--seed 1] [--out FILE]
 

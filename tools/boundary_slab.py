@@ -1,9 +1,9 @@
-"""The boundary of a scattering medium on its own: a flat, semi-infinite slab of a reference scene's
-material (default head-skin1: skin1 at index 1.3 under a rough dielectric, roughness 0.45), path
-traced by Mitsuba (tiny renders, cached like every reference) against the NumPy boundary model and
-Skinlab's frame. Used for docs/ground-truth.md "The rough boundary at index 1.3".
+"""A one-off analysis, not a feature: the boundary of a scattering medium on its own: a flat, semi-infinite
+slab of a reference scene's material (default head-skin1: skin1 at index 1.3 under a rough dielectric,
+roughness 0.45), path traced by Mitsuba (tiny renders, cached like every reference) against the NumPy
+boundary model and Skinlab's frame. Used for docs/ground-truth.md "The rough boundary at index 1.3".
 
-    python -m tools.boundary_slab [SCENE] [--roughness R,R,...] [--technique tsd]
+    python -m tools.boundary_slab [SCENE] [--roughness R,R,...] [--technique tsd] [--spp 1024] [--angles 0,45,70]
 
 Rows: the slab under a uniform sky of radiance 1 seen from 0, 45 and 70 degrees (by reciprocity its
 directional albedo at that cosine, boundary reflection included: 8x8 pixels, 1024 spp), and lit by
@@ -67,12 +67,15 @@ def model_sky(material: Material, mu: float) -> np.ndarray:
     return ms + ss + spec
 
 
-def main(argv: list[str]) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m tools.boundary_slab", description=__doc__.split("\n\n")[0])
     ap.add_argument("scene", nargs="?", default="head-skin1")
     ap.add_argument("--roughness", default="", help="comma-separated roughnesses to render besides the material's")
     ap.add_argument("--technique", default="tsd")
+    ap.add_argument("--spp", type=int, default=1024, help="samples per pixel of the truths (default 1024)")
+    ap.add_argument("--angles", default="0,45,70", help="comma-separated view and light angles, degrees")
     args = ap.parse_args(argv)
+    angles = [float(x) for x in args.angles.split(",") if x]
     scene = load_scene(REFERENCE_SCENES / f"{args.scene}.toml")
     base = next(n.material for n in scene.mesh_nodes() if n.material.has_subsurface)
     rough = [float(base["roughness"])] + [float(x) for x in args.roughness.split(",") if x]
@@ -87,13 +90,13 @@ def main(argv: list[str]) -> int:
             if colour is not None:
                 mat.values["subsurface_color"] = colour
                 mat.values["base_color"] = colour
-            cases = [("sky", v, None) for v in (0.0, 45.0, 70.0)]
+            cases = [("sky", v, None) for v in angles]
             if rg * rg >= SMOOTH_ALPHA or material_medium(mat.values).eta <= 1.0:
-                cases += [("sun", 0.0, a) for a in (0.0, 45.0, 70.0)]
+                cases += [("sun", 0.0, a) for a in angles]
             for kind, view, light in cases:
                 n = 8 if light is None else 16
                 ref = render_reference(
-                    slab(mat, view, light), ReferenceRequest(n, n, spp=1024, passes=2), progress=False
+                    slab(mat, view, light), ReferenceRequest(n, n, spp=args.spp, passes=2), progress=False
                 )
                 got = ref.image[..., :3].reshape(-1, 3).mean(0)
                 se = np.abs(ref.half_a - ref.half_b)[..., :3].reshape(-1, 3).mean(0) / 2 / n
@@ -105,8 +108,9 @@ def main(argv: list[str]) -> int:
                 if light is None and colour is None:
                     line += f"  model {pct(model_sky(mat, math.cos(math.radians(view))) / got - 1)} %"
                 print(line, flush=True)
+    r.release()
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())

@@ -1,8 +1,9 @@
-"""Measurement variants of a pass for the cost tools (tools/forward_cost.py, tools/irradiance_cost.py),
-each declared where it lives: a shader library whose expansions of one pass file carry defines its
-shaders declare for measuring only (``#ifdef MEASURE_...``: a part of the pass taken out), checked to
-be read, so that a variant cannot silently time the pass as shipped after the shader changed; a
-scene whose materials lack their maps (the passes then compile without them)."""
+"""Part of two one-off measurements, not a feature: measurement variants of a pass for the cost tools
+(tools/forward_cost.py, tools/irradiance_cost.py), each declared where it lives: a shader library whose
+expansions of one pass file carry defines its shaders declare for measuring only (``#ifdef
+MEASURE_...``: a part of the pass taken out), checked to be read, so that a variant cannot silently time
+the pass as shipped after the shader changed; a scene whose materials lack their maps (the passes then
+compile without them)."""
 
 from __future__ import annotations
 

@@ -1,8 +1,8 @@
-"""Per-technique frame times with and without reuse, and each pass's GPU time (timer queries), on
-whatever GL the machine has, for the fragment and the compute path of every pass that has both
-(RenderSettings.compute, skinlab/render/compute.py): the figures for a real GPU in README.md
-("Measured") came from this on a lent H100 (see docs/interreflection.md for how to carry the project
-there).
+"""A one-off measurement, not a feature: per-technique frame times with and without reuse, and each pass's
+GPU time (timer queries), on whatever GL the machine has, for the fragment and the compute path of every
+pass that has both (RenderSettings.compute, skinlab/render/compute.py): the figures for a real GPU in
+README.md ("Measured") came from this on a lent H100 (see docs/interreflection.md for how to carry the
+project there).
 
     python -m tools.frame_times [--size 1920x1080] [--frames 15] [--warmup-s 10] [--compute off,on]
                                 [--scenes head,bunny-skimmilk] [--techniques tsd,ssss] [--out times.json]
@@ -40,14 +40,14 @@ SETTINGS = (
 )
 
 
-def main(argv: list[str]) -> int:
+def main(argv: list[str] | None = None) -> int:
     from skinlab.gl.context import create_headless_context, describe
     from skinlab.render.renderer import Renderer
     from skinlab.render.settings import RenderSettings, parse_size
     from skinlab.scene.interreflection import build_transfer, clear_cache
     from skinlab.scene.scenefile import load_scene
 
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p = argparse.ArgumentParser(prog="python -m tools.frame_times", description=__doc__.split("\n\n")[0])
     p.add_argument("--size", default="1920x1080")
     p.add_argument("--frames", type=int, default=15)
     p.add_argument("--warmup-s", type=float, default=10.0)
@@ -169,4 +169,4 @@ def compare_paths(rows: list[dict]) -> list[dict]:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())

@@ -1,12 +1,12 @@
-"""The full default frame against the plain one, by process CPU time and wall time: the head and the
-skim-milk bunny, three renderers (`full`: the default settings, every pass every frame; `plain`:
-sss none, no interreflection; `orbit`: the default settings with reuse, the camera still), frames
-alternating, glFinish after every pass, medians (of frames and of each pass's process CPU time).
-What `skinlab bench orbit` reports as full_over_plain(_cpu), for any revision:
+"""A one-off measurement, not a feature: the full default frame against the plain one, by process CPU time
+and wall time: the head and the skim-milk bunny, three renderers (`full`: the default settings, every
+pass every frame; `plain`: sss none, no interreflection; `orbit`: the default settings with reuse, the
+camera still), frames alternating, glFinish after every pass, medians (of frames and of each pass's
+process CPU time). What `skinlab bench orbit` reports as full_over_plain(_cpu), for any revision:
 ``--code DIR`` imports skinlab from DIR first (a ``git archive REV | tar -x -C DIR`` of an older
 revision), so the same measurement times the code before a change.
 
-    .venv/bin/python -m tools.full_over_plain [--frames 7] [--size 640] [--code DIR]
+    .venv/bin/python -m tools.full_over_plain [--frames 7] [--size 640] [--scenes head,bunny-skimmilk] [--code DIR]
 
 Prints one JSON object: per scene the medians (cpu_ms, wall_ms) and the ratios, the load average."""
 
@@ -23,9 +23,10 @@ from pathlib import Path
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python -m tools.full_over_plain", description=__doc__.split("\n\n")[0])
     ap.add_argument("--frames", type=int, default=7)
     ap.add_argument("--size", type=int, default=640)
+    ap.add_argument("--scenes", default="head,bunny-skimmilk", help="comma-separated bundled scenes")
     ap.add_argument("--code", default=None, help="a folder holding the skinlab package to time")
     args = ap.parse_args(argv)
     if args.code:  # time another checkout's package (its folder first on the path), else this one's
@@ -47,48 +48,51 @@ def main(argv=None) -> int:
             yield
         passes.setdefault((self.mode, name), []).append((time.process_time() - c0) * 1e3)
 
-    timing.PassTimer.measure = measure_cpu
-    ctx = create_headless_context()
-    out = {"code": str(Path(skinlab.__file__).parent), "size": args.size, "load_start": os.getloadavg()}
-    n = args.size
-    for name in ("head", "bunny-skimmilk"):
-        scene = load_scene(name)
-        modes = {
-            "full": RenderSettings(n, n),
-            "plain": RenderSettings(n, n, sss_model="none", bounces=0),
-            "orbit": RenderSettings(n, n),
-        }
-        rs = {}
-        for m, st in modes.items():
-            r = rs[m] = Renderer(ctx)
-            r.reuse = m == "orbit"
-            r.timer.mode = m  # glFinish after every pass (the default): each pass's CPU time is its own
-            for _ in range(2):
-                r.render(scene, st, readback=False)
-        cpu = {m: [] for m in modes}
-        wall = {m: [] for m in modes}
-        passes.clear()
-        for _ in range(args.frames):
+    timing.PassTimer.measure = measure_cpu  # (restored below: a caller in the same process keeps its own)
+    try:
+        ctx = create_headless_context()
+        out = {"code": str(Path(skinlab.__file__).parent), "size": args.size, "load_start": os.getloadavg()}
+        n = args.size
+        for name in args.scenes.split(","):
+            scene = load_scene(name)
+            modes = {
+                "full": RenderSettings(n, n),
+                "plain": RenderSettings(n, n, sss_model="none", bounces=0),
+                "orbit": RenderSettings(n, n),
+            }
+            rs = {}
             for m, st in modes.items():
-                c0, t0 = time.process_time(), time.perf_counter()
-                rs[m].render(scene, st, readback=False)
-                ctx.finish()
-                cpu[m].append((time.process_time() - c0) * 1e3)
-                wall[m].append((time.perf_counter() - t0) * 1e3)
-        c = {m: statistics.median(v) for m, v in cpu.items()}
-        w = {m: statistics.median(v) for m, v in wall.items()}
-        out[name] = {
-            "cpu_ms": c,
-            "wall_ms": w,
-            "full_over_plain_cpu": c["full"] / c["plain"],
-            "full_over_plain_wall": w["full"] / w["plain"],
-            "orbit_over_plain_cpu": c["orbit"] / c["plain"],
-            "passes_cpu_ms": {
-                m: {p: round(statistics.median(v), 2) for (mm, p), v in passes.items() if mm == m} for m in modes
-            },
-        }
-        for r in rs.values():
-            r.release()
+                r = rs[m] = Renderer(ctx)
+                r.reuse = m == "orbit"
+                r.timer.mode = m  # glFinish after every pass (the default): each pass's CPU time is its own
+                for _ in range(2):
+                    r.render(scene, st, readback=False)
+            cpu = {m: [] for m in modes}
+            wall = {m: [] for m in modes}
+            passes.clear()
+            for _ in range(args.frames):
+                for m, st in modes.items():
+                    c0, t0 = time.process_time(), time.perf_counter()
+                    rs[m].render(scene, st, readback=False)
+                    ctx.finish()
+                    cpu[m].append((time.process_time() - c0) * 1e3)
+                    wall[m].append((time.perf_counter() - t0) * 1e3)
+            c = {m: statistics.median(v) for m, v in cpu.items()}
+            w = {m: statistics.median(v) for m, v in wall.items()}
+            out[name] = {
+                "cpu_ms": c,
+                "wall_ms": w,
+                "full_over_plain_cpu": c["full"] / c["plain"],
+                "full_over_plain_wall": w["full"] / w["plain"],
+                "orbit_over_plain_cpu": c["orbit"] / c["plain"],
+                "passes_cpu_ms": {
+                    m: {p: round(statistics.median(v), 2) for (mm, p), v in passes.items() if mm == m} for m in modes
+                },
+            }
+            for r in rs.values():
+                r.release()
+    finally:
+        timing.PassTimer.measure = measure
     out["load_end"] = os.getloadavg()
     print(json.dumps(out, indent=1))
     return 0

@@ -1,6 +1,6 @@
-"""Path-traced references rendered on another machine (a lent GPU, Mitsuba's ``cuda_ad_rgb``), for
-the cases a 2-core CPU cannot make quiet enough (the head at its real index, docs/ground-truth.md:
-"Known hard case"). Three steps:
+"""A workflow for maintainers, not a feature of the package: path-traced references rendered on another
+machine (a lent GPU, Mitsuba's ``cuda_ad_rgb``), for the cases a 2-core CPU cannot make quiet enough
+(the head at its real index, docs/ground-truth.md: "Known hard case"). Three steps:
 
     python -m tools.gpu_reference export SCENE.toml --size 96x96 --out DIR      # here: the description
     python -m tools.gpu_reference render DIR/NAME.npz --spp N --out RESULT.npz  # there: numpy + Mitsuba only
@@ -9,7 +9,7 @@ the cases a 2-core CPU cannot make quiet enough (the head at its real index, doc
 ``render`` imports only skinlab/truth/description.py (no scene graph, no GL), so the GPU machine needs
 nothing but numpy and Mitsuba. ``store`` files the result under the cache key of the request it was
 rendered with (size, spp, passes, seed, variant), so `load_truth` / tools/truth_table.py find it
-(SKINLAB_TRUTH=96:SPP:cuda_ad_rgb)."""
+(``--truth 96:SPP:cuda_ad_rgb:SEED``)."""
 
 from __future__ import annotations
 
@@ -92,8 +92,8 @@ def store(args) -> int:
     return 0
 
 
-def main(argv: list[str]) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(prog="python -m tools.gpu_reference", description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="cmd", required=True)
     e = sub.add_parser("export", help="write a scene's reference description (npz)")
     e.add_argument("scene")
@@ -115,4 +115,4 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())

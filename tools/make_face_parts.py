@@ -1,9 +1,10 @@
-"""Make the bundled face's extra parts (skinlab/assets/face-parts/): eyeballs from UV spheres in the Lee
-Perry-Smith head's eye sockets, a cornea cap over each, a lash card above each upper lid (one mesh for
-both), as one GLB of plain meshes (skinlab/scenes/head-eyes.toml gives each its material), and the iris
-and lash textures, procedural (seeded) PNGs.
+"""Maintenance, not a feature: make the bundled face's extra parts (skinlab/assets/face-parts/):
+eyeballs from UV spheres in the Lee Perry-Smith head's eye sockets, a cornea cap over each, a lash
+card above each upper lid (one mesh for both), as one GLB of plain meshes
+(skinlab/scenes/head-eyes.toml gives each its material), and the iris and lash textures, procedural
+(seeded) PNGs.
 
-    python -m tools.make_face_parts          # rewrites skinlab/assets/face-parts/{face-parts.glb,iris.png,lashes.png}
+    python -m tools.make_face_parts [--out DIR]   # default skinlab/assets/face-parts/
 
 Geometry is in the head's own units (the scan's, 45 mm per unit: head.toml). The eye centres were
 read off the scan by casting rays along -z over the face (the lids' bulge, symmetric about the nose at
@@ -14,6 +15,7 @@ path tracer sees two media overlap there: the head's and the eye's).
 
 from __future__ import annotations
 
+import argparse
 import math
 import sys
 from pathlib import Path
@@ -126,7 +128,10 @@ def lashes_png(w: int = 128, h: int = 32, seed: int = 7) -> np.ndarray:
     return img
 
 
-def main() -> int:
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m tools.make_face_parts", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", type=Path, default=OUT, help=f"folder to write into (default {OUT})")
+    out = ap.parse_args(argv).out
     from PIL import Image
 
     from skinlab.scene.gltf_export import export_gltf
@@ -134,9 +139,9 @@ def main() -> int:
     from skinlab.scene.materials import Material
     from skinlab.scene.mesh import Mesh
 
-    OUT.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(iris_png()).save(OUT / "iris.png", optimize=True)
-    Image.fromarray(lashes_png(), "RGBA").save(OUT / "lashes.png", optimize=True)
+    out.mkdir(parents=True, exist_ok=True)
+    Image.fromarray(iris_png()).save(out / "iris.png", optimize=True)
+    Image.fromarray(lashes_png(), "RGBA").save(out / "lashes.png", optimize=True)
     scene = Scene("face-parts", 45.0)
     p, n, idx = uv_sphere(EYE_R)
     uv = np.column_stack([0.5 + p[:, 0] / (2 * EYE_R), 0.5 + p[:, 1] / (2 * EYE_R)]).astype(np.float32)
@@ -149,8 +154,8 @@ def main() -> int:
         scene.add(MeshNode(f"Cornea{side}", Mesh(f"Cornea{side}", pc + cc, ic, nc), Material("cornea")))
     lp, ln, luv, li = lash_cards()
     scene.add(MeshNode("Lashes", Mesh("Lashes", lp, li, ln, luv), Material("lashes")))
-    path, _ = export_gltf(scene, OUT / "face-parts.glb")
-    print(f"wrote {path}, {OUT / 'iris.png'}, {OUT / 'lashes.png'}")
+    path, _ = export_gltf(scene, out / "face-parts.glb")
+    print(f"wrote {path}, {out / 'iris.png'}, {out / 'lashes.png'}")
     return 0
 
 

@@ -1,10 +1,14 @@
-"""Write the slab and occluder meshes of the reference scenes (skinlab/assets/meshes/*.obj):
-`python -m tools.make_reference_meshes`.
-Sizes in millimetres (the scenes say mm_per_unit = 1)."""
+"""Maintenance, not a feature: write the slab and occluder meshes of the reference scenes
+(skinlab/assets/meshes/*.obj). Sizes in millimetres (the scenes say mm_per_unit = 1).
 
+    python -m tools.make_reference_meshes [--out DIR]   # default: the package's meshes folder
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
 from pathlib import Path
-
-from skinlab.scene.primitives import box_mesh, write_obj
 
 OUT = Path(__file__).resolve().parents[1] / "skinlab" / "assets" / "meshes"  # the package data (skinlab/resources.py)
 MESHES = {
@@ -22,8 +26,19 @@ MESHES = {
     "slab-100x100x3.obj": (100.0, 100.0, 3.0),
 }
 
-if __name__ == "__main__":
-    OUT.mkdir(parents=True, exist_ok=True)
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m tools.make_reference_meshes", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", type=Path, default=OUT, help=f"folder to write into (default {OUT})")
+    out = ap.parse_args(argv).out
+    from skinlab.scene.primitives import box_mesh, write_obj
+
+    out.mkdir(parents=True, exist_ok=True)
     for name, size in MESHES.items():
-        write_obj(box_mesh(size, name.split(".")[0]), OUT / name)
-        print(f"wrote {OUT / name}")
+        write_obj(box_mesh(size, name.split(".")[0]), out / name)
+        print(f"wrote {out / name}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,4 +1,5 @@
-"""Make the bundled Stanford bunny a closed surface (skinlab/assets/stanford-bunny/bunny.ply).
+"""Maintenance, not a feature: make the bundled Stanford bunny a closed surface
+(skinlab/assets/stanford-bunny/bunny.ply).
 
 The scan (bun_zipper_res2: 8,171 vertices, 16,301 triangles) had 123 open edges (holes in its base)
 and 150 non-manifold ones (81 triangles stored twice, with both windings, and five edges where two
@@ -48,11 +49,11 @@ def ply_text(positions: np.ndarray, faces: np.ndarray) -> str:
     return "\n".join(head + verts + tris) + "\n"
 
 
-def main() -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m tools.repair_bunny", description=__doc__.split("\n\n")[0])
     ap.add_argument("--source", type=Path, required=True, help="the original scan (see above)")
     ap.add_argument("--out", type=Path, default=BUNNY)
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     import trimesh
 
     mesh = trimesh.load(str(args.source), process=False)

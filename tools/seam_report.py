@@ -1,8 +1,9 @@
-"""UV seams in texture-space diffusion (docs/tsd.md "UV seams"): per reference scene, the seam
-geometry (seam edges, sides continued, band, extension triangles, the one-off unfolding time), the
-cost of the passes with seams on and off (interleaved, median of --rounds frames, every pass run),
-the gutter of the UV layout (how far its texels are from a chart), and with --truth the error against
-the cached 96x96 path-traced references with seams off and on (tools/truth_table.py's measure).
+"""A one-off analysis, not a feature: UV seams in texture-space diffusion (docs/tsd.md "UV seams"): per
+reference scene, the seam geometry (seam edges, sides continued, band, extension triangles, the one-off
+unfolding time), the cost of the passes with seams on and off (interleaved, median of --rounds frames,
+every pass run), the gutter of the UV layout (how far its texels are from a chart), and with --truth the
+error against the cached 96x96 path-traced references with seams off and on (the ledger's truth_errors,
+as tools/truth_table.py).
 
     .venv/bin/python -m tools.seam_report [--scenes a,b] [--size 320] [--rounds 3] [--truth]
 """
@@ -17,7 +18,7 @@ import numpy as np
 from scipy.ndimage import distance_transform_edt
 
 from skinlab.bench.sweep import QUICK
-from skinlab.bench.truth_ledger import REFERENCE_SCENES, TruthSpec, load_truth
+from skinlab.bench.truth_ledger import REFERENCE_SCENES, TruthSpec, load_truth, truth_errors
 from skinlab.gl.context import create_headless_context
 from skinlab.render.renderer import Renderer
 from skinlab.render.settings import RenderSettings
@@ -25,7 +26,6 @@ from skinlab.render.techniques.tsd.passes import frame_nodes, read_texture
 from skinlab.scene.mesh import with_atlas
 from skinlab.scene.scenefile import load_scene
 from skinlab.scene.uv_seams import seam_extension
-from skinlab.truth.compare import image_error
 
 
 def pass_key(name: str) -> str:
@@ -89,18 +89,17 @@ def report(r: Renderer, name: str, size: int, rounds: int, truth: bool) -> None:
             row = []
             for seams in (False, True):
                 rs = RenderSettings.for_technique(technique, 96, 96, shadow_size=QUICK.shadow_size, seams=seams)
-                e = image_error(r.render(scene, rs, readback=("hdr",)).hdr, ref.image)
-                row.append(
-                    f"{100 * e['rel_l1_block']:.2f} % (energy {' '.join(f'{100 * x:+.1f}' for x in e['energy'])})"
-                )
+                e = truth_errors(r.render(scene, rs, readback=("hdr",)).hdr, ref)
+                energy = " ".join(f"{100 * e[f'truth_energy_{c}']:+.1f}" for c in "rgb")
+                row.append(f"{100 * e['truth_rel_l1_block']:.2f} % (energy {energy})")
             print(
                 f"  truth, {technique}: 4x4 blocks seams off {row[0]}, on {row[1]}; "
                 f"noise {100 * ref.noise['rel_l1_block']:.1f} %"
             )
 
 
-def main(argv: list[str]) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m tools.seam_report", description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", default="bunny-marble,bunny-skimmilk,bunny-ketchup,head-skin1-matched")
     ap.add_argument("--size", type=int, default=320, help="image pixels per side (default 320)")
     ap.add_argument("--rounds", type=int, default=3, help="frames per setting, interleaved (default 3)")
@@ -109,8 +108,9 @@ def main(argv: list[str]) -> int:
     r = Renderer(create_headless_context())
     for name in a.scenes.split(","):
         report(r, name, a.size, a.rounds, a.truth)
+    r.release()
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())

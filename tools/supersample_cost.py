@@ -1,13 +1,15 @@
-"""What antialiasing by supersampling costs (RenderSettings.supersample): the plain (no scattering)
-head frame at 640x640 with N = 1, 2, 4, interleaved rounds, every pass run each frame (reuse off);
-median frame time and the forward, tone-mapping and shadow passes, with the load average.
+"""A one-off measurement, not a feature: what antialiasing by supersampling costs
+(RenderSettings.supersample): the plain (no scattering) head frame at 640x640 with N = 1, 2, 4,
+interleaved rounds, every pass run each frame (reuse off); median frame time and the forward,
+tone-mapping and shadow passes, with the load average.
 
-    python -m tools.supersample_cost [ROUNDS] [FRAMES_PER_ROUND]      # default 5 3
+    python -m tools.supersample_cost [--rounds 5] [--frames 3] [--size 640] [--scene SCENE]
 
-Used for the README's timing table."""
+Used for the timing table of docs/measured.md."""
 
 from __future__ import annotations
 
+import argparse
 import os
 import statistics
 import sys
@@ -21,13 +23,18 @@ FACTORS = (1, 2, 4)
 PASSES = ("forward", "tonemap", "shadow[key]")
 
 
-def main(argv: list[str]) -> int:
-    rounds = int(argv[0]) if argv else 5
-    per_round = int(argv[1]) if len(argv) > 1 else 3
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m tools.supersample_cost", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rounds", type=int, default=5, help="interleaved rounds (default 5)")
+    ap.add_argument("--frames", type=int, default=3, help="frames per setting and round (default 3)")
+    ap.add_argument("--size", type=int, default=640, help="frame width and height (default 640)")
+    ap.add_argument("--scene", default=None, help="scene name or file (default: the head)")
+    args = ap.parse_args(argv)
+    rounds, per_round = args.rounds, args.frames
     r = Renderer(create_headless_context())
     r.reuse = False
-    scene = load_scene(None)
-    sts = {n: RenderSettings.for_technique("none", 640, 640, supersample=n) for n in FACTORS}
+    scene = load_scene(args.scene)
+    sts = {n: RenderSettings.for_technique("none", args.size, args.size, supersample=n) for n in FACTORS}
     for st in sts.values():
         r.render(scene, st, readback=False)  # compiles and uploads are not frame time
     load0 = os.getloadavg()[0]
@@ -53,4 +60,4 @@ def main(argv: list[str]) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    sys.exit(main())

@@ -1,0 +1,134 @@
+"""Every tool in tools/ runs from the package (``tools.NAME.main(argv)``) at a tiny size, with its
+argparse options, and reports what it says it does. The larger tools have modules of their own here
+(truth_table, closeup_table, the cost tools); gpu_reference is run by tests/truth/test_gpu_reference.py."""
+
+import json
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tools
+from skinlab.resources import asset_path
+
+TOOLS = Path(tools.__file__).parent
+TESTED_ELSEWHERE = {"truth_table", "closeup_table", "forward_cost", "irradiance_cost", "cost_variants", "gpu_reference"}
+HERE = {
+    "accuracy_table", "boundary_slab", "frame_times", "full_over_plain", "make_face_parts",
+    "make_reference_meshes", "repair_bunny", "seam_report", "supersample_cost",
+}  # fmt: skip
+
+
+def test_every_tool_is_tested_says_what_it_is_and_takes_options():
+    names = {p.stem for p in TOOLS.glob("*.py")} - {"__init__"}
+    assert names == TESTED_ELSEWHERE | HERE, names ^ (TESTED_ELSEWHERE | HERE)
+    for name in sorted(names):
+        text = (TOOLS / f"{name}.py").read_text(encoding="utf-8")
+        assert "not a feature" in text.split("\n\n")[0], name  # a one-off analysis, maintenance, ...
+        assert "os.environ" not in text and "sys.argv" not in text, name  # options, not variables or argv by hand
+        assert "from tests" not in text and "import tests" not in text, name
+
+
+def test_accuracy_table(tmp_path):
+    from tools import accuracy_table
+
+    out = tmp_path / "table.md"
+    assert accuracy_table.main(["--photons", "2000", "--no-progress", "--out", str(out)]) == 0
+    rows = [line for line in out.read_text().splitlines() if re.match(r"\| 0\.\d+ \|", line)]
+    assert len(rows) == 2 * len(accuracy_table.ALBEDOS)  # the total and the shape table
+    assert [line.count("|") for line in rows] == [len(accuracy_table.MODELS) + 3] * len(accuracy_table.ALBEDOS) + [
+        len(accuracy_table.MODELS) + 2
+    ] * len(accuracy_table.ALBEDOS)  # albedo, MC total, models; albedo, models
+
+
+def test_boundary_slab(capsys):
+    pytest.importorskip("mitsuba")
+    from tools import boundary_slab
+
+    assert boundary_slab.main(["--spp", "4", "--angles", "0"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("head-skin1: eta 1.300")
+    assert [line.split(":")[0] for line in out[1:]] == [
+        "rough 0.45 medium sky view  0", "rough 0.45 medium sun light  0",
+        "rough 0.45 dark   sky view  0", "rough 0.45 dark   sun light  0",
+    ]  # fmt: skip
+    assert "model" in out[1] and "model" not in out[3]  # the boundary model for the medium under the sky only
+
+
+def test_frame_times(tmp_path, capsys):
+    from tools import frame_times
+
+    out = tmp_path / "times.json"
+    argv = ["--size", "16x16", "--frames", "1", "--warmup-s", "0", "--scenes", "head", "--techniques", "none"]
+    assert frame_times.main([*argv, "--compute", "off", "--out", str(out)]) == 0
+    d = json.loads(out.read_text())
+    assert d["size"] == [16, 16] and len(d["results"]) == 4  # none with and without interreflection, full / reuse
+    assert {r["reuse"] for r in d["results"]} == {True, False} and all(r["frame_ms"] > 0 for r in d["results"])
+
+
+def test_full_over_plain(capsys):
+    from tools import full_over_plain
+
+    assert full_over_plain.main(["--frames", "1", "--size", "16", "--scenes", "head"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["size"] == 16 and set(d["head"]["cpu_ms"]) == {"full", "plain", "orbit"}
+    assert d["head"]["full_over_plain_cpu"] == pytest.approx(d["head"]["cpu_ms"]["full"] / d["head"]["cpu_ms"]["plain"])
+    assert "tsd_irradiance[LeePerrySmith]" in d["head"]["passes_cpu_ms"]["full"]
+
+
+def test_supersample_cost(capsys):
+    from tools import supersample_cost
+
+    assert supersample_cost.main(["--rounds", "1", "--frames", "1", "--size", "16"]) == 0
+    out = capsys.readouterr().out
+    assert [line.split(":")[0] for line in out.splitlines()[:3]] == ["N=1", "N=2", "N=4"]
+    assert "(x1.00 of N=1)" in out
+
+
+def test_seam_report(capsys):
+    from tools import seam_report
+
+    assert seam_report.main(["--scenes", "slab-thin-backlit-skin1", "--size", "16", "--rounds", "1"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("slab-thin-backlit-skin1: 12 triangles") and "gutter" in out and "seams on vs off" in out
+
+
+def test_make_reference_meshes_writes_the_shipped_meshes(tmp_path):
+    from tools import make_reference_meshes
+
+    assert make_reference_meshes.main(["--out", str(tmp_path)]) == 0
+    for name in make_reference_meshes.MESHES:
+        made = (tmp_path / name).read_text().splitlines()
+        shipped = asset_path("meshes", name).read_text().splitlines()
+        assert made[1:] == shipped[1:], name  # (the first line names the writer)
+
+
+def test_make_face_parts_writes_the_shipped_parts(tmp_path):
+    from tools import make_face_parts
+
+    assert make_face_parts.main(["--out", str(tmp_path)]) == 0
+    for name in ("face-parts.glb", "iris.png", "lashes.png"):
+        assert (tmp_path / name).read_bytes() == asset_path("face-parts", name).read_bytes(), name
+
+
+def test_repair_bunny_closes_an_open_mesh(tmp_path, capsys):
+    from skinlab.scene.mesh_topology import edge_report
+    from tools import repair_bunny
+
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], np.float64)  # index 4x + 2y + z
+    quads = [(0, 1, 3, 2), (4, 5, 7, 6), (0, 1, 5, 4), (2, 3, 7, 6), (0, 2, 6, 4)]  # x 0, x 1, y 0, y 1, z 0
+    faces = []
+    for a, b, c, d in quads:  # two triangles each, wound outward; the z = 1 side left open (a hole)
+        for tri in ((a, b, c), (a, c, d)):
+            n = np.cross(cube[tri[1]] - cube[tri[0]], cube[tri[2]] - cube[tri[0]])
+            faces.append(tri if n @ (cube[list(tri)].mean(0) - 0.5) > 0 else tri[::-1])
+    open_box = tmp_path / "open.ply"
+    open_box.write_text(repair_bunny.ply_text(cube, np.array(faces)))
+    out = tmp_path / "closed.ply"
+    assert repair_bunny.main(["--source", str(open_box), "--out", str(out)]) == 0
+    assert "watertight True, winding consistent True" in capsys.readouterr().out
+    from skinlab.scene.loaders import load_mesh_file
+
+    mesh = load_mesh_file(out)[0].mesh
+    assert mesh is not None and edge_report(mesh).closed and np.isfinite(mesh.positions).all()
