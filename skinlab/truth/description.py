@@ -10,6 +10,7 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -238,7 +239,7 @@ def save(desc: ReferenceDescription, path: Path) -> None:
             {"name": s.name, "material": s.material, "bsdf": s.bsdf, "interior": s.interior} for s in desc.shapes
         ],
     }
-    arrays = {"header": np.frombuffer(json.dumps(header, default=float).encode(), np.uint8)}
+    arrays: dict[str, Any] = {"header": np.frombuffer(json.dumps(header, default=float).encode(), np.uint8)}
     if desc.environment is not None:
         arrays["environment"] = desc.environment
     for i, s in enumerate(desc.shapes):
@@ -255,7 +256,7 @@ def load(path: Path) -> ReferenceDescription:
         header = json.loads(bytes(z["header"]).decode())
         shapes = []
         for i, s in enumerate(header["shapes"]):
-            arr = {a: (z[f"shape{i}_{a}"] if f"shape{i}_{a}" in z else None) for a in _ARRAYS}
+            arr: dict[str, Any] = {a: (z[f"shape{i}_{a}"] if f"shape{i}_{a}" in z else None) for a in _ARRAYS}
             shapes.append(ShapeDesc(s["name"], s["material"], bsdf=s["bsdf"], interior=s["interior"], **arr))
         environment = z["environment"] if "environment" in z else None
     return ReferenceDescription(
@@ -309,7 +310,9 @@ def render_pass(desc: ReferenceDescription, spp: int, seed: int, index: int, pro
     acc = np.zeros((desc.height, desc.width, 4), np.float64)
     for c in range(k):
         n = spp // k + (1 if c < spp % k else 0)
-        acc += np.asarray(mi.render(mscene, spp=n, seed=pass_seed(seed, index, c)), np.float64) * n
+        # Mitsuba's stubs type the seed as drjit's UInt32; it takes a Python int (pass_seed: below 2^32)
+        img = mi.render(mscene, spp=n, seed=pass_seed(seed, index, c))  # type: ignore[arg-type]
+        acc += np.asarray(img, np.float64) * n
         if progress is not None:
             progress(n)
     return (acc / spp).astype(np.float32), time.perf_counter() - t0
@@ -327,7 +330,7 @@ def path_trace(desc: ReferenceDescription, spp: int, passes: int, seed: int, pro
     sums = np.zeros((passes, desc.height, desc.width, 4), np.float64)
     counts = np.zeros(passes, np.int64)
     for i, (p, n) in enumerate(chunk_plan(spp, passes, chunk)):
-        img = np.asarray(mi.render(mscene, spp=n, seed=seed * 1_000_003 + i), np.float64)
+        img = np.asarray(mi.render(mscene, spp=n, seed=seed * 1_000_003 + i), np.float64)  # type: ignore[arg-type]
         sums[p] += img * n
         counts[p] += n
         if progress is not None:

@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -77,12 +78,13 @@ class ReferenceError(ValueError):
 # -- the description -------------------------------------------------------------------------------
 
 
-def medium_dict(values: dict, mm_per_unit: float = 1.0) -> dict:
+def medium_dict(values: dict, mm_per_unit: float = 1.0) -> dict[str, Any]:
     """The homogeneous medium of a subsurface material, coefficients in 1/unit for a frame of
     mm_per_unit millimetres per unit (the reference frame's: 1)."""
     m = material_medium(values)
     mfp = np.maximum(m.mfp_arr, REFERENCE_MIN_MFP_MM)
-    albedo, phase = np.clip(m.alpha_arr, 0.0, 1.0), {"type": "isotropic"}
+    albedo = np.clip(m.alpha_arr, 0.0, 1.0)
+    phase: dict[str, Any] = {"type": "isotropic"}
     g = float(values.get("subsurface_scatter_anisotropy", 0.0))
     if g != 0.0:  # the real coefficients of the reduced medium (similarity), with its HG phase
         mfp, albedo = real_mfp(mfp, albedo, g), real_albedo(albedo, g)
@@ -195,7 +197,8 @@ def _alpha_bsdf(values: dict, bsdf: dict, has_uv: bool) -> tuple[dict, np.ndarra
         op = (np.asarray(op) >= float(values["alpha_cutoff"])).astype(np.float32)
     if np.ndim(op) == 0 or not has_uv:
         return {"type": "mask", "opacity": float(np.mean(op)), "bsdf": bsdf}, None
-    return {"type": "mask", "opacity": {"type": "opacity_ref"}, "bsdf": bsdf}, np.ascontiguousarray(op[..., None])
+    texture = np.ascontiguousarray(np.asarray(op)[..., None])
+    return {"type": "mask", "opacity": {"type": "opacity_ref"}, "bsdf": bsdf}, texture
 
 
 def _scatters(values: dict) -> bool:
@@ -215,7 +218,7 @@ def frame_origin(scene: Scene) -> np.ndarray:
 
 
 def _camera_frame(scene: Scene, origin: np.ndarray, scale: float) -> np.ndarray:
-    w = scene.camera.world_matrix
+    w = scene.active_camera().world_matrix
     x, y, z = (w[:3, i] / np.linalg.norm(w[:3, i]) for i in range(3))
     m = np.eye(4)
     m[:3, 0], m[:3, 1], m[:3, 2] = -x, y, -z  # Skinlab looks down -Z, +X right

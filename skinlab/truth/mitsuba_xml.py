@@ -106,12 +106,12 @@ def _emitter(e: dict, indent: str) -> list[str]:
     i2 = indent + "    "
     rgb = lambda name, v: f'{i2}<rgb name="{name}" value="{", ".join(_float(x) for x in v)}"/>'  # noqa: E731
     if e["kind"] == "directional":
-        d = ", ".join(_float(x) for x in e["direction"])
-        return [f'{indent}<emitter type="directional">', f'{i2}<vector name="direction" value="{d}"/>',
+        towards = ", ".join(_float(x) for x in e["direction"])
+        return [f'{indent}<emitter type="directional">', f'{i2}<vector name="direction" value="{towards}"/>',
                 rgb("irradiance", e["irradiance"]), f"{indent}</emitter>"]  # fmt: skip
     if e["kind"] == "point":
-        p = ", ".join(_float(x) for x in e["position"])
-        return [f'{indent}<emitter type="point">', f'{i2}<point name="position" value="{p}"/>',
+        at = ", ".join(_float(x) for x in e["position"])
+        return [f'{indent}<emitter type="point">', f'{i2}<point name="position" value="{at}"/>',
                 rgb("intensity", e["intensity"]), f"{indent}</emitter>"]  # fmt: skip
     if e["kind"] == "constant":
         return [f'{indent}<emitter type="constant">', rgb("radiance", e["radiance"]), f"{indent}</emitter>"]
@@ -230,6 +230,8 @@ def write_mitsuba_xml(desc: ReferenceDescription, folder: str | Path, spp: int =
         if e["kind"] == "envmap":  # its pixels beside the XML, as an EXR Mitsuba reads
             from skinlab.scene.envmap import write_map
 
+            if desc.environment is None:
+                raise ValueError("the description has an environment map emitter but not its pixels")
             (folder / "textures").mkdir(exist_ok=True)
             write_map(folder / "textures" / "envmap.exr", desc.environment)
             e = {**e, "file": "textures/envmap.exr"}

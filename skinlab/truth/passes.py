@@ -56,6 +56,8 @@ class PassStore:
         self._memory: dict[int, Pass] = {}
 
     def path(self, index: int) -> Path:
+        if self.folder is None:
+            raise ValueError("a pass store kept in memory has no files")
         return self.folder / f"pass-{index:05d}.npz"
 
     def _read(self, path: Path, index: int) -> Pass | None:

@@ -113,9 +113,9 @@ class Reference:
 def cache_dir() -> Path:
     """$SKINLAB_CACHE_DIR/reference, else $XDG_CACHE_HOME/skinlab/reference, else ~/.cache/skinlab/reference."""
     base = os.environ.get("SKINLAB_CACHE_DIR")
-    if not base:
-        base = Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "skinlab"
-    return Path(base) / "reference"
+    if base:
+        return Path(base) / "reference"
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "skinlab" / "reference"
 
 
 def mitsuba_module():
@@ -171,10 +171,12 @@ def load_cached(key: str, shape: tuple[int, int, int] | None = None) -> Referenc
             img, a, b = z["image"], z["half_a"], z["half_b"]
         meta = json.loads(js.read_text())
     except Exception as exc:  # BadZipFile, EOFError, ValueError, KeyError, UnicodeDecodeError...: damaged
-        return _discard(npz, js, f"it does not read back ({type(exc).__name__})")
+        _discard(npz, js, f"it does not read back ({type(exc).__name__})")
+        return None
     problem = _whole_problem(img, a, b, meta, shape)
     if problem:
-        return _discard(npz, js, problem)
+        _discard(npz, js, problem)
+        return None
     return Reference(img, a, b, key, meta, cached=True)
 
 

@@ -124,10 +124,8 @@ def light_edges(plain: np.ndarray, mask: np.ndarray, ratio: float = EDGE_RATIO) 
     out = np.zeros(mask.shape, bool)
     thr = math.log(ratio)
     for ax in (0, 1):
-        a = [slice(None)] * 2
-        b = [slice(None)] * 2
-        a[ax], b[ax] = slice(1, None), slice(None, -1)
-        a, b = tuple(a), tuple(b)
+        a = tuple(slice(1, None) if k == ax else slice(None) for k in range(2))
+        b = tuple(slice(None, -1) if k == ax else slice(None) for k in range(2))
         jump = (np.abs(lg[a] - lg[b]) > thr) & mask[a] & mask[b]
         out[a] |= jump
         out[b] |= jump
@@ -178,8 +176,8 @@ def profile(img: np.ndarray, px: PixelPoints, spec, mask: np.ndarray) -> Profile
         [np.bincount(idx, weights=img[..., c][ok].astype(np.float64), minlength=n) for c in range(3)], axis=1
     )
     with np.errstate(invalid="ignore", divide="ignore"):
-        rgb = rgb / cnt[:, None]
-    return Profile((edges[:-1] + edges[1:]) / 2, rgb, cnt.astype(np.int64))
+        mean = rgb / cnt[:, None]
+    return Profile((edges[:-1] + edges[1:]) / 2, mean, cnt.astype(np.int64))
 
 
 def profile_error(a: Profile, b: Profile) -> float:
