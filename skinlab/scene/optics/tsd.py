@@ -61,7 +61,6 @@ class DiffusionKernel:
     steps: tuple  # BlurStep per kept level, ascending variance
     identity: np.ndarray  # (3,) weight of the unblurred irradiance
     skipped: tuple = field(default=())  # (what, why) for the plan
-    fit: ProfileFit | None = None
 
     @property
     def levels(self) -> int:
@@ -137,7 +136,7 @@ def design_kernel(
         sigma = math.sqrt(max(v - prev, 0.0))
         steps.append(BlurStep(i, v, sigma, int(taps) if taps else tap_count(sigma / p10), tuple(float(x) for x in w)))
         prev = v
-    return DiffusionKernel(tuple(steps), ident, tuple(skipped), fit)
+    return DiffusionKernel(tuple(steps), ident, tuple(skipped))
 
 
 # -- NumPy reference twin of the GPU passes ------------------------------------------------------------

@@ -96,7 +96,7 @@ class DiskTechnique(Technique[DiskSettings]):
             ctx.settings.render_size,
             f"Burley disk SSS (Golubev 2018): {o.samples} samples per pixel"
             f"{', rotated per pixel' if o.rotate else ''}, depth-aware; {len(keys)} profile(s): {names}" + path.note,
-            DiskParams(o.samples, o.rotate, kernels, labels, path.compute),
+            DiskParams(o.samples, o.rotate, kernels, path.compute),
         )
         through = plan_translucency(ctx, True, o.translucency)
         return TechniquePlan(DiskForward(nodes, through), after_forward=[p], shadow_distance=through)

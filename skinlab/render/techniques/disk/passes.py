@@ -25,7 +25,6 @@ class DiskParams:
     samples: int
     rotate: bool
     kernels: list  # skinlab.scene.optics.disk.DiskKernel per profile index
-    labels: list  # the material named for each profile (the plan's explanation)
     compute: bool = False  # the compute shader (techniques/disk/gather.comp), else the fragment shader
 
     def table(self) -> np.ndarray:
