@@ -20,9 +20,13 @@ viewer's window asks for GL 3.3 core) runs the fragment path, and the plan says 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 import moderngl
+
+if TYPE_CHECKING:
+    from skinlab.gl.programs import ProgramCache
+    from skinlab.gl.uniforms import Shader
 
 
 class ComputeSetting(Protocol):
@@ -99,3 +103,11 @@ def bind_images(cs: moderngl.ComputeShader, images: dict) -> None:
     for unit, (name, tex) in enumerate(images.items()):
         tex.bind_to_image(unit, read=False, write=True)
         set_uniform(cs, name, unit)
+
+
+def pass_program(programs: ProgramCache, shader: str, compute: bool) -> Shader:
+    """The two paths of a pass that has both: `shader` (a path under the shader root, no ending) as
+    the compute shader ``<shader>.comp`` or as the fullscreen fragment pass ``<shader>.frag``."""
+    if compute:
+        return programs.compute(f"{shader}.comp")
+    return programs.get("passes/fullscreen.vert", f"{shader}.frag")

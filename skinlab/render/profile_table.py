@@ -8,7 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from skinlab.gl.uniforms import set_uniform
 from skinlab.render.scattering import scattering_material
+from skinlab.render.technique import ForwardHook, NodeShading
+from skinlab.render.translucency import REASON, translucent_shading
 from skinlab.scene.optics.material_medium import material_medium
 
 MAX_PROFILES = 16  # rows in a frame's profile table (the MAX_*_PROFILES defines of the technique shaders)
@@ -42,3 +45,25 @@ def plan_profile_table(meshes, settings, plan, technique: str) -> ProfileTable:
             t.materials.append(mat)
         t.nodes[n.uid] = (mat, t.keys.index(key))
     return t
+
+
+class ProfileIndexForward(ForwardHook):
+    """The forward pass's part of a screen-space technique that filters a second target by profile:
+    every mesh writes its subsurface diffuse (with `translucency`, the light through thin parts too)
+    to `target`, its alpha the mesh's profile index + 1 through the hook's `uniform` (0: not filtered,
+    plain diffuse). `profiles`: node uid -> (the material to bind, profile index); `what` ends the
+    forward pass's reason."""
+
+    def __init__(self, hook: str, uniform: str, target: str, what: str, profiles: dict, translucency: bool):
+        self.hook, self.uniform, self.profiles, self.translucency = hook, uniform, profiles, translucency
+        self.outputs = (target,)
+        self.reason = "; subsurface diffuse" + (f" and {REASON}" if translucency else "") + f" {what}"
+
+    def shading(self, node, frame) -> NodeShading:
+        mat, index = self.profiles.get(node.uid, (node.material, -1))
+        value = float(index + 1)
+
+        def bind(prog, units):
+            set_uniform(prog, self.uniform, value)
+
+        return translucent_shading(mat, self.hook, frame, self.translucency and index >= 0, bind, subsurface=index >= 0)

@@ -10,15 +10,14 @@ texture-space diffusion's irradiance pass does) to the light the disk pass gathe
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from skinlab.declare import option
-from skinlab.gl.uniforms import set_uniform
 from skinlab.render.frame_plan import FramePlan, PlannedPass
 from skinlab.render.options import TechniqueSettings
-from skinlab.render.profile_table import plan_profile_table
-from skinlab.render.technique import ForwardHook, LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
-from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
+from skinlab.render.profile_table import ProfileIndexForward, plan_profile_table
+from skinlab.render.technique import LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
+from skinlab.render.translucency import OPTION_DOC, plan_translucency
 from skinlab.scene.optics.disk import MAX_DISK_SAMPLES, disk_edge_response, disk_kernel
 
 from .passes import DIFFUSE_TARGET, DiskParams, DiskPass
@@ -38,32 +37,6 @@ class DiskSettings(TechniqueSettings):
     )
     rotate: bool = option(True, "rotate each pixel's sample spiral (noise instead of banding)", "bool")
     translucency: bool = option(True, OPTION_DOC, "bool")
-
-
-@dataclass
-class DiskForward(ForwardHook):
-    profiles: dict = field(default_factory=dict)  # node uid -> (effective material, profile index)
-    translucency: bool = False  # add the light through thin parts (shadow distance maps) before the disk pass
-
-    outputs = (DIFFUSE_TARGET,)
-
-    def __post_init__(self) -> None:
-        self.reason = (
-            "; subsurface diffuse"
-            + (f" and {REASON}" if self.translucency else "")
-            + (" and profile index to a second target for the disk pass")
-        )
-
-    def shading(self, node, frame):
-        hit = self.profiles.get(node.uid)
-        mat, index = hit if hit is not None else (node.material, -1)
-        value = float(index + 1)
-        through = self.translucency and index >= 0
-
-        def bind(prog, units):
-            set_uniform(prog, "u_disk_profile", value)
-
-        return translucent_shading(mat, HOOK, frame, through, bind, subsurface=index >= 0)
 
 
 class DiskTechnique(Technique[DiskSettings]):
@@ -99,7 +72,9 @@ class DiskTechnique(Technique[DiskSettings]):
             DiskParams(o.samples, o.rotate, kernels, path.compute),
         )
         through = plan_translucency(ctx, True, o.translucency)
-        return TechniquePlan(DiskForward(nodes, through), after_forward=[p], shadow_distance=through)
+        what = "and profile index to a second target for the disk pass"
+        hook = ProfileIndexForward(HOOK, "u_disk_profile", DIFFUSE_TARGET, what, nodes, through)
+        return TechniquePlan(hook, after_forward=[p], shadow_distance=through)
 
     def edge_response(self, model, medium, plan: FramePlan):
         """The disk kernel's edge response averaged over the per-pixel rotation."""

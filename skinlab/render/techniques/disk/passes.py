@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from skinlab.gl.uniforms import Shader, set_array, set_uniform, set_uniforms
-from skinlab.render.compute import bind_images, dispatch
+from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
+from skinlab.render.compute import bind_images, dispatch, pass_program
 from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
 from skinlab.render.profile_table import MAX_PROFILES
 from skinlab.render.technique import RenderPass
@@ -51,11 +51,7 @@ class DiskPass(RenderPass):
         ffilt, fout = self._gpu.fbos
         cam = frame.scene.camera
         table = self._gpu.table(prm.table())
-        prog: Shader
-        if prm.compute:
-            prog = self.r.programs.compute("techniques/disk/gather.comp")
-        else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/disk/gather.frag")
+        prog = pass_program(self.r.programs, "techniques/disk/gather", prm.compute)
         reach = np.array([k.reach_mm for k in prm.kernels], np.float32)
         set_array(prog, "u_reach_mm", reach, MAX_PROFILES)
         set_uniforms(

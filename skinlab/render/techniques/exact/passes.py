@@ -8,7 +8,8 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from skinlab.gl.uniforms import Shader, set_uniforms
+from skinlab.gl.uniforms import set_uniforms
+from skinlab.render.compute import pass_program
 from skinlab.render.techniques.tsd.passes import TsdPass, store
 from skinlab.render.techniques.tsd.plan import TsdExactParams
 from skinlab.scene.optics.exact_profile import exact_profile_lut
@@ -59,11 +60,7 @@ class TsdExactPass(TsdPass):
         t = store(self.r).targets(node, size)
         lut, r_max = self.lut(prm.model, material_medium(prm.material.values))
         dst = t.level(ctx, 0)
-        prog: Shader
-        if prm.compute:
-            prog = self.r.programs.compute("techniques/exact/gather.comp")
-        else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/exact/gather.frag")
+        prog = pass_program(self.r.programs, "techniques/exact/gather", prm.compute)
         set_uniforms(
             prog,
             {

@@ -11,15 +11,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from skinlab.declare import option
-from skinlab.gl.uniforms import set_uniform
 from skinlab.render.frame_plan import FramePlan, PlannedPass
 from skinlab.render.options import TechniqueSettings
-from skinlab.render.technique import ForwardHook, LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
-from skinlab.render.translucency import OPTION_DOC, REASON, plan_translucency, translucent_shading
+from skinlab.render.profile_table import ProfileIndexForward
+from skinlab.render.technique import LedgerStyle, LedgerSweep, PlanContext, Technique, TechniquePlan
+from skinlab.render.translucency import OPTION_DOC, plan_translucency
 from skinlab.scene.optics.edges import separable_edge
 
 from .passes import MAX_SSSS_TAPS, SsssBlurParams, SsssBlurPass
-from .plan import SsssPlan, plan_ssss
+from .plan import plan_ssss
 
 HOOK = "techniques/ssss/forward.glsl"
 # the path `compute = auto` takes for the blur on software GL (skinlab/render/compute.py; measured:
@@ -36,32 +36,6 @@ class SsssSettings(TechniqueSettings):
     )
     gaussians: int = option(6, "Gaussians fitted to the profile the kernel is sampled from", "int", range=(1, 6))
     translucency: bool = option(True, OPTION_DOC, "bool")
-
-
-@dataclass
-class SsssForward(ForwardHook):
-    ssss: SsssPlan
-    translucency: bool = False  # add the light through thin parts (shadow distance maps) before the blur
-
-    outputs = (DIFFUSE_TARGET,)
-
-    def __post_init__(self) -> None:
-        self.reason = (
-            "; subsurface diffuse"
-            + (f" and {REASON}" if self.translucency else "")
-            + (" to a second target for the screen-space blur")
-        )
-
-    def shading(self, node, frame):
-        # every mesh writes the second target, its alpha the profile index + 1 (0: not blurred); the
-        # node's own values apply (sss_model overrides change no uniform)
-        index = float(self.ssss.profile.get(node.uid, -1) + 1)
-        through = self.translucency and index > 0
-
-        def bind(prog, units):
-            set_uniform(prog, "u_ssss_profile", index)
-
-        return translucent_shading(node.material, HOOK, frame, through, bind, subsurface=index > 0)
 
 
 class SsssTechnique(Technique[SsssSettings]):
@@ -94,7 +68,11 @@ class SsssTechnique(Technique[SsssSettings]):
             SsssBlurParams(ssss, o.gaussians, path.compute),
         )
         through = plan_translucency(ctx, True, o.translucency)
-        return TechniquePlan(SsssForward(ssss, through), after_forward=[blur], shadow_distance=through)
+        # the node's own material binds (an sss_model override changes no uniform)
+        profiles = {n.uid: (n.material, ssss.profile[n.uid]) for n in ctx.meshes if n.uid in ssss.profile}
+        what = "to a second target for the screen-space blur"
+        hook = ProfileIndexForward(HOOK, "u_ssss_profile", DIFFUSE_TARGET, what, profiles, through)
+        return TechniquePlan(hook, after_forward=[blur], shadow_distance=through)
 
     def edge_response(self, model, medium, plan: FramePlan):
         """The 1-D kernel of the material's profile across an edge along a screen axis (the separable

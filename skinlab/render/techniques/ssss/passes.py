@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from skinlab.gl.uniforms import Shader, set_array, set_uniforms
-from skinlab.render.compute import bind_images, dispatch
+from skinlab.gl.uniforms import set_array, set_uniforms
+from skinlab.render.compute import bind_images, dispatch, pass_program
 from skinlab.render.passes.screen_targets import ScreenTargets, composite, publish_composite
 from skinlab.render.profile_table import MAX_PROFILES
 from skinlab.render.technique import RenderPass
@@ -46,11 +46,7 @@ class SsssBlurPass(RenderPass):
         # pixels per scene unit at view depth 1: rows span 2 tan(yfov/2), columns the same times aspect
         ppu_y = h / (2.0 * math.tan(cam.yfov / 2.0))
         ppu_x = ppu_y  # square pixels (aspect = w / h)
-        prog: Shader
-        if p.params.compute:
-            prog = self.r.programs.compute("techniques/ssss/blur.comp")
-        else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/ssss/blur.frag")
+        prog = pass_program(self.r.programs, "techniques/ssss/blur", p.params.compute)
         n = plan.taps
         table = self._gpu.table(plan.table())
         ranges = np.array([k.range_mm for k in plan.kernels], np.float32)

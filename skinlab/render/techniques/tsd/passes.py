@@ -29,7 +29,7 @@ from skinlab.gl.state import gl_state
 from skinlab.gl.uniforms import Shader, set_array, set_uniform, set_uniforms
 from skinlab.render.ambient import ambient_defines, bind_ambient
 from skinlab.render.boundary import bind_boundary
-from skinlab.render.compute import bind_images, dispatch
+from skinlab.render.compute import bind_images, dispatch, pass_program
 from skinlab.render.environment import bind_env_bands
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
@@ -583,11 +583,7 @@ class TsdBlurPass(TsdPass):
         # u then v; with seams the v step goes to the scratch texture and the seam fill from there
         # into the level (its gutter across the seams, for the next blur and the gather)
         steps = ((src, dst), (dst, t.scratch)) if seams else ((src, t.scratch), (t.scratch, dst))
-        prog: Shader
-        if prm.compute:
-            prog = self.r.programs.compute("techniques/tsd/blur.comp")
-        else:
-            prog = self.r.programs.get("passes/fullscreen.vert", "techniques/tsd/blur.frag")
+        prog = pass_program(self.r.programs, "techniques/tsd/blur", prm.compute)
         taps_t, taps_w = blur_taps(step.taps)
         set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
         set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)
