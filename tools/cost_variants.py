@@ -7,7 +7,9 @@ compile without them)."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import os
+import time
+from collections.abc import Callable, Mapping
 
 from skinlab.gl.shader_source import ShaderLibrary
 from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK
@@ -30,3 +32,17 @@ def without_maps(scene, maps: tuple[str, ...]):
     for node in scene.mesh_nodes():
         node.material = node.material.with_overrides({k: None for k in maps})
     return scene
+
+
+def finished_ms(ctx, run: Callable[..., object], *args) -> float:
+    """Wall milliseconds of `run(*args)` with the GL work before it finished and its own waited for."""
+    ctx.finish()
+    t0 = time.perf_counter()
+    run(*args)
+    ctx.finish()
+    return (time.perf_counter() - t0) * 1e3
+
+
+def load_line(start: tuple[float, ...]) -> str:
+    """The load average at the start and now, for the printout."""
+    return f"load average {tuple(round(x, 2) for x in start)} -> {tuple(round(x, 2) for x in os.getloadavg())}"

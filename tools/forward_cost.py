@@ -41,7 +41,7 @@ def main(argv=None) -> int:
     from skinlab.render.settings import RenderSettings
     from skinlab.scene.scenefile import load_scene
 
-    from .cost_variants import measure_library, without_maps
+    from .cost_variants import load_line, measure_library, without_maps
 
     def scene_without_shadows(maps=True):
         scene = load_scene(args.scene)
@@ -81,7 +81,7 @@ def main(argv=None) -> int:
                 r.render(sc, st, readback=("ldr", "depth"))
                 times[name].append((time.perf_counter() - t0) * 1e3)
         print(f"{describe(ctx)}; plain frame {n}x{n} (sss_model none, no shadows), median of {args.rounds}")
-        print(f"load average {tuple(round(x, 2) for x in load0)} -> {tuple(round(x, 2) for x in os.getloadavg())}")
+        print(load_line(load0))
         base = statistics.median(times["base"])
         for name, v in times.items():
             m = statistics.median(v)

@@ -40,7 +40,6 @@ import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
@@ -74,6 +73,8 @@ def coverage(rounds: int, sides=(1.0, 0.5, 0.25, 0.1), size: int = 512) -> int:
     from skinlab.scene.mesh import Mesh
     from skinlab.scene.scenefile import load_scene
 
+    from .cost_variants import finished_ms, load_line
+
     ctx = create_headless_context()
     runs = {}
     for side in sides:
@@ -92,13 +93,9 @@ def coverage(rounds: int, sides=(1.0, 0.5, 0.25, 0.1), size: int = 512) -> int:
     times: dict[float, list[float]] = {k: [] for k in runs}
     for _ in range(rounds):
         for side, (r, frame, irr, _) in runs.items():
-            ctx.finish()
-            t0 = time.perf_counter()
-            r.pass_for("tsd_irradiance").run(frame, irr)
-            ctx.finish()
-            times[side].append((time.perf_counter() - t0) * 1e3)
+            times[side].append(finished_ms(ctx, r.pass_for("tsd_irradiance").run, frame, irr))
     print(f"{describe(ctx)}; tsd_irradiance {size}x{size} texels on the slab of {SLAB}, median of {rounds}")
-    print(f"load average {tuple(round(x, 2) for x in load0)} -> {tuple(round(x, 2) for x in os.getloadavg())}")
+    print(load_line(load0))
     for side, v in times.items():
         print(f"  UVs x {side:4g}: {runs[side][3]:7.2%} of the layout covered: {statistics.median(v):7.2f} ms")
     for r, *_ in runs.values():
@@ -145,7 +142,7 @@ def main(argv=None) -> int:
     from skinlab.render.settings import RenderSettings
     from skinlab.scene.scenefile import load_scene
 
-    from .cost_variants import measure_library, without_maps
+    from .cost_variants import finished_ms, load_line, measure_library, without_maps
 
     ctx = create_headless_context()
     scene = load_scene(args.scene)
@@ -183,31 +180,20 @@ def main(argv=None) -> int:
             if base_irr.params.translucency:  # the record's fill alone (the base pass runs it last)
                 r = runs["base"][0]
                 t = store(r).targets(base_irr.params.node, base_irr.params.size)
-                ctx.finish()
-                t0 = time.perf_counter()
                 prm = base_irr.params
                 slots = min(len(prm.shadow_lights), SHADOW_SLOTS)
-                through_fill(r, t, prm.seams is not None, node_border_strips(prm.node.mesh, prm.size), slots)
-                ctx.finish()
-                fill_times.append((time.perf_counter() - t0) * 1e3)
+                strips = node_border_strips(prm.node.mesh, prm.size)
+                fill_times.append(finished_ms(ctx, through_fill, r, t, prm.seams is not None, strips, slots))
             for name, (r, frame, irr, _fwd) in runs.items():
-                ctx.finish()
-                t0 = time.perf_counter()
-                r.pass_for("tsd_irradiance").run(frame, irr)
-                ctx.finish()
-                times[name].append((time.perf_counter() - t0) * 1e3)
+                times[name].append(finished_ms(ctx, r.pass_for("tsd_irradiance").run, frame, irr))
             r, frame, irr, fwd = runs["base"]
-            ctx.finish()
-            t0 = time.perf_counter()
-            r.pass_for("forward").run(frame, fwd)
-            ctx.finish()
-            fwd_times.append((time.perf_counter() - t0) * 1e3)
+            fwd_times.append(finished_ms(ctx, r.pass_for("forward").run, frame, fwd))
         r, frame, irr, _ = runs["base"]
         texels = irr.resolution[0] * irr.resolution[1]
         print(f"{describe(ctx)}; {irr.name} {irr.resolution[0]}x{irr.resolution[1]} texels, frame {args.size}^2")
         share = covered(r, irr)
         print(f"texels covered by a triangle: {share:.1%} (the pass rasterises triangles: only those are shaded)")
-        print(f"load average {tuple(round(x, 2) for x in load0)} -> {tuple(round(x, 2) for x in os.getloadavg())}")
+        print(load_line(load0))
         base = statistics.median(times["base"])
         for name, v in times.items():
             m = statistics.median(v)
