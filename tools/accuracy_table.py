@@ -45,12 +45,13 @@ def measure(photons, eta, seed, progress=True):
         sel = EDGES[:-1] >= 0.05
         area = np.pi * np.diff(EDGES**2)[sel]
         ref = res.R[sel]
-        row = {"albedo": a, "mc_total": res.total, "mc_se": res.total_se, "models": {}}
+        models: dict[str, tuple[float, float]] = {}
+        row = {"albedo": a, "mc_total": res.total, "mc_se": res.total_se, "models": models}
         for name in MODELS:
             t = float(total_reflectance(name, m)[0])
             mod = bin_average(name, m, EDGES)[sel]
             shape = float(np.sum(np.abs(mod - ref) * area) / np.sum(ref * area))
-            row["models"][name] = ((t - res.total) / res.total, shape)
+            models[name] = ((t - res.total) / res.total, shape)
         rows.append(row)
     return rows
 

@@ -90,7 +90,7 @@ def main(argv: list[str] | None = None) -> int:
             if colour is not None:
                 mat.values["subsurface_color"] = colour
                 mat.values["base_color"] = colour
-            cases = [("sky", v, None) for v in angles]
+            cases: list[tuple[str, float, float | None]] = [("sky", v, None) for v in angles]
             if rg * rg >= SMOOTH_ALPHA or material_medium(mat.values).eta <= 1.0:
                 cases += [("sun", 0.0, a) for a in angles]
             for kind, view, light in cases:
@@ -98,6 +98,7 @@ def main(argv: list[str] | None = None) -> int:
                 ref = render_reference(
                     slab(mat, view, light), ReferenceRequest(n, n, spp=args.spp, passes=2), progress=False
                 )
+                assert ref is not None  # rendered when not cached
                 got = ref.image[..., :3].reshape(-1, 3).mean(0)
                 se = np.abs(ref.half_a - ref.half_b)[..., :3].reshape(-1, 3).mean(0) / 2 / n
                 rs = RenderSettings.for_technique(args.technique, n, n, supersample=4)

@@ -29,6 +29,7 @@ import math
 import os
 import sys
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -137,12 +138,12 @@ def ray_geometry(scene, width: int, height: int):
         owner.append(np.full(len(node.mesh.indices), k))
         start += len(p)
     mesh = trimesh.Trimesh(np.concatenate(pos), np.concatenate(faces), process=False)
-    owner = np.concatenate(owner)
+    owners = np.concatenate(owner)
     ray = RayMeshIntersector(mesh)
     o, d = camera_rays(scene, width, height)
     tri, idx, loc = ray.intersects_id(o, d, multiple_hits=False, return_locations=True)
     node = np.full(len(o), -1)
-    node[idx] = owner[tri]
+    node[idx] = owners[tri]
     light = scene.lights()[0]
     lit = np.zeros(len(o), bool)
     if len(idx):
@@ -249,7 +250,7 @@ def main(argv: list[str] | None = None) -> int:
     extra = {} if args.bounces is None else {"bounces": args.bounces}
     model = args.sss_model
     r = Renderer(create_headless_context())
-    saved = {}
+    saved: dict[str, Any] = {}  # name -> array (np.savez's keyword arguments)
     print("load average at start: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
     for s in scenes:
         spec = CLOSEUPS[s].at(args.size, args.spp)
@@ -264,7 +265,7 @@ def main(argv: list[str] | None = None) -> int:
             f"{s:24s} truth {spec.size[0]}x{spec.size[1]} {spec.spp} spp: noise 4x4 "
             f"{100 * noise['rel_l1_block']:.2f} %, px {100 * noise['rel_l1']:.2f} %"
         )
-        masks = None
+        masks: tuple = ()  # the kind's regions (shadow: deep, lit, edge; slabs: front, back)
         if spec.kind == "slit":
             pa, pb, pt = line_profile(ha), line_profile(hb), line_profile(t_img)
             head += f", profile {100 * profile_error(pa, pb):.2f} %"

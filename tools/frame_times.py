@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-SETTINGS = (
+SETTINGS: tuple[tuple[str, dict], ...] = (
     ("none", {"bounces": 0}),
     ("none", {}),
     ("tsd", {"bounces": 0}),
@@ -65,7 +65,8 @@ def main(argv: list[str] | None = None) -> int:
     w, h = parse_size(args.size)
     ctx = create_headless_context()
     r = Renderer(ctx)
-    out = {"gl": describe(ctx), "size": [w, h], "loadavg": list(os.getloadavg()), "results": []}
+    results: list[dict] = []
+    out: dict[str, object] = {"gl": describe(ctx), "size": [w, h], "loadavg": list(os.getloadavg()), "results": results}
     print(out["gl"], flush=True)
     for name in [x.strip() for x in args.scenes.split(",") if x.strip()]:
         s = load_scene(name)
@@ -81,11 +82,13 @@ def main(argv: list[str] | None = None) -> int:
         for tech, extra in settings:
             for mode in modes:
                 for reuse in (False, True):
-                    out["results"].append(time_setting(ctx, r, s, name, tech, extra, mode, reuse, w, h, args.frames))
-                    out["results"][-1]["interreflection_ray_cast_s"] = cast_s
-    out["fragment_vs_compute"] = compare_paths(out["results"])
+                    results.append(time_setting(ctx, r, s, name, tech, extra, mode, reuse, w, h, args.frames))
+                    results[-1]["interreflection_ray_cast_s"] = cast_s
+    out["fragment_vs_compute"] = compare_paths(results)
     if args.out:
-        Path(args.out).write_text(json.dumps(out, indent=1))
+        from skinlab.atomic_write import write_text_atomic
+
+        write_text_atomic(Path(args.out), json.dumps(out, indent=1))
     return 0
 
 
@@ -100,7 +103,8 @@ def time_setting(ctx, r, s, name, tech, extra, mode, reuse, w, h, frames) -> dic
     r.timer.sync = False  # whole frames are timed; the GPU timer queries time the passes
     for _ in range(2):
         r.render(s, st, readback=False)
-    times, passes = [], {}
+    times: list[float] = []
+    passes: dict[str, list[float]] = {}
     for _ in range(n):
         t1 = time.perf_counter()
         res = r.render(s, st, readback=False)

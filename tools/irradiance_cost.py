@@ -174,7 +174,7 @@ def main(argv=None) -> int:
         base_irr = runs["base"][2]
         fill_times = []
         load0 = os.getloadavg()
-        times = {k: [] for k in runs}
+        times: dict[str, list[float]] = {k: [] for k in runs}
         fwd_times = []
         for _ in range(args.rounds):
             if base_irr.params.translucency:  # the record's fill alone (the base pass runs it last)

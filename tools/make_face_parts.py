@@ -61,7 +61,7 @@ def cap(r: float, theta_max: float, n_rings: int = 8, n_seg: int = 28):
             ph = 2 * math.pi * j / n_seg
             n = (math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th))
             nrm.append(n)
-            pos.append(tuple(r * c for c in n))
+            pos.append((r * n[0], r * n[1], r * n[2]))
     idx = [(0, 1 + j, 1 + (j + 1) % n_seg) for j in range(n_seg)]
     for i in range(n_rings - 1):
         a0, b0 = 1 + i * n_seg, 1 + (i + 1) * n_seg
@@ -73,7 +73,10 @@ def cap(r: float, theta_max: float, n_rings: int = 8, n_seg: int = 28):
 
 def lash_cards():
     """One strip per eye along the upper lid, leaning forward; u along the lid, v from root to tip."""
-    pos, nrm, uv, idx = [], [], [], []
+    pos: list[tuple[float, float, float]] = []
+    nrm: list[tuple[float, float, float]] = []
+    uv: list[tuple[float, float]] = []
+    idx: list[tuple[int, int, int]] = []
     n = 10
     for cx, cy in EYES:
         base = len(pos)

@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     import trimesh
 
-    mesh = trimesh.load(str(args.source), process=False)
+    mesh = trimesh.load_mesh(str(args.source), process=False)
     positions, faces = close_mesh(mesh.vertices, mesh.faces, unfold_rounds=10)
     write_text_atomic(args.out, ply_text(positions, faces))
     closed = trimesh.Trimesh(positions, faces, process=False)

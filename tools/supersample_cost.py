@@ -38,7 +38,7 @@ def main(argv: list[str] | None = None) -> int:
     for st in sts.values():
         r.render(scene, st, readback=False)  # compiles and uploads are not frame time
     load0 = os.getloadavg()[0]
-    ms = {n: {k: [] for k in ("frame", *PASSES)} for n in sts}
+    ms: dict[int, dict[str, list[float]]] = {n: {k: [] for k in ("frame", *PASSES)} for n in sts}
     for _ in range(rounds):
         for n, st in sts.items():
             for _ in range(per_round):
