@@ -115,7 +115,7 @@ def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
     t_n = slab_through(cos_far, np.nan_to_num(d_n) * mm, table, med.mfp_arr, med.alpha_arr, 1.0)
     through_normal = radiance(cos_far, np.nan_to_num(d_n) * mm, np.where(lit[:, None], cos_far[:, None] * t_n, 0.0))
 
-    out = {"seen": seen}
+    out: dict[str, np.ndarray] = {"seen": seen}
     for name, v in (("chord", through_chord), ("normal", through_normal)):
         full = np.zeros((h * w, 3))
         full[seen] = v

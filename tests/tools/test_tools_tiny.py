@@ -16,7 +16,7 @@ TOOLS = Path(tools.__file__).parent
 TESTED_ELSEWHERE = {"truth_table", "closeup_table", "forward_cost", "irradiance_cost", "cost_variants", "gpu_reference"}
 HERE = {
     "accuracy_table", "boundary_slab", "frame_times", "full_over_plain", "make_face_parts",
-    "make_reference_meshes", "repair_bunny", "seam_report", "supersample_cost",
+    "make_reference_meshes", "repair_bunny", "seam_report", "supersample_cost", "translucency_check",
 }  # fmt: skip
 
 
@@ -132,3 +132,29 @@ def test_repair_bunny_closes_an_open_mesh(tmp_path, capsys):
 
     mesh = load_mesh_file(out)[0].mesh
     assert mesh is not None and edge_report(mesh).closed and np.isfinite(mesh.positions).all()
+
+
+def test_translucency_check(tmp_path, capsys):
+    pytest.importorskip("mitsuba")
+    from skinlab.bench.truth_ledger import REFERENCE_SCENES
+    from skinlab.gl.context import create_headless_context
+    from skinlab.image_output import write_image
+    from skinlab.render.renderer import Renderer
+    from skinlab.render.settings import RenderSettings
+    from skinlab.scene.scenefile import load_scene
+    from skinlab.truth.reference import ReferenceRequest, render_reference
+    from tools import translucency_check
+
+    path = REFERENCE_SCENES / "slab-thin-backlit-skin1.toml"
+    scene = load_scene(path)
+    truth = render_reference(scene, ReferenceRequest(8, 8, spp=4, passes=2), progress=False)
+    r = Renderer(create_headless_context())
+    frame = r.render(scene, RenderSettings(8, 8), readback=("hdr",)).hdr
+    r.release()
+    write_image(tmp_path / "truth.exr", truth.image.astype(np.float32))
+    write_image(tmp_path / "frame.exr", frame.astype(np.float32))
+    argv = [str(path), str(tmp_path / "truth.exr"), str(tmp_path / "frame.exr"), "--out", str(tmp_path / "out")]
+    assert translucency_check.main(argv) == 0
+    out = capsys.readouterr().out
+    assert "frame " in out and "chord  model" in out and "normal model" in out
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["chord.png", "normal.png", "truth.png"]
