@@ -40,6 +40,33 @@ def material_boundary(material) -> BoundaryTables | None:
     return boundary_tables(medium.alpha_arr, colour, medium.eta, boundary_ggx_alpha(material))
 
 
+def boundary_data(material) -> None:
+    """Make (or read) everything :func:`bind_boundary` binds for `material`: its boundary tables and
+    its slab tables (both memoised: a later bind finds them)."""
+    if material_boundary(material) is not None:
+        medium = material_medium(material.values)
+        colour = subsurface_albedo(material.values)
+        _slab_tables(tuple(medium.alpha_arr), tuple(float(x) for x in colour), float(medium.eta))
+
+
+def prefetch_boundaries(meshes, settings) -> None:
+    """Start making the boundary and slab tables of every visible scattering material on a worker
+    thread (skinlab/cache.py in_background) while the frame is planned: on a first run they are
+    0.3 s of NumPy work in large arrays (the GIL released) that the plan's own GIL-bound work (UV
+    seams) can overlap; the frame's first bind waits for them (the tables are memoised: never made
+    twice). Nothing to make when they are cached."""
+    from skinlab.cache import in_background
+
+    from .scattering import effective_material
+
+    seen: set[int] = set()
+    for node in meshes:
+        material = effective_material(node, settings)
+        if id(material) not in seen and material.has_subsurface:
+            seen.add(id(material))
+            in_background(boundary_data, material)
+
+
 def single_scattering_factor(material, tables: BoundaryTables) -> np.ndarray:
     """u_sss_single: Jensen's term per unit subsurface albedo with the medium's real single-scattering
     albedo (similarity: a = a' / (1 - g + g a'), skinlab/scene/optics/similarity.py); g = 0 keeps the

@@ -6,6 +6,7 @@ import math
 from typing import TYPE_CHECKING
 
 from .bounce import plan_bounce, prefetch_bounce
+from .boundary import prefetch_boundaries
 from .compute import Device, choose_path
 from .environment import plan_environment, plan_sky, prefetch_sky
 from .frame_plan import FramePlan, PlannedPass, ShadowParams, TonemapParams, shadow_pass_name
@@ -63,6 +64,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
     technique = get_technique(settings.technique_name)
     prefetch_bounce(scene, settings, meshes, lights)  # rays are cast while the technique plans
     prefetch_sky(scene, settings, meshes)  # (the same records, for what the scene hides of the map)
+    prefetch_boundaries(meshes, settings)  # the materials' boundary tables, for the frame's binds
     tp = technique.plan(PlanContext(scene, settings, meshes, lights, shadow_lights[:2], plan, state, device))
     plan.vertex_streams = tuple(technique.vertex_streams) if meshes else ()
     sky = plan_sky(scene, settings, meshes, plan, environment)

@@ -229,3 +229,34 @@ def test_a_registered_technique_declares_its_view_independent_passes(ctx):
     finally:
         r.release()
         registry.unregister("toybake")
+
+
+def test_planning_starts_the_materials_boundary_tables(monkeypatch):
+    """plan_frame hands the boundary and slab tables of every visible scattering material to a worker
+    (render/boundary.py prefetch_boundaries): they are made without any pass binding them, once, and
+    a later bind reads the same (memoised) tables."""
+    import time
+
+    from skinlab import cache
+    from skinlab.render.boundary import boundary_data, material_boundary
+    from skinlab.render.plan import plan_frame
+
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", "off")
+    radius = (7.123, 3.456, 1.789)  # a medium no other test made
+    scene = slab_scene(material=skin(radius=radius))
+    before = cache.BUILT["boundary._tables"], cache.BUILT["boundary._slab_tables"]
+    plan_frame(scene, settings())
+    deadline = time.monotonic() + 60.0
+    while (cache.BUILT["boundary._tables"], cache.BUILT["boundary._slab_tables"]) == before:
+        assert time.monotonic() < deadline, "the plan did not start the boundary tables"
+        time.sleep(0.05)
+    while cache.computing():  # let the worker finish
+        assert time.monotonic() < deadline
+        time.sleep(0.05)
+    made = cache.BUILT["boundary._tables"], cache.BUILT["boundary._slab_tables"]
+    material = scene.mesh_nodes()[0].material
+    first = material_boundary(material)
+    boundary_data(material)  # what a bind reads: made once already
+    assert material_boundary(material) is first
+    assert (cache.BUILT["boundary._tables"], cache.BUILT["boundary._slab_tables"]) == made
+    assert made[0] > before[0] and made[1] > before[1]
