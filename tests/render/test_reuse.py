@@ -242,8 +242,8 @@ def test_planning_starts_the_materials_boundary_tables(monkeypatch):
     from skinlab.render.plan import plan_frame
 
     monkeypatch.setenv("SKINLAB_CACHE_DIR", "off")
-    radius = (7.123, 3.456, 1.789)  # a medium no other test made
-    scene = slab_scene(material=skin(radius=radius))
+    colour = (0.8123, 0.6071, 0.5013)  # a medium no other test made (the tables are keyed by albedo, not radius)
+    scene = slab_scene(material=skin(color=colour))
     before = cache.BUILT["boundary._tables"], cache.BUILT["boundary._slab_tables"]
     plan_frame(scene, settings())
     deadline = time.monotonic() + 60.0
