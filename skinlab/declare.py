@@ -35,13 +35,14 @@ class Field:
     name: str
     kind: str
     default: Any = None
-    range: tuple[float, float] | None = None  # inclusive (the low end excluded with lo_open)
+    range: tuple[float, float] | None = None  # inclusive (an end excluded with lo_open, hi_open)
     doc: str = ""
     unit: str = ""
     choices: tuple[str, ...] = ()  # kind "choice"
     odd: bool = False  # ints only: odd values
     none: str = ""  # when not empty, None is allowed and means this (e.g. "from each blur's width")
     lo_open: bool = False  # the range's low end is not a valid value: (lo, hi]
+    hi_open: bool = False  # nor its high end: [lo, hi)
     colorspace: str = "linear"  # textures: "srgb" colour data or "linear" data
     flags: tuple[str, ...] = ()  # command-line spellings besides --<name> (kept for compatibility)
     cli: bool = True  # a command-line option of the commands that take it
@@ -59,10 +60,16 @@ class Field:
 
     def _range_text(self) -> str:
         """`in [lo, hi]`, or `> lo` / `>= lo` for a range without a top ('' for none)."""
-        lo, hi = self.limits
-        if hi == math.inf:
-            return "" if lo == -math.inf else f"{'>' if self.lo_open else '>='} {lo:g}"
-        return f"in {'(' if self.lo_open else '['}{lo:g}, {hi:g}]"
+        lo, hi = (self._number_text(x) for x in self.limits)
+        if self.limits[1] == math.inf:
+            return "" if self.limits[0] == -math.inf else f"{'>' if self.lo_open else '>='} {lo}"
+        return f"in {'(' if self.lo_open else '['}{lo}, {hi}{')' if self.hi_open else ']'}"
+
+    def _number_text(self, x: float) -> str:
+        """A bound as written: an integer's bounds exactly (4294967295, not 4.29497e+09)."""
+        if self.kind == "int" and math.isfinite(x) and x == int(x):
+            return str(int(x))
+        return f"{x:g}"
 
     def expected(self, with_none: bool = True) -> str:
         """What a valid value is, in words (errors and --help)."""
@@ -96,7 +103,8 @@ class Field:
             return True
         lo, hi = self.range
         low_ok = (arr > lo) if self.lo_open else (arr >= lo)
-        return bool(low_ok.all() and (arr <= hi).all())
+        high_ok = (arr < hi) if self.hi_open else (arr <= hi)
+        return bool(low_ok.all() and high_ok.all())
 
     def _numbers(self, value: Any, label: str) -> np.ndarray:
         """A colour/vec3 or vec2 value as an array (a scalar fills every component)."""

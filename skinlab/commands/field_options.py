@@ -10,12 +10,14 @@ the parsed arguments: :func:`add_command_options`, checked by :func:`check_comma
 from __future__ import annotations
 
 import argparse
-from collections.abc import Iterable
+import dataclasses
+import math
+from collections.abc import Callable, Iterable
 from typing import Any
 
-from skinlab.declare import Field
+from skinlab.declare import VECTOR_SIZES, Field
 
-_METAVAR = {"int": "N", "float": "X"}
+_METAVAR = {"int": "N", "float": "X", "color": "R,G,B", "vec3": "X,Y,Z", "vec2": "U,V"}
 
 # an option two commands share with one meaning (`skinlab render --size`, `skinlab demo --size`)
 IMAGE_SIZE = Field("size", "string", "640x640", doc="image size WIDTHxHEIGHT in pixels")
@@ -57,35 +59,82 @@ def setting_value(f: Field, raw: Any, flag: str) -> Any:
     return f.check(raw, flag)
 
 
-def add_command_options(parser, fields: Iterable[Field]) -> None:
+def add_command_options(
+    parser, fields: Iterable[Field], required: Iterable[str] = (), parse: dict[str, Callable[[str], Any]] | None = None
+) -> None:
     """A command's own options, each from its declaration: a bool is a switch (off unless given), the
-    others take a value with the declared default (check them with :func:`check_command_options`)."""
+    others take a value with the declared default (check them with :func:`check_command_options`).
+    ``parser`` may be a group (``add_mutually_exclusive_group()``: one of the fields at most);
+    ``required``: the names of fields that must be given; ``parse``: by name, how a value's text is
+    read where a plain number is not enough (a percentage), raising ValueError on text it cannot read."""
+    required, parse = set(required), parse or {}
     for f in fields:
         flags = option_flags(f)
-        kw: dict[str, Any] = dict(dest=f.name, default=f.default, help=_help(_command_help(f)))
+        need = f.name in required
+        help = f.doc if need else _command_help(f)
+        kw: dict[str, Any] = dict(dest=f.name, default=f.default, help=_help(help))
+        if need:
+            kw["required"] = True
         if f.kind == "bool":  # a switch; one that is on by default also has its --no- spelling
             parser.add_argument(*flags, action=argparse.BooleanOptionalAction if f.default else "store_true", **kw)
         elif f.kind == "choice":
             parser.add_argument(*flags, choices=f.choices, **kw)
         else:
-            meta = f.unit.upper() if f.unit and " " not in f.unit else _METAVAR.get(f.kind, f.name.upper())
-            kind = {"int": int, "float": float}.get(f.kind, str)
-            parser.add_argument(*flags, type=kind, metavar=meta, **kw)
+            meta = _METAVAR.get(f.kind) if f.kind in VECTOR_SIZES else None
+            if meta is None:
+                meta = f.unit.upper() if f.unit and " " not in f.unit else _METAVAR.get(f.kind, f.name.upper())
+            parser.add_argument(*flags, type=_reader(f, parse.get(f.name)), metavar=meta, **kw)
+
+
+def _reader(f: Field, parse: Callable[[str], Any] | None) -> Callable[[str], Any]:
+    """The argparse type of a field's value: its text read as the kind (an integer may be written 1e5);
+    text that is no such value: `expected <what>, got <text>` (argparse names the option)."""
+    if parse is None and f.kind not in ("int", "float", *VECTOR_SIZES):
+        return str
+
+    def read(text: str) -> Any:
+        try:
+            if parse is not None:
+                return parse(text)
+            if f.kind in VECTOR_SIZES:  # R,G,B (or one number for all)
+                return tuple(float(x) for x in text.split(","))
+            if f.kind == "float":
+                return float(text)
+            try:
+                return int(text)
+            except ValueError:
+                x = float(text)  # 1e5: an integer in a float's spelling
+                if not (math.isfinite(x) and x == int(x)):
+                    raise
+                return int(x)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected {f.expected()}, got {text!r}") from None
+
+    read.__name__ = f.kind  # argparse's name for the type
+    return read
+
+
+def own_default(f: Field, default: Any, why: str, shown: str = "") -> Field:
+    """A declared setting as a command's own option whose default differs on purpose: the help says
+    so (``why``: "this benchmark's own default, smaller than a render's 2048 so that ..."; ``shown``:
+    the default in words, where it is computed)."""
+    return dataclasses.replace(f, default=default, doc=f"{f.doc}: {why}", none="", flags=(), shown=shown)
 
 
 def _command_help(f: Field) -> str:
     if f.kind == "bool":
         return f"{f.doc} (default: {f.default})" if f.default else f.doc
+    values = f"; {f.expected(with_none=False)}" if f.kind in ("int", "float", *VECTOR_SIZES) and f.range else ""
     if f.default is None:
-        return f"{f.doc} (default: {f.shown or f.none or 'none'})"
-    values = f"; {f.expected(with_none=False)}" if f.kind in ("int", "float") and f.range else ""
+        return f"{f.doc}{values} (default: {f.shown or f.none or 'none'})"
     unit = f" {f.unit}" if f.unit else ""
     return f"{f.doc}{values} (default: {f.shown or f'{f.default}{unit}'})"
 
 
 def check_command_options(args, fields: Iterable[Field]) -> None:
-    """Every declared option of a command given a value outside its declaration: an error naming it."""
+    """Every declared option of a command given a value outside its declaration: an error naming it;
+    the values checked are left on ``args`` in their canonical form (a vector's one number repeated)."""
     for f in fields:
         value = getattr(args, f.name, None)
-        if value is not None and f.kind in ("int", "float"):
-            f.check(value, option_flags(f)[0])
+        if value is not None and f.kind in ("int", "float", *VECTOR_SIZES):
+            setattr(args, f.name, f.check(value, option_flags(f)[0]))  # canonical: one number fills R,G,B

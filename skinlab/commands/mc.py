@@ -9,12 +9,16 @@ names."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import math
 import os
 
 import numpy as np
 
 from skinlab.commands import refused_option
+from skinlab.commands.field_options import add_command_options, check_command_options
+from skinlab.declare import Field
 
 UNITS = "r in mean free paths 1/sigma_t; R(r) in 1/mfp^2 (per unit area) per photon entering"
 
@@ -25,6 +29,38 @@ ALBEDO = (
 )  # one meaning per name: two albedos, two names
 
 
+def _walk(key: str, **kw):
+    """A walk parameter of skinlab/scene/optics/montecarlo.py (its range, the one the walk checks) as an option."""
+    from skinlab.scene.optics.montecarlo import WALK_FIELDS
+
+    return dataclasses.replace(WALK_FIELDS[key], **kw)
+
+
+def mc_options() -> tuple[tuple[Field, ...], tuple[Field, ...]]:
+    """(the medium: one of --single-albedo and --preset; the walk's options), each from its declaration."""
+    single = _walk("albedo", name="single_albedo", doc=f"{_walk('albedo').doc} (not the surface albedo: "
+                   "skinlab profile --surface-albedo)")  # fmt: skip
+    preset = Field(
+        "preset",
+        "string",
+        doc="a Jensen 2001 Table 1 medium (e.g. skin1, marble): one walk per channel, R, G and B, each with that "
+        "channel's single-scattering albedo, at the preset's index (unless --eta)",
+    )
+    walk = (
+        _walk("eta", default=None, shown="1.3, or the preset's"),
+        _walk("incidence", doc="normal: a pencil beam along the normal; diffuse: cosine-distributed, refracted"),
+        _walk("photons", doc="photons to trace (e.g. 1e6)"),
+        _walk("g"),
+        _walk("seed"),
+        _walk("max_steps"),
+        Field("entry_fresnel", "bool", False, doc="weight by the entry transmittance (default: per photon that enters)"),
+        _walk("workers", default=0, range=(0, math.inf), doc="processes (0: one per core)"),
+        Field("no_progress", "bool", False, doc="no progress bar on stderr"),
+        Field("json", "bool", False, doc="print JSON (every bin, with r_edges)"),
+    )
+    return (single, preset), walk
+
+
 def register(sub) -> None:
     p = sub.add_parser(
         "mc",
@@ -32,65 +68,19 @@ def register(sub) -> None:
         description="Random walk in a semi-infinite homogeneous medium (the ground truth for the "
         f"diffusion profiles). Units: {UNITS}; multiply r by the mean free path in mm to get mm.",
     )
+    source, walk = mc_options()
     src = p.add_mutually_exclusive_group(required=True)
-    src.add_argument(
-        "--single-albedo",
-        type=float,
-        metavar="A",
-        help="single-scattering albedo sigma_s/sigma_t in [0, 1] (not the surface albedo: skinlab profile "
-        "--surface-albedo)",
-    )
-    src.add_argument(
-        "--preset",
-        help="a Jensen 2001 Table 1 medium (e.g. skin1, marble): one walk per channel, R, G and B, each with that "
-        "channel's single-scattering albedo, at the preset's index (unless --eta)",
-    )
+    add_command_options(src, source)
     src.add_argument("--albedo", action=refused_option(ALBEDO), help=argparse.SUPPRESS)
-    p.add_argument(
-        "--eta",
-        type=float,
-        default=None,
-        help="relative index of refraction, medium/outside (default 1.3, or the preset's)",
-    )
-    p.add_argument(
-        "--incidence",
-        choices=("normal", "diffuse"),
-        default="normal",
-        help="normal: a pencil beam along the normal; diffuse: cosine-distributed, refracted (default normal)",
-    )
-    p.add_argument(
-        "--photons", type=float, default=1e5, help="photons to trace, an integer in [2, 1e10] (default 1e5; e.g. 1e6)"
-    )
-    p.add_argument("--g", type=float, default=0.0, help="Henyey-Greenstein mean cosine in (-1, 1) (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="random seed; the same seed gives the same result (default 0)")
-    p.add_argument(
-        "--max-steps",
-        type=int,
-        default=100_000,
-        help="collisions per walk before it is dropped and counted as capped, >= 1 (default 100000)",
-    )
-    p.add_argument(
-        "--entry-fresnel",
-        action="store_true",
-        help="weight by the entry transmittance (default: per photon that enters)",
-    )
-    p.add_argument("--workers", type=int, default=0, help="processes, >= 1 (default 0: one per core)")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
-    p.add_argument("--json", action="store_true", help="print JSON (every bin, with r_edges)")
+    add_command_options(p, walk)
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     from skinlab.scene.optics.montecarlo import simulate
 
-    if args.seed < 0:
-        raise ValueError(f"--seed: expected an integer >= 0, got {args.seed}")
-    if args.workers < 0:
-        raise ValueError(f"--workers: expected an integer >= 1 (or 0: one per core), got {args.workers}")
-    if args.max_steps < 1:
-        raise ValueError(f"--max-steps: expected an integer >= 1, got {args.max_steps}")
-    if not np.isfinite(args.photons) or args.photons != int(args.photons) or args.photons < 2:
-        raise ValueError(f"--photons: expected an integer >= 2, got {args.photons!r}")
+    for fields in mc_options():
+        check_command_options(args, fields)
     workers = args.workers or (os.cpu_count() or 1)
 
     def walk(albedo, eta):
@@ -99,7 +89,7 @@ def run(args) -> int:
             eta,
             args.g,
             args.incidence,
-            int(args.photons),
+            args.photons,
             args.seed,
             max_steps=args.max_steps,
             entry_fresnel=args.entry_fresnel,

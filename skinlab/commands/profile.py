@@ -7,6 +7,7 @@ refused with both names."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 
@@ -14,23 +15,12 @@ import numpy as np
 
 from skinlab.atomic_write import atomic_path
 from skinlab.commands import refused_option
+from skinlab.commands.field_options import add_command_options, check_command_options
+from skinlab.declare import Field
+from skinlab.scene.optics.montecarlo import WALK_FIELDS
 
 MAX_LENGTH_MM = 1e6  # a kilometre of mean free path: beyond it the profiles underflow to nothing
 DEFAULT_R = "0,0.01,0.02,0.05,0.1,0.2,0.5,1,2,5,10"
-
-
-def _triple(text: str, name: str):
-    try:
-        vals = [float(v) for v in text.split(",")]
-    except ValueError:
-        raise ValueError(f"{name}: expected a number or R,G,B numbers, got {text!r}") from None
-    if len(vals) == 1:
-        vals *= 3
-    if len(vals) != 3:
-        raise ValueError(f"{name}: expected 1 or 3 comma-separated values, got {len(vals)}")
-    if name in ("mfp", "radius") and any(abs(v) > MAX_LENGTH_MM for v in vals if np.isfinite(v)):
-        raise ValueError(f"{name}: expected lengths of at most {MAX_LENGTH_MM:g} mm, got {text!r}")
-    return vals
 
 
 def _radii(text: str):
@@ -49,60 +39,75 @@ ALBEDO = (
 )  # one meaning per name: two albedos, two names
 
 
+SOURCE_OPTIONS = (
+    Field("preset", "string", doc="Jensen 2001 Table 1 material (e.g. skin1, marble)", shown="skin1"),
+    Field(
+        "surface_albedo",
+        "color",
+        None,
+        (0.0, 1.0),
+        doc="surface albedo (total diffuse reflectance, the colour seen from afar: a scene's subsurface_color), "
+        "one number or R,G,B; needs --mfp or --radius. Not the single-scattering albedo (skinlab mc --single-albedo)",
+    ),
+)
+PROFILE_OPTIONS = (
+    Field(
+        "mfp",
+        "color",
+        None,
+        (0.0, MAX_LENGTH_MM),
+        unit="mm",
+        doc="mean free path l = 1/sigma_t' in mm, one number or R,G,B (with --surface-albedo)",
+    ),
+    Field(
+        "radius",
+        "color",
+        None,
+        (0.0, MAX_LENGTH_MM),
+        unit="mm",
+        doc="artist radius R = 4 pi l in mm, R,G,B (with --surface-albedo): the scene files' subsurface_radius "
+        "and Blender's Subsurface Radius x Scale",
+    ),
+    Field("eta", "float", None, doc="relative index of refraction", shown="1.3, or the preset's"),
+    Field(
+        "albedo_method",
+        "choice",
+        "pbd",
+        choices=("pbd", "dipole", "cycles"),
+        doc="how --surface-albedo is inverted to the single-scattering albedo",
+    ),
+    Field("r", "string", DEFAULT_R, doc="radii in mm, comma-separated, each >= 0"),
+    Field("json", "bool", False, doc="print JSON"),
+    Field("plot", "string", doc="PNG path: every model vs the Monte Carlo reference (log axes)"),
+    dataclasses.replace(WALK_FIELDS["photons"], name="mc_photons", default=200_000, doc="Monte Carlo photons per "
+                        "channel for --plot"),  # fmt: skip
+    dataclasses.replace(WALK_FIELDS["seed"], doc="Monte Carlo random seed for --plot"),
+)
+
+
 def register(sub) -> None:
     from skinlab.scene.optics.profiles import profile_names
 
     p = sub.add_parser("profile", help="evaluate a diffusion profile R(r) for a medium")
     p.add_argument("model", choices=profile_names() + ["all"], help="profile model ('all': every model)")
     src = p.add_mutually_exclusive_group()
-    src.add_argument("--preset", help="Jensen 2001 Table 1 material (e.g. skin1, marble)")
-    src.add_argument(
-        "--surface-albedo",
-        dest="albedo",
-        metavar="R,G,B",
-        help="surface albedo (total diffuse reflectance, the colour seen from afar: a scene's subsurface_color) "
-        "R,G,B in [0, 1]; needs --mfp or --radius. Not the single-scattering albedo (skinlab mc --single-albedo)",
-    )
+    add_command_options(src, SOURCE_OPTIONS)
     src.add_argument("--albedo", action=refused_option(ALBEDO), help=argparse.SUPPRESS)
-    p.add_argument("--mfp", help="mean free path l = 1/sigma_t' in mm, R,G,B (with --surface-albedo)")
-    p.add_argument(
-        "--radius",
-        help="artist radius R = 4 pi l in mm, R,G,B (with --surface-albedo): the scene files' subsurface_radius "
-        "and Blender's Subsurface Radius x Scale",
-    )
-    p.add_argument(
-        "--eta", type=float, default=None, help="relative index of refraction (default 1.3, or the preset's)"
-    )
-    p.add_argument(
-        "--albedo-method",
-        choices=("pbd", "dipole", "cycles"),
-        default="pbd",
-        help="how --surface-albedo is inverted to the single-scattering albedo (default pbd)",
-    )
-    p.add_argument("--r", default=DEFAULT_R, help=f"radii in mm (default {DEFAULT_R})")
-    p.add_argument("--json", action="store_true", help="print JSON")
-    p.add_argument("--plot", help="PNG path: every model vs the Monte Carlo reference (log axes)")
-    p.add_argument(
-        "--mc-photons",
-        type=float,
-        default=2e5,
-        help="Monte Carlo photons per channel for --plot, an integer >= 2 (default 2e5)",
-    )
-    p.add_argument("--seed", type=int, default=0, help="Monte Carlo random seed for --plot (default 0)")
+    add_command_options(p, PROFILE_OPTIONS)
     p.set_defaults(func=run)
 
 
 def medium_from_args(args):
     from skinlab.scene.optics.media import Medium, preset
 
-    if args.albedo is not None:
+    if args.surface_albedo is not None:
         if (args.mfp is None) == (args.radius is None):
             raise ValueError("mfp: --surface-albedo needs exactly one of --mfp or --radius (mm)")
         eta = 1.3 if args.eta is None else args.eta
-        A = _triple(args.albedo, "albedo")
+        A = list(args.surface_albedo)
         if args.mfp is not None:
-            return Medium.from_surface_albedo(A, _triple(args.mfp, "mfp"), eta, args.albedo_method, "custom")
-        return Medium.from_artist_radius(A, _triple(args.radius, "radius"), eta, args.albedo_method, "custom")
+            return Medium.from_surface_albedo(A, list(args.mfp), eta, args.albedo_method, "custom")
+        return Medium.from_artist_radius(A, list(args.radius), eta, args.albedo_method, "custom")
     if args.mfp is not None or args.radius is not None:
         raise ValueError("albedo: --mfp/--radius need --surface-albedo R,G,B")
     m = preset(args.preset or "skin1")
@@ -116,8 +121,7 @@ def medium_from_args(args):
 def run(args) -> int:
     from skinlab.scene.optics.profiles import PROFILE_MODELS, evaluate_profile, profile_names, total_reflectance
 
-    if args.seed < 0:
-        raise ValueError(f"--seed: expected an integer >= 0, got {args.seed}")
+    check_command_options(args, SOURCE_OPTIONS + PROFILE_OPTIONS)
     m = medium_from_args(args)
     r = _radii(args.r)
     names = profile_names() if args.model == "all" else [args.model]
@@ -134,14 +138,12 @@ def run(args) -> int:
         "surface_albedo": m.surface_albedo().tolist(),
     }
     if args.plot:
-        if not np.isfinite(args.mc_photons) or args.mc_photons != int(args.mc_photons) or args.mc_photons < 2:
-            raise ValueError(f"--mc-photons: expected an integer >= 2, got {args.mc_photons!r}")
         from skinlab.image_output import check_output_path
 
         if not args.plot.lower().endswith(".png"):
             raise ValueError(f"--plot: expected a .png path, got {args.plot!r}")
         check_output_path(args.plot, "--plot")
-        plot_models(m, args.plot, int(args.mc_photons), args.seed)
+        plot_models(m, args.plot, args.mc_photons, args.seed)
     notes = {n: PROFILE_MODELS[n].note for n in names if PROFILE_MODELS[n].note}
     if args.json:
         out = {"medium": medium, "r_mm": r.tolist(), "units": "R in 1/mm^2 per unit entering flux"}

@@ -314,7 +314,7 @@ CASES = [
     ("mc-albedo", {}, ["mc", "--single-albedo", "1.5"], ["albedo"]),
     ("mc-seed", {}, ["mc", "--single-albedo", "0.5", "--seed", "-1"], ["--seed"]),
     ("profile-seed", {}, ["profile", "burley", "--seed", "-1"], ["--seed"]),
-    ("profile-mfp-huge", {}, ["profile", "all", "--surface-albedo", "0.5", "--mfp", "1e300"], ["mfp", "mm"]),
+    ("profile-mfp-huge", {}, ["profile", "all", "--surface-albedo", "0.5", "--mfp", "1e300"], ["--mfp", "1e+06"]),
     ("profile-needs-mfp", {}, ["profile", "burley", "--surface-albedo", "0.5"], ["--mfp", "--radius"]),
     ("profile-radii", {}, ["profile", "burley", "--r", "-1"], ["r:", "mm"]),
     ("profile-preset", {}, ["profile", "burley", "--preset", "cheese"], ["cheese"]),

@@ -28,6 +28,7 @@ SeedSequence(seed).spawn(...)[k], independent of the number of worker processes.
 
 from __future__ import annotations
 
+import math
 import sys
 from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor
@@ -35,10 +36,28 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from skinlab.declare import Field
+
 from .fresnel import fresnel_dielectric
 
 BATCH = 1 << 16
 MAX_PHOTONS = 10**10  # about a day on one core; more is a typo (1e30) rather than a plan
+
+# a walk's parameters, declared once: simulate() checks them, `skinlab mc` takes them as options
+WALK_FIELDS = {
+    f.name: f
+    for f in (
+        Field("albedo", "float", None, (0.0, 1.0), doc="single-scattering albedo sigma_s/sigma_t"),
+        Field("eta", "float", 1.3, (0.0, math.inf), lo_open=True, doc="relative index of refraction, medium/outside"),
+        Field("g", "float", 0.0, (-1.0, 1.0), lo_open=True, hi_open=True, doc="Henyey-Greenstein mean cosine"),
+        Field("incidence", "choice", "normal", choices=("normal", "diffuse"), doc="how light enters"),
+        Field("photons", "int", 100_000, (2, MAX_PHOTONS), doc="photons to trace"),
+        Field("seed", "int", 0, (0, math.inf), doc="random seed; the same seed gives the same result"),
+        Field("max_steps", "int", 100_000, (1, math.inf), doc="collisions per walk before it is dropped and "
+              "counted as capped"),  # fmt: skip
+        Field("workers", "int", 1, (1, math.inf), doc="processes"),
+    )
+}
 DEFAULT_EDGES = np.concatenate([[0.0], np.geomspace(1e-2, 1e2, 81)])
 
 
@@ -69,16 +88,11 @@ class MCResult:
 
 
 def _check(albedo, eta, g, incidence, photons):
-    if not np.isfinite(albedo) or not 0.0 <= albedo <= 1.0:
-        raise ValueError(f"albedo: single-scattering albedo must lie in [0, 1], got {albedo!r}")
-    if not np.isfinite(eta) or eta <= 0:
-        raise ValueError(f"eta: relative index of refraction must be > 0, got {eta!r}")
-    if not np.isfinite(g) or not -1.0 < g < 1.0:
-        raise ValueError(f"g: Henyey-Greenstein asymmetry must lie in (-1, 1), got {g!r}")
-    if incidence not in ("normal", "diffuse"):
-        raise ValueError(f"incidence: expected 'normal' or 'diffuse', got {incidence!r}")
-    if not np.isfinite(float(photons)) or int(photons) != photons or not 2 <= photons <= MAX_PHOTONS:
-        raise ValueError(f"photons: need an integer in [2, {MAX_PHOTONS:.0e}], got {photons!r}")
+    for name, value in (("albedo", albedo), ("eta", eta), ("g", g), ("incidence", incidence)):
+        WALK_FIELDS[name].check(value)
+    if isinstance(photons, float) and np.isfinite(photons) and photons == int(photons):
+        photons = int(photons)  # 1e5
+    WALK_FIELDS["photons"].check(photons)
 
 
 def _sample_hg(rng, n, g):
@@ -203,10 +217,9 @@ def simulate(
     albedo, eta, g = float(albedo), float(eta), float(g)
     _check(albedo, eta, g, incidence, photons)
     photons = int(photons)
-    if int(max_steps) != max_steps or max_steps < 1:
-        raise ValueError(f"max_steps: need an integer >= 1 (collisions per walk), got {max_steps!r}")
-    if int(workers) != workers or workers < 1:
-        raise ValueError(f"workers: need an integer >= 1, got {workers!r}")
+    WALK_FIELDS["max_steps"].check(max_steps)
+    WALK_FIELDS["seed"].check(seed)
+    WALK_FIELDS["workers"].check(workers)
     edges = DEFAULT_EDGES if r_edges is None else np.asarray(r_edges, dtype=np.float64)
     if edges.ndim != 1 or len(edges) < 2 or np.any(np.diff(edges) <= 0) or edges[0] < 0:
         raise ValueError("r_edges: need an increasing sequence of at least 2 radii >= 0")
