@@ -53,7 +53,7 @@ def mc_options() -> tuple[tuple[Field, ...], tuple[Field, ...]]:
         _walk("g"),
         _walk("seed"),
         _walk("max_steps"),
-        Field("entry_fresnel", "bool", False, doc="weight by the entry transmittance (default: per photon that enters)"),
+        Field("entry_fresnel", "bool", False, doc="weight by the entry transmittance (default: per photon entering)"),
         _walk("workers", default=0, range=(0, math.inf), doc="processes (0: one per core)"),
         Field("no_progress", "bool", False, doc="no progress bar on stderr"),
         Field("json", "bool", False, doc="print JSON (every bin, with r_edges)"),

@@ -79,8 +79,9 @@ PROFILE_OPTIONS = (
     Field("r", "string", DEFAULT_R, doc="radii in mm, comma-separated, each >= 0"),
     Field("json", "bool", False, doc="print JSON"),
     Field("plot", "string", doc="PNG path: every model vs the Monte Carlo reference (log axes)"),
-    dataclasses.replace(WALK_FIELDS["photons"], name="mc_photons", default=200_000, doc="Monte Carlo photons per "
-                        "channel for --plot"),  # fmt: skip
+    dataclasses.replace(
+        WALK_FIELDS["photons"], name="mc_photons", default=200_000, doc="Monte Carlo photons per channel for --plot"
+    ),  # fmt: skip
     dataclasses.replace(WALK_FIELDS["seed"], doc="Monte Carlo random seed for --plot"),
 )
 

@@ -6,8 +6,45 @@ from __future__ import annotations
 
 import json
 
+from skinlab.commands.field_options import IMAGE_SIZE, add_command_options, check_command_options, own_default
 from skinlab.commands.scene_options import add_scene_edit_options, scene_edits_from_args
+from skinlab.declare import Field
 from skinlab.render.settings import parse_size
+
+
+def reference_options() -> tuple[Field, ...]:
+    """The command's options: the request's fields (skinlab/truth/reference.py ReferenceRequest: their
+    ranges are what the request checks), how passes are added, and the command's own."""
+    from skinlab.truth.reference import NOISE_ON, TIME_S, UNTIL_NOISE, ReferenceRequest
+
+    request = ReferenceRequest.fields()
+    return (
+        Field(
+            "out",
+            "string",
+            "out/reference.exr",
+            doc="linear EXR with alpha; a .png beside it is tone mapped like skinlab render's",
+        ),
+        own_default(
+            IMAGE_SIZE,
+            "192x192",
+            f"this command's own default, smaller than a render's {IMAGE_SIZE.default}: path tracing takes minutes",
+        ),  # fmt: skip
+        *(request[name] for name in ("spp", "passes", "seed", "variant", "sun_deg", "max_depth")),
+        UNTIL_NOISE,
+        TIME_S,
+        NOISE_ON,
+        request["rr_depth"],
+        Field("no_cache", "bool", False, doc="render even when an identical reference is cached"),
+        Field("json", "bool", False, doc="print the result (path, noise floor, time, notes) as JSON"),
+        Field(
+            "export_xml",
+            "string",
+            doc="write the path tracer's scene as a Mitsuba 3 scene file, DIR/scene.xml with its meshes (PLY) and "
+            "textures (EXR), for Mitsuba alone (`mitsuba DIR/scene.xml`), instead of rendering",
+            shown="render",
+        ),
+    )
 
 
 def register(sub) -> None:
@@ -22,68 +59,17 @@ def register(sub) -> None:
         "See docs/ground-truth.md.",
     )
     p.add_argument("scene", nargs="?", help="scene file (TOML); default: the Lee Perry-Smith head")
-    p.add_argument(
-        "--out", default="out/reference.exr", help="linear EXR with alpha (default out/reference.exr); a .png "
-        "beside it is tone mapped like skinlab render's"
-    )  # fmt: skip
-    p.add_argument("--size", default="192x192", help="WIDTHxHEIGHT in pixels (default 192x192)")
-    p.add_argument("--spp", type=int, default=1024, help="samples per pixel over all passes (default 1024)")
-    p.add_argument("--passes", type=int, default=4, help="independent passes, >= 2, for the noise floor (default 4)")
-    p.add_argument("--seed", type=int, default=0, help="random seed, >= 0 (default 0)")
-    p.add_argument(
-        "--variant", default="scalar_rgb", choices=("scalar_rgb", "llvm_ad_rgb", "cuda_ad_rgb"),
-        help="Mitsuba variant (default scalar_rgb: any CPU; llvm_ad_rgb needs libllvm19; cuda_ad_rgb an NVIDIA GPU)",
-    )  # fmt: skip
-    p.add_argument(
-        "--sun-deg", type=float, default=0.0, help="angular diameter of directional lights in degrees, 0-10 "
-        "(default 0: a delta light as in the realtime frame; e.g. 0.53 for the sun: makes lights behind a "
-        "dielectric boundary reachable by BSDF sampling)"
-    )  # fmt: skip
-    p.add_argument("--max-depth", type=int, default=-1, help="path length limit (default -1: none)")
-    p.add_argument(
-        "--until-noise", type=noise_level, default=None, metavar="X",
-        help="add passes (of SPP/PASSES samples each) until the noise floor is at most X (a fraction, 0.01, "
-        "or a percentage, 1%%), measured as --noise-on says; passes already cached count",
-    )  # fmt: skip
-    p.add_argument(
-        "--time", type=float, default=None, metavar="S",
-        help="add passes for S seconds (with --until-noise: whichever comes first); every pass is saved as it "
-        "finishes, so the reference only gets quieter from run to run",
-    )  # fmt: skip
-    p.add_argument(
-        "--noise-on", choices=("block", "pixel"), default="block",
-        help="the noise --until-noise reads: block (relative L1 between the halves on 4x4 blocks, the ledger's) or "
-        "pixel (per pixel) (default block)",
-    )  # fmt: skip
-    p.add_argument(
-        "--rr-depth", type=int, default=64, help="path depth from which Russian roulette ends paths (default 64; "
-        "media with a single-scattering albedo near 1, whose light travels hundreds of scattering events, need "
-        "about 1 / (1 - albedo) or more: the slit-marble reference takes 1024)"
-    )  # fmt: skip
-    p.add_argument("--no-cache", action="store_true", help="render even when an identical reference is cached")
-    p.add_argument("--json", action="store_true", help="print the result (path, noise floor, time, notes) as JSON")
-    p.add_argument(
-        "--export-xml",
-        metavar="DIR",
-        help="write the path tracer's scene as a Mitsuba 3 scene file, DIR/scene.xml with its meshes (PLY) and "
-        "textures (EXR), for Mitsuba alone (`mitsuba DIR/scene.xml`), instead of rendering (default: render)",
-    )
+    add_command_options(p, reference_options(), parse={"until_noise": noise_level})
     add_scene_edit_options(p)  # --preset, --set KEY=VALUE, --mm-per-unit, as skinlab render's
     p.set_defaults(func=run)
 
 
-SEED_LIMIT = 1 << 32  # Mitsuba's sampler seed is a 32-bit unsigned integer
-DEPTH_LIMIT = (1 << 31) - 1  # and its path depths 32-bit signed ones
+def _check_options(args) -> None:
+    """Every option in its declaration's range (past Mitsuba's: its RuntimeError, a traceback)."""
+    from skinlab.truth.reference import check_max_depth
 
-
-def _check_path_options(args) -> None:
-    """--seed and --max-depth in what Mitsuba takes (past it: its RuntimeError, a traceback)."""
-    if not 0 <= args.seed < SEED_LIMIT:
-        raise ValueError(f"--seed: expected an integer in [0, {SEED_LIMIT - 1}], got {args.seed}")
-    if not (args.max_depth == -1 or 1 <= args.max_depth <= DEPTH_LIMIT):
-        raise ValueError(
-            f"--max-depth: expected -1 (no limit) or a path length in [1, {DEPTH_LIMIT}], got {args.max_depth}"
-        )
+    check_command_options(args, reference_options())
+    check_max_depth(args.max_depth, "--max-depth")
 
 
 def run(args) -> int:
@@ -92,7 +78,7 @@ def run(args) -> int:
     from skinlab.scene.scenefile import load_scene
     from skinlab.truth.reference import ReferenceRequest, ReferenceUnavailable, render_reference
 
-    _check_path_options(args)
+    _check_options(args)
     if args.export_xml:
         return export_xml(args)
     out = check_output_path(args.out, "--out")  # before minutes of path tracing
@@ -167,19 +153,16 @@ def run(args) -> int:
 
 
 def noise_level(text: str) -> float:
-    """'0.01' or '1%' -> 0.01 (argparse type of --until-noise)."""
+    """'0.01' or '1%' -> 0.01 (how --until-noise is read; its range is UNTIL_NOISE's)."""
     import argparse
-    import math
 
     t = text.strip()
     try:
-        v = float(t[:-1]) / 100 if t.endswith("%") else float(t)
+        return float(t[:-1]) / 100 if t.endswith("%") else float(t)
     except ValueError:
-        want = "expected a fraction such as 0.01 or a percentage such as 1%"
-        raise argparse.ArgumentTypeError(f"{want}, got {text!r}") from None
-    if not (v > 0 and math.isfinite(v)):
-        raise argparse.ArgumentTypeError(f"expected a noise level > 0, got {text!r}")
-    return v
+        raise argparse.ArgumentTypeError(
+            f"expected a fraction such as 0.01 or a percentage such as 1%, got {text!r}"
+        ) from None
 
 
 def noise_map_rgb(ref):

@@ -55,6 +55,7 @@ from typing import Any
 
 import numpy as np
 
+from skinlab.declare import Field
 from skinlab.scene.graph import LightNode, MeshNode, Scene
 from skinlab.scene.mesh_topology import boundary_loops, edge_report, weld
 from skinlab.scene.optics.constants import MIN_MFP_MM
@@ -73,6 +74,18 @@ REFERENCE_MIN_MFP_MM = max(MIN_MFP_MM, 1e-3)
 
 class ReferenceError(ValueError):
     """The scene cannot be represented for the reference renderer (the message names what)."""
+
+
+# directional lights as distant disks (a ReferenceRequest's field and `skinlab reference --sun-deg`)
+SUN_DEG = Field(
+    "sun_deg",
+    "float",
+    0.0,
+    (0.0, 10.0),
+    unit="deg",
+    doc="angular diameter of directional lights (0: a delta light as in the realtime frame; e.g. 0.53 for the sun: "
+    "makes lights behind a dielectric boundary reachable by BSDF sampling)",
+)
 
 
 # -- the description -------------------------------------------------------------------------------
@@ -302,8 +315,10 @@ def describe(
     """The Mitsuba description of `scene` seen by its camera at width x height pixels."""
     if scene.camera is None:
         raise ReferenceError(f"scene {scene.name!r}: has no camera")
-    if not (0 <= sun_deg <= 10):
-        raise ReferenceError(f"sun_deg: expected an angular diameter in [0, 10] degrees, got {sun_deg}")
+    try:
+        SUN_DEG.check(sun_deg)
+    except ValueError as exc:
+        raise ReferenceError(str(exc)) from None
     notes: list[str] = []
     shapes: list[ShapeDesc] = []
     lo, hi = scene.world_bounds()

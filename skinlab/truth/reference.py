@@ -31,10 +31,11 @@ from pathlib import Path
 import numpy as np
 
 from skinlab.atomic_write import atomic_path, write_text_atomic
+from skinlab.declare import Field, declared_fields
 from skinlab.scene.graph import Scene
 
 from .compare import image_error, object_mask
-from .export import ReferenceDescription, describe
+from .export import SUN_DEG, ReferenceDescription, describe
 from .passes import Pass, PassSet, PassStore
 
 EXPORT_VERSION = 2  # bump when the exporter changes what a scene renders as
@@ -46,40 +47,97 @@ class ReferenceUnavailable(RuntimeError):
     """Mitsuba or the asked-for variant cannot run here (the message says how to fix it)."""
 
 
+SEED_LIMIT = 1 << 32  # Mitsuba's sampler seed is a 32-bit unsigned integer
+DEPTH_LIMIT = (1 << 31) - 1  # and its path depths 32-bit signed ones
+
+
+def _declared(default, doc: str, kind: str = "int", **kw):
+    """A request field declared by a Field (its range is what the request checks, and `skinlab
+    reference`'s option of the same name is made from it)."""
+    f = Field("", kind, default, doc=doc, **kw)
+    if default is None:
+        return field(metadata={"declared": f})
+    return field(default=default, metadata={"declared": f})
+
+
 @dataclass(frozen=True)
 class ReferenceRequest:
-    width: int
-    height: int
-    spp: int = 1024  # samples per pixel, all passes together
-    passes: int = 4
-    seed: int = 0
-    variant: str = "scalar_rgb"
-    sun_deg: float = 0.0  # > 0: directional lights as distant disks of this angular diameter
-    max_depth: int = -1  # volpath path length limit (-1: none; Russian roulette ends paths)
-    rr_depth: int = 64  # Russian roulette from this depth (media with albedo near 1 need ~ 1 / (1 - albedo))
+    width: int = _declared(None, "image width in pixels", range=(1, 16384), unit="px")
+    height: int = _declared(None, "image height in pixels", range=(1, 16384), unit="px")
+    spp: int = _declared(1024, "samples per pixel over all passes", range=(2, 1 << 24))
+    passes: int = _declared(4, "independent passes, for the noise floor", range=(2, 1024))
+    seed: int = _declared(0, "random seed (Mitsuba's: 32 bits)", range=(0, SEED_LIMIT - 1))
+    variant: str = _declared(
+        "scalar_rgb",
+        "Mitsuba variant (scalar_rgb: any CPU; llvm_ad_rgb needs libllvm19; cuda_ad_rgb an NVIDIA GPU)",
+        "choice",
+        choices=VARIANTS,
+    )
+    sun_deg: float = field(default=SUN_DEG.default, metadata={"declared": SUN_DEG})  # describe() checks it too
+    max_depth: int = _declared(-1, "path length limit (-1: none, Russian roulette ends paths; 0 is refused)",
+                               range=(-1, DEPTH_LIMIT))  # fmt: skip
+    rr_depth: int = _declared(
+        64,
+        "path depth from which Russian roulette ends paths (media with a single-scattering albedo near 1, whose "
+        "light travels hundreds of scattering events, need about 1 / (1 - albedo) or more: the slit-marble "
+        "reference takes 1024)",
+        range=(1, 1 << 20),
+    )
 
     @property
     def pass_spp(self) -> int:
         return max(1, self.spp // self.passes)
 
+    @classmethod
+    def fields(cls) -> dict[str, Field]:
+        """The request's declared fields, by name."""
+        return declared_fields(cls)
+
     def __post_init__(self) -> None:
-        limits = (
-            ("width", 1, 16384),
-            ("height", 1, 16384),
-            ("spp", 2, 1 << 24),
-            ("passes", 2, 1024),
-            ("rr_depth", 1, 1 << 20),
-        )
-        for name, lo, hi in limits:
-            v = getattr(self, name)
-            if not isinstance(v, int) or not lo <= v <= hi:
-                raise ValueError(f"reference {name}: expected an integer in [{lo}, {hi}], got {v!r}")
+        for name, f in self.fields().items():
+            f.check(getattr(self, name), f"reference {name}")
+        check_max_depth(self.max_depth, "reference max_depth")
         if self.spp < self.passes:
             raise ValueError(f"reference spp: {self.spp} samples cannot be split into {self.passes} passes")
-        if self.variant not in VARIANTS:
-            raise ValueError(f"reference variant: expected one of {', '.join(VARIANTS)}, got {self.variant!r}")
-        if not isinstance(self.seed, int) or self.seed < 0:
-            raise ValueError(f"reference seed: expected an integer >= 0, got {self.seed!r}")
+
+
+def check_max_depth(value: int, label: str) -> None:
+    """0 lies in max_depth's declared range (-1 is no limit) but is no path: refused, naming `label`."""
+    if value == 0:
+        raise ValueError(f"{label}: expected -1 (no limit) or a path length in [1, {DEPTH_LIMIT}], got 0")
+
+
+# how a reference's passes are added (render_reference's keywords; `skinlab reference`'s options)
+UNTIL_NOISE = Field(
+    "until_noise",
+    "float",
+    None,
+    (0.0, math.inf),
+    lo_open=True,
+    doc="add passes (of SPP/PASSES samples each) until the noise floor is at most this (a fraction, 0.01, or a "
+    "percentage, 1%), measured as --noise-on says; passes already cached count",
+    shown="none: the samples and passes asked for",
+)
+TIME_S = Field(
+    "time",
+    "float",
+    None,
+    (0.0, math.inf),
+    lo_open=True,
+    unit="s",
+    doc="add passes for this many seconds (with --until-noise: whichever comes first); every pass is saved as "
+    "it finishes, so the reference only gets quieter from run to run",
+    shown="none: the samples and passes asked for",
+)
+NOISE_MEASURES = {"block": "rel_l1_block", "pixel": "rel_l1"}
+NOISE_ON = Field(
+    "noise_on",
+    "choice",
+    "block",
+    choices=tuple(NOISE_MEASURES),
+    doc="the noise --until-noise reads: block (relative L1 between the halves on 4x4 blocks, the ledger's) or "
+    "pixel (per pixel)",
+)
 
 
 @dataclass
@@ -232,9 +290,6 @@ def store_reference(ref: Reference) -> None:
     write_text_atomic(d / f"{ref.key}.json", json.dumps(ref.meta, indent=1))
 
 
-NOISE_MEASURES = {"block": "rel_l1_block", "pixel": "rel_l1"}
-
-
 def _noise_of(ps: PassSet) -> dict:
     if ps.count < 2:
         return {"rel_l1": float("inf"), "rel_l1_block": float("inf"), "energy": [float("nan")] * 3, "pixels": 0}
@@ -288,12 +343,11 @@ def render_reference(
     ``req.spp`` samples in ``req.passes`` passes and, where given, the noise floor (``noise_measure``
     "block": 4x4 blocks, "pixel") is at most ``until_noise`` or this call has spent ``time_s``
     seconds. ``render=False``: only what the cache holds (None if it holds too few passes)."""
-    if until_noise is not None and not (until_noise > 0 and math.isfinite(until_noise)):
-        raise ValueError(f"--until-noise: expected a noise level > 0 (e.g. 0.01 or 1%), got {until_noise!r}")
-    if time_s is not None and not (time_s > 0 and math.isfinite(time_s)):
-        raise ValueError(f"--time: expected seconds > 0, got {time_s!r}")
-    if noise_measure not in NOISE_MEASURES:
-        raise ValueError(f"noise measure: expected one of {', '.join(NOISE_MEASURES)}, got {noise_measure!r}")
+    if until_noise is not None:
+        UNTIL_NOISE.check(until_noise, "until_noise")
+    if time_s is not None:
+        TIME_S.check(time_s, "time_s")
+    NOISE_ON.check(noise_measure, "noise_measure")
     desc = desc or describe(
         scene, req.width, req.height, sun_deg=req.sun_deg, max_depth=req.max_depth, rr_depth=req.rr_depth
     )

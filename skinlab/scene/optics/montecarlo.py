@@ -53,8 +53,13 @@ WALK_FIELDS = {
         Field("incidence", "choice", "normal", choices=("normal", "diffuse"), doc="how light enters"),
         Field("photons", "int", 100_000, (2, MAX_PHOTONS), doc="photons to trace"),
         Field("seed", "int", 0, (0, math.inf), doc="random seed; the same seed gives the same result"),
-        Field("max_steps", "int", 100_000, (1, math.inf), doc="collisions per walk before it is dropped and "
-              "counted as capped"),  # fmt: skip
+        Field(
+            "max_steps",
+            "int",
+            100_000,
+            (1, math.inf),
+            doc="collisions per walk before it is dropped and counted as capped",
+        ),  # fmt: skip
         Field("workers", "int", 1, (1, math.inf), doc="processes"),
     )
 }
