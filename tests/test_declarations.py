@@ -1,4 +1,4 @@
-"""Every setting is declared once (skinlab/declare.py Field): each option of `skinlab render` and `skinlab view`,
+"""Every setting is declared once (skinlab/declare.py Field): each option of every command,
 each viewer widget and each scene-file key comes from a declaration, its default stated there alone."""
 
 import argparse
@@ -37,29 +37,118 @@ BUNNY = ROOT / "skinlab/assets/stanford-bunny/bunny.ply"
 
 
 def declarations() -> list[Field]:
+    from skinlab.commands.bench import accuracy_options, orbit_options, peer_options, reload_options, startup_options
+    from skinlab.commands.mc import mc_options
+    from skinlab.commands.profile import PROFILE_OPTIONS, SOURCE_OPTIONS
+    from skinlab.commands.reference import reference_options
+
     out = [*PRINCIPLED_PARAMS, *RenderSettings.fields().values(), *RENDER_OPTIONS, *VIEW_OPTIONS]
     out += [*EXPORT_OPTIONS, *SCENES_OPTIONS, *DEMO_OPTIONS, *COMPARE_OPTIONS]
+    out += [*(f for fields in mc_options() for f in fields), *SOURCE_OPTIONS, *PROFILE_OPTIONS, *reference_options()]
+    out += [*peer_options(), *orbit_options(), *reload_options(), *accuracy_options(), *startup_options()]
     out += [CAMERA_ORBIT, SET_OPTION, LIGHT_ANGULAR_RADIUS]
     out += [f for t in techniques() for f in t.settings_type.options().values()]
     return out + [f for keys in SCENE_FILE_KEYS.values() for f in keys]
 
 
+def subcommands(parser=None, prefix=()):
+    """(path, parser) of every command of the CLI, subcommands included (("bench", "reload"), ...)."""
+    parser = parser or build_parser()
+    for a in parser._actions:
+        if isinstance(a, argparse._SubParsersAction):
+            for name, sub in a.choices.items():
+                yield (*prefix, name), sub
+                yield from subcommands(sub, (*prefix, name))
+
+
 def command_options(command: str) -> dict[str, argparse.Action]:
-    parser = build_parser()
-    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    return {flag: a for a in sub.choices[command]._actions for flag in a.option_strings}
+    sub = dict(subcommands())[tuple(command.split())]
+    return {flag: a for a in sub._actions for flag in a.option_strings}
 
 
-@pytest.mark.parametrize("command", ["render", "view", "export", "scenes", "demo", "compare"])
+COMMANDS = [" ".join(path) for path, sub in subcommands() if not any(
+    isinstance(a, argparse._SubParsersAction) for a in sub._actions)]  # fmt: skip
+# options that are no declaration's, and why
+NOT_DECLARED = {
+    "--help": "argparse's own (-h)",
+    "--technique": "the registry's techniques with their descriptions (skinlab/commands/technique_options.py)",
+    "--albedo": "mc and profile: a refused spelling, hidden (two albedos, two names: --single-albedo, "
+    "--surface-albedo)",
+    "--tiny": "bench accuracy: hidden, for tests (4 settings, the head, 64x64)",
+}
+
+
+def test_the_commands_checked_are_every_command_of_the_cli():
+    assert {"render", "view", "export", "scenes", "demo", "compare", "mc", "profile", "reference"} <= set(COMMANDS)
+    assert {f"bench {b}" for b in ("peer", "orbit", "reload", "accuracy", "startup")} <= set(COMMANDS)
+    assert "bench" not in COMMANDS  # a group: its subcommands have the options
+
+
+@pytest.mark.parametrize("command", COMMANDS)
 def test_every_option_of_a_command_comes_from_a_declaration(command):
-    """render and view (and export, scenes, demo, compare; not yet mc, profile, reference, bench)."""
+    """Every option of every command (all of build_parser()'s subparsers) takes its help from a
+    declaration, but those NOT_DECLARED lists."""
     docs = [f.doc.replace("%", "%%") for f in declarations() if f.doc]
     options = command_options(command)
     assert len(options) > (40 if command in ("render", "view") else 2)  # the parser is real
     for flag, action in options.items():
-        if flag in ("-h", "--help", "--technique"):  # argparse's own; the registry's descriptions
+        if flag in NOT_DECLARED or flag == "-h":
+            assert flag != "--albedo" or action.help == argparse.SUPPRESS, flag
             continue
         assert any(doc in action.help for doc in docs), f"{command} {flag}: help from no declaration"
+
+
+def own_options() -> dict[str, list[Field]]:
+    """Each command's own declared options (render's and view's frame settings are None until given:
+    test_render_settings_are_options_of_both_commands_with_their_declared_help)."""
+    from skinlab.commands import bench
+    from skinlab.commands.mc import mc_options
+    from skinlab.commands.profile import PROFILE_OPTIONS, SOURCE_OPTIONS
+    from skinlab.commands.reference import reference_options
+
+    out = {"render": RENDER_OPTIONS, "view": VIEW_OPTIONS, "export": EXPORT_OPTIONS, "scenes": SCENES_OPTIONS}
+    out |= {"demo": DEMO_OPTIONS, "compare": COMPARE_OPTIONS, "mc": [f for fs in mc_options() for f in fs]}
+    out |= {"profile": [*SOURCE_OPTIONS, *PROFILE_OPTIONS], "reference": reference_options()}
+    for name in ("peer", "orbit", "reload", "accuracy", "startup"):
+        out[f"bench {name}"] = getattr(bench, f"{name}_options")()
+    return {k: list(v) for k, v in out.items()}
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_a_command_s_own_options_have_their_declared_spelling_default_and_help(command):
+    from skinlab.commands.field_options import option_flags
+
+    fields = own_options()[command]  # every command has its own declared options
+    options = command_options(command)
+    for f in fields:
+        a = options[option_flags(f)[0]]
+        assert a.dest == f.name and a.default == f.default and f.doc.replace("%", "%%") in a.help, (command, f.name)
+        if f.kind == "choice":
+            assert tuple(a.choices) == f.choices
+
+
+def test_an_option_value_outside_its_declaration_is_one_line_naming_it(capsys):
+    """The one error shape, `--NAME: expected <what>, got <value>`, for the commands declared last."""
+    from skinlab.cli import main
+
+    for argv, line in (
+        (["mc", "--single-albedo", "0.5", "--max-steps", "0"], "--max-steps: expected an integer >= 1, got 0"),
+        (["mc", "--single-albedo", "0.5", "--g", "1"], "--g: expected a number in (-1, 1), got 1.0"),
+        (["profile", "burley", "--mc-photons", "1"], "--mc-photons: expected an integer in [2, 10000000000], got 1"),
+        (["reference", "--seed", "-1"], "--seed: expected an integer in [0, 4294967295], got -1"),
+        (["reference", "--rr-depth", "0"], "--rr-depth: expected an integer in [1, 1048576], got 0"),
+        (["bench", "reload", "--settle", "11"], "--settle: expected a number in [0, 10], got 11.0"),
+        (["bench", "accuracy", "--out", "x", "--exact-size", "8"], "--exact-size: expected an integer in [16, 8192]"),
+        (["bench", "startup", "--rounds", "0"], "--rounds: expected an integer >= 1, got 0"),
+    ):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert line in err and len(err.strip().splitlines()) == 1, (argv, err)
+    # the request checks through the same declaration as the option
+    from skinlab.truth.reference import ReferenceRequest
+
+    with pytest.raises(ValueError, match=r"^reference rr_depth: expected an integer in \[1, 1048576\], got 0$"):
+        ReferenceRequest(8, 8, rr_depth=0)
 
 
 def test_render_settings_are_options_of_both_commands_with_their_declared_help():

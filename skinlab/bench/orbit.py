@@ -29,11 +29,16 @@ import time
 
 import numpy as np
 
+from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings
 from skinlab.resources import scenes_root
 
 ASSETS = scenes_root()
 SCENES = {"head": None, "bunny": ASSETS / "bunny-skimmilk.toml", "head-studio": ASSETS / "head-studio.toml"}
+# timed steps over one turn (checked here; `skinlab bench orbit --frames`)
+ORBIT_FRAMES = Field(
+    "frames", "int", 24, (1, math.inf), doc="timed camera steps per scene over one full turn, after 2 warm-up frames"
+)
 MODES = ("orbit", "full", "plain", "plain_orbit")
 WARMUP = 2
 
@@ -129,8 +134,7 @@ def orbit_bench(
 
     from skinlab.gl.context import create_headless_context, describe
 
-    if frames < 1:
-        raise ValueError(f"--frames: expected >= 1, got {frames}")
+    ORBIT_FRAMES.check(frames, "--frames")
     unknown = [s for s in scenes if s not in SCENES]
     if unknown:
         raise ValueError(f"--scenes: expected names from {', '.join(SCENES)}, got {unknown[0]!r}")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import statistics
 import sys
@@ -9,7 +10,24 @@ import time
 
 from tqdm import tqdm
 
+from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings
+
+# the benchmark's counts, declared once (checked here; `skinlab bench peer`'s options)
+PEER_FIELDS = {
+    f.name: f
+    for f in (
+        Field("frames", "int", 30, (1, math.inf), doc="timed frames per renderer, after 2 warm-up frames"),
+        Field(
+            "rounds",
+            "int",
+            3,
+            (1, math.inf),
+            doc="rounds the frames are split into, each timing Skinlab's settings then pyrender's, so that a "
+            "change of machine load hits both alike; the ratio is the median of the rounds'",
+        ),
+    )
+}
 
 
 def _loadavg():
@@ -35,10 +53,8 @@ def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False, rounds
     from skinlab.render.renderer import Renderer
     from skinlab.scene.scenefile import load_scene
 
-    if frames < 1:
-        raise ValueError(f"--frames: expected >= 1, got {frames}")
-    if rounds < 1:
-        raise ValueError(f"--rounds: expected >= 1, got {rounds}")
+    PEER_FIELDS["frames"].check(frames, "--frames")
+    PEER_FIELDS["rounds"].check(rounds, "--rounds")
     rounds = min(rounds, frames)
     share = [frames // rounds + (1 if i < frames % rounds else 0) for i in range(rounds)]
     scene = load_scene(None)

@@ -3,12 +3,35 @@ rendered with the recompiled program, in the viewer's loop without a window."""
 
 from __future__ import annotations
 
+import math
 import re
 import statistics
 import time
 from pathlib import Path
 
+from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings
+
+# the benchmark's own parameters, declared once (checked here; `skinlab bench reload`'s options)
+RELOAD_FIELDS = {
+    f.name: f
+    for f in (
+        Field("repeats", "int", 10, (1, math.inf), doc="edits to time"),
+        Field("file", "string", "passes/tonemap.frag", doc="shader file to edit, relative to shaders/"),
+        Field("settle", "float", 0.05, (0.0, 10.0), unit="s", doc="ShaderWatcher settle time, as skinlab view's"),
+        Field(
+            "mode",
+            "choice",
+            "on-demand",
+            choices=("on-demand", "continuous"),
+            doc="on-demand: the viewer's default loop (idle polls at 60 Hz, a frame only after a change); "
+            "continuous: a frame every iteration (as with skinlab view --continuous)",
+        ),
+        Field("timeout", "float", 20.0, (0.0, math.inf), lo_open=True, unit="s", doc="give up on one edit after this"),
+    )
+}
+RELOAD_SHADOW_SIZE = 512  # the timed frames' shadow map: smaller than a render's, for a quick frame after an edit
+RELOAD_TSD_SIZE = 256  # and their texture-space irradiance texels per side
 
 _MAIN = re.compile(r"\bvoid\s+main\s*\(\s*(void)?\s*\)")
 _OUT = re.compile(r"^\s*(?:layout\s*\([^)]*\)\s*)?out\s+vec4\s+(\w+)\s*;", re.M)
@@ -45,8 +68,8 @@ def reload_bench(
     repeats: int = 10,
     file: str = "passes/tonemap.frag",
     settle_s: float = 0.05,
-    shadow_size: int = 512,
-    tsd_size: int = 256,
+    shadow_size: int = RELOAD_SHADOW_SIZE,
+    tsd_size: int = RELOAD_TSD_SIZE,
     timeout_s: float = 20.0,
     mode: str = "on-demand",
 ) -> dict:
@@ -69,12 +92,8 @@ def reload_bench(
     from skinlab.render.renderer import Renderer
     from skinlab.scene.scenefile import load_scene
 
-    if repeats < 1:
-        raise ValueError(f"--repeats: expected >= 1, got {repeats}")
-    if mode not in ("on-demand", "continuous"):
-        raise ValueError(f"--mode: expected on-demand or continuous, got {mode!r}")
-    if not 0.0 <= settle_s <= 10.0:
-        raise ValueError(f"--settle: expected seconds in [0, 10], got {settle_s}")
+    for name, value in (("repeats", repeats), ("mode", mode), ("settle", settle_s), ("timeout", timeout_s)):
+        RELOAD_FIELDS[name].check(value, f"--{name}")
     w, h = size
     from skinlab.render.techniques.tsd import TsdSettings
 

@@ -24,6 +24,7 @@ its load: the load average is reported with them.
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 import statistics
@@ -32,6 +33,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from skinlab.declare import Field
 
 KINDS = ("fresh", "cold", "warm")
 PHASES = ("imports", "scene", "gl", "plan", "frame", "write")
@@ -92,10 +95,15 @@ def _run_child(scene: str | None, size: tuple[int, int], env: dict, out: str) ->
     return res
 
 
+# rounds of starts (checked here; `skinlab bench startup --rounds`)
+STARTUP_ROUNDS = Field(
+    "rounds", "int", 3, (1, math.inf), doc="rounds of fresh, cold and warm starts; medians are shown"
+)
+
+
 def startup_bench(scene: str | None = None, size: tuple[int, int] = (64, 64), rounds: int = 3, progress=None) -> dict:
     """``rounds`` rounds of (fresh, cold, warm) starts (see the module docstring)."""
-    if not isinstance(rounds, int) or rounds < 1:
-        raise ValueError(f"--rounds: expected a positive count, got {rounds}")
+    STARTUP_ROUNDS.check(rounds, "--rounds")
     runs: dict[str, list[dict]] = {k: [] for k in KINDS}
     load_start = _loadavg()
     with tempfile.TemporaryDirectory(prefix="skinlab-startup-") as tmp:

@@ -12,186 +12,193 @@ This module only parses options and prints; the benchmarks live in skinlab/bench
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import math
 from pathlib import Path
 
 from skinlab.bench.orbit import SCENES as ORBIT_SCENES
 from skinlab.bench.orbit import orbit_bench
 from skinlab.bench.peer import peer_bench
 from skinlab.bench.reload import reload_bench
+from skinlab.commands.field_options import IMAGE_SIZE, add_command_options, check_command_options, own_default
+from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings, parse_size
 
-RELOAD_SHADOW_SIZE = 512  # `skinlab bench reload --shadow-size`: its own default, stated in its help
+JSON = Field("json", "bool", False, doc="print the result as JSON")
+NO_PROGRESS = Field("no_progress", "bool", False, doc="no progress bar on stderr")
+
+
+def _own_size(default: str) -> Field:
+    return own_default(IMAGE_SIZE, default, f"this benchmark's own default (a render's is {IMAGE_SIZE.default})")
+
+
+def peer_options() -> tuple[Field, ...]:
+    from skinlab.bench.peer import PEER_FIELDS
+
+    return (
+        _own_size("512x512"),
+        PEER_FIELDS["frames"],
+        PEER_FIELDS["rounds"],
+        JSON,
+        NO_PROGRESS,
+        Field(
+            "blender",
+            "bool",
+            False,
+            doc="instead: Blender's EEVEE and Cycles beside Skinlab's default frame on the reference scenes, "
+            "against the path-traced truth, in one ledger run (--quick sizes; writes the ledger to --out; see "
+            "docs/ledger.md)",
+        ),
+        Field("out", "string", "out/peer-blender", doc="with --blender: the ledger's folder"),
+        Field("scenes", "string", doc="with --blender: comma-separated scene names", shown="every reference scene"),
+        Field("references", "bool", False, doc="with --blender: path-trace the references not cached yet"),
+        Field(
+            "cycles_truth",
+            "bool",
+            False,
+            doc="with --blender: Cycles at 1024 spp (random walk and random walk skin) as a second truth against "
+            "Mitsuba's, instead of the EEVEE/Cycles frame-time rows (docs/ground-truth.md)",
+        ),
+    )
+
+
+def orbit_options() -> tuple[Field, ...]:
+    from skinlab.bench.orbit import ORBIT_FRAMES
+
+    scenes = Field(
+        "scenes",
+        "string",
+        ",".join(ORBIT_SCENES),
+        doc=f"comma-separated scene names, from {', '.join(ORBIT_SCENES)}",
+    )
+    return (IMAGE_SIZE, ORBIT_FRAMES, scenes, JSON, NO_PROGRESS)
+
+
+def reload_options() -> tuple[Field, ...]:
+    """The benchmark's own parameters (skinlab/bench/reload.py) and the two render settings its frames
+    use, from their declarations, with this benchmark's own (smaller) defaults, said in their help."""
+    from skinlab.bench.reload import RELOAD_FIELDS, RELOAD_SHADOW_SIZE, RELOAD_TSD_SIZE
+    from skinlab.render.registry import get_technique
+
+    shadow = RenderSettings.fields()["shadow_size"]
+    tsd = dataclasses.replace(get_technique("tsd").settings_type.options()["size"], name="tsd_size")
+    quick = "so that a frame after an edit is quick"
+    return (
+        _own_size("128x128"),
+        RELOAD_FIELDS["repeats"],
+        RELOAD_FIELDS["file"],
+        RELOAD_FIELDS["settle"],
+        own_default(
+            shadow,
+            RELOAD_SHADOW_SIZE,
+            f"this benchmark's own default, smaller than a render's {shadow.default} {quick}",
+        ),  # fmt: skip
+        own_default(
+            tsd,
+            RELOAD_TSD_SIZE,
+            f"texture-space diffusion's; this benchmark's own default, smaller than a render's {tsd.default} {quick}",
+        ),  # fmt: skip
+        RELOAD_FIELDS["mode"],
+        RELOAD_FIELDS["timeout"],
+        Field("json", "bool", False, doc="print the result as JSON (every sample)"),
+    )
+
+
+def accuracy_options() -> tuple[Field, ...]:
+    """The ledger's options; the defaults the sweeps hold (skinlab/bench/accuracy.py SWEEPS) are stated
+    in their help."""
+    from skinlab.bench.accuracy import SWEEPS
+    from skinlab.bench.sweep import base_setting, reference_technique
+    from skinlab.render.registry import get_technique
+    from skinlab.scene.optics.montecarlo import WALK_FIELDS
+
+    full, quick = SWEEPS["full"], SWEEPS["quick"]
+    ref = reference_technique()
+    ref_size = {n: base_setting(ref, SWEEPS[n]).value("size") if ref else None for n in ("full", "quick")}
+    both = lambda a, b: f"{a}; --quick {b}"  # noqa: E731
+    sizes = (full.size, quick.size)
+    exact = get_technique(ref).settings_type.options()["size"] if ref else Field("size", "int", None, (16, 8192))
+    exact = dataclasses.replace(exact, name="exact_size")
+    return (
+        Field(
+            "out",
+            "string",
+            doc="output folder (ledger.csv, ledger.md, ledger.html, ledger.json, pareto.png, cost.png, profiles.png, "
+            "error_maps/, flip_maps/, images/, mc_cache/)",
+        ),
+        Field("quick", "bool", False, doc="a subset at 160x160 (a few minutes at most on 2 cores)"),
+        own_default(IMAGE_SIZE, None, "each sweep's own default", shown=both(*(f"{w}x{h}" for w, h in sizes))),
+        Field(
+            "scenes",
+            "string",
+            doc="comma-separated scene names (bundled: `skinlab scenes`; head, bunny) or .toml paths",
+            shown="every reference scene; --quick head-skin1-matched, bunny-skimmilk, slab-edge-skin1",
+        ),
+        Field(
+            "references",
+            "bool",
+            False,
+            doc="path-trace the scenes' references that are not cached yet (skinlab reference; minutes per scene "
+            "on 2 cores: full 192x192 at 1024 spp, --quick 96x96 at 256 spp); without it a scene whose reference "
+            "is not cached is measured without the truth",
+        ),
+        Field(
+            "frames", "int", None, (1, math.inf), doc="timed frames per setting", shown=both(full.frames, quick.frames)
+        ),  # fmt: skip
+        dataclasses.replace(
+            WALK_FIELDS["photons"],
+            default=None,
+            doc="Monte Carlo photons per channel",
+            shown=both(full.photons, quick.photons),
+        ),  # fmt: skip
+        own_default(exact, None, "of the exact reference", shown=both(ref_size["full"], ref_size["quick"])),
+        Field("no_peer", "bool", False, doc="skip the pyrender comparison"),
+        Field(
+            "blender",
+            "bool",
+            False,
+            doc="add Blender's EEVEE and Cycles as peer rows (bpy in a child process: `make test` or `make bench` "
+            "installs it into .venv-blender)",
+        ),
+        Field("no_images", "bool", False, doc="do not write images/SCENE-SETTING.png"),
+        Field("no_progress", "bool", False, doc="no progress bar"),
+    )
+
+
+def startup_options() -> tuple[Field, ...]:
+    from skinlab.bench.startup import STARTUP_ROUNDS
+
+    return (_own_size("64x64"), STARTUP_ROUNDS, JSON)
 
 
 def register(sub) -> None:
-    from skinlab.bench.accuracy import SWEEPS  # the sweeps' numbers are the help's defaults
-
     p = sub.add_parser("bench", help="benchmarks (timings are printed, never asserted)")
     bsub = p.add_subparsers(dest="bench", metavar="BENCH")
     bsub.required = True
     peer = bsub.add_parser("peer", help="Skinlab vs pyrender on the same head, size and EGL context kind")
-    peer.add_argument("--size", default="512x512", help="frame size WIDTHxHEIGHT in pixels (default 512x512)")
-    peer.add_argument(
-        "--frames", type=int, default=30, help="timed frames per renderer, after 2 warm-up frames (default 30)"
-    )
-    peer.add_argument(
-        "--rounds",
-        type=int,
-        default=3,
-        help="rounds the frames are split into, each timing Skinlab's settings then pyrender's, so that a change "
-        "of machine load hits both alike; the ratio is the median of the rounds' (default 3)",
-    )
-    peer.add_argument("--json", action="store_true", help="print the result as JSON")
-    peer.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
-    peer.add_argument(
-        "--blender",
-        action="store_true",
-        help="instead: Blender's EEVEE and Cycles beside Skinlab's default frame on the reference scenes, against "
-        "the path-traced truth, in one ledger run (--quick sizes; writes the ledger to --out; see docs/ledger.md)",
-    )
-    peer.add_argument(
-        "--out", default="out/peer-blender", help="with --blender: the ledger's folder (default out/peer-blender)"
-    )
-    peer.add_argument(
-        "--scenes",
-        default=None,
-        help="with --blender: comma-separated scene names (default: every reference scene)",
-    )
-    peer.add_argument(
-        "--references", action="store_true", help="with --blender: path-trace the references not cached yet"
-    )
-    peer.add_argument(
-        "--cycles-truth",
-        action="store_true",
-        help="with --blender: Cycles at 1024 spp (random walk and random walk skin) as a second truth against "
-        "Mitsuba's, instead of the EEVEE/Cycles frame-time rows (docs/ground-truth.md)",
-    )
+    add_command_options(peer, peer_options())
     peer.set_defaults(func=run_peer_bench)
     orb = bsub.add_parser(
         "orbit",
         help="frame time while the camera orbits the head and the bunny: with reuse across frames (as the viewer), "
         "without, and the plain frame (--sss none), in one run",
     )
-    orb.add_argument("--size", default="640x640", help="frame size WIDTHxHEIGHT in pixels (default 640x640)")
-    orb.add_argument(
-        "--frames",
-        type=int,
-        default=24,
-        help="timed camera steps per scene over one full turn, after 2 warm-up frames (default 24)",
-    )
-    orb.add_argument(
-        "--scenes",
-        default=",".join(ORBIT_SCENES),
-        help=f"comma-separated scene names, from {', '.join(ORBIT_SCENES)} (default {','.join(ORBIT_SCENES)})",
-    )
-    orb.add_argument("--json", action="store_true", help="print the result as JSON")
-    orb.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    add_command_options(orb, orbit_options())
     orb.set_defaults(func=run_orbit_bench)
     rel = bsub.add_parser(
         "reload",
         help="shader hot reload: time from saving a file to the first frame rendered with the new program (headless)",
     )
-    rel.add_argument("--size", default="128x128", help="frame size (default 128x128)")
-    rel.add_argument("--repeats", type=int, default=10, help="edits to time (default 10)")
-    rel.add_argument(
-        "--file",
-        default="passes/tonemap.frag",
-        help="shader file to edit, relative to shaders/ (default passes/tonemap.frag)",
-    )
-    rel.add_argument(
-        "--settle",
-        type=float,
-        default=0.05,
-        help="ShaderWatcher settle time in seconds (default 0.05, as skinlab view)",
-    )
-    shadow = RenderSettings.fields()["shadow_size"]  # the render setting this benchmark's frames use
-    rel.add_argument(
-        "--shadow-size",
-        type=int,
-        default=RELOAD_SHADOW_SIZE,
-        help=f"the timed frames' {shadow.doc}: this benchmark's own default, smaller than a render's "
-        f"{shadow.default} so that a frame after an edit is quick; {shadow.expected()} "
-        f"(default: {RELOAD_SHADOW_SIZE} {shadow.unit})",
-    )
-    rel.add_argument("--tsd-size", type=int, default=256, help="texture-space diffusion texels per side (default 256)")
-    rel.add_argument(
-        "--mode",
-        choices=("on-demand", "continuous"),
-        default="on-demand",
-        help="on-demand: the viewer's default loop (idle polls at 60 Hz, a frame only after a "
-        "change); continuous: a frame every iteration (as with skinlab view --continuous)",
-    )
-    rel.add_argument(
-        "--timeout", type=float, default=20.0, help="give up on one edit after this many seconds (default 20)"
-    )
-    rel.add_argument("--json", action="store_true", help="print the result as JSON (every sample)")
+    add_command_options(rel, reload_options())
     rel.set_defaults(func=run_reload_bench)
     acc = bsub.add_parser(
         "accuracy",
         help="accuracy/time ledger: every SSS technique and setting timed and compared with the "
         "path-traced truth, the exact convolution and the Monte Carlo profile",
     )
-    acc.add_argument(
-        "--out",
-        required=True,
-        help="output folder (ledger.csv, ledger.md, ledger.html, ledger.json, pareto.png, cost.png, profiles.png, "
-        "error_maps/, flip_maps/, images/, mc_cache/)",
-    )
-    acc.add_argument("--quick", action="store_true", help="a subset at 160x160 (a few minutes at most on 2 cores)")
+    add_command_options(acc, accuracy_options(), required=("out",))
     acc.add_argument("--tiny", action="store_true", help=argparse.SUPPRESS)  # tests: 4 settings, head, 64x64
-    full, quick = SWEEPS["full"], SWEEPS["quick"]
-    from skinlab.bench.sweep import base_setting, reference_technique
-
-    ref = reference_technique()
-    ref_size = {n: base_setting(ref, SWEEPS[n]).value("size") if ref else None for n in ("full", "quick")}
-    acc.add_argument(
-        "--size",
-        default=None,
-        help=f"WIDTHxHEIGHT (default {full.size[0]}x{full.size[1]}; --quick {quick.size[0]}x{quick.size[1]})",
-    )
-    acc.add_argument(
-        "--scenes",
-        default=None,
-        help="comma-separated scene names (bundled: `skinlab scenes`; head, "
-        "bunny) or .toml paths (default: every reference scene; --quick head-skin1-matched, bunny-skimmilk, "
-        "slab-edge-skin1)",
-    )
-    acc.add_argument(
-        "--references",
-        action="store_true",
-        help="path-trace the scenes' references that are not cached yet (skinlab reference; minutes per scene "
-        "on 2 cores: full 192x192 at 1024 spp, --quick 96x96 at 256 spp); without it a scene whose reference "
-        "is not cached is measured without the truth",
-    )
-    acc.add_argument(
-        "--frames",
-        type=int,
-        default=None,
-        help=f"timed frames per setting (default {full.frames}; --quick {quick.frames})",
-    )
-    acc.add_argument(
-        "--photons",
-        type=int,
-        default=None,
-        help=f"Monte Carlo photons per channel (default {full.photons}; --quick {quick.photons})",
-    )
-    acc.add_argument(
-        "--exact-size",
-        type=int,
-        default=None,
-        help=f"irradiance texels per side of the exact reference (default {ref_size['full']}; "
-        f"--quick {ref_size['quick']})",
-    )
-    acc.add_argument("--no-peer", action="store_true", help="skip the pyrender comparison")
-    acc.add_argument(
-        "--blender",
-        action="store_true",
-        help="add Blender's EEVEE and Cycles as peer rows (bpy in a child process: `make test` or `make bench` "
-        "installs it into .venv-blender)",
-    )
-    acc.add_argument("--no-images", action="store_true", help="do not write images/SCENE-SETTING.png")
-    acc.add_argument("--no-progress", action="store_true", help="no progress bar")
     acc.set_defaults(func=run_accuracy_bench)
     st = bsub.add_parser(
         "startup",
@@ -199,11 +206,7 @@ def register(sub) -> None:
         "and Mesa's shader caches empty), cold (Skinlab's empty, Mesa's kept) and warm (both kept)",
     )
     st.add_argument("scene", nargs="?", default=None, help="a bundled scene name or a scene/mesh file (default head)")
-    st.add_argument("--size", default="64x64", help="frame size WIDTHxHEIGHT in pixels (default 64x64)")
-    st.add_argument(
-        "--rounds", type=int, default=3, help="rounds of fresh, cold and warm starts (default 3); medians are shown"
-    )
-    st.add_argument("--json", action="store_true", help="print the result as JSON")
+    add_command_options(st, startup_options())
     st.set_defaults(func=run_startup_bench)
 
 
@@ -212,6 +215,7 @@ def run_startup_bench(args) -> int:
 
     from skinlab.bench.startup import report, startup_bench
 
+    check_command_options(args, startup_options())
     res = startup_bench(args.scene, parse_size(args.size), args.rounds, lambda m: print(m, file=sys.stderr))
     print(json.dumps(res, indent=2) if args.json else report(res))
     return 0
@@ -236,6 +240,7 @@ def blender_peer_sweep(scenes: str | None):
 
 
 def run_peer_bench(args) -> int:
+    check_command_options(args, peer_options())
     if args.blender:
         from skinlab.bench.accuracy import resolve_scene, run_sweep
 
@@ -294,6 +299,7 @@ def blender_summary(rows: list[dict], meta: dict) -> list[str]:
 
 
 def run_orbit_bench(args) -> int:
+    check_command_options(args, orbit_options())
     scenes = tuple(s.strip() for s in args.scenes.split(",") if s.strip())
     res = orbit_bench(parse_size(args.size), args.frames, scenes, progress=not args.no_progress)
     if args.json:
@@ -328,6 +334,7 @@ def run_orbit_bench(args) -> int:
 
 
 def run_reload_bench(args) -> int:
+    check_command_options(args, reload_options())
     res = reload_bench(
         parse_size(args.size),
         args.repeats,
@@ -370,17 +377,12 @@ def accuracy_sweep_from_args(args):
     over = {}
     if args.size:
         over["size"] = parse_size(args.size)
+    check_command_options(args, accuracy_options())
     if args.frames is not None:
-        if args.frames < 1:
-            raise ValueError(f"--frames: expected >= 1, got {args.frames}")
         over["frames"] = args.frames
     if args.photons is not None:
-        if args.photons < 2:
-            raise ValueError(f"--photons: expected >= 2, got {args.photons}")
         over["photons"] = args.photons
     if args.exact_size is not None:
-        if not 16 <= args.exact_size <= 8192:
-            raise ValueError(f"--exact-size: expected texels per side in [16, 8192], got {args.exact_size}")
         over["reference_values"] = (("size", args.exact_size),)  # the image reference's base setting
     if args.scenes is not None:
         names = tuple(s.strip() for s in args.scenes.split(",") if s.strip())

@@ -49,8 +49,8 @@ def test_accuracy_help_defaults_come_from_the_sweeps():
     from skinlab.bench.sweep import base_setting
 
     size = {n: base_setting("exact", SWEEPS[n]).value("size") for n in ("full", "quick")}
-    assert f"default {size['full']}; --quick {size['quick']}" in helps["exact_size"]
-    assert f"default {SWEEPS['full'].photons}; --quick {SWEEPS['quick'].photons}" in helps["photons"]
+    assert f"default: {size['full']}; --quick {size['quick']}" in helps["exact_size"]
+    assert f"default: {SWEEPS['full'].photons}; --quick {SWEEPS['quick'].photons}" in helps["photons"]
 
 
 def test_a_named_command_imports_only_its_own_module():
