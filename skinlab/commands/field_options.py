@@ -5,7 +5,9 @@ the value given (an error naming the option and what was expected).
 Two uses: a *setting* (a render or technique setting, a scene-file key) is None when not given, so
 that the declaration's own default (or the scene's value) holds: :func:`add_setting_option` and
 :func:`setting_value`; a command's *own* option (``--out``, ``--frames``) has its declared default on
-the parsed arguments: :func:`add_command_options`, checked by :func:`check_command_options`."""
+the parsed arguments: :func:`add_command_options`, checked by :func:`check_command_options` (into a
+mutually exclusive group too; a colour/vec kind is typed R,G,B; an integer may be typed 1e5). A
+setting a command takes with a deliberately different default is :func:`own_default`: its help says so."""
 
 from __future__ import annotations
 
