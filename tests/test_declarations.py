@@ -3,6 +3,7 @@ each viewer widget and each scene-file key comes from a declaration, its default
 
 import argparse
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -125,6 +126,26 @@ def test_a_command_s_own_options_have_their_declared_spelling_default_and_help(c
         assert a.dest == f.name and a.default == f.default and f.doc.replace("%", "%%") in a.help, (command, f.name)
         if f.kind == "choice":
             assert tuple(a.choices) == f.choices
+
+
+def test_a_shared_setting_taken_with_another_default_says_so():
+    """--size, --shadow-size, --tsd-size, --exact-size ...: an option made from a render or technique setting
+    (or the image size) has that declaration's default, None (the declaration's holds), or says in its help
+    that its default is its own."""
+    from skinlab.commands.field_options import IMAGE_SIZE
+
+    shared = [IMAGE_SIZE, *RenderSettings.fields().values()]
+    shared += [replace(f, name=f"{t.name}_{n}") for t in techniques() for n, f in t.settings_type.options().items()]
+    seen = 0
+    for command in COMMANDS:
+        for flag, a in command_options(command).items():
+            for f in shared:
+                if not f.doc or f.doc.replace("%", "%%") not in (a.help or ""):
+                    continue
+                if a.default not in (None, f.default):
+                    assert "own default" in a.help, (command, flag)
+                    seen += 1
+    assert seen >= 6  # reference --size, bench peer/reload/startup --size, reload --shadow-size and --tsd-size
 
 
 def test_an_option_value_outside_its_declaration_is_one_line_naming_it(capsys):
