@@ -55,6 +55,8 @@ from pathlib import Path
 
 import numpy as np
 
+from skinlab.bench.machine_load import load_average
+
 from .image_error import image_error, lit_mask
 from .ledger_analysis import error_key, log_slope, pareto_front, recommendations, usable
 from .ledger_csv import NUMERIC_COLUMNS, csv_columns, csv_text
@@ -105,13 +107,6 @@ __all__ = [  # the ledger's public names, importable from here as before the spl
     "error_key",
     "write_ledger",
 ]
-
-
-def _loadavg():
-    try:
-        return [round(x, 2) for x in os.getloadavg()]
-    except OSError:
-        return None
 
 
 def _first_line(exc: BaseException) -> str:
@@ -418,7 +413,7 @@ class LedgerRun:
             "peer": peer_res,
             "blender": None if peers is None else peers.meta,
             "loadavg_start": load_start,
-            "loadavg_end": _loadavg(),
+            "loadavg_end": load_average(),
             "command": command,
             "date": time.strftime("%Y-%m-%d %H:%M:%S %Z"),
         }
@@ -459,7 +454,7 @@ def run_sweep(
     scenes = tuple(scenes or sweep.scenes)
     paths = {s: resolve_scene(s) for s in scenes}
     settings = sweep_settings(sweep)
-    t_start, load_start = time.perf_counter(), _loadavg()
+    t_start, load_start = time.perf_counter(), load_average()
     bar = tqdm(total=len(settings) * len(scenes), file=sys.stderr, unit="setting", disable=not progress,
                desc="ledger", dynamic_ncols=True)  # fmt: skip
     run = LedgerRun(sweep, out, images, references, progress, bar.set_postfix_str)

@@ -29,6 +29,7 @@ import time
 
 import numpy as np
 
+from skinlab.bench.machine_load import load_average
 from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings
 from skinlab.resources import scenes_root
@@ -41,13 +42,6 @@ ORBIT_FRAMES = Field(
 )
 MODES = ("orbit", "full", "plain", "plain_orbit")
 WARMUP = 2
-
-
-def _loadavg():
-    try:
-        return [round(x, 2) for x in os.getloadavg()]
-    except OSError:
-        return None
 
 
 def orbit_path(camera, centre: np.ndarray, steps: int):
@@ -139,7 +133,7 @@ def orbit_bench(
     if unknown:
         raise ValueError(f"--scenes: expected names from {', '.join(SCENES)}, got {unknown[0]!r}")
     ctx = create_headless_context()
-    load_start = _loadavg()
+    load_start = load_average()
     t0 = time.perf_counter()
     rows = []
     with tqdm(total=frames * len(scenes), desc="orbit", unit="step", disable=not progress) as bar:
@@ -153,7 +147,7 @@ def orbit_bench(
         "gl": describe(ctx),
         "cpu_count": os.cpu_count(),
         "loadavg_start": load_start,
-        "loadavg_end": _loadavg(),
+        "loadavg_end": load_average(),
         "total_s": round(time.perf_counter() - t0, 1),
         "scenes": rows,
     }

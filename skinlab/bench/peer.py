@@ -3,13 +3,13 @@
 from __future__ import annotations
 
 import math
-import os
 import statistics
 import sys
 import time
 
 from tqdm import tqdm
 
+from skinlab.bench.machine_load import load_average
 from skinlab.declare import Field
 from skinlab.render.settings import RenderSettings
 
@@ -28,13 +28,6 @@ PEER_FIELDS = {
         ),
     )
 }
-
-
-def _loadavg():
-    try:
-        return [round(x, 2) for x in os.getloadavg()]
-    except OSError:
-        return None
 
 
 def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False, rounds: int = 3) -> dict:
@@ -129,7 +122,7 @@ def peer_bench(size=(512, 512), frames: int = 30, progress: bool = False, rounds
         "skinlab_no_prepass_ms": med["no_prepass"],
         "ratio_no_prepass_over_pyrender": med["no_prepass"] / mt,
         "skinlab_passes_ms": {k: statistics.median(v) for k, v in per.items()},
-        "loadavg": _loadavg(),
+        "loadavg": load_average(),
         "skinlab_default_ms": med["default"],
         "ratio_default_over_pyrender": med["default"] / mt,
     }

@@ -34,6 +34,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from skinlab.bench.machine_load import load_average
 from skinlab.declare import Field
 
 KINDS = ("fresh", "cold", "warm")
@@ -105,7 +106,7 @@ def startup_bench(scene: str | None = None, size: tuple[int, int] = (64, 64), ro
     """``rounds`` rounds of (fresh, cold, warm) starts (see the module docstring)."""
     STARTUP_ROUNDS.check(rounds, "--rounds")
     runs: dict[str, list[dict]] = {k: [] for k in KINDS}
-    load_start = _loadavg()
+    load_start = load_average()
     with tempfile.TemporaryDirectory(prefix="skinlab-startup-") as tmp:
         for i in range(rounds):
             cache, mesa = Path(tmp) / f"cache{i}", Path(tmp) / f"mesa{i}"
@@ -117,7 +118,7 @@ def startup_bench(scene: str | None = None, size: tuple[int, int] = (64, 64), ro
                     shutil.rmtree(cache, ignore_errors=True)
                 runs[kind].append(_run_child(scene, size, env, str(Path(tmp) / "x.png")))
     out = {"scene": scene or "head", "size": list(size), "rounds": rounds, "cpu_count": os.cpu_count()}
-    out["loadavg_start"], out["loadavg_end"] = load_start, _loadavg()
+    out["loadavg_start"], out["loadavg_end"] = load_start, load_average()
     # with PYTHONDONTWRITEBYTECODE set no .pyc is kept: every start compiles Skinlab's sources again
     out["bytecode_cached"] = not os.environ.get("PYTHONDONTWRITEBYTECODE")
     for kind, rs in runs.items():
@@ -129,13 +130,6 @@ def startup_bench(scene: str | None = None, size: tuple[int, int] = (64, 64), ro
             "loaded": rs[-1]["loaded"],
         }
     return out
-
-
-def _loadavg() -> list[float] | None:
-    try:
-        return [round(x, 2) for x in os.getloadavg()]
-    except OSError:
-        return None
 
 
 def report(res: dict) -> str:

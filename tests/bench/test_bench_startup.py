@@ -31,3 +31,18 @@ def test_startup_bench_counts_what_each_start_builds_and_reads(capsys, monkeypat
 def test_startup_bench_refuses_a_bad_round_count(capsys):
     assert main(["bench", "startup", "--rounds", "0"]) == 2
     assert "--rounds" in capsys.readouterr().err
+
+
+def test_the_load_average_every_benchmark_reports(monkeypatch):
+    import os
+
+    from skinlab.bench.machine_load import load_average
+
+    got = load_average()
+    assert got is not None and len(got) == 3 and all(x >= 0 and round(x, 2) == x for x in got)
+
+    def no_load():
+        raise OSError("no load average here")
+
+    monkeypatch.setattr(os, "getloadavg", no_load)
+    assert load_average() is None
