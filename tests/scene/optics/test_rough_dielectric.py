@@ -71,3 +71,17 @@ def test_matches_mitsubas_roughdielectric():
             for got, want in ((np.mean(wr), r), (np.mean(wt), t)):
                 se = np.std(wr if want is r else wt) / np.sqrt(n)
                 assert abs(got - want) < 4 * se + 3e-3, (inside, mu, got, want, se)
+
+
+def test_rough_albedos_in_blocks_are_each_cosines_own_numbers():
+    """rough_albedos works through long lists of cosines a block at a time (memory, not maths): every
+    entry is what the cosine alone gives, shapes kept, an empty list empty."""
+    mu = np.linspace(0.0, 1.0, 131)  # two blocks and a part
+    r, t = rough_albedos(mu, 0.3, 1.3)
+    alone = np.array([rough_albedos(m, 0.3, 1.3) for m in mu[::13]])
+    np.testing.assert_array_equal(r[::13], alone[:, 0])
+    np.testing.assert_array_equal(t[::13], alone[:, 1])
+    r2, t2 = rough_albedos(mu.reshape(1, -1), 0.3, 1.3)
+    assert r2.shape == (1, 131) and np.array_equal(r2[0], r) and np.array_equal(t2[0], t)
+    empty = rough_albedos(np.zeros(0), 0.3, 1.3)
+    assert empty[0].shape == (0,) and empty[1].shape == (0,)
