@@ -2,7 +2,7 @@
 
 Material parameters (skinlab/scene/materials.py ``PRINCIPLED_PARAMS``), render and technique settings
 (dataclass fields declared with :func:`option`: skinlab/render/settings.py, skinlab/render/options.py),
-scene-file keys (skinlab/scene/scenefile.py ``SCENE_FILE_KEYS``) and the commands' own options
+scene-file keys (skinlab/scene/scene_keys.py ``SCENE_FILE_KEYS``) and the commands' own options
 (skinlab/commands/) are all Fields. What follows from one: its validation and error (one line naming
 it and what was expected), its command-line option (skinlab/commands/field_options.py), its viewer
 widget (skinlab/viewer/panel.py ``WIDGETS``), its uniform (material kinds) and its row in docs/scenes.md.
