@@ -89,14 +89,15 @@ def exact_profile(model, medium):
     return lambda r: get_profile(MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
 
 
-def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab") -> float:
+def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab", averaged: bool = False) -> float:
     """How far (mm, along +x) slab_scene's shadow edge moves for the light feeding the diffusion:
     the light travels along (1, 0, -1), so the diffusion is centred sin(theta_t) z0 further along +x
     than where the light entered (oblique entry, skinlab/scene/optics/oblique.py; the frame looks the shadow
     up at the entry point). Edge responses of the multiply scattered light are centred there. The
     light is sampled at the centres of a grid of grid_mm (irradiance texels, or pixels for the
     screen-space techniques) whose boundaries fall on x = 0: the sampled edge moves by the shift
-    rounded to whole cells."""
+    rounded to whole cells. averaged: the light is averaged over each cell instead (the texture-space
+    irradiance's texels, lib/shadow.glsl shadow_pcf_area): the edge moves by the shift itself."""
     from skinlab.scene.optics.material_medium import material_medium
     from skinlab.scene.optics.oblique import entry_offset
 
@@ -104,7 +105,7 @@ def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab") -> float:
     z0 = np.asarray(medium.mfp_arr)  # 1 / mu_t' (isotropic phase): the shaders' u_sss_mfp
     to_light = -scene.lights()[0].direction
     off = entry_offset(np.array([[0.0, 0.0, 1.0]]), to_light[None], z0, medium.eta, 1.0)[0]
-    return float(np.round(-off[0] / grid_mm) * grid_mm)
+    return float(-off[0]) if averaged else float(np.round(-off[0] / grid_mm) * grid_mm)
 
 
 def sky_slab(color, mfp=(1.0, 1.0, 1.0)) -> Scene:

@@ -37,6 +37,11 @@ MIN_LIGHT_DISTANCE_M = 1.0e-3
 SHADOW_BIAS_TEXELS = 1.0
 SHADOW_SLOPE_TEXELS = 3.0
 SHADOW_SLOPE_MAX = 5.0
+# A footprint's shadow (shadow.py shadow_pcf_area: a texture-space texel's) is averaged over it where
+# it spans more than SHADOW_AREA_MIN_TEXELS of the map's texels (the 3x3 PCF's width; below, the 3x3
+# PCF), with a tap per texel along each side, at most SHADOW_AREA_TAPS (wider: taps further apart).
+SHADOW_AREA_MIN_TEXELS = 3.0
+SHADOW_AREA_TAPS = 16
 
 GLSL_CONSTANTS: dict[str, float] = {
     "PI": PI,
@@ -49,6 +54,8 @@ GLSL_CONSTANTS: dict[str, float] = {
     "SHADOW_BIAS_TEXELS": SHADOW_BIAS_TEXELS,
     "SHADOW_SLOPE_TEXELS": SHADOW_SLOPE_TEXELS,
     "SHADOW_SLOPE_MAX": SHADOW_SLOPE_MAX,
+    "SHADOW_AREA_MIN_TEXELS": SHADOW_AREA_MIN_TEXELS,
+    "SHADOW_AREA_TAPS": float(SHADOW_AREA_TAPS),
     "MIN_LIGHT_DISTANCE_M": MIN_LIGHT_DISTANCE_M,
 }
 

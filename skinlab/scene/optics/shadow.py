@@ -12,7 +12,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from .constants import SHADOW_BIAS_TEXELS, SHADOW_SLOPE_MAX, SHADOW_SLOPE_TEXELS
+from .constants import (
+    SHADOW_AREA_MIN_TEXELS,
+    SHADOW_AREA_TAPS,
+    SHADOW_BIAS_TEXELS,
+    SHADOW_SLOPE_MAX,
+    SHADOW_SLOPE_TEXELS,
+)
 
 
 def _light_space(shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
@@ -61,6 +67,40 @@ def shadow_pcf(depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarr
             j = np.clip(np.floor(v * h).astype(np.int64), 0, h - 1)
             total += (ref <= depth_map[j, i]).astype(np.float64)
     return np.where(outside, 1.0, total / 9.0)
+
+
+def shadow_pcf_area(depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarray, NoL, du, dv) -> np.ndarray:
+    """The visibility averaged over each receiver's footprint, the parallelogram spanned by the world
+    vectors du and dv (N, 3) centred on world (N, 3) (a texture-space texel's; GLSL shadow_pcf_area):
+    shadow_pcf where the footprint spans at most SHADOW_AREA_MIN_TEXELS of the map's texels along both
+    sides, else ceil(e) taps along a side spanning e texels (at most SHADOW_AREA_TAPS), each a compare
+    at its own depth on the footprint's plane with shadow_pcf's bias at the centre."""
+    m, p = _light_space(shadow_matrix, world)
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    c = p[:, :3] / p[:, 3:4]
+    outside = (c < 0).any(1) | (c > 1).any(1)
+    h, w = depth_map.shape
+    _, pa = _light_space(m, world + np.atleast_2d(np.asarray(du, np.float64)))
+    _, pb = _light_space(m, world + np.atleast_2d(np.asarray(dv, np.float64)))
+    a = pa[:, :3] / pa[:, 3:4] - c
+    b = pb[:, :3] / pb[:, 3:4] - c
+    ea = np.hypot(a[:, 0] * w, a[:, 1] * h)
+    eb = np.hypot(b[:, 0] * w, b[:, 1] * h)
+    na = np.clip(np.ceil(ea), 1, SHADOW_AREA_TAPS).astype(np.int64)
+    nb = np.clip(np.ceil(eb), 1, SHADOW_AREA_TAPS).astype(np.int64)
+    bias = shadow_bias(NoL, m, world, (w, h))
+    total = np.zeros(len(c))
+    for j in range(SHADOW_AREA_TAPS):
+        for i in range(SHADOW_AREA_TAPS):
+            on = (i < na) & (j < nb)
+            s = (i + 0.5) / na - 0.5
+            t = (j + 0.5) / nb - 0.5
+            q = c + s[:, None] * a + t[:, None] * b
+            lit = q[:, 2] - bias <= _nearest(depth_map, q[:, 0], q[:, 1])
+            total += np.where(on, lit, 0.0)
+    area = total / (na * nb)
+    small = np.maximum(ea, eb) <= SHADOW_AREA_MIN_TEXELS
+    return np.where(outside, 1.0, np.where(small, shadow_pcf(depth_map, m, world, NoL), area))
 
 
 SOFT_SEARCH_TAPS = 8  # blocker search taps (lib/shadow_soft.glsl)

@@ -88,6 +88,28 @@ float light_visibility(int i, vec3 world, float NoL_geom) {
     return 1.0;
 }
 
+// light_visibility averaged over a receiver's footprint (world vectors du, dv: one texture-space
+// texel along u and v; lib/shadow.glsl shadow_pcf_area). A soft slot's filter (its penumbra, at least
+// the 3x3 PCF's width) as light_visibility's.
+float light_visibility_area(int i, vec3 world, float NoL_geom, vec3 du, vec3 dv) {
+#if SHADOW_SLOTS > 0
+    int slot = u_light_shadow[i];
+#ifdef SHADOW_SOFT0
+    if (slot == 0) return shadow_soft(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom);
+#else
+    if (slot == 0) return shadow_pcf_area(u_shadow0, u_shadow_matrix[0], world, NoL_geom, du, dv);
+#endif
+#if SHADOW_SLOTS > 1
+#ifdef SHADOW_SOFT1
+    if (slot == 1) return shadow_soft(u_shadow1, u_shadow_distance1, u_shadow_matrix[1], u_shadow_soft[1], u_shadow_eye[1], world, NoL_geom);
+#else
+    if (slot == 1) return shadow_pcf_area(u_shadow1, u_shadow_matrix[1], world, NoL_geom, du, dv);
+#endif
+#endif
+#endif
+    return 1.0;
+}
+
 // The direction (ls) and GGX alpha of light i's specular at world toward v (n the shading normal):
 // an area light's representative point (lib/area_lights.glsl), widened alpha and its energy factor;
 // for the other kinds l, a and 1.

@@ -2,6 +2,8 @@
 // the map's texel at the receiver (skinlab/scene/optics/constants.py SHADOW_BIAS_TEXELS, ...): a
 // constant in normalised depth was far too large at close range and grazing light (light through
 // the nose's shadow on the cheek) and too small on a scene many times larger.
+// shadow_pcf_area: the same lookup averaged over a receiver's footprint wider than the 3x3 PCF (a
+// texture-space texel's: techniques/tsd/irradiance.frag).
 // NumPy twin: skinlab/scene/optics/shadow.py (exact for NEAREST compare filtering).
 #include "skinlab/constants.glsl"
 
@@ -44,4 +46,43 @@ float shadow_pcf(sampler2DShadow map, mat4 shadow_matrix, vec3 world, float NoL)
             sum += texture(map, vec3(c.xy + vec2(x, y) * texel, c.z - bias));
     return sum / 9.0;
 #endif
+}
+
+// The visibility averaged over a receiver's footprint: the parallelogram spanned by the world vectors
+// du and dv centred on world (a texture-space texel's, one texel along u and along v). A texel's
+// irradiance is then its square's mean, as the gather's bilinear reading of it needs for the light in
+// the texture to be the light on the surface; one point's visibility (the 3x3 PCF, a few shadow-map
+// texels wide) aliases a shadow's edge to the texel grid, which a straight edge along the grid
+// (a slit of light along u or v) turns into up to half a texel of light too much or too little per
+// edge (docs/ground-truth.md "Close-ups": +8 % on marble's 2 mm slit at 0.8 mm per texel). The
+// footprint projected into the map spans e_a x e_b texels; where both are at most 3 (the 3x3 PCF's
+// width), shadow_pcf as it is; else ceil(e) taps along each side (at most SHADOW_AREA_TAPS), their
+// depths on the footprint's plane (exact on a flat receiver), the bias as shadow_pcf's.
+const int AREA_TAPS = int(SHADOW_AREA_TAPS);
+float shadow_pcf_area(sampler2DShadow map, mat4 m, vec3 world, float NoL, vec3 du, vec3 dv) {
+    vec4 p = m * vec4(world, 1.0);
+    vec3 c = p.xyz / p.w;
+    if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0)))) return 1.0;
+    vec2 size = vec2(textureSize(map, 0));
+    vec4 pa = m * vec4(world + du, 1.0);
+    vec4 pb = m * vec4(world + dv, 1.0);
+    vec3 a = pa.xyz / pa.w - c;
+    vec3 b = pb.xyz / pb.w - c;
+    float ea = length(a.xy * size);
+    float eb = length(b.xy * size);
+    if (max(ea, eb) <= SHADOW_AREA_MIN_TEXELS) return shadow_pcf(map, m, world, NoL);
+    int na = clamp(int(ceil(ea)), 1, AREA_TAPS);
+    int nb = clamp(int(ceil(eb)), 1, AREA_TAPS);
+    float bias = shadow_bias(m, p, size, NoL);
+    float sum = 0.0;
+    for (int j = 0; j < AREA_TAPS; ++j) {
+        if (j >= nb) break;
+        vec3 row = c + ((float(j) + 0.5) / float(nb) - 0.5) * b;
+        for (int i = 0; i < AREA_TAPS; ++i) {
+            if (i >= na) break;
+            vec3 q = row + ((float(i) + 0.5) / float(na) - 0.5) * a;
+            sum += texture(map, vec3(q.xy, q.z - bias));
+        }
+    }
+    return sum / float(na * nb);
 }

@@ -31,10 +31,15 @@ def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer
     t = frame_nodes(renderer.last_frame)[scene.find("slab").uid]
     medium = material_medium(t.material.values)
     row, lit = edge_row(res, n)
+    texel_mm = 2 * scene.mm_per_unit / n
     x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
-        scene, 2 * scene.mm_per_unit / n
+        scene, texel_mm, averaged=True
     )  # where the light entered
-    edge = edge_response(-x_mm, exact_profile(model, medium), "profile")
+    # the edge response averaged over an irradiance texel: each texel holds the light over its square
+    # (lib/shadow.glsl shadow_pcf_area)
+    within = (np.arange(16) + 0.5) / 16 - 0.5
+    profile = exact_profile(model, medium)
+    edge = np.mean([edge_response(-(x_mm + w * texel_mm), profile, "profile") for w in within], axis=0)
     err = np.abs(row / lit - edge)
     assert err.max() < 0.03, (err.max(axis=0), int(err.argmax()) // 3)
     # texture level against the NumPy brute-force convolution of the same irradiance

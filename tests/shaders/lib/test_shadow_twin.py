@@ -143,3 +143,105 @@ def test_no_light_through_a_close_occluder_at_grazing_light(degrees):
     assert np.all(shadow.shadow_pcf(dmap, m, lit, nol) == 1.0)
     old_bias = 0.0015 * (1.0 + 3.0 * math.tan(math.radians(min(degrees, 87.13)))) * depth_range  # world units
     assert old_bias > gap  # what let the light through
+
+
+@pytest.mark.parametrize("matrix", ["orthographic", "perspective"])
+def test_shadow_pcf_area_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
+    """The footprint's average (a texture-space texel's) against its twin: footprints from half a
+    texel (the 3x3 PCF) to 40 texels (more than SHADOW_AREA_TAPS taps a side), at any angle to the
+    map's axes, across the light (the depth constant over them, so that the compare margin of the
+    plain PCF's test holds for every tap)."""
+    rng = np.random.default_rng(11)
+    h, w = 32, 48
+    depth = rng.uniform(0.2, 0.9, (h, w)).astype(np.float32)
+    tex = ctx.depth_texture((w, h), data=depth.tobytes())
+    tex.compare_func = "<="
+    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    tex.repeat_x = tex.repeat_y = False
+    m = ORTHO if matrix == "orthographic" else PERSPECTIVE
+    n = 1500
+    uv = rng.uniform(0.1, 0.9, (n, 2))
+    z = rng.uniform(0.0, 1.0, n)
+    ndc = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, z * 2 - 1, np.ones(n)], 1)
+    world = ndc @ np.linalg.inv(m @ np.linalg.inv(CLIP_TO_TEXTURE)).T if matrix == "perspective" else ndc
+    world = world[:, :3] / world[:, 3:]
+    texel = shadow.shadow_texel_scale(m, world, (w, h))[0]  # world units per map texel there
+    ang = rng.uniform(0, np.pi, n)
+    la, lb = (texel * 10 ** rng.uniform(-0.3, 1.6, n) for _ in range(2))
+    du = np.stack([np.cos(ang), np.sin(ang), np.zeros(n)], 1) * la[:, None]
+    dv = np.stack([-np.sin(ang), np.cos(ang), np.zeros(n)], 1) * lb[:, None]
+    nol = rng.uniform(0.1, 1.0, n)
+    world, du, dv, nol = (a.astype(np.float32).astype(np.float64) for a in (world, du, dv, nol))
+    gpu = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_pcf_area(u_map, u_m, world, nol, du, dv)",
+        {"world": world, "nol": nol, "du": du, "dv": dv},
+        uniforms={"u_m": ("mat4", m)},
+        samplers={"u_map": ("sampler2DShadow", tex)},
+    )[:, 0]
+    ref = shadow.shadow_pcf_area(depth, m, world, nol, du, dv)
+    p = np.c_[world, np.ones(n)] @ m.T
+    zt = p[:, 2] / p[:, 3]
+    bias = shadow.shadow_bias(nol, m, world, (w, h))
+    margin = np.abs(depth.reshape(-1)[None, :] - (zt[:, None] - bias[:, None])).min(1) > 1e-5
+    assert margin.mean() > 0.9
+    # a tap on a texel border may pick either texel in fp32: a few footprints differ by a tap
+    diff = np.abs(gpu[margin] - ref[margin])
+    assert np.mean(diff < 1e-5) > 0.97 and diff.max() < 0.05, diff.max()
+    wide = np.maximum(la, lb) / texel > 4
+    assert wide.sum() > n // 3 and 0 < ref[wide].mean() < 1
+
+
+def test_shadow_pcf_area_is_the_lit_share_of_the_footprint():
+    """A map lit over u > 0.5 (its depth far behind the receivers') and shadowed over u < 0.5, and
+    footprints 12 texels wide across the edge at any offset: the visibility is the footprint's lit
+    share within a tap's (1/12); one point's 3x3 PCF is 0 or 1 beyond 1.5 texels from the edge."""
+    size = 256
+    m = ORTHO.copy()
+    m[2, 2] = -0.5  # the light travels -z
+    dmap = np.ones((size, size))
+    dmap[:, : size // 2] = 0.1  # an occluder near the light over u < 0.5
+    texel = 2.0 / size  # world units
+    offsets = np.linspace(-8, 8, 97)  # the footprint's centre from the edge, texels
+    world = np.stack([offsets * texel, np.zeros_like(offsets), np.zeros_like(offsets)], 1)
+    du = np.tile([12 * texel, 0.0, 0.0], (len(offsets), 1))
+    dv = np.tile([0.0, 2 * texel, 0.0], (len(offsets), 1))
+    nol = np.ones(len(offsets))
+    got = shadow.shadow_pcf_area(dmap, m, world, nol, du, dv)
+    share = np.clip(offsets / 12 + 0.5, 0, 1)
+    np.testing.assert_allclose(got, share, atol=1 / 12 + 1e-9)
+    assert np.abs(got - share).mean() < 0.03
+    point = shadow.shadow_pcf(dmap, m, world, nol)
+    assert set(point[np.abs(offsets) > 1.5]) <= {0.0, 1.0}
+
+
+@pytest.mark.parametrize("degrees", [0.0, 45.0, 70.0])
+def test_a_lit_plane_stays_lit_under_a_wide_footprint(ctx, glsl, degrees):
+    """A plane tilted to the light with its own depth map, footprints 20 texels across on it: every
+    tap's depth on the footprint's plane, so all stay lit (at the centre's depth, the taps up the
+    slope would fall behind the surface: acne), GPU and twin."""
+    size, slope = 256, math.tan(math.radians(degrees))
+    m = ORTHO.copy()
+    m[2, 2] = -0.5
+    dmap = _tilted_plane_map(size, slope)
+    rng = np.random.default_rng(3)
+    n = 400
+    x, y = rng.uniform(-0.7, 0.7, n), rng.uniform(-0.7, 0.7, n)
+    world = np.stack([x, y, slope * x], 1)
+    step = 20 * 2.0 / size
+    du = np.tile([step, 0.0, slope * step], (n, 1))
+    dv = np.tile([0.0, step, 0.0], (n, 1))
+    nol = np.full(n, math.cos(math.radians(degrees)))
+    assert np.all(shadow.shadow_pcf_area(dmap, m, world, nol, du, dv) == 1.0)
+    tex = ctx.depth_texture((size, size), data=dmap.astype(np.float32).tobytes())
+    tex.compare_func = "<="
+    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    tex.repeat_x = tex.repeat_y = False
+    gpu = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_pcf_area(u_map, u_m, world, nol, du, dv)",
+        {"world": world, "nol": nol, "du": du, "dv": dv},
+        uniforms={"u_m": ("mat4", m)},
+        samplers={"u_map": ("sampler2DShadow", tex)},
+    )[:, 0]
+    assert np.all(gpu == 1.0)

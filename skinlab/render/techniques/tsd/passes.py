@@ -438,6 +438,7 @@ class TsdIrradiancePass(TsdPass):
         for k, tex in enumerate(surface):
             units.bind(prog, f"u_surface{k}", tex)
         bind_shadow_maps(self.r, frame, prog, units)
+        units.bind(prog, "u_tsd_stretch", t.stretch)  # the texel's footprint for the shadow's average
         set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
         set_uniforms(prog, {**node_uniforms(node), "u_ambient": frame.scene.environment.ambient, "u_tsd_mix": prm.mix})
         self.r.resources.bind_material(prog, mat, units, isotropic=square_footprint(mat))

@@ -34,6 +34,22 @@ in vec4 v_color;  // the vertex colour (1 where the mesh has none)
 #endif
 
 uniform float u_tsd_mix;
+uniform sampler2D u_tsd_stretch;  // mm per texel along u (r) and v (g) / the radius scale (techniques/tsd/stretch.frag)
+vec3 v_du;  // the texel's footprint on the surface: world vectors of one texel along u and v
+vec3 v_dv;
+
+// The texel's footprint from the stretch map (the surface's mm per texel, dilated past the charts)
+// along the tangent frame (u along the tangent, v along the bitangent: the UV layout's axes where it
+// is not sheared); the same in both variants (the deferred one has no derivatives across the charts).
+void texel_footprint(vec3 ng, vec4 t) {
+    vec2 mm = texelFetch(u_tsd_stretch, ivec2(gl_FragCoord.xy), 0).rg * max(sss_radius_scale_at(v_uv), 1e-3);
+    vec3 tt = t.xyz - ng * dot(ng, t.xyz);
+    float lt = length(tt);
+    tt = lt > 1e-6 ? tt / lt : normalize(cross(ng, abs(ng.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    vec3 b = cross(ng, tt) * (t.w < 0.0 ? -1.0 : 1.0);
+    v_du = tt * (mm.x / u_mm_per_unit);
+    v_dv = b * (mm.y / u_mm_per_unit);
+}
 uniform int u_slot_light[2];              // the light each shadow slot holds (lib/lights.glsl slots)
 #ifdef TSD_TRANSLUCENCY
 #include "lib/sss_translucency.glsl"
@@ -65,7 +81,9 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
         // the shadow where this texel's diffusion entered: oblique entry (lib/sss_oblique.glsl)
         vec3 z0 = u_sss_mfp * sss_radius_scale_at(v_uv);  // the radius map scales the mean free path
         vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
-        sum += e * (light_visibility(i, entry, dot(ng, l)) * NoL) * sss_entry(NoL);
+        // averaged over the texel's footprint (lib/shadow.glsl shadow_pcf_area): the texel holds its
+        // square's mean, not its centre's, so a shadow edge along the layout's grid does not alias
+        sum += e * (light_visibility_area(i, entry, dot(ng, l), v_du, v_dv) * NoL) * sss_entry(NoL);
     }
 #ifdef TSD_TRANSLUCENCY
     float back = -dot(ng, l);
@@ -91,6 +109,7 @@ void main() {
     MaterialSample m = material_sample(v_uv, v_color);  // the material's maps, as the forward pass reads them
     vec3 ng = normalize(v_normal);
     vec3 n = ng;
+    texel_footprint(ng, v_tangent);
 #ifdef HAS_NORMAL_MAP
     n = perturb_normal(ng, v_tangent, texture(u_normal_map, m.uv).rgb, u_normal_scale);
 #endif
