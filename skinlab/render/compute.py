@@ -105,9 +105,9 @@ def bind_images(cs: moderngl.ComputeShader, images: dict) -> None:
         set_uniform(cs, name, unit)
 
 
-def pass_program(programs: ProgramCache, shader: str, compute: bool) -> Shader:
+def pass_program(programs: ProgramCache, shader: str, compute: bool, defines: dict | None = None) -> Shader:
     """The two paths of a pass that has both: `shader` (a path under the shader root, no ending) as
     the compute shader ``<shader>.comp`` or as the fullscreen fragment pass ``<shader>.frag``."""
     if compute:
-        return programs.compute(f"{shader}.comp")
-    return programs.get("passes/fullscreen.vert", f"{shader}.frag")
+        return programs.compute(f"{shader}.comp", defines or {})
+    return programs.get("passes/fullscreen.vert", f"{shader}.frag", defines or {})

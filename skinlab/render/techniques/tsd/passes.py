@@ -584,7 +584,7 @@ class TsdBlurPass(TsdPass):
         # u then v; with seams the v step goes to the scratch texture and the seam fill from there
         # into the level (its gutter across the seams, for the next blur and the gather)
         steps = ((src, dst), (dst, t.scratch)) if seams else ((src, t.scratch), (t.scratch, dst))
-        prog = pass_program(self.r.programs, "techniques/tsd/blur", prm.compute)
+        prog = pass_program(self.r.programs, "techniques/tsd/blur", prm.compute, {"TSD_TAPS": step.taps})
         taps_t, taps_w = blur_taps(step.taps)
         set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
         set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)

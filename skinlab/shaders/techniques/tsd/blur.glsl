@@ -21,8 +21,12 @@ vec4 tsd_blur_at(ivec2 p) {
     float mm = max(texelFetch(u_stretch, p, 0)[u_axis], TSD_MIN_MM_PER_TEXEL);
     float step_texels = min(u_sigma_mm / mm, TSD_MAX_STEP_TEXELS);
     vec4 sum = vec4(0.0);
+#ifdef TSD_TAPS
+    for (int i = 0; i < TSD_TAPS; ++i) {  // a constant count: the loop unrolls
+#else
     for (int i = 0; i < MAX_TAPS; ++i) {
         if (i >= u_taps) break;
+#endif
         float x = u_tap_t[i] * step_texels;
         float fl = floor(x);
         float f = x - fl;
