@@ -7,9 +7,12 @@ targets (vertex i of the frame's meshes at texel (i % 1024, i / 1024)):
 
 1. radiant exitance per vertex (skinlab/shaders/passes/bounce_exitance.{vert,frag}: one point per vertex):
    sender albedo x (the lights with their shadow maps + the sky + the previous order's bounce);
-2. gather (skinlab/shaders/passes/bounce_gather.frag): each vertex's irradiance from what its rays met, with
-   the ray records of skinlab/scene/interreflection.py (computed once per geometry on the CPU, cached);
-3. the one-ring average of those estimates (skinlab/shaders/passes/bounce_smooth.frag).
+2. gather: each vertex's irradiance from what its rays met, with the ray records of
+   skinlab/scene/interreflection.py (computed once per geometry on the CPU, cached) collapsed into each
+   vertex's distinct senders and their summed weights (``BounceTransfer.sender_*``: on the head about a
+   tenth of the 3 x 64 corner fetches a vertex had, the rays that met nothing left out);
+3. the one-ring average of those estimates.
+Both are sparse row sums over the vertex-space target (skinlab/shaders/passes/bounce_rows.frag).
 
 The last order's target holds all orders' light (each order's senders carry the previous ones). The
 passes that shade ambient light read it per vertex (lib/bounce_vertex.glsl in forward.vert and
@@ -171,7 +174,7 @@ class BouncePass(RenderPass):
         self.targets: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer]] = {}  # order -> irradiance
         self.exitance: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
         self.gathered: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None  # before the one-ring average
-        # (transfer key, ray vertices, ray weights, ring index, ring entries)
+        # (transfer key, sender index, sender entries, ring index, ring entries)
         self.records: tuple | None = None
         self._point_vaos: dict[tuple, moderngl.VertexArray] = {}
         self._footprints: dict[tuple[int, int], float] = {}  # (mesh uid, version) -> uv_footprint
@@ -207,14 +210,14 @@ class BouncePass(RenderPass):
         """The transfer's ray records and one-rings on the GPU (uploaded once per transfer)."""
         if self.records is None or self.records[0] != transfer.key:
             self._release_records()
-            ring = np.stack([transfer.ring_offsets[:-1], np.diff(transfer.ring_offsets)], 1)
-            self.records = (
-                transfer.key,
-                self._upload(transfer.vertices, RECORD_TEXTURE_WIDTH),
-                self._upload(transfer.weights, RECORD_TEXTURE_WIDTH),
-                self._upload(ring, VERTEX_TEXTURE_WIDTH),
-                self._upload(np.stack([transfer.ring_vertices, transfer.ring_weights], 1), RECORD_TEXTURE_WIDTH),
-            )
+            rows = []
+            for offsets, vertices, weights in (
+                (transfer.sender_offsets, transfer.sender_vertices, transfer.sender_weights),
+                (transfer.ring_offsets, transfer.ring_vertices, transfer.ring_weights),
+            ):
+                rows.append(self._upload(np.stack([offsets[:-1], np.diff(offsets)], 1), VERTEX_TEXTURE_WIDTH))
+                rows.append(self._upload(np.stack([vertices, weights], 1), RECORD_TEXTURE_WIDTH))
+            self.records = (transfer.key, *rows)
         return self.records[1:]
 
     def _points(self, node, prog) -> moderngl.VertexArray:
@@ -291,24 +294,21 @@ class BouncePass(RenderPass):
                 },
             )
             self._points(node, prog).render(moderngl.POINTS)
-        verts, weights, ring_index, ring_entries = self._records(tr)
+        sender_index, sender_entries, ring_index, ring_entries = self._records(tr)
         gathered = self._target(p.resolution, "gathered")
-        textures = {"u_exitance": exitance, "u_ray_vertices": verts, "u_ray_weights": weights}
-        self._fullscreen(gathered[1], "bounce_gather", textures, {"u_rays": tr.rays, "u_vertices": tr.total_vertices})
-        textures = {"u_gathered": gathered[0], "u_ring_index": ring_index, "u_ring_entries": ring_entries}
-        self._fullscreen(
-            self._target(p.resolution, prm.order)[1], "bounce_smooth", textures, {"u_vertices": tr.total_vertices}
-        )
+        self._rows(gathered[1], exitance, sender_index, sender_entries, tr.total_vertices)  # the gather
+        self._rows(self._target(p.resolution, prm.order)[1], gathered[0], ring_index, ring_entries, tr.total_vertices)
         self.publish(frame, p)
 
-    def _fullscreen(self, fbo, shader: str, textures: dict, uniforms: dict) -> None:
-        """One fullscreen draw of skinlab/shaders/passes/<shader>.frag into `fbo` (vertex-space targets)."""
+    def _rows(self, fbo, source, index, entries, vertices: int) -> None:
+        """One sparse row sum (skinlab/shaders/passes/bounce_rows.frag) of the per-vertex `source` into
+        `fbo` (a vertex-space target): the gather or the one-ring average."""
         fbo.use()
-        prog = self.r.programs.get("passes/fullscreen.vert", f"passes/{shader}.frag")
+        prog = self.r.programs.get("passes/fullscreen.vert", "passes/bounce_rows.frag")
         units = TextureUnits(self.r.ctx)
-        for sampler, tex in textures.items():
+        for sampler, tex in (("u_source", source), ("u_row_index", index), ("u_row_entries", entries)):
             units.bind(prog, sampler, tex)
-        set_uniforms(prog, uniforms)
+        set_uniforms(prog, {"u_vertices": vertices})
         self.r.fullscreen(prog)
 
 

@@ -21,9 +21,10 @@ one-ring (area-weighted, on the welded mesh): bounce light varies slowly, and th
 independent estimates has about a third of the variance of one (a bias of about an edge length).
 
 Sources: docs/references.md#interreflection. The GPU twin is skinlab/render/bounce.py with
-skinlab/shaders/passes/bounce_exitance.{vert,frag} (M per vertex), bounce_gather.frag (the sum above) and
-bounce_smooth.frag (the one-ring average); the records are computed here once per geometry and cached
-(ray casting with trimesh through Embree, the ``embreex`` package).
+skinlab/shaders/passes/bounce_exitance.{vert,frag} (M per vertex) and bounce_rows.frag (the sum above, from
+the records collapsed per receiver into its distinct senders and their summed weights, and the one-ring
+average); the records are computed here once per geometry and cached (ray casting with trimesh through
+Embree, the ``embreex`` package).
 """
 
 from __future__ import annotations
@@ -75,6 +76,13 @@ class BounceTransfer:
     # rays that met any surface, front or back: the irradiance a vertex loses of a radiance L(w) is
     # sum_lm L_lm sky_blocked[i, lm] (one-ring averaged like the bounce light)
     sky_blocked: np.ndarray = field(default_factory=lambda: np.zeros((0, 9), np.float32))
+    # the records collapsed per receiver (CSR, like the one-ring): vertex i gathers
+    # sum_j sender_weights[j] M[sender_vertices[j]] over j in sender_offsets[i] .. sender_offsets[i + 1],
+    # each sender once with the summed weights of every ray and corner that met it (no empty rays):
+    # gather's sum in fewer terms (the GPU's, skinlab/shaders/passes/bounce_rows.frag)
+    sender_offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))  # (V + 1,)
+    sender_vertices: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    sender_weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
 
     @property
     def total_vertices(self) -> int:
@@ -137,7 +145,7 @@ def geometry_key(nodes: list[MeshNode], rays: int, seed: int) -> str:
     return h.hexdigest()
 
 
-_CACHE = Memo(8)  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights, sky
+_CACHE = Memo(8)  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights, sky, sender rows
 
 
 def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> BounceTransfer:
@@ -158,7 +166,7 @@ def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> Boun
             "interreflection", key, lambda: _cast(nodes, rays, seed, total), "interreflection rays", code=__name__
         ),
     )
-    vertices, weights, fractions, r_off, r_vert, r_w, sky = hit
+    vertices, weights, fractions, r_off, r_vert, r_w, sky, s_off, s_vert, s_w = hit
     return BounceTransfer(
         rays,
         offsets,
@@ -171,6 +179,9 @@ def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> Boun
         r_vert,
         r_w,
         sky,
+        s_off,
+        s_vert,
+        s_w,
     )
 
 
@@ -225,7 +236,8 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
     if total == 0:
         z = np.zeros(0, np.int64)
         sky = np.zeros((0, 9), np.float32)
-        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), [], np.zeros(1, np.int64), z, z, sky
+        one, w0 = np.zeros(1, np.int64), np.zeros(0, np.float32)
+        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), [], one, z, w0, sky, one, z, w0
 
     pos, nrm, faces = [], [], []
     start = 0
@@ -276,7 +288,26 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
         fractions.append(float(hit_rays[start : start + k].mean()))
         start += k
     rings = one_rings(p_all, f_all, first, inverse)
-    return vertices, weights, fractions, *rings, sky_blocked(dirs, blocked, rays, inverse, no_normal, rings)
+    sky = sky_blocked(dirs, blocked, rays, inverse, no_normal, rings)
+    return vertices, weights, fractions, *rings, sky, *sender_rows(vertices, weights, rays)
+
+
+def sender_rows(vertices: np.ndarray, weights: np.ndarray, rays: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ray records (BounceTransfer.vertices / weights, `rays` rows per receiver) collapsed per
+    receiver: CSR (offsets, senders, weights), each receiver's distinct senders in increasing order
+    with the summed weights (float64 sums, stored as float32) of every ray corner that met them;
+    corners of zero weight (rays that met nothing) left out."""
+    n = len(vertices) // max(rays, 1)
+    receiver = np.repeat(np.arange(n, dtype=np.int64), rays * 3)
+    sender = vertices.reshape(-1).astype(np.int64)
+    w = weights.reshape(-1).astype(np.float64)
+    live = w > 0.0
+    key = receiver[live] * max(n, 1) + sender[live]
+    uniq, inverse = np.unique(key, return_inverse=True)
+    summed = np.bincount(inverse, w[live], minlength=len(uniq))
+    owner = uniq // max(n, 1)
+    offsets = np.concatenate([[0], np.cumsum(np.bincount(owner, minlength=n))]).astype(np.int64)
+    return offsets, uniq % max(n, 1), summed.astype(np.float32)
 
 
 def sky_blocked(dirs, blocked, rays: int, inverse, no_normal, rings) -> np.ndarray:

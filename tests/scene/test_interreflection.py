@@ -235,3 +235,23 @@ def test_one_rings_match_a_vertex_by_vertex_construction():
     np.testing.assert_array_equal(
         ring_vertices[offsets[2] : offsets[3]], ring_vertices[offsets[10] : offsets[11]]
     )  # copies share the ring
+
+
+def test_sender_rows_sum_to_the_gather_with_fewer_terms():
+    """The records collapsed per receiver (what the GPU sums) give gather's irradiance, each sender
+    once per receiver and no empty ray; a ray that met nothing adds no entry."""
+    tr = build_transfer(open_book(), rays=32)
+    offsets, senders, weights = tr.sender_offsets, tr.sender_vertices, tr.sender_weights
+    assert offsets.shape == (tr.total_vertices + 1,) and offsets[-1] == len(senders) == len(weights)
+    assert 0 < len(senders) < np.count_nonzero(tr.weights)  # collapsed: fewer entries than live corners
+    assert (weights > 0).all()
+    for i in range(tr.total_vertices):  # distinct, increasing senders per receiver
+        assert np.all(np.diff(senders[offsets[i] : offsets[i + 1]]) > 0)
+    m = np.random.default_rng(3).uniform(0.0, 2.0, (tr.total_vertices, 3))
+    owner = np.repeat(np.arange(tr.total_vertices), np.diff(offsets))
+    rows = np.zeros_like(m)
+    np.add.at(rows, owner, weights.astype(np.float64)[:, None] * m[senders])
+    np.testing.assert_allclose(rows, gather(tr, m), rtol=1e-6, atol=1e-9)
+    # a convex mesh: every ray leaves the scene, every row is empty
+    convex = build_transfer([MeshNode("box", box_mesh((1.0, 2.0, 3.0)), Material())], rays=16)
+    assert len(convex.sender_vertices) == 0 and np.all(convex.sender_offsets == 0)
