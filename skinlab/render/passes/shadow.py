@@ -15,6 +15,7 @@ from skinlab.render.alpha import bind_mask, blended, mask_defines
 from skinlab.render.frame_plan import ShadowParams
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SOFT_KEY, soft_shadow
+from skinlab.render.shadow_facing import AWAY, TOWARD, layer_triangles
 from skinlab.render.technique import RenderPass
 from skinlab.render.texture_units import TextureUnits
 from skinlab.scene import transform as tf
@@ -90,6 +91,22 @@ def soft_parameters(light: LightNode, m: np.ndarray, lo: np.ndarray, hi: np.ndar
     return np.array([size, float(local), k, diameter])
 
 
+class LayerSubset:
+    """The triangles of one node a distance-map layer draws: `partial` False when it draws them all
+    (the mesh's own vertex array), else `vao` over their index buffer (None: no triangle at all);
+    `key` what they were chosen from."""
+
+    def __init__(self, key: tuple, partial: bool):
+        self.key, self.partial = key, partial
+        self.ibo: moderngl.Buffer | None = None
+        self.vao: moderngl.VertexArray | None = None
+
+    def release(self) -> None:
+        for x in (self.vao, self.ibo):
+            if x is not None:
+                x.release()
+
+
 class ShadowPass(RenderPass):
     def __init__(self, renderer):
         super().__init__(renderer)
@@ -98,6 +115,9 @@ class ShadowPass(RenderPass):
         # with distance maps: per slot (exit texture, its framebuffer, the distance texture's second
         # layer's framebuffer, their depth buffer)
         self.layers: dict[int, tuple] = {}
+        # (node uid, facing) -> the triangles a layer draws (skinlab/render/shadow_facing.py), kept
+        # while the light and the node hold still
+        self._layer_draws: dict[tuple, LayerSubset] = {}
 
     def target(self, slot: int, size: int, distance: bool = False):
         """(depth texture, framebuffer, distance texture or None) for a slot. With `distance`, the
@@ -148,6 +168,9 @@ class ShadowPass(RenderPass):
         self.maps.clear()
         for slot in list(self.layers):
             self._release_layers(slot)
+        for subset in self._layer_draws.values():
+            subset.release()
+        self._layer_draws.clear()
 
     def outputs(self, frame, p) -> tuple:
         """The textures holding the pass's result (reuse across frames, skinlab/render/reuse.py)."""
@@ -193,9 +216,13 @@ class ShadowPass(RenderPass):
                 self._draw_layers(frame, slot, light, vp)
         self.publish(frame, p)
 
-    def _draw(self, frame, defines: dict, uniforms: dict, vp, textures: dict | None = None) -> None:
+    def _draw(
+        self, frame, defines: dict, uniforms: dict, vp, textures: dict | None = None, facing: str | None = None
+    ) -> None:
         """Every mesh that casts a shadow, each with its program (a masked material's cut-away pixels
-        cast no shadow, skinlab/render/alpha.py; a see-through surface, alpha_mode "blend", none)."""
+        cast no shadow, skinlab/render/alpha.py; a see-through surface, alpha_mode "blend", none).
+        `facing` (a layer, under a directional light): only the triangles it can use
+        (skinlab/render/shadow_facing.py; the same texels)."""
         for node in frame.scene.mesh_nodes():
             if blended(node.material):
                 continue
@@ -207,7 +234,33 @@ class ShadowPass(RenderPass):
             for sampler, tex in (textures or {}).items():
                 units.bind(prog, sampler, tex)
             bind_mask(self.r.resources, prog, node.material, units)
+            if facing is not None and uniforms["u_light_eye"][3] == 0.0:
+                subset = self._layer_subset(node, prog, facing, uniforms["u_light_eye"][:3])
+                if subset is not None:  # else every triangle: the mesh's own vertex array
+                    if subset.vao is not None:  # else none of them
+                        subset.vao.render(moderngl.TRIANGLES)
+                    continue
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+
+    def _layer_subset(self, node, prog, facing: str, travel: np.ndarray) -> LayerSubset | None:
+        """The triangles of `node` a layer facing `facing` can use, as a vertex array (None in it:
+        none of them); None when it needs them all."""
+        gm = self.r.resources.mesh(node.mesh)
+        key = (id(prog), id(gm.vbo), gm.active, node.mesh.version, node.world_matrix.tobytes(), travel.tobytes())
+        held = self._layer_draws.get((node.uid, facing))
+        if held is not None and held.key == key:
+            return held if held.partial else None
+        if held is not None:
+            held.release()
+        tris = layer_triangles(node, travel, facing)
+        subset = LayerSubset(key, tris is not None and len(tris) < node.mesh.indices.size)
+        if tris is not None and subset.partial and len(tris):
+            subset.ibo = self.r.ctx.buffer(np.ascontiguousarray(tris).tobytes())
+            subset.vao = self.r.ctx.vertex_array(
+                prog, gm.content(), index_buffer=subset.ibo, index_element_size=4, skip_errors=True
+            )
+        self._layer_draws[(node.uid, facing)] = subset
+        return subset if subset.partial else None
 
     def _draw_layers(self, frame, slot: int, light: LightNode, vp) -> None:
         """The distance maps' layers for light through thin parts (skinlab/shaders/passes/shadow.frag
@@ -219,12 +272,12 @@ class ShadowPass(RenderPass):
         exit_fbo.color_mask = (True, True, True, True)
         exit_fbo.clear(1e30, 0.0, 0.0, 0.0, depth=1.0)
         exit_fbo.use()
-        self._draw(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp)
+        self._draw(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp, facing=AWAY)
         second_fbo.color_mask = (False, True, False, False)  # clears and writes G only
         second_fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
         second_fbo.use()
         self._draw(
             frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 2}, {"u_light_eye": eye, "u_part_gap": part_gap(frame)},
-            vp, {"u_exit": exit_tex},
+            vp, {"u_exit": exit_tex}, facing=TOWARD,
         )  # fmt: skip
         second_fbo.color_mask = (True, True, True, True)
