@@ -5,8 +5,9 @@ vertex meets the front of a surface (a convex mesh alone has nothing to gather: 
 and the plan says so). Each order is one pass, ``bounce[N]``, in three draws on small vertex-space
 targets (vertex i of the frame's meshes at texel (i % 1024, i / 1024)):
 
-1. radiant exitance per vertex (skinlab/shaders/passes/bounce_exitance.{vert,frag}: one point per vertex):
-   sender albedo x (the lights with their shadow maps + the sky + the previous order's bounce);
+1. radiant exitance per vertex (skinlab/shaders/passes/bounce_exitance.frag, drawn fullscreen over the
+   target once per mesh, its vertices read from a texture of them): sender albedo x (the lights with
+   their shadow maps + the sky + the previous order's bounce);
 2. gather: each vertex's irradiance from what its rays met, with the ray records of
    skinlab/scene/interreflection.py (computed once per geometry on the CPU, cached) collapsed into each
    vertex's distinct senders and their summed weights (``BounceTransfer.sender_*``: on the head about a
@@ -176,7 +177,8 @@ class BouncePass(RenderPass):
         self.gathered: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None  # before the one-ring average
         # (transfer key, sender index, sender entries, ring index, ring entries)
         self.records: tuple | None = None
-        self._point_vaos: dict[tuple, moderngl.VertexArray] = {}
+        # (mesh uid, version) -> (mesh, its vertices as a texture: bounce_exitance.frag u_vertex_data)
+        self._vertex_data: dict[tuple[int, int], tuple[object, moderngl.Texture]] = {}
         self._footprints: dict[tuple[int, int], float] = {}  # (mesh uid, version) -> uv_footprint
 
     # -- GPU objects ---------------------------------------------------------------------
@@ -220,14 +222,27 @@ class BouncePass(RenderPass):
             self.records = (transfer.key, *rows)
         return self.records[1:]
 
-    def _points(self, node, prog) -> moderngl.VertexArray:
-        """A mesh's vertices as points, without its index buffer (gl_VertexID = the vertex)."""
-        gm = self.r.resources.mesh(node.mesh)
-        key = (id(gm.vbo), id(prog), gm.active)
-        vao = self._point_vaos.get(key)
-        if vao is None or vao.program is not prog:
-            vao = self._point_vaos[key] = self.r.ctx.vertex_array(prog, gm.content(), skip_errors=True)
-        return vao
+    def _vertices(self, mesh) -> moderngl.Texture:
+        """The mesh's positions, normals and UVs as a texture, vertex j at texels (3 (j % 1024) + k, j / 1024),
+        k = 0, 1, 2 (uploaded once per mesh version)."""
+        key = (mesh.uid, mesh.version)
+        held = self._vertex_data.get(key)
+        if held is None:
+            n = len(mesh.positions)
+            rows = np.zeros((n, 3, 4), np.float32)
+            rows[:, 0, :3] = mesh.positions
+            rows[:, 1, :3] = mesh.normals
+            if mesh.uvs is not None:
+                rows[:, 2, :2] = mesh.uvs
+            height = max(1, math.ceil(n / VERTEX_TEXTURE_WIDTH))
+            padded = np.zeros((height * VERTEX_TEXTURE_WIDTH, 3, 4), np.float32)
+            padded[:n] = rows
+            tex = self.r.ctx.texture((3 * VERTEX_TEXTURE_WIDTH, height), 4, padded.tobytes(), dtype="f4")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            for old_key in [k for k in self._vertex_data if k[0] == mesh.uid]:
+                self._vertex_data.pop(old_key)[1].release()
+            held = self._vertex_data[key] = (mesh, tex)
+        return held[1]
 
     def _release_records(self) -> None:
         if self.records is not None:
@@ -242,9 +257,9 @@ class BouncePass(RenderPass):
         self.targets.clear()
         self.exitance = self.gathered = None
         self._release_records()
-        for vao in self._point_vaos.values():
-            vao.release()
-        self._point_vaos.clear()
+        for _, tex in self._vertex_data.values():
+            tex.release()
+        self._vertex_data.clear()
 
     # -- the pass ------------------------------------------------------------------------
     def outputs(self, frame, p) -> tuple:
@@ -267,11 +282,14 @@ class BouncePass(RenderPass):
         for node in prm.nodes:
             mat = node.material
             defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **environment_defines(frame, node)}
-            prog = self.r.programs.get("passes/bounce_exitance.vert", "passes/bounce_exitance.frag", defines)
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/bounce_exitance.frag", defines)
             units = TextureUnits(ctx)
             bind_shadow_maps(self.r, frame, prog, units)
             set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
-            self.r.resources.bind_material(prog, mat, units)
+            # the maps read trilinearly at the vertex's level: llvmpipe's anisotropic filter takes its
+            # ellipse from the derivatives even at an explicit level, and neighbouring texels here are
+            # unrelated vertices
+            self.r.resources.bind_material(prog, mat, units, isotropic=True)
             bind_environment(frame, node, prog, units)
             lod = 0.0
             maps = mat.textures()
@@ -282,18 +300,21 @@ class BouncePass(RenderPass):
                     self._footprints[key] = uv_footprint(node.mesh)
                 lod = max(0.0, math.log2(max(max(tex.size) * self._footprints[key], 1e-30)))
             units.bind(prog, "u_bounce_previous", previous[0] if previous is not None else self.r.dummy_texture())
+            units.bind(prog, "u_vertex_data", self._vertices(node.mesh))
             set_uniforms(
                 prog,
                 {
                     **node_uniforms(node),
                     "u_vertex_offset": tr.offsets[node.uid],
+                    "u_vertex_count": tr.counts[node.uid],
                     "u_target_size": np.asarray(p.resolution, np.int32).tobytes(),
                     "u_ambient": frame.scene.environment.ambient,
                     "u_albedo_lod": lod,
                     "u_has_previous": int(previous is not None),
                 },
             )
-            self._points(node, prog).render(moderngl.POINTS)
+            self.r.fullscreen(prog)
+            self.r.resources.unbind_samplers()
         sender_index, sender_entries, ring_index, ring_entries = self._records(tr)
         gathered = self._target(p.resolution, "gathered")
         self._rows(gathered[1], exitance, sender_index, sender_entries, tr.total_vertices)  # the gather

@@ -21,7 +21,7 @@ one-ring (area-weighted, on the welded mesh): bounce light varies slowly, and th
 independent estimates has about a third of the variance of one (a bias of about an edge length).
 
 Sources: docs/references.md#interreflection. The GPU twin is skinlab/render/bounce.py with
-skinlab/shaders/passes/bounce_exitance.{vert,frag} (M per vertex) and bounce_rows.frag (the sum above, from
+skinlab/shaders/passes/bounce_exitance.frag (M per vertex) and bounce_rows.frag (the sum above, from
 the records collapsed per receiver into its distinct senders and their summed weights, and the one-ring
 average); the records are computed here once per geometry and cached (ray casting with trimesh through
 Embree, the ``embreex`` package).

@@ -195,3 +195,35 @@ def test_a_mesh_too_large_for_the_ray_budget_casts_fewer_rays_then_none(monkeypa
     plan = plan_frame(s, settings())
     assert not any(n.startswith("bounce") for n in plan.names())
     assert any("interreflection skipped: 1250 vertices" in w for w in plan.warnings)
+
+
+def test_a_vertex_exitance_does_not_depend_on_its_neighbours_in_the_target(renderer):
+    """The head (colour maps) with its vertices in another order: each vertex leaves the same exitance.
+    Neighbouring texels of the vertex-space target are unrelated vertices, so their UVs' differences
+    must not reach the maps' filtering (llvmpipe's anisotropic filter takes them as derivatives even
+    at an explicit level: the maps are read trilinearly at the vertex's level)."""
+    from skinlab.scene.mesh import Mesh
+    from skinlab.scene.scenefile import load_scene
+
+    def exitance(scene) -> np.ndarray:
+        renderer.render(scene, RenderSettings(32, 32, shadow_size=256, bounces=1), readback=False)
+        n = len(scene.mesh_nodes()[0].mesh.positions)
+        return np.frombuffer(renderer.passes["bounce"].exitance[0].read(), np.float32).reshape(-1, 4)[:n, :3]
+
+    scene = load_scene("head")
+    node = scene.mesh_nodes()[0]
+    m = node.mesh
+    assert m.uvs is not None and node.material.textures()  # textured
+    before = exitance(scene).copy()
+    order = np.random.default_rng(7).permutation(len(m.positions))  # new vertex k is old vertex order[k]
+    where = np.argsort(order)
+    node.mesh = Mesh(
+        m.name,
+        m.positions[order],
+        where[m.indices].astype(np.uint32),
+        normals=m.normals[order],
+        uvs=m.uvs[order],
+    )
+    after = exitance(scene)
+    assert before.max() > 0.1
+    np.testing.assert_allclose(after, before[order], rtol=1e-5, atol=1e-6)

@@ -6,8 +6,10 @@
 // NumPy twin: skinlab/render/environment.py env_diffuse.
 #include "lib/environment.glsl"
 #ifdef SKY_OCCLUSION
-#ifdef DEFERRED_SURFACE
-vec4 v_sky03;  // read from a G-buffer by the pass (techniques/tsd/surface.glsl), not interpolated
+#if defined(DEFERRED_SURFACE) || defined(VERTEX_TEXELS)
+// read by the pass, not interpolated: from a G-buffer (techniques/tsd/surface.glsl) or per vertex
+// (passes/bounce_exitance.frag)
+vec4 v_sky03;
 vec4 v_sky47;
 float v_sky8;
 #else

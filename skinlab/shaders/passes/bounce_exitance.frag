@@ -3,6 +3,12 @@
 // radiant exitance of a mesh vertex, M = sender albedo x (the lights with their shadows + the sky
 // + the environment map, variant ENV_MAP + the previous order's bounce light). The colour map is read at the mip level whose texel spans
 // about one vertex's share of the UV area (a vertex stands for the surface around it).
+// Drawn fullscreen over the vertex-space target (vertex i of the frame's meshes at texel
+// (i % width, i / width)), once per mesh: a texel outside the mesh's vertices is left as it is; the
+// vertex's position, normal and UV are read from the mesh's vertex texture (u_vertex_data: vertex j
+// at texels (3 (j % 1024) + k, j / 1024), k = 0 position, 1 normal, 2 uv), so every texel of a block
+// is a vertex (one point per vertex left a software rasteriser shading a block for each).
+#define VERTEX_TEXELS 1
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/bounce.glsl"
@@ -12,11 +18,20 @@ uniform float u_albedo_lod;           // mip level of the colour map for one ver
 
 #ifdef ENV_MAP
 #include "lib/sky_occlusion.glsl"
+#ifdef SKY_OCCLUSION
+#include "lib/sky_blocked.glsl"
+#endif
 #endif
 
-in vec3 v_world;
-in vec3 v_normal;
-in vec2 v_uv;
+uniform sampler2D u_vertex_data;  // this mesh's vertices (above)
+uniform mat4 u_model;
+uniform mat3 u_normal_matrix;
+uniform int u_vertex_offset;      // this mesh's first vertex in the target
+uniform int u_vertex_count;       // its vertices
+uniform ivec2 u_target_size;      // the vertex-space target's
+vec3 v_world;
+vec3 v_normal;
+vec2 v_uv;
 
 uniform vec3 u_ambient;
 uniform sampler2D u_bounce_previous;  // the previous order's irradiance per vertex
@@ -25,6 +40,16 @@ uniform int u_has_previous;           // 0 for the first order
 out vec4 f_exitance;
 
 void main() {
+    ivec2 t = ivec2(gl_FragCoord.xy);
+    int j = t.y * u_target_size.x + t.x - u_vertex_offset;  // this mesh's vertex
+    if (j < 0 || j >= u_vertex_count) discard;
+    ivec2 d = ivec2(3 * (j % 1024), j / 1024);
+    v_world = (u_model * vec4(texelFetch(u_vertex_data, d, 0).xyz, 1.0)).xyz;
+    v_normal = u_normal_matrix * texelFetch(u_vertex_data, d + ivec2(1, 0), 0).xyz;
+    v_uv = texelFetch(u_vertex_data, d + ivec2(2, 0), 0).xy;
+#if defined(ENV_MAP) && defined(SKY_OCCLUSION)
+    sky_blocked_fetch(j, v_sky03, v_sky47, v_sky8);
+#endif
     if (dot(v_normal, v_normal) == 0.0) {  // a vertex without a normal (no triangle uses it) sends nothing
         f_exitance = vec4(0.0, 0.0, 0.0, 1.0);
         return;
@@ -48,6 +73,6 @@ void main() {
         float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, NoL) : 1.0;
         e += li * (vis * NoL);
     }
-    if (u_has_previous != 0) e += texelFetch(u_bounce_previous, ivec2(gl_FragCoord.xy), 0).rgb;
+    if (u_has_previous != 0) e += texelFetch(u_bounce_previous, t, 0).rgb;
     f_exitance = vec4(bounce_sender_albedo(base, u_metallic, u_specular) * e, 1.0);
 }
