@@ -201,6 +201,16 @@ def upload_levels(ctx: moderngl.Context, levels: list[np.ndarray]) -> moderngl.T
     return tex
 
 
+def upload_kernels(ctx: moderngl.Context, kernels: np.ndarray) -> moderngl.TextureArray:
+    """The kernel maps (layers, h, w, 3) as an RGB float texture array (bilinear in each layer, repeat
+    across u, clamped in v; lib/environment.glsl env_kernel)."""
+    layers, h, w, _ = kernels.shape
+    tex = ctx.texture_array((w, h, layers), 3, np.ascontiguousarray(kernels, np.float32).tobytes(), dtype="f4")
+    tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+    tex.repeat_x, tex.repeat_y = True, False
+    return tex
+
+
 def upload_table(ctx: moderngl.Context, table: np.ndarray) -> moderngl.Texture:
     """The split-sum table as an RG float texture (bilinear, clamped)."""
     tex = ctx.texture(
@@ -229,18 +239,23 @@ class EnvironmentPass(RenderPass):
         brdf = upload_table(ctx, brdf_table())
         assert prepared.irradiance is not None  # envmap.prepare makes it
         irr = upload_levels(ctx, [prepared.irradiance])
+        assert prepared.kernels is not None  # envmap.prepare makes them
+        kernels = upload_kernels(ctx, prepared.kernels)
         bg = None
         if prm.background:
             pixels, _ = envmap.load_pixels(prm.path)
             bg = ctx.texture((pixels.shape[1], pixels.shape[0]), 3, pixels.tobytes(), dtype="f4")
             bg.filter = (moderngl.LINEAR, moderngl.LINEAR)
             bg.repeat_x, bg.repeat_y = True, False
-        self.held = {"key": prepared.key, "radiance": tex, "brdf": brdf, "irradiance": irr, "background": bg}
+        self.held = {
+            "key": prepared.key, "radiance": tex, "brdf": brdf, "irradiance": irr, "kernels": kernels,
+            "background": bg,
+        }  # fmt: skip
         return self.held
 
     def release(self) -> None:
         if self.held is not None:
-            for name in ("radiance", "brdf", "irradiance", "background"):
+            for name in ("radiance", "brdf", "irradiance", "kernels", "background"):
                 if self.held[name] is not None:
                     self.held[name].release()
             self.held = None
@@ -248,7 +263,7 @@ class EnvironmentPass(RenderPass):
     def outputs(self, frame, p) -> tuple:
         held = self._textures(p.params)
         return tuple(
-            t for t in (held["radiance"], held["brdf"], held["irradiance"], held["background"]) if t is not None
+            held[k] for k in ("radiance", "brdf", "irradiance", "kernels", "background") if held[k] is not None
         )
 
     def publish(self, frame: Frame, p) -> None:
@@ -259,6 +274,7 @@ class EnvironmentPass(RenderPass):
             "radiance": held["radiance"],
             "brdf": held["brdf"],
             "irradiance": held["irradiance"],
+            "kernels": held["kernels"],
             "background": held["background"] if prm.background else None,
         }
 
@@ -338,6 +354,7 @@ def bind_environment(frame: Frame, node: MeshNode | None, prog, units: TextureUn
     units.bind(prog, "u_env_radiance", data["radiance"])
     units.bind(prog, "u_env_brdf", data["brdf"])
     units.bind(prog, "u_env_irradiance", data["irradiance"])
+    units.bind(prog, "u_env_kernels", data["kernels"])
     sky = frame.data.get(SKY_KEY)
     if sky is not None and node is not None and node.uid in sky["offsets"]:
         units.bind(prog, "u_sky_blocked", frame.targets["sky_blocked"])
@@ -346,16 +363,17 @@ def bind_environment(frame: Frame, node: MeshNode | None, prog, units: TextureUn
 
 @lru_cache(maxsize=256)
 def _band_tables(alpha: tuple, colour: tuple, eta: float, ggx_alpha: float) -> tuple[np.ndarray, np.ndarray]:
-    from skinlab.scene.optics.boundary import entry_band_tables, single_band_tables
+    from skinlab.scene.optics.boundary import entry_kernel_coefficients, single_band_tables
 
     a, c = np.array(alpha), np.array(colour)
-    return single_band_tables(a, c, eta), entry_band_tables(a, c, eta, ggx_alpha)
+    return single_band_tables(a, c, eta), entry_kernel_coefficients(a, c, eta, ggx_alpha)
 
 
 def bind_env_bands(prog, material) -> None:
-    """The SH-band tables of lib/env_single.glsl (single scattering) and lib/ambient_entering.glsl (the
-    light entering the multiple scattering) for a mesh shaded as scattering; zeros for the others."""
-    names = ("u_sss_single_band1", "u_sss_single_band2", "u_sss_entry_bands")
+    """The tables of lib/env_single.glsl (single scattering: the SH-band factors at eta > 1, alpha /
+    A_colour for the kernel maps at eta = 1) and lib/ambient_entering.glsl (the light entering the
+    multiple scattering: the kernel coefficients) for a mesh shaded as scattering; zeros for the others."""
+    names = ("u_sss_single_band1", "u_sss_single_band2", "u_sss_entry_kernel", "u_sss_env_single")
     if not any(n in prog or f"{n}[0]" in prog for n in names):
         return
     from skinlab.render.boundary import boundary_ggx_alpha
@@ -363,16 +381,18 @@ def bind_env_bands(prog, material) -> None:
     from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
 
     if material is None or not material.has_subsurface:
-        single, entry = np.zeros((3, ANGULAR_NODES, 3)), np.zeros((3, 3))
+        single, entry, ratio = np.zeros((3, ANGULAR_NODES, 3)), np.zeros((3, 3)), np.zeros(3)
     else:  # the same medium and colour as the boundary's tables (skinlab/render/boundary.py material_boundary)
         m = material_medium(material.values)
         alpha = tuple(round(float(x), 9) for x in np.clip(m.alpha_arr, 0.0, 1.0))
         colour = tuple(round(float(x), 9) for x in np.clip(np.ravel(subsurface_albedo(material.values)), 0.0, 1.0))
         ga = boundary_ggx_alpha(material)
         single, entry = _band_tables(alpha, colour, round(float(m.eta), 6), round(ga if ga >= SMOOTH_ALPHA else 0.0, 9))
+        ratio = np.where(np.array(colour) > 0, np.array(alpha) / np.maximum(colour, 1e-30), 0.0)
     set_array(prog, "u_sss_single_band1", single[1], ANGULAR_NODES)
     set_array(prog, "u_sss_single_band2", single[2], ANGULAR_NODES)
-    set_array(prog, "u_sss_entry_bands", entry, 3)
+    set_array(prog, "u_sss_entry_kernel", entry, 3)
+    set_uniform(prog, "u_sss_env_single", tuple(float(x) for x in ratio))
 
 
 def env_band_ratio(world_sh: np.ndarray, n, bands, uniform, limit: float = 4.0) -> np.ndarray:
@@ -387,6 +407,34 @@ def env_band_ratio(world_sh: np.ndarray, n, bands, uniform, limit: float = 4.0) 
     uniform = np.broadcast_to(np.asarray(uniform, np.float64), irr.shape)
     ok = irr > 1e-6 * np.maximum(s[0], 1e-20)
     return np.where(ok, np.clip(got / np.where(ok, irr, 1.0), 0.0, limit * uniform), uniform)
+
+
+def env_single(kernels: np.ndarray, n_map, mu, single) -> np.ndarray:
+    """NumPy twin of lib/env_single.glsl env_single at index 1, intensity 1: (..., 3) the single
+    scattering of the map toward a view at cosine mu, per unit base colour, from the kernel maps
+    (split_sum.kernel_maps) at map-frame normals n_map, linear in mu between the 17 view cosines,
+    times `single` (alpha / A_colour)."""
+    x = np.clip(np.asarray(mu, np.float64), 0.0, 1.0) * (split_sum.KERNEL_NODES - 1)
+    i = np.minimum(np.floor(x).astype(int), split_sum.KERNEL_NODES - 2)
+    f = (x - i)[..., None]
+    u, v = split_sum.equirect_uv(n_map)
+    out = np.zeros(np.shape(u) + (3,))
+    for j in np.unique(np.concatenate([np.ravel(i), np.ravel(i) + 1])):
+        w = np.where(i == j, 1.0, 0.0)[..., None] * (1 - f) + np.where(i + 1 == j, 1.0, 0.0)[..., None] * f
+        out += w * split_sum.bilinear(kernels[j], u, v)
+    return np.asarray(single, np.float64) * out
+
+
+def env_entering(kernels: np.ndarray, irradiance: np.ndarray, n_map, coefficients) -> np.ndarray:
+    """NumPy twin of lib/ambient_entering.glsl's map term at intensity 1, unoccluded: (..., 3) c_0 E(n)
+    + c_1 int L t^2 dw + c_2 int L t^3 dw per unit base colour (boundary.entry_kernel_coefficients),
+    clamped at 0, from the irradiance map and the kernel maps at map-frame normals n_map."""
+    c = np.asarray(coefficients, np.float64)
+    u, v = split_sum.equirect_uv(n_map)
+    e = c[0] * split_sum.bilinear(irradiance, u, v)
+    for k in range(1, len(c)):
+        e = e + c[k] * split_sum.bilinear(kernels[split_sum.KERNEL_NODES + k - 1], u, v)
+    return np.maximum(e, 0.0)
 
 
 def env_diffuse(world_sh: np.ndarray, n, blocked=None, irradiance=None) -> np.ndarray:

@@ -26,7 +26,10 @@ the file's content and the preparation's version, since it takes a second or two
    is prefiltered.
 2. *Diffuse*: the rest's irradiance for every normal, an exact cosine convolution on 64 x 32 texels
    (skinlab/scene/optics/split_sum.py ``irradiance_map``), and its radiance in 9 spherical-harmonic
-   coefficients (skinlab/scene/optics/sh.py) for what the scene hides of it.
+   coefficients (skinlab/scene/optics/sh.py) for what the scene hides of it; and the rest convolved
+   with the zonal kernels of the light a medium takes from it (``kernel_maps``: the single scattering
+   of an index-matched medium toward 17 view cosines, and the t^2, t^3 kernels of the light entering
+   its multiple scattering), 19 layers of 64 x 32.
 3. *Specular*: the rest prefiltered into ``LEVELS`` GGX levels and the split-sum table
    (skinlab/scene/optics/split_sum.py).
 
@@ -47,7 +50,7 @@ import numpy as np
 from .optics import sh, split_sum
 from .optics.constants import LUMA_B, LUMA_G, LUMA_R
 
-PREPARE_VERSION = 2  # bump when preparation changes what it makes (the disk cache's key)
+PREPARE_VERSION = 3  # bump when preparation changes what it makes (the disk cache's key)
 MIN_WIDTH, MIN_HEIGHT = 8, 4
 SOURCE_THRESHOLD = 20.0  # x the map's mean radiance: texels above it may form a source
 SOURCE_MIN_POWER = 0.02  # a source carries at least this share of the map's power (luminance)
@@ -95,6 +98,8 @@ class PreparedMap:
     negative_texels: int = 0  # set to 0 on loading
     seconds: float = 0.0  # time the preparation took (0 when it came from a cache)
     cached: str = ""  # "", "memory" or "disk"
+    # (split_sum.KERNEL_LAYERS, h, w, 3) the rest's kernel maps (split_sum.kernel_maps); None: not made
+    kernels: np.ndarray | None = None
 
     @property
     def power(self) -> float:
@@ -271,21 +276,26 @@ def _prepare_pixels(img: np.ndarray, key: str, name: str, negative: int) -> Prep
     h, w, _ = img.shape
     if not (img > 0).any():
         zero = np.zeros((1, 2, 3), np.float32)
-        return PreparedMap(key, name, w, h, np.zeros((9, 3)), [zero], [], zero, True, True, negative)
+        kernels = np.zeros((split_sum.KERNEL_LAYERS, 1, 2, 3), np.float32)
+        return PreparedMap(key, name, w, h, np.zeros((9, 3)), [zero], [], zero, True, True, negative, kernels=kernels)
     if (img == img[0, 0]).all():
         c = img[0, 0].astype(np.float64)
         coeffs = np.zeros((9, 3))
         coeffs[0] = c * 4.0 * math.pi * sh.SH_C0
         level = np.broadcast_to(img[0, 0], (1, 2, 3)).astype(np.float32)
         irr = (level * np.float32(math.pi)).astype(np.float32)
-        return PreparedMap(key, name, w, h, coeffs, [level], [], irr, True, False, negative, time.perf_counter() - t0)
+        kernels = split_sum.uniform_kernel_maps(c)
+        seconds = time.perf_counter() - t0
+        return PreparedMap(key, name, w, h, coeffs, [level], [], irr, True, False, negative, seconds, kernels=kernels)
     sources, rest = extract_sources(img)
     directions = split_sum.texel_directions(w, h).reshape(-1, 3)
     omega = split_sum.texel_solid_angles(w, h).ravel()
     coeffs = sh.project(rest.reshape(-1, 3), directions, omega)
     levels = split_sum.prefilter(rest, width=max(64, min(split_sum.BASE_WIDTH, w)))  # no finer than the map
     irr = split_sum.irradiance_map(rest)
-    return PreparedMap(key, name, w, h, coeffs, levels, sources, irr, False, False, negative, time.perf_counter() - t0)
+    kernels = split_sum.kernel_maps(rest)
+    seconds = time.perf_counter() - t0
+    return PreparedMap(key, name, w, h, coeffs, levels, sources, irr, False, False, negative, seconds, kernels=kernels)
 
 
 _PREPARED: dict[str, PreparedMap] = {}
@@ -301,7 +311,7 @@ def cache_root() -> Path | None:
 def _save(prepared: PreparedMap, path: Path) -> None:
     from skinlab.atomic_write import atomic_path
 
-    assert prepared.irradiance is not None  # prepare() makes it
+    assert prepared.irradiance is not None and prepared.kernels is not None  # prepare() makes them
     arrays: dict[str, Any] = {f"level{k}": lv for k, lv in enumerate(prepared.levels)}
     src = prepared.sources
     arrays["source_dir"] = np.array([s.direction for s in src]).reshape(-1, 3)
@@ -309,7 +319,10 @@ def _save(prepared: PreparedMap, path: Path) -> None:
     arrays["source_omega"] = np.array([[s.solid_angle, s.texels] for s in src]).reshape(-1, 2)
     flags = [prepared.width, prepared.height, prepared.uniform, prepared.black, prepared.negative_texels]
     with atomic_path(path) as tmp:
-        np.savez(tmp, sh=prepared.sh, irradiance=prepared.irradiance, flags=np.array(flags, np.int64), **arrays)
+        np.savez(
+            tmp, sh=prepared.sh, irradiance=prepared.irradiance, kernels=prepared.kernels,
+            flags=np.array(flags, np.int64), **arrays,
+        )  # fmt: skip
 
 
 def _load(path: Path, key: str, name: str) -> PreparedMap | None:
@@ -323,11 +336,13 @@ def _load(path: Path, key: str, name: str) -> PreparedMap | None:
             ]
             coeffs = z["sh"]
             irr = z["irradiance"]
+            kernels = z["kernels"]
     except Exception:  # missing, truncated, from another version: prepare again
         return None
-    if coeffs.shape != (9, 3) or not levels:
+    if coeffs.shape != (9, 3) or not levels or kernels.ndim != 4 or len(kernels) != split_sum.KERNEL_LAYERS:
         return None
-    return PreparedMap(key, name, w, h, coeffs, levels, sources, irr, bool(uniform), bool(black), negative, 0.0, "disk")
+    flags = bool(uniform), bool(black), negative
+    return PreparedMap(key, name, w, h, coeffs, levels, sources, irr, *flags, 0.0, "disk", kernels=kernels)
 
 
 def prepare(path: str | Path) -> PreparedMap:

@@ -253,20 +253,29 @@ def single_band_tables(alpha, colour, eta) -> np.ndarray:
     return out
 
 
-def entry_band_tables(alpha, colour, eta, ggx_alpha: float = 0.0) -> np.ndarray:
-    """(3 bands, 3 channels) what band l of a sky's SH radiance brings into the multiple scattering,
-    per unit base colour: the entering light of a sky sum L_lm Y_lm is sum_l eps_l sum_m L_lm Y_lm(n)
-    with eps_l = 2 pi int_0^1 A_ms(m) m P_l(m) dm / A_colour (Funk-Hecke; eps_0 = pi A_ms_d / A_colour,
-    the uniform sky's: pi x the entry_diffuse of BoundaryTables)."""
+ENTRY_TERMS = 3  # A_ms(t) ~ c_0 + c_1 t + c_2 t^2: kernels t, t^2, t^3 (split_sum.KERNEL_POWERS after the irradiance)
+
+
+def entry_kernel_coefficients(alpha, colour, eta, ggx_alpha: float = 0.0) -> np.ndarray:
+    """(ENTRY_TERMS, 3 channels) c_k with A_ms(t) / A_colour ~ sum_k c_k t^k: the light a map brings
+    into the multiple scattering at normal n, int L(w) A_ms(n.w) (n.w) dw / A_colour, is then
+    sum_k c_k int L (n.w)^(k+1) dw, the irradiance map and the map's t^2, t^3 kernel maps
+    (skinlab/scene/optics/split_sum.py kernel_maps): exact for any map up to the fit, where nine SH
+    bands with per-band factors were 2-5 % off per normal under the studio map's rest. Least squares
+    in t weighted by t (the kernel's own cosine), the constant then set so that the uniform sky's
+    entry, pi A_ms_d, is exact."""
     m, w = _gl()
-    out = np.zeros((3, 3))
+    v = np.stack([m**k for k in range(ENTRY_TERMS)], 1)
+    wt = w * m
+    out = np.zeros((ENTRY_TERMS, 3))
     for c in range(3):
         a, col = float(np.ravel(alpha)[c]), float(np.ravel(colour)[c])
         if col <= 0.0 or a <= 0.0:
             continue
-        f = ms_albedo(a, eta, m, ggx_alpha) * m
-        for band, p in enumerate((np.ones_like(m), m, 0.5 * (3 * m * m - 1))):
-            out[band, c] = 2.0 * np.pi * np.sum(w * f * p) / col
+        f = ms_albedo(a, eta, m, ggx_alpha)
+        coef = np.linalg.lstsq(v * np.sqrt(wt)[:, None], f * np.sqrt(wt), rcond=None)[0]
+        coef[0] += float(np.sum(wt * (f - v @ coef)) / np.sum(wt))
+        out[:, c] = coef / col
     return out
 
 

@@ -133,6 +133,65 @@ def irradiance_map(image: np.ndarray, width: int = IRRADIANCE_WIDTH, source_widt
     return out.reshape(width // 2, width, 3).astype(np.float32)
 
 
+KERNEL_NODES = 17  # single-scattering layers: view cosines mu_j = j / 16 (boundary.ANGULAR_NODES)
+KERNEL_POWERS = (2, 3)  # the entering light's layers after them: int L max(n.w, 0)^k dw
+KERNEL_LAYERS = KERNEL_NODES + len(KERNEL_POWERS)
+
+
+def kernel_weights(cosines: np.ndarray) -> np.ndarray:
+    """(KERNEL_LAYERS, ...) the zonal kernels of :func:`kernel_maps` at cosines t = n.w (0 for t <= 0):
+    t / (4 pi (mu_j + t)) for the single-scattering layers, then t^k."""
+    t = np.maximum(np.asarray(cosines, np.float64), 0.0)
+    mu = np.linspace(0.0, 1.0, KERNEL_NODES).reshape((-1,) + (1,) * t.ndim)
+    single = np.where(t > 0.0, t / (4.0 * np.pi * np.maximum(mu + t, 1e-30)), 0.0)
+    return np.concatenate([single, np.stack([t**k for k in KERNEL_POWERS])])
+
+
+def kernel_maps(image: np.ndarray, width: int = IRRADIANCE_WIDTH, source_width: int = 128) -> np.ndarray:
+    """(KERNEL_LAYERS, width / 2, width, 3): the map convolved with the zonal kernels of the light a
+    medium takes from it at each texel's normal n (exact sums over the image box-averaged to
+    source_width, as :func:`irradiance_map`). Layer j < KERNEL_NODES: S_j(n) = int L(w) t / (4 pi
+    (mu_j + t)) dw, t = max(n.w, 0): Jensen's single scattering of an index-matched medium of albedo a
+    toward a view at cosine mu_j is a S_j(n) (isotropic phase; Chandrasekhar's first order,
+    skinlab/scene/optics/boundary.py), exact for any map, where nine SH bands are not: its kernel is
+    nearly a step toward grazing views. Then int L t^k dw for k in KERNEL_POWERS: with the irradiance
+    (k = 1) they give the light entering the multiple scattering, int L A_ms(t) t dw, for A_ms fitted
+    by c_0 + c_1 t + c_2 t^2 (boundary.entry_kernel_coefficients)."""
+    src = resample(np.asarray(image, np.float64), source_width)
+    d = texel_directions(source_width, source_width // 2).reshape(-1, 3)
+    weighted = src.reshape(-1, 3) * texel_solid_angles(source_width, source_width // 2).reshape(-1, 1)
+    n = texel_directions(width, width // 2).reshape(-1, 3)
+    weighted32 = weighted.astype(np.float32)
+    mus = np.linspace(0.0, 1.0, KERNEL_NODES, dtype=np.float32)
+    out = np.zeros((KERNEL_LAYERS, len(n), 3))
+    for start in range(0, len(n), 512):
+        t = np.maximum(n[start : start + 512] @ d.T, 0.0).astype(np.float32)  # (512, texels)
+        for j, mu in enumerate(mus):  # t / (mu + t): float32 is plenty for a sum of positive terms
+            out[j, start : start + 512] = (t / (mu + t + np.float32(1e-30))) @ weighted32
+        for i, k in enumerate(KERNEL_POWERS):
+            out[KERNEL_NODES + i, start : start + 512] = (t**k) @ weighted32
+    out[:KERNEL_NODES] /= 4.0 * np.pi
+    return out.reshape(KERNEL_LAYERS, width // 2, width, 3).astype(np.float32)
+
+
+def uniform_kernel_maps(radiance) -> np.ndarray:
+    """(KERNEL_LAYERS, 1, 2, 3) :func:`kernel_maps` of a uniform sky of this radiance (closed forms):
+    S_j = L (1 - mu_j ln(1 + 1/mu_j)) / 2, int L t^k dw = 2 pi L / (k + 1)."""
+    c = np.asarray(radiance, np.float64).reshape(3)
+    mu = np.linspace(0.0, 1.0, KERNEL_NODES)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_term = np.where(mu > 0, mu * np.log1p(1.0 / np.where(mu > 0, mu, 1.0)), 0.0)
+    f = np.concatenate([0.5 * (1.0 - log_term), [2.0 * np.pi / (k + 1) for k in KERNEL_POWERS]])
+    return np.broadcast_to((f[:, None] * c)[:, None, None, :], (KERNEL_LAYERS, 1, 2, 3)).astype(np.float32)
+
+
+def kernel_lookup(kernels: np.ndarray, d, layer: int) -> np.ndarray:
+    """Layer `layer` of :func:`kernel_maps` read bilinearly at map-frame directions d (the shader's
+    env_kernel)."""
+    u, v = equirect_uv(d)
+    return bilinear(kernels[layer], u, v)
+
+
 def _frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Tangent and bitangent of unit normals (N, 3) (Duff et al. 2017)."""
     sign = np.where(n[:, 2] >= 0.0, 1.0, -1.0)

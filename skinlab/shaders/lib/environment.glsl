@@ -16,6 +16,8 @@ uniform float u_env_max_lod;       // levels - 1
 uniform float u_env_intensity;
 uniform sampler2D u_env_brdf;      // split-sum table: x n.v, y roughness; (A, B)
 uniform sampler2D u_env_irradiance;  // the irradiance for each normal (the map's frame, intensity 1)
+uniform sampler2DArray u_env_kernels;  // the map's zonal kernel maps per normal (split_sum.kernel_maps)
+#define ENV_KERNEL_NODES 17           // single-scattering layers (view cosines j / 16); then t^2, t^3
 
 // The real SH basis at a unit direction (skinlab/scene/optics/sh.py sh9_basis), as 9 values.
 void sh9_basis(vec3 d, out float y[9]) {
@@ -59,6 +61,15 @@ vec2 equirect_uv(vec3 d) {
 // The map's irradiance on a surface of world normal n (exact, from the irradiance map; unoccluded).
 vec3 env_map_irradiance(vec3 n) {
     return u_env_intensity * textureLod(u_env_irradiance, equirect_uv(u_env_to_map * n), 0.0).rgb;
+}
+
+// Layer `layer` of the map's kernel maps at world normal n, x intensity (unoccluded): layers j < 17 the
+// single scattering toward a view at cosine j / 16 per unit albedo of an index-matched medium,
+// int L t / (4 pi (mu_j + t)) dw; then int L t^2 dw and int L t^3 dw (t = max(n.w, 0)).
+// NumPy twin: skinlab/scene/optics/split_sum.py kernel_lookup.
+vec3 env_kernel(vec3 n, int layer) {
+    vec2 uv = equirect_uv(u_env_to_map * n);
+    return u_env_intensity * textureLod(u_env_kernels, vec3(uv, float(layer)), 0.0).rgb;
 }
 
 // The prefiltered radiance arriving along world direction w for a lobe of this roughness.
