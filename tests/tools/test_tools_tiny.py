@@ -15,7 +15,7 @@ from skinlab.resources import asset_path
 TOOLS = Path(tools.__file__).parent
 TESTED_ELSEWHERE = {"truth_table", "closeup_table", "forward_cost", "irradiance_cost", "cost_variants", "gpu_reference"}
 HERE = {
-    "accuracy_table", "boundary_slab", "frame_times", "full_over_plain", "make_face_parts",
+    "accuracy_table", "boundary_slab", "env_sphere", "frame_times", "full_over_plain", "make_face_parts",
     "make_reference_meshes", "repair_bunny", "seam_report", "supersample_cost", "translucency_check",
 }  # fmt: skip
 
@@ -54,6 +54,23 @@ def test_boundary_slab(capsys):
         "rough 0.45 dark   sky view  0", "rough 0.45 dark   sun light  0",
     ]  # fmt: skip
     assert "model" in out[1] and "model" not in out[3]  # the boundary model for the medium under the sky only
+
+
+def test_env_sphere(tmp_path, capsys):
+    from skinlab.scene.scenefile import load_scene
+    from tools import env_sphere
+
+    assert env_sphere.main(["scenes", str(tmp_path)]) == 0
+    for name in ("sphere-white", "sphere-studio-rest"):
+        scene = load_scene(tmp_path / f"{name}.toml")
+        lo, hi = scene.world_bounds()
+        assert np.allclose(hi - lo, 2 * env_sphere.RADIUS_MM, rtol=1e-3)  # the sphere, whole
+    capsys.readouterr()
+    assert env_sphere.main(["mc", "--radii", "5,1000", "--photons", "4000"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 3 and all(line.startswith("albedo") for line in out)
+    gains = [[float(x) for x in re.findall(r"l: ([+-][0-9.]+)", line)] for line in out]
+    assert all(small > large for small, large in gains)  # a small sphere reflects more than a large one
 
 
 def test_frame_times(tmp_path, capsys):
