@@ -1,7 +1,9 @@
 """A one-off analysis, not a feature: every technique (default settings) on the close-up reference
 scenes against their cached path-traced truth (issue 21; docs/ground-truth.md, "Close-ups"): relative
-L1 on 4x4 blocks and per pixel, per-channel energy, and per scene what it was made to measure, each with the truth's own
-noise (the same measure between the halves of its passes):
+L1 on 4x4 blocks and per pixel, per-channel energy, NVIDIA's FLIP (the mean of the LDR-FLIP map of the
+tone-mapped frame against the tone-mapped truth over the object, skinlab/truth/metrics.py; with its
+ratio to plain diffuse's, issue 21's "a fifth of plain diffuse's"), and per scene what it was made to
+measure, each with the truth's own noise (the same measure between the halves of its passes):
 
 * slit scenes: the line profile (the image averaged along the slit, per channel): its relative L1
   against the truth's, and the fraction of the energy in view beyond 2, 5 and 10 mm from the slit;
@@ -35,6 +37,7 @@ import numpy as np
 
 from skinlab.bench.truth_ledger import REFERENCE_SCENES, TRUTH_SUPERSAMPLE
 from skinlab.truth.compare import image_error
+from skinlab.truth.metrics import flip_mean
 
 TECHNIQUES = ["none", "tint", "tsd", "exact", "ssss", "disk", "preintegrated"]
 
@@ -261,10 +264,13 @@ def main(argv: list[str] | None = None) -> int:
             continue
         t_img, ha, hb = truth.image, truth.half_a, truth.half_b
         noise = truth.noise
+        exposure = scene.environment.exposure
         head = (
             f"{s:24s} truth {spec.size[0]}x{spec.size[1]} {spec.spp} spp: noise 4x4 "
-            f"{100 * noise['rel_l1_block']:.2f} %, px {100 * noise['rel_l1']:.2f} %"
+            f"{100 * noise['rel_l1_block']:.2f} %, px {100 * noise['rel_l1']:.2f} %, "
+            f"FLIP {flip_mean(ha, hb, exposure=exposure):.4f}"
         )
+        plain_flip = math.nan  # plain diffuse's FLIP mean, for the others' ratio to it
         masks: tuple = ()  # the kind's regions (shadow: deep, lit, edge; slabs: front, back)
         if spec.kind == "slit":
             pa, pb, pt = line_profile(ha), line_profile(hb), line_profile(t_img)
@@ -304,7 +310,13 @@ def main(argv: list[str] | None = None) -> int:
             img = r.render(scene, rs, readback=("hdr",)).hdr
             e = image_error(img, t_img)
             energy = "/".join(f"{100 * x:+.1f}" for x in e["energy"])
+            fl = flip_mean(img, t_img, exposure=exposure)
+            if t == "none":
+                plain_flip = fl
             line = f"  {t:14s} 4x4 {100 * e['rel_l1_block']:6.2f} %  px {100 * e['rel_l1']:6.2f} %  energy {energy} %"
+            line += f"  FLIP {fl:.4f}" + (
+                f" ({fl / plain_flip:.2f} of none's)" if t != "none" and plain_flip > 0 else ""
+            )
             if spec.kind == "slit":
                 pf = line_profile(img)
                 tf = tail_fractions(pf, spec.mm_per_px)
