@@ -9,9 +9,10 @@ Planned by the core (skinlab/render/plan.py, :func:`plan_environment`):
   than 50 ms) and uploaded: the levels as
   one texture's mip chain, the irradiance map, the split-sum BRDF table, and the map itself when it is
   drawn behind the scene. A uniform map is one radiance (no prefilter, one level); a black map plans nothing.
-* ``sky_occlusion``: what each vertex's rays meet (the interreflection's ray records,
-  skinlab/scene/interreflection.py ``sky_blocked``) as 9 SH coefficients per vertex, so a surface
-  receives the map's light less what the scene hides of it; skipped when no ray meets anything.
+* ``sky_occlusion``: the share of the map's light each vertex's rays see (the interreflection's rays,
+  skinlab/scene/interreflection.py ``sky_visible_share``, against the map's smooth part prefiltered at
+  ``SKY_LOD``), so a surface receives the map's light less what the scene hides of it; per map and
+  rotation (computed on the CPU, a few tens of ms on the head); skipped when no ray meets anything.
 * the map's sources as directional lights with shadow maps (``skinlab.scene.envmap.environment_lights``),
   after the scene's own lights.
 
@@ -32,6 +33,7 @@ from typing import TYPE_CHECKING
 import moderngl
 import numpy as np
 
+from skinlab.cache import Memo
 from skinlab.gl.uniforms import set_array, set_uniform, set_uniforms
 from skinlab.scene import envmap
 from skinlab.scene.optics import sh, split_sum
@@ -54,7 +56,11 @@ ENV_PASS = "environment"
 SKY_PASS = "sky_occlusion"
 DATA_KEY = "environment"  # frame.data: the prepared map and its textures
 SKY_KEY = "sky_occlusion"  # frame.data: {"offsets": node uid -> first vertex}
-SKY_WIDTH = 1024  # vertices per row of the sky-occlusion texture (3 texels each)
+SKY_WIDTH = 1024  # vertices per row of the sky-occlusion texture (one texel each)
+# the prefiltered level (GGX roughness SKY_LOD / 5) the rays read the map's smooth part at: smooth enough
+# that a vertex's 64 rays do not alias a small bright part of it (level 0: 4.1 % on the studio head's
+# blocks), sharp enough to keep where it is (level 2: 2.8 %, 3: 3.3 %; level 1: 2.4 %)
+SKY_LOD = 1
 
 
 @dataclass
@@ -67,6 +73,22 @@ class EnvironmentParams:
 @dataclass
 class SkyParams:
     transfer: BounceTransfer
+    prepared: envmap.PreparedMap
+    rotation_deg: float
+
+
+def sky_share(transfer: BounceTransfer, prepared: envmap.PreparedMap, rotation_deg: float) -> np.ndarray:
+    """(V, 4) the sky occlusion's per-vertex record (lib/sky_blocked.glsl): the share of the map's
+    smooth part each vertex's rays see, per channel, and the share of its rays that leave the scene."""
+    from skinlab.scene.interreflection import sky_visible_share
+
+    level = prepared.levels[min(int(SKY_LOD), len(prepared.levels) - 1)]
+    u, v = _SKY_UV.get(transfer.key, lambda: split_sum.equirect_uv(transfer.sky_directions.astype(np.float64)))
+    # the map turned by R_y(rotation) about +Y reads a world direction at u + rotation / 360 (equirect_uv)
+    return sky_visible_share(transfer, split_sum.bilinear(level, np.mod(u + rotation_deg / 360.0, 1.0), v))
+
+
+_SKY_UV = Memo(4)  # transfer key -> the rays' (u, v) in the unturned map's frame
 
 
 def plan_environment(
@@ -151,15 +173,17 @@ def plan_sky(
     if not transfer.any_blocked:
         plan.skipped.append((SKY_PASS, "nothing hides the sky: every ray from every vertex leaves the scene"))
         return None
+    prepared = environment[0].params.prepared
+    rotation = 0.0 if prepared.uniform else float(scene.environment.rotation_deg)  # a uniform map is the same turned
     return PlannedPass(
         SKY_PASS,
         "sky_occlusion",
         "sky_blocked",
-        (3 * SKY_WIDTH, max(1, math.ceil(transfer.total_vertices / SKY_WIDTH))),
+        (SKY_WIDTH, max(1, math.ceil(transfer.total_vertices / SKY_WIDTH))),
         f"what the scene hides of the sky: {transfer.total_vertices} vertices x {transfer.rays} rays "
-        "(the interreflection's), 9 SH coefficients each",
-        SkyParams(transfer),
-        inputs=(transfer.key,),
+        "(the interreflection's) against the map's smooth part, the visible share per channel",
+        SkyParams(transfer, prepared, rotation),
+        inputs=(transfer.key, prepared.key, rotation),
     )
 
 
@@ -287,19 +311,21 @@ class SkyOcclusionPass(RenderPass):
 
     def __init__(self, renderer):
         super().__init__(renderer)
-        self.held: tuple | None = None  # (transfer key, texture)
+        self.held: tuple | None = None  # ((transfer key, map key, rotation), texture)
 
-    def _texture(self, transfer: BounceTransfer) -> moderngl.Texture:
-        if self.held is not None and self.held[0] == transfer.key:
+    def _texture(self, prm: SkyParams) -> moderngl.Texture:
+        transfer = prm.transfer
+        key = (transfer.key, prm.prepared.key, prm.rotation_deg)
+        if self.held is not None and self.held[0] == key:
             return self.held[1]
         self.release()
         n = transfer.total_vertices
         rows = max(1, math.ceil(n / SKY_WIDTH))
-        data = np.zeros((rows * SKY_WIDTH, 12), np.float32)
-        data[:n, :9] = transfer.sky_blocked
-        tex = self.r.ctx.texture((3 * SKY_WIDTH, rows), 4, data.tobytes(), dtype="f4")
+        data = np.ones((rows * SKY_WIDTH, 4), np.float32)
+        data[:n] = sky_share(transfer, prm.prepared, prm.rotation_deg)
+        tex = self.r.ctx.texture((SKY_WIDTH, rows), 4, data.tobytes(), dtype="f4")
         tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        self.held = (transfer.key, tex)
+        self.held = (key, tex)
         return tex
 
     def release(self) -> None:
@@ -308,11 +334,11 @@ class SkyOcclusionPass(RenderPass):
             self.held = None
 
     def outputs(self, frame, p) -> tuple:
-        return (self._texture(p.params.transfer),)
+        return (self._texture(p.params),)
 
     def publish(self, frame: Frame, p) -> None:
         tr = p.params.transfer
-        frame.targets["sky_blocked"] = self._texture(tr)
+        frame.targets["sky_blocked"] = self._texture(p.params)
         frame.data[SKY_KEY] = {"offsets": dict(tr.offsets)}
 
     def run(self, frame: Frame, p) -> None:
@@ -437,14 +463,12 @@ def env_entering(kernels: np.ndarray, irradiance: np.ndarray, n_map, coefficient
     return np.maximum(e, 0.0)
 
 
-def env_diffuse(world_sh: np.ndarray, n, blocked=None, irradiance=None) -> np.ndarray:
-    """NumPy twin of lib/sky_occlusion.glsl env_diffuse_irradiance at world normals n (..., 3): the
-    unoccluded irradiance `irradiance` (..., 3) (the irradiance map's lookup; default: the SH
-    irradiance of the radiance coefficients world_sh (9, 3)) times 1 - the share the blocked
-    coefficients b (..., 9) hide, sum L_lm b_lm / E_sh(n), clamped to [0, 1]."""
-    e_sh = sh.irradiance(world_sh, n)
-    e = e_sh if irradiance is None else np.asarray(irradiance, np.float64)
-    if blocked is None:
+def env_diffuse(irradiance, sky=None) -> np.ndarray:
+    """NumPy twin of lib/sky_occlusion.glsl env_diffuse_irradiance: the unoccluded irradiance
+    `irradiance` (..., 3) (the irradiance map's lookup at the normal) times the share of the map's light
+    the point sees, the sky occlusion's record `sky` (..., 4) (sky_share: RGB share, then the rays'
+    share) clamped to [0, 1] (env_sky_share); unoccluded without it."""
+    e = np.asarray(irradiance, np.float64)
+    if sky is None:
         return e
-    hidden = np.asarray(blocked, np.float64) @ np.asarray(world_sh, np.float64)
-    return e * (1.0 - np.clip(hidden / np.maximum(e_sh, 1e-20), 0.0, 1.0))
+    return e * np.clip(np.asarray(sky, np.float64)[..., :3], 0.0, 1.0)

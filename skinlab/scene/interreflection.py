@@ -44,7 +44,8 @@ if TYPE_CHECKING:
 
 GOLDEN = 0.6180339887498949  # the golden ratio's fractional part: the second coordinate's sequence
 RAY_OFFSET = 1e-5  # ray origins leave the surface by this fraction of the scene's bounding diagonal
-# rays per frame's geometry: the records take 24 bytes a ray (48 MB at the budget) and Embree casts about
+# rays per frame's geometry: the records take 24 bytes a ray (48 MB at the budget; the sky occlusion's
+# direction and open flag 13 more, 26 MB) and Embree casts about
 # a million a second on 2 cores; past it each vertex casts fewer rays, down to MIN_RAYS, then none
 # (skinlab/render/bounce.py plans with it, and so does the environment's sky occlusion)
 MAX_RAYS = 2_000_000
@@ -71,11 +72,6 @@ class BounceTransfer:
     ring_offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))  # (V + 1,)
     ring_vertices: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     ring_weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
-    # what the scene hides of the sky (environment light, skinlab/render/environment.py): per vertex
-    # the 9 spherical-harmonic coefficients (skinlab/scene/optics/sh.py) of pi/K sum Y(w_k) over its
-    # rays that met any surface, front or back: the irradiance a vertex loses of a radiance L(w) is
-    # sum_lm L_lm sky_blocked[i, lm] (one-ring averaged like the bounce light)
-    sky_blocked: np.ndarray = field(default_factory=lambda: np.zeros((0, 9), np.float32))
     # the records collapsed per receiver (CSR, like the one-ring): vertex i gathers
     # sum_j sender_weights[j] M[sender_vertices[j]] over j in sender_offsets[i] .. sender_offsets[i + 1],
     # each sender once with the summed weights of every ray and corner that met it (no empty rays):
@@ -83,6 +79,12 @@ class BounceTransfer:
     sender_offsets: np.ndarray = field(default_factory=lambda: np.zeros(1, np.int64))  # (V + 1,)
     sender_vertices: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     sender_weights: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
+    # the rays themselves, for the share of a map's light each vertex sees (sky_visible_share): per
+    # welded vertex w its rays' unit directions sky_directions[w * rays + k] (world axes) and whether
+    # each leaves the scene (sky_open); vertex i's welded vertex sky_welded[i] (-1: no normal)
+    sky_directions: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.float32))
+    sky_open: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
+    sky_welded: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
 
     @property
     def total_vertices(self) -> int:
@@ -97,7 +99,7 @@ class BounceTransfer:
     @property
     def any_blocked(self) -> bool:
         """True when some ray met any surface (some vertex sees less than its whole sky)."""
-        return bool(len(self.sky_blocked)) and bool((self.sky_blocked[:, 0] > 0.0).any())
+        return bool((~self.sky_open.reshape(-1, max(self.rays, 1))[self.sky_welded[self.sky_welded >= 0]]).any())
 
 
 def cosine_directions(normals: np.ndarray, rays: int, seed: int = 0) -> np.ndarray:
@@ -145,7 +147,7 @@ def geometry_key(nodes: list[MeshNode], rays: int, seed: int) -> str:
     return h.hexdigest()
 
 
-_CACHE = Memo(8)  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights, sky, sender rows
+_CACHE = Memo(8)  # key -> vertices, weights, hit fractions, ring offsets, vertices, weights, sender rows, sky rays
 
 
 def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> BounceTransfer:
@@ -166,7 +168,7 @@ def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> Boun
             "interreflection", key, lambda: _cast(nodes, rays, seed, total), "interreflection rays", code=__name__
         ),
     )
-    vertices, weights, fractions, r_off, r_vert, r_w, sky, s_off, s_vert, s_w = hit
+    vertices, weights, fractions, r_off, r_vert, r_w, s_off, s_vert, s_w, sky_dirs, sky_open, sky_welded = hit
     return BounceTransfer(
         rays,
         offsets,
@@ -178,10 +180,12 @@ def build_transfer(nodes: list[MeshNode], rays: int = 64, seed: int = 0) -> Boun
         r_off,
         r_vert,
         r_w,
-        sky,
         s_off,
         s_vert,
         s_w,
+        sky_dirs,
+        sky_open,
+        sky_welded,
     )
 
 
@@ -235,9 +239,9 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
 
     if total == 0:
         z = np.zeros(0, np.int64)
-        sky = np.zeros((0, 9), np.float32)
         one, w0 = np.zeros(1, np.int64), np.zeros(0, np.float32)
-        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), [], one, z, w0, sky, one, z, w0
+        rays_none = (np.zeros((0, 3), np.float32), np.zeros(0, bool), z)
+        return np.zeros((0, 3), np.int64), np.zeros((0, 3), np.float32), [], one, z, w0, one, z, w0, *rays_none
 
     pos, nrm, faces = [], [], []
     start = 0
@@ -288,8 +292,9 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
         fractions.append(float(hit_rays[start : start + k].mean()))
         start += k
     rings = one_rings(p_all, f_all, first, inverse)
-    sky = sky_blocked(dirs, blocked, rays, inverse, no_normal, rings)
-    return vertices, weights, fractions, *rings, sky, *sender_rows(vertices, weights, rays)
+    welded = np.where(no_normal, -1, inverse).astype(np.int64)
+    sky_rays = (dirs.astype(np.float32), ~blocked, welded)
+    return vertices, weights, fractions, *rings, *sender_rows(vertices, weights, rays), *sky_rays
 
 
 def sender_rows(vertices: np.ndarray, weights: np.ndarray, rays: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -310,19 +315,36 @@ def sender_rows(vertices: np.ndarray, weights: np.ndarray, rays: int) -> tuple[n
     return offsets, uniq % max(n, 1), summed.astype(np.float32)
 
 
-def sky_blocked(dirs, blocked, rays: int, inverse, no_normal, rings) -> np.ndarray:
-    """(V, 9) the SH coefficients of what each vertex's blocked rays hide of the sky (BounceTransfer)."""
-    from .optics.sh import sh9_basis
-
-    nw = len(dirs) // rays
-    # the blocked rays' SH, summed per vertex in ray order (the unblocked ones add nothing)
-    hit = np.flatnonzero(blocked)
-    per = _sum_rows(hit // rays, sh9_basis(dirs[hit]), nw) * (np.pi / rays)
-    per = per[inverse]
-    per[no_normal] = 0.0
-    offsets, ring_vertices, ring_weights = rings
-    owner = np.repeat(np.arange(len(per)), np.diff(offsets))
-    return _sum_rows(owner, ring_weights.astype(np.float64)[:, None] * per[ring_vertices], len(per)).astype(np.float32)
+def sky_visible_share(transfer: BounceTransfer, radiance: np.ndarray) -> np.ndarray:
+    """(V, 4) per vertex the share of a map's light its rays see, per channel (RGB), and the share of
+    its rays that leave the scene (the sky's visibility, a). `radiance` (N, 3): the (smooth) map along
+    each ray of ``transfer.sky_directions``. With cosine-weighted rays w_k, sum_k L(w_k) over the open rays
+    against the sum over all is the visible share of E = int L cos dw, exact as the rays grow (the
+    rays' estimate, not nine SH coefficients of the blocked set: a sharp occluder in front of a small
+    bright part of the map hides it). Numerator and denominator are each one-ring averaged like the
+    bounce light; a vertex whose rays see no light keeps its rays' share; one without a normal sees all."""
+    v = transfer.total_vertices
+    out = np.ones((v, 4), np.float64)
+    if v == 0 or len(transfer.sky_open) == 0:
+        return out.astype(np.float32)
+    rays = transfer.rays
+    nw = len(transfer.sky_open) // rays
+    lit = np.asarray(radiance, np.float64).reshape(nw, rays, -1)
+    open_ = transfer.sky_open.reshape(nw, rays)
+    per = np.concatenate([(lit * open_[..., None]).sum(1), lit.sum(1), open_.mean(1, keepdims=True)], 1)
+    welded = transfer.sky_welded
+    rows = np.where(welded[:, None] >= 0, per[np.maximum(welded, 0)], 1.0)
+    ring = transfer.ring_weights.astype(np.float64)[:, None] * rows[transfer.ring_vertices]
+    owner = np.repeat(np.arange(v), np.diff(transfer.ring_offsets))
+    avg = _sum_rows(owner, ring, v)
+    c = lit.shape[-1]
+    num, den, fraction = avg[:, :c], avg[:, c : 2 * c], avg[:, 2 * c]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        share = np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), fraction[:, None])
+    out[:, :3] = np.clip(share, 0.0, 1.0)
+    out[:, 3] = np.clip(fraction, 0.0, 1.0)
+    out[welded < 0] = 1.0
+    return out.astype(np.float32)
 
 
 def _sum_rows(owner: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:

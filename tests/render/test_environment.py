@@ -8,15 +8,15 @@ import math
 import numpy as np
 import pytest
 
-from skinlab.render.environment import brdf_table
+from skinlab.render.environment import SKY_LOD, brdf_table, sky_share
 from skinlab.render.registry import technique_names
 from skinlab.render.settings import RenderSettings
+from skinlab.scene import envmap
 from skinlab.scene.envmap import write_map
 from skinlab.scene.graph import CameraNode, MeshNode, Scene
-from skinlab.scene.interreflection import build_transfer
+from skinlab.scene.interreflection import build_transfer, sky_visible_share
 from skinlab.scene.materials import Material
 from skinlab.scene.optics import split_sum
-from skinlab.scene.optics.sh import SH_C0
 from skinlab.scene.primitives import sphere_mesh
 from tests.render.test_bounce import N, open_book_scene
 from tests.tsd_scenes import skin
@@ -121,7 +121,9 @@ def test_the_scene_hides_part_of_the_map(tmp_path, renderer):
     tr = build_transfer(s.mesh_nodes(), 64)
     b = s.find("B")
     i = j = N // 2
-    blocked = tr.sky_blocked[tr.offsets[b.uid] + i * (N + 1) + j, 0] / (math.pi * SH_C0)
+    record = sky_visible_share(tr, np.ones(tr.sky_directions.shape))[tr.offsets[b.uid] + i * (N + 1) + j]
+    assert np.allclose(record[:3], record[3])  # under a uniform map the share of the light is the rays'
+    blocked = 1.0 - record[3]
     assert 0.05 < blocked < 0.5  # the middle of B sees some of A below it
     want = np.asarray(MATTE["base_color"]) * (1.0 - blocked)
     centre = res.hdr[14:18, 14:18, :3].reshape(-1, 3).mean(0)
@@ -135,10 +137,32 @@ def test_the_scene_hides_part_of_the_map(tmp_path, renderer):
     assert bounced[-2, 16, 0] > res.hdr[-2, 16, 0] * 1.05
 
 
+@pytest.mark.parametrize("rotation", [0.0, 30.0, -135.0])
+def test_sky_record_reads_the_turned_map_along_each_ray(tmp_path, rotation):
+    """The sky occlusion's record (sky_share: the map's level SKY_LOD along each ray, the turn applied
+    as a shift in u) is the share computed from the map looked up as the frame looks it up
+    (lib/environment.glsl: the world direction turned into the map's frame, u_env_to_map)."""
+    s = open_book_scene(Material("matte", MATTE))
+    d = split_sum.texel_directions(64, 32)
+    px = 0.2 + np.maximum(d, 0.0) * [1.0, 0.5, 0.25]  # brighter toward +x, +y, +z by channel: not turn-symmetric
+    prepared = envmap.prepare(write_map(tmp_path / "sides.exr", px.astype(np.float32)))
+    tr = build_transfer(s.mesh_nodes(), 32)
+    to_map = envmap.rotation_y(rotation).T
+    lit = split_sum.sample_levels(prepared.levels, tr.sky_directions.astype(np.float64) @ to_map.T, SKY_LOD)
+    want = sky_visible_share(tr, lit)
+    got = sky_share(tr, prepared, rotation)
+    assert np.allclose(got, want, atol=2e-6), np.abs(got - want).max()
+    assert got[:, :3].min() < 0.9  # some vertex sees less than the whole of the map's light
+    if rotation:
+        assert np.abs(got - sky_share(tr, prepared, 0.0)).max() > 0.02  # the turn matters
+
+
 def test_plan_and_reuse_when_the_map_turns(tmp_path, renderer):
-    """Turning the map re-runs what depends on light (the source's shadow map, the interreflection,
-    texture-space irradiance and what follows) and nothing that does not (the upload of the prepared
-    map, the sky occlusion, the stretch map); an orbiting camera re-runs only the per-view passes."""
+    """Turning the map re-runs what depends on light (the source's shadow map, the share of the map's
+    light each vertex sees, the interreflection, texture-space irradiance and what follows) and nothing
+    that does not (the upload of the prepared map, the stretch map, the rays: the sky occlusion's
+    record is recomputed from the cached rays); an orbiting camera re-runs only the per-view passes;
+    the intensity leaves the visible share as it is."""
     s = open_book_scene(skin(radius=(1.0, 0.5, 0.3)))
     for l in list(s.lights()):
         l.visible = False
@@ -152,7 +176,7 @@ def test_plan_and_reuse_when_the_map_turns(tmp_path, renderer):
     s.environment.rotation_deg = 30.0
     turned = renderer.render(s, rs).plan
     ran = set(turned.ran())
-    assert {"environment", "sky_occlusion"} <= set(turned.reused())
+    assert "environment" in turned.reused() and "sky_occlusion" in ran
     assert not any(n.startswith(("tsd_stretch", "tsd_seams")) for n in ran), ran
     assert {"shadow[sky:source1]", "bounce[1]"} <= ran and any(n.startswith("tsd_irradiance") for n in ran)
     s.camera.look_at((3.0, 0.6, 0.5), (0.0, 0.5, 0.5), up=(0.0, 0.0, 1.0))
@@ -160,7 +184,7 @@ def test_plan_and_reuse_when_the_map_turns(tmp_path, renderer):
     assert set(orbit.ran()) == {"forward", "tonemap"}, orbit.ran()
     s.environment.intensity = 2.0
     brighter = renderer.render(s, rs).plan
-    assert "environment" in brighter.reused() and "bounce[1]" in brighter.ran()
+    assert {"environment", "sky_occlusion"} <= set(brighter.reused()) and "bounce[1]" in brighter.ran()
 
 
 def test_black_map_plans_nothing_and_bad_settings_stop_the_frame(tmp_path, renderer):

@@ -14,6 +14,7 @@ from skinlab.scene.interreflection import (
     gather,
     one_rings,
     sender_albedo,
+    sky_visible_share,
     smooth,
     weld,
 )
@@ -70,6 +71,51 @@ def test_perpendicular_plates_receive_their_form_factor(rays):
     assert rows[0] > 0.4 and rows[-1] < 0.15
     # every ray of A's vertices that meets B is counted in A's hit fraction, and the fraction is the form factor
     assert tr.hit_fraction[a.uid] == pytest.approx(PERPENDICULAR_SQUARES, abs=0.02)
+
+
+def test_sky_share_holds_a_sharp_occluder():
+    """The share of a map's light a vertex's rays see, per channel, from three one-sided skies: B's
+    middle (0, 0.5, 0.5) sees all the light from above (nothing is there), none from a cone that only
+    plate A fills, and of the light from below what misses A, as a dense independent count of the
+    geometry gives it (no ray record). Nine SH coefficients of the blocked rays cannot hold such a
+    step. A uniform sky's share is the rays' share (the fourth column); scaling the sky changes nothing."""
+    n = 24
+    a, b = open_book(n)
+    tr = build_transfer([a, b], 64)
+
+    def sky(d):
+        below = d[..., 2] < 0.0
+        cone = (d[..., 2] < -0.6) & (np.abs(d[..., 1]) < 0.3)  # from B's middle and its ring these all meet A
+        return np.stack([below, ~below, cone], -1).astype(np.float64)
+
+    share = sky_visible_share(tr, sky(tr.sky_directions))
+    mid = share[tr.offsets[b.uid] + (n // 2) * (n + 1) + n // 2]
+    d = cosine_directions(np.array([[1.0, 0.0, 0.0]]), 400_000, seed=3)[0]
+    down = d[:, 2] < 0.0
+    t = 0.5 / np.maximum(-d[:, 2], 1e-12)
+    y = 0.5 + t * d[:, 1]
+    hits_a = down & (t * d[:, 0] <= 1.0) & (y >= 0.0) & (y <= 1.0)
+    want_below = 1.0 - hits_a.sum() / down.sum()
+    assert 0.2 < want_below < 0.8  # a real test: A hides part of the light from below
+    assert mid[0] == pytest.approx(want_below, abs=0.05)
+    assert mid[1] == pytest.approx(1.0, abs=1e-6)
+    assert mid[2] == 0.0
+    # uniform light: the share is the rays' share, per channel alike; a brighter sky the same share
+    flat = sky_visible_share(tr, np.ones(tr.sky_directions.shape))
+    assert np.allclose(flat[:, :3], flat[:, 3:4], atol=1e-6)
+    assert np.allclose(sky_visible_share(tr, 5.0 * sky(tr.sky_directions)), share, atol=1e-6)
+    # A's vertices see B above them only toward -x
+    on_a = share[tr.offsets[a.uid] : tr.offsets[a.uid] + tr.counts[a.uid]]
+    assert np.all((on_a >= 0.0) & (on_a <= 1.0)) and on_a[:, 3].max() < 1.0
+
+
+def test_sky_share_of_a_convex_mesh_is_whole():
+    node = MeshNode("box", box_mesh((1.0, 2.0, 3.0)), Material())
+    tr = build_transfer([node], 16)
+    assert not tr.any_blocked
+    d = tr.sky_directions
+    lit = sky_visible_share(tr, np.stack([d[..., 0] > 0.5, d[..., 1] ** 2, np.ones(d.shape[:-1])], -1))
+    assert np.all(lit == 1.0)
 
 
 def test_cosine_directions_are_unit_in_the_hemisphere_and_cosine_weighted():

@@ -3,8 +3,8 @@
 // skinlab/scene/optics/split_sum.py (equirect_uv, sample_levels, table_lookup, specular_occlusion).
 // Diffuse: the irradiance of the map (without its bright sources, which are lights of their own) on
 // every normal, from a 64 x 32 irradiance map (an exact cosine convolution); the map's radiance in nine
-// spherical-harmonic coefficients, world axes, x intensity (Ramamoorthi & Hanrahan 2001) for what the
-// scene hides of it (lib/sky_occlusion.glsl). Specular: the split sum (Karis 2013): the
+// spherical-harmonic coefficients, world axes, x intensity (Ramamoorthi & Hanrahan 2001) for the
+// band ratio of the single scattering at a real index (env_band_ratio). Specular: the split sum (Karis 2013): the
 // radiance prefiltered with the GGX lobe of each roughness (level k of u_env_radiance: roughness
 // k / u_env_max_lod) times F0 A + B from the BRDF table. docs/references.md#environment-lighting.
 #include "skinlab/constants.glsl"
@@ -40,14 +40,6 @@ vec3 env_sh_irradiance(vec3 n) {
     for (int k = 1; k < 4; ++k) e += SH_A1 * y[k] * u_env_sh[k];
     for (int k = 4; k < 9; ++k) e += SH_A2 * y[k] * u_env_sh[k];
     return e;
-}
-
-// What a vertex loses of that irradiance, from its blocked rays' SH coefficients b
-// (skinlab/scene/interreflection.py sky_blocked): sum L_lm b_lm.
-vec3 env_sh_blocked(vec4 b03, vec4 b47, float b8) {
-    return u_env_sh[0] * b03.x + u_env_sh[1] * b03.y + u_env_sh[2] * b03.z + u_env_sh[3] * b03.w
-         + u_env_sh[4] * b47.x + u_env_sh[5] * b47.y + u_env_sh[6] * b47.z + u_env_sh[7] * b47.w
-         + u_env_sh[8] * b8;
 }
 
 // Texture coordinates of a direction in the map's frame (Mitsuba's axes): u = atan2(x, -z) / 2 pi in

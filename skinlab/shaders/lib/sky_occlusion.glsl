@@ -1,35 +1,29 @@
 // Environment light as the surface receives it (skinlab/render/environment.py): the map's irradiance at
 // the shading normal (lib/environment.glsl env_map_irradiance), times the share of it the scene leaves
-// visible at this point (variant SKY_OCCLUSION): 1 - sum L_lm b_lm / E_sh(n), the vertex's blocked rays'
-// SH coefficients (lib/sky_vertex.glsl, interpolated) against the SH irradiance, per channel, in
-// [0, 1]. The light the hidden surfaces send instead is the interreflection's (lib/ambient.glsl).
-// NumPy twin: skinlab/render/environment.py env_diffuse.
+// visible at this point (variant SKY_OCCLUSION): per channel, the vertex's open rays' sum of the map's
+// radiance against all its rays' (skinlab/scene/interreflection.py sky_visible_share; lib/sky_vertex.glsl,
+// interpolated), in [0, 1]. The light the hidden surfaces send instead is the interreflection's
+// (lib/ambient.glsl). NumPy twin: skinlab/render/environment.py env_diffuse.
 #include "lib/environment.glsl"
 #ifdef SKY_OCCLUSION
 #if defined(DEFERRED_SURFACE) || defined(VERTEX_TEXELS)
 // read by the pass, not interpolated: from a G-buffer (techniques/tsd/surface.glsl) or per vertex
 // (passes/bounce_exitance.frag)
-vec4 v_sky03;
-vec4 v_sky47;
-float v_sky8;
+vec4 v_sky;
 #else
-in vec4 v_sky03;
-in vec4 v_sky47;
-in float v_sky8;
+in vec4 v_sky;
 #endif
 #endif
 
-// The share of the map's irradiance at normal n that the blocked rays b hide (0: none), in [0, 1].
-vec3 env_hidden_share(vec3 n, vec4 b03, vec4 b47, float b8) {
-    vec3 total = env_sh_irradiance(n);
-    vec3 hidden = env_sh_blocked(b03, b47, b8);
-    return clamp(hidden / max(total, vec3(1e-20)), 0.0, 1.0);
-}
+// The sky occlusion's record (lib/sky_blocked.glsl): the share of the map's light seen, per channel,
+// and the share of the rays that leave the scene, each in [0, 1].
+vec3 env_sky_share(vec4 sky) { return clamp(sky.rgb, 0.0, 1.0); }
+float env_sky_rays(vec4 sky) { return clamp(sky.a, 0.0, 1.0); }
 
 // The share of the map's light at normal n that this point sees (1 without SKY_OCCLUSION).
 vec3 env_visible_share(vec3 n) {
 #ifdef SKY_OCCLUSION
-    return 1.0 - env_hidden_share(n, v_sky03, v_sky47, v_sky8);
+    return env_sky_share(v_sky);
 #else
     return vec3(1.0);
 #endif
@@ -42,7 +36,7 @@ vec3 env_diffuse_irradiance(vec3 n) {
 // The share of the sky this point sees (1 - its rays' blocked share).
 float env_sky_visibility() {
 #ifdef SKY_OCCLUSION
-    return clamp(1.0 - v_sky03.x / (PI * SH_C0), 0.0, 1.0);
+    return env_sky_rays(v_sky);
 #else
     return 1.0;
 #endif

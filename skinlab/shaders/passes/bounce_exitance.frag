@@ -48,7 +48,7 @@ void main() {
     v_normal = u_normal_matrix * texelFetch(u_vertex_data, d + ivec2(1, 0), 0).xyz;
     v_uv = texelFetch(u_vertex_data, d + ivec2(2, 0), 0).xy;
 #if defined(ENV_MAP) && defined(SKY_OCCLUSION)
-    sky_blocked_fetch(j, v_sky03, v_sky47, v_sky8);
+    sky_blocked_fetch(j, v_sky);
 #endif
     if (dot(v_normal, v_normal) == 0.0) {  // a vertex without a normal (no triangle uses it) sends nothing
         f_exitance = vec4(0.0, 0.0, 0.0, 1.0);

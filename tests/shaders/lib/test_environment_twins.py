@@ -71,28 +71,22 @@ def test_sh_rotation_turns_the_light_with_the_map():
     assert np.allclose(sh.rotation(np.eye(3)), np.eye(9), atol=1e-12)
 
 
-def test_hidden_share_and_occluded_diffuse_match_numpy(glsl):
+def test_sky_share_and_occluded_diffuse_match_numpy(glsl):
+    """The sky occlusion's record (RGB share seen, rays' share) as lib/sky_occlusion.glsl reads it, the
+    hard cases (nothing and everything hidden, out of [0, 1]) included, against env_diffuse."""
     rng = np.random.default_rng(4)
-    coeffs = rng.normal(size=(9, 3)) * 0.3
-    coeffs[0] = [4.0, 3.0, 2.0]
-    n = hard_directions(rng)
-    b = rng.normal(size=(len(n), 9)) * 0.2
-    b[:, 0] = rng.uniform(0, np.pi * sh.SH_C0, len(n))
-    b[0] = 0.0  # nothing blocked
-    b[1] = [np.pi * sh.SH_C0 * 2, *([0.0] * 8)]  # more than everything: all hidden
-    b = b.astype(F32).astype(np.float64)
-    inputs = {"n": n, "b03": b[:, :4], "b47": b[:, 4:8], "b8": b[:, 8]}
-    gpu = glsl.evaluate(
-        "lib/sky_occlusion.glsl", "env_hidden_share(n, b03, b47, b8)", inputs, 3, setup=sh_setup(coeffs)
-    )
-    e_sh = sh.irradiance(coeffs, n)
-    ref = np.clip((b @ coeffs) / np.maximum(e_sh, 1e-20), 0.0, 1.0)
-    assert_close_fp32(gpu, ref, rtol=2e-4, atol=2e-5, what="hidden share")
-    assert np.allclose(ref[0], 0.0) and np.allclose(ref[1], 1.0)
-    # the twin of the whole: the unoccluded irradiance times what is left
-    irr = rng.uniform(0.5, 2.0, (len(n), 3))
-    assert np.allclose(env_diffuse(coeffs, n, b, irr), irr * (1 - ref))
-    assert np.allclose(env_diffuse(coeffs, n), e_sh)
+    sky = rng.uniform(-0.2, 1.2, (300, 4))
+    sky[0], sky[1], sky[2] = 1.0, 0.0, [1.0, 0.5, 0.0, 0.25]
+    sky = sky.astype(F32).astype(np.float64)
+    e = rng.uniform(0.5, 2.0, (len(sky), 3)).astype(F32).astype(np.float64)
+    inputs = {"sky": sky, "e": e}
+    gpu = glsl.evaluate("lib/sky_occlusion.glsl", "e * env_sky_share(sky)", inputs, 3)
+    ref = env_diffuse(e, sky)
+    assert_close_fp32(gpu, ref, rtol=1e-6, atol=1e-7, what="occluded diffuse")
+    assert np.allclose(ref[0], e[0]) and np.allclose(ref[1], 0.0) and np.allclose(ref[2], e[2] * [1, 0.5, 0])
+    assert np.allclose(env_diffuse(e), e)
+    rays = glsl.evaluate("lib/sky_occlusion.glsl", "env_sky_rays(sky)", inputs, 1)
+    assert_close_fp32(rays[:, 0], np.clip(sky[:, 3], 0.0, 1.0), rtol=0, atol=0, what="rays' share")
 
 
 def test_irradiance_map_reads_as_numpy_does_and_is_the_exact_convolution(glsl, ctx):

@@ -156,11 +156,11 @@ class TsdNodeTargets:
 
     def surface_buffer(self, ctx, bounce: bool, sky: bool = False) -> list:
         """The irradiance pass's surface G-buffer (deferred shading, techniques/tsd/surface.glsl): world
-        position and coverage, normal and the tangent's handedness, tangent (its a: the ninth sky
-        coefficient), the vertex colour, with `bounce` the interreflection's irradiance, and with `sky`
-        the sky occlusion's first eight coefficients (two more; the bounce slot is kept so the layout
-        is fixed), as the UV raster interpolates them. Nearest filtering."""
-        want = 7 if sky else 5 if bounce else 4
+        position and coverage, normal and the tangent's handedness, tangent, the vertex colour, with
+        `bounce` the interreflection's irradiance, and with `sky` the sky occlusion's record (one more;
+        the bounce slot is kept so the layout is fixed), as the UV raster interpolates them. Nearest
+        filtering."""
+        want = 6 if sky else 5 if bounce else 4
         while len(self.surface) < want:
             t = ctx.texture((self.size, self.size), 4, dtype="f4")
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)

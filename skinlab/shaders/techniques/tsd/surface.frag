@@ -2,7 +2,7 @@
 // Texture-space diffusion's surface G-buffer, the writing side: the mesh rasterised at its UVs
 // (techniques/tsd/uv.vert), each texel's interpolated vertex outputs written as they are, for the
 // irradiance pass's variant DEFERRED_SURFACE to shade each texel once (techniques/tsd/surface.glsl);
-// with SKY_OCCLUSION the vertex's sky coefficients too (lib/sky_vertex.glsl).
+// with SKY_OCCLUSION the vertex's sky occlusion too (lib/sky_vertex.glsl).
 in vec3 v_world;
 in vec3 v_normal;
 in vec2 v_uv;
@@ -12,9 +12,7 @@ in vec4 v_color;
 in vec3 v_bounce;
 #endif
 #ifdef SKY_OCCLUSION
-in vec4 v_sky03;
-in vec4 v_sky47;
-in float v_sky8;
+in vec4 v_sky;
 #endif
 layout(location = 0) out vec4 f_surface0;
 layout(location = 1) out vec4 f_surface1;
@@ -25,7 +23,6 @@ layout(location = 4) out vec4 f_surface4;
 #endif
 #ifdef SKY_OCCLUSION
 layout(location = 5) out vec4 f_surface5;
-layout(location = 6) out vec4 f_surface6;
 #endif
 void main() {
     f_surface0 = vec4(v_world, 1.0);
@@ -36,11 +33,8 @@ void main() {
 #elif defined(SKY_OCCLUSION)
     f_surface4 = vec4(0.0);
 #endif
-#ifdef SKY_OCCLUSION
-    f_surface2 = vec4(v_tangent.xyz, v_sky8);
-    f_surface5 = v_sky03;
-    f_surface6 = v_sky47;
-#else
     f_surface2 = vec4(v_tangent.xyz, 0.0);
+#ifdef SKY_OCCLUSION
+    f_surface5 = v_sky;
 #endif
 }

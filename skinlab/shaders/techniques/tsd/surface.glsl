@@ -2,7 +2,7 @@
 // techniques/tsd/irradiance.frag, drawn as one fullscreen triangle over the UV layout): the vertex
 // outputs of techniques/tsd/uv.vert at each texel, as techniques/tsd/surface.frag rasterised them, become the
 // globals the irradiance code reads (v_world, v_normal, v_uv, v_tangent, v_color, v_bounce for
-// lib/ambient.glsl and v_sky03/47/8 for lib/sky_occlusion.glsl). A vertex output added to techniques/tsd/uv.vert must be carried here too (the fullscreen
+// lib/ambient.glsl and v_sky for lib/sky_occlusion.glsl). A vertex output added to techniques/tsd/uv.vert must be carried here too (the fullscreen
 // pass would not link without it). The same values, so the same light, as rasterising the mesh with the shading in
 // the fragment shader, but each texel shaded once: a software rasteriser shades whole blocks of
 // pixels for every small UV triangle that touches them (about 2.4x the covered texels on the head).
@@ -16,8 +16,7 @@ uniform sampler2D u_surface3;  // the vertex colour
 uniform sampler2D u_surface4;  // the interreflection's irradiance (lib/bounce_vertex.glsl)
 #endif
 #ifdef SKY_OCCLUSION
-uniform sampler2D u_surface5;  // the sky occlusion's coefficients 0-3 (lib/sky_vertex.glsl)
-uniform sampler2D u_surface6;  // and 4-7; the 9th in u_surface2's a
+uniform sampler2D u_surface5;  // the sky occlusion's record (lib/sky_vertex.glsl)
 #endif
 vec3 v_world;
 vec3 v_normal;
@@ -41,9 +40,7 @@ bool load_surface() {
     v_bounce = texelFetch(u_surface4, p, 0).rgb;
 #endif
 #ifdef SKY_OCCLUSION
-    v_sky03 = texelFetch(u_surface5, p, 0);
-    v_sky47 = texelFetch(u_surface6, p, 0);
-    v_sky8 = s2.a;
+    v_sky = texelFetch(u_surface5, p, 0);
 #endif
     return true;
 }
