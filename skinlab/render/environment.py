@@ -75,17 +75,65 @@ class SkyParams:
     transfer: BounceTransfer
     prepared: envmap.PreparedMap
     rotation_deg: float
+    meshes: list | None = None  # the transfer's mesh nodes (rays toward the smooth part's small sources)
 
 
-def sky_share(transfer: BounceTransfer, prepared: envmap.PreparedMap, rotation_deg: float) -> np.ndarray:
+def smooth_sources(prepared: envmap.PreparedMap) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The bright small regions left in the map's smooth part (past the frame's shadowed sources: the
+    studio map's third lamp), found as envmap.extract_sources finds sources, in the map's frame:
+    (directions (J, 3), irradiances (J, 3), the smooth part without them at the level SKY_LOD,
+    its irradiance map). Cached on disk per prepared map (a prefilter: seconds)."""
+    from skinlab.cache import stored
+
+    def make():
+        found, rest = envmap.extract_sources(prepared.levels[0])
+        width = prepared.levels[0].shape[1]
+        level = split_sum.prefilter(rest, width=width)[min(SKY_LOD, split_sum.LEVELS - 1)] if found else np.zeros(0)
+        irr = split_sum.irradiance_map(rest) if found else np.zeros(0)
+        d = np.array([s.direction for s in found], np.float64).reshape(-1, 3)
+        e = np.array([s.irradiance for s in found], np.float64).reshape(-1, 3)
+        return d, e, np.asarray(level, np.float32), np.asarray(irr, np.float32)
+
+    if prepared.uniform or len(prepared.levels) <= SKY_LOD:
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0)
+    return _SMOOTH.get(prepared.key, lambda: stored("environment", f"{prepared.key}-sky", make, "sky sources"))
+
+
+_SMOOTH = Memo(4)  # prepared map key -> smooth_sources
+
+
+def sky_share(
+    transfer: BounceTransfer, prepared: envmap.PreparedMap, rotation_deg: float, meshes: list | None = None
+) -> np.ndarray:
     """(V, 4) the sky occlusion's per-vertex record (lib/sky_blocked.glsl): the share of the map's
-    smooth part each vertex's rays see, per channel, and the share of its rays that leave the scene."""
-    from skinlab.scene.interreflection import sky_visible_share
+    smooth part each vertex sees, per channel, and the share of its rays that leave the scene. The
+    vertex's rays read the smooth part at level SKY_LOD; with `meshes` (the transfer's nodes) the small
+    bright regions left in it (smooth_sources) are taken out of that and seen along one ray per vertex
+    each instead: share = (s' E'(n) + sum_j open_j E_j max(n.l_j, 0)) / (E'(n) + sum_j E_j max(n.l_j, 0)),
+    s' the rays' share of the rest without them, E' its irradiance at the vertex normal."""
+    from skinlab.scene.interreflection import open_toward, sky_visible_share, world_geometry
 
-    level = prepared.levels[min(int(SKY_LOD), len(prepared.levels) - 1)]
+    directions, irradiances, level_rest, irr_rest = smooth_sources(prepared)
+    lamps = meshes is not None and len(directions) > 0
+    level = level_rest if lamps else prepared.levels[min(SKY_LOD, len(prepared.levels) - 1)]
     u, v = _SKY_UV.get(transfer.key, lambda: split_sum.equirect_uv(transfer.sky_directions.astype(np.float64)))
     # the map turned by R_y(rotation) about +Y reads a world direction at u + rotation / 360 (equirect_uv)
-    return sky_visible_share(transfer, split_sum.bilinear(level, np.mod(u + rotation_deg / 360.0, 1.0), v))
+    out = sky_visible_share(transfer, split_sum.bilinear(level, np.mod(u + rotation_deg / 360.0, 1.0), v))
+    if not lamps:
+        return out
+    assert meshes is not None
+    rot = envmap.rotation_y(rotation_deg)
+    normals = np.concatenate([world_geometry(n)[1] for n in meshes])
+    nu, nv = split_sum.equirect_uv(normals @ rot)  # the normals in the map's frame (u_env_to_map)
+    e_rest = split_sum.bilinear(irr_rest, nu, nv)
+    toward = directions @ rot.T  # world directions of the sources
+    e_lamps = np.maximum(normals @ toward.T, 0.0)[..., None] * irradiances[None]  # (V, J, 3)
+    seen = open_toward(meshes, transfer.key, toward)[..., None]
+    num = out[:, :3] * e_rest + (seen * e_lamps).sum(1)
+    den = e_rest + e_lamps.sum(1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out[:, :3] = np.where(den > 0.0, np.clip(num / np.where(den > 0.0, den, 1.0), 0.0, 1.0), out[:, :3])
+    return out
 
 
 _SKY_UV = Memo(4)  # transfer key -> the rays' (u, v) in the unturned map's frame
@@ -182,7 +230,7 @@ def plan_sky(
         (SKY_WIDTH, max(1, math.ceil(transfer.total_vertices / SKY_WIDTH))),
         f"what the scene hides of the sky: {transfer.total_vertices} vertices x {transfer.rays} rays "
         "(the interreflection's) against the map's smooth part, the visible share per channel",
-        SkyParams(transfer, prepared, rotation),
+        SkyParams(transfer, prepared, rotation, list(meshes)),
         inputs=(transfer.key, prepared.key, rotation),
     )
 
@@ -322,7 +370,7 @@ class SkyOcclusionPass(RenderPass):
         n = transfer.total_vertices
         rows = max(1, math.ceil(n / SKY_WIDTH))
         data = np.ones((rows * SKY_WIDTH, 4), np.float32)
-        data[:n] = sky_share(transfer, prm.prepared, prm.rotation_deg)
+        data[:n] = sky_share(transfer, prm.prepared, prm.rotation_deg, prm.meshes)
         tex = self.r.ctx.texture((SKY_WIDTH, rows), 4, data.tobytes(), dtype="f4")
         tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
         self.held = (key, tex)

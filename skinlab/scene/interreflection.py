@@ -347,6 +347,41 @@ def sky_visible_share(transfer: BounceTransfer, radiance: np.ndarray) -> np.ndar
     return out.astype(np.float32)
 
 
+def open_toward(nodes: list[MeshNode], key: str, directions: np.ndarray) -> np.ndarray:
+    """(V, J) whether a ray from each vertex (global order, off its surface as the records' rays) along
+    each world direction `directions` (J, 3) leaves the scene: the visibility of a small bright source,
+    sharper than a vertex's cosine-weighted rays hold it. `key`: the transfer's (the geometry's) key,
+    under which the ray intersector is kept. A vertex without a normal sees everything."""
+    p_all, n_all, intersector, diag = _INTERSECTORS.get(key, lambda: _intersector(nodes))
+    d = np.asarray(directions, np.float64).reshape(-1, 3)
+    out = np.ones((len(p_all), len(d)), bool)
+    has = np.linalg.norm(n_all, axis=1) > 0
+    origins = p_all[has] + n_all[has] * (RAY_OFFSET * diag)
+    for j, w in enumerate(d):
+        out[has, j] = ~intersector.intersects_any(origins, np.broadcast_to(w, origins.shape).copy())
+    return out
+
+
+_INTERSECTORS = Memo(2)  # geometry key -> world positions, normals, Embree intersector, bounding diagonal
+
+
+def _intersector(nodes: list[MeshNode]):
+    import trimesh
+    from trimesh.ray.ray_pyembree import RayMeshIntersector
+
+    pos, nrm, faces, start = [], [], [], 0
+    for node in nodes:
+        p, n = world_geometry(node)
+        pos.append(p)
+        nrm.append(np.where(np.linalg.norm(node.mesh.normals, axis=1, keepdims=True) > 0, n, 0.0))
+        faces.append(node.mesh.indices.astype(np.int64) + start)
+        start += len(p)
+    p_all, n_all = np.concatenate(pos), np.concatenate(nrm)
+    mesh = trimesh.Trimesh(p_all, np.concatenate(faces), process=False)
+    diag = float(np.linalg.norm(p_all.max(0) - p_all.min(0))) or 1.0
+    return p_all, n_all, RayMeshIntersector(mesh), diag
+
+
 def _sum_rows(owner: np.ndarray, values: np.ndarray, n: int) -> np.ndarray:
     """(n, C): the rows of `values` (M, C) summed by `owner` (M,) in their order (np.add.at's sums,
     through bincount per column: several times faster)."""
@@ -400,3 +435,4 @@ def sender_albedo(base, metallic, specular) -> np.ndarray:
 
 def clear_cache() -> None:
     _CACHE.clear()
+    _INTERSECTORS.clear()

@@ -157,6 +157,47 @@ def test_sky_record_reads_the_turned_map_along_each_ray(tmp_path, rotation):
         assert np.abs(got - sky_share(tr, prepared, 0.0)).max() > 0.02  # the turn matters
 
 
+def open_book_visible(w):
+    """Whether direction w (N, 3) from B's middle (0, 0.5, 0.5) of the open book misses plate A."""
+    t = 0.5 / np.maximum(-w[:, 2], 1e-12)
+    y = 0.5 + t * w[:, 1]
+    return ~((w[:, 2] < 0.0) & (t * w[:, 0] <= 1.0) & (y >= 0.0) & (y <= 1.0))
+
+
+def test_a_small_source_left_in_the_smooth_part_is_hidden_by_a_ray_of_its_own(tmp_path):
+    """Three lamps: the two brightest become shadowed lights, the third stays in the smooth part, placed
+    where plate A hides it from B's middle. With a ray per vertex toward it (sky_share with the meshes)
+    the share B's middle sees is the exact one, a sum over the smooth part's texels of L cos and the
+    open book's own geometry (no ray record); its 64 rays alone cannot be relied on to meet it."""
+    from skinlab.render.environment import smooth_sources
+    from skinlab.scene.interreflection import open_toward
+
+    s = open_book_scene(Material("matte", MATTE))
+    px = np.full((32, 64, 3), 0.05, np.float32)
+    px[2:4, 40:42] = 2000.0  # up
+    px[8:10, 20:22] = 2000.0  # up, toward -x
+    px[15:17, 5:7] = 1000.0  # on the horizon, 30 degrees from -z toward +x: toward A from B
+    prepared = envmap.prepare(write_map(tmp_path / "lamps.exr", px))
+    assert len(prepared.sources) == 2
+    directions, irradiances, _, _ = smooth_sources(prepared)
+    lamp = split_sum.texel_directions(64, 32)[15:17, 5:7].reshape(-1, 3).mean(0)
+    assert np.degrees(np.arccos(np.clip(directions @ (lamp / np.linalg.norm(lamp)), -1, 1))).min() < 3.0
+    nodes = s.mesh_nodes()
+    tr = build_transfer(nodes, 64)
+    b = s.find("B")
+    mid = tr.offsets[b.uid] + (N // 2) * (N + 1) + N // 2
+    assert not open_toward(nodes, tr.key, directions @ envmap.rotation_y(0.0).T)[mid].all()
+    got = sky_share(tr, prepared, 0.0, nodes)[mid, :3]
+    rest = prepared.levels[0].astype(np.float64)
+    h, w = rest.shape[:2]
+    d = split_sum.texel_directions(w, h).reshape(-1, 3)
+    weight = split_sum.texel_solid_angles(w, h).reshape(-1, 1) * np.maximum(d[:, 0], 0.0)[:, None]  # n = +x
+    lit = rest.reshape(-1, 3) * weight
+    want = (lit * open_book_visible(d)[:, None]).sum(0) / lit.sum(0)
+    assert want.max() < 0.7  # the hidden lamp is most of B's light
+    assert np.allclose(got, want, atol=0.05), (got, want)
+
+
 def test_plan_and_reuse_when_the_map_turns(tmp_path, renderer):
     """Turning the map re-runs what depends on light (the source's shadow map, the share of the map's
     light each vertex sees, the interreflection, texture-space irradiance and what follows) and nothing

@@ -13,10 +13,12 @@ from skinlab.scene.interreflection import (
     cosine_directions,
     gather,
     one_rings,
+    open_toward,
     sender_albedo,
     sky_visible_share,
     smooth,
     weld,
+    world_geometry,
 )
 from skinlab.scene.materials import Material
 from skinlab.scene.mesh import Mesh
@@ -107,6 +109,26 @@ def test_sky_share_holds_a_sharp_occluder():
     # A's vertices see B above them only toward -x
     on_a = share[tr.offsets[a.uid] : tr.offsets[a.uid] + tr.counts[a.uid]]
     assert np.all((on_a >= 0.0) & (on_a <= 1.0)) and on_a[:, 3].max() < 1.0
+
+
+def test_rays_toward_a_source_meet_what_is_in_the_way():
+    """One ray per vertex and direction: from B's middle, toward A (down at 60 degrees) it is blocked,
+    along B's normal and straight up it leaves, behind B (through B itself) it is blocked; A's vertices
+    see B toward -x and up where it is in the way; a convex box sees every direction it faces."""
+    n = 24
+    a, b = open_book(n)
+    tr = build_transfer([a, b], 16)
+    toward = np.array([[0.5, 0.0, -np.sqrt(0.75)], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [-0.6, 0.0, 0.8]])
+    seen = open_toward([a, b], tr.key, toward)
+    assert seen.shape == (tr.total_vertices, 4)
+    mid = tr.offsets[b.uid] + (n // 2) * (n + 1) + n // 2
+    assert seen[mid].tolist() == [False, True, True, False]
+    on_a = seen[tr.offsets[a.uid] : tr.offsets[a.uid] + tr.counts[a.uid]]
+    assert on_a[:, 2].all() and not on_a[:, 3].all() and on_a[:, 3].any()
+    box = MeshNode("box", box_mesh((1.0, 2.0, 3.0)), Material())
+    facing = world_geometry(box)[1] @ toward.T > 1e-6  # what a vertex receives a source from
+    seen = open_toward([box], build_transfer([box], 4).key, toward)
+    assert seen[facing].all() and facing.any()
 
 
 def test_sky_share_of_a_convex_mesh_is_whole():
