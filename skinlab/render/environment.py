@@ -96,7 +96,9 @@ def smooth_sources(prepared: envmap.PreparedMap) -> tuple[np.ndarray, np.ndarray
 
     if prepared.uniform or len(prepared.levels) <= SKY_LOD:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0)
-    return _SMOOTH.get(prepared.key, lambda: stored("environment", f"{prepared.key}-sky", make, "sky sources"))
+    return _SMOOTH.get(
+        prepared.key, lambda: stored("environment", f"{prepared.key}-sky", make, "sky sources", code=__name__)
+    )
 
 
 _SMOOTH = Memo(4)  # prepared map key -> smooth_sources
