@@ -231,7 +231,8 @@ def plan_sky(
         "sky_blocked",
         (SKY_WIDTH, max(1, math.ceil(transfer.total_vertices / SKY_WIDTH))),
         f"what the scene hides of the sky: {transfer.total_vertices} vertices x {transfer.rays} rays "
-        "(the interreflection's) against the map's smooth part, the visible share per channel",
+        "(the interreflection's) against the map's smooth part, the visible share per channel; one ray "
+        "per vertex toward each small bright region left in it",
         SkyParams(transfer, prepared, rotation, list(meshes)),
         inputs=(transfer.key, prepared.key, rotation),
     )
