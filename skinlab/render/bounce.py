@@ -177,8 +177,8 @@ class BouncePass(RenderPass):
         self.gathered: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None  # before the one-ring average
         # (transfer key, sender index, sender entries, ring index, ring entries)
         self.records: tuple | None = None
-        # (mesh uid, version) -> (mesh, its vertices as a texture: bounce_exitance.frag u_vertex_data)
-        self._vertex_data: dict[tuple[int, int], tuple[object, moderngl.Texture]] = {}
+        # (mesh uid, version) -> its vertices as a texture (bounce_exitance.frag u_vertex_data)
+        self._vertex_data: dict[tuple[int, int], moderngl.Texture] = {}
         self._footprints: dict[tuple[int, int], float] = {}  # (mesh uid, version) -> uv_footprint
 
     # -- GPU objects ---------------------------------------------------------------------
@@ -229,20 +229,18 @@ class BouncePass(RenderPass):
         held = self._vertex_data.get(key)
         if held is None:
             n = len(mesh.positions)
-            rows = np.zeros((n, 3, 4), np.float32)
-            rows[:, 0, :3] = mesh.positions
-            rows[:, 1, :3] = mesh.normals
-            if mesh.uvs is not None:
-                rows[:, 2, :2] = mesh.uvs
             height = max(1, math.ceil(n / VERTEX_TEXTURE_WIDTH))
             padded = np.zeros((height * VERTEX_TEXTURE_WIDTH, 3, 4), np.float32)
-            padded[:n] = rows
+            padded[:n, 0, :3] = mesh.positions
+            padded[:n, 1, :3] = mesh.normals
+            if mesh.uvs is not None:
+                padded[:n, 2, :2] = mesh.uvs
             tex = self.r.ctx.texture((3 * VERTEX_TEXTURE_WIDTH, height), 4, padded.tobytes(), dtype="f4")
             tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
             for old_key in [k for k in self._vertex_data if k[0] == mesh.uid]:
-                self._vertex_data.pop(old_key)[1].release()
-            held = self._vertex_data[key] = (mesh, tex)
-        return held[1]
+                self._vertex_data.pop(old_key).release()
+            held = self._vertex_data[key] = tex
+        return held
 
     def _release_records(self) -> None:
         if self.records is not None:
@@ -257,7 +255,7 @@ class BouncePass(RenderPass):
         self.targets.clear()
         self.exitance = self.gathered = None
         self._release_records()
-        for _, tex in self._vertex_data.values():
+        for tex in self._vertex_data.values():
             tex.release()
         self._vertex_data.clear()
 

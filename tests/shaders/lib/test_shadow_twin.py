@@ -24,23 +24,34 @@ _VIEW[2, 3] = -4.0  # the light at z = 4, looking down -z
 PERSPECTIVE = CLIP_TO_TEXTURE @ tf.perspective(math.radians(40), 1.0, 2.0, 6.0) @ _VIEW
 
 
-@pytest.mark.parametrize("matrix", ["orthographic", "perspective"])
-def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
-    rng = np.random.default_rng(7)
-    h, w = 16, 24
+def nearest_depth_map(ctx, rng, h: int, w: int):
+    """A random depth map (0.2-0.9) and its depth-compare texture ('<=', NEAREST: the twins' filtering)."""
     depth = rng.uniform(0.2, 0.9, (h, w)).astype(np.float32)
     tex = ctx.depth_texture((w, h), data=depth.tobytes())
     tex.compare_func = "<="
     tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
     tex.repeat_x = tex.repeat_y = False
+    return depth, tex
+
+
+def world_at(m: np.ndarray, uv: np.ndarray, z: np.ndarray, perspective: bool) -> np.ndarray:
+    """World points whose shadow-map texture coordinates under `m` are (uv, z)."""
+    ndc = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, z * 2 - 1, np.ones(len(uv))], 1)
+    world = ndc @ np.linalg.inv(m @ np.linalg.inv(CLIP_TO_TEXTURE)).T if perspective else ndc
+    return world[:, :3] / world[:, 3:]
+
+
+@pytest.mark.parametrize("matrix", ["orthographic", "perspective"])
+def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
+    rng = np.random.default_rng(7)
+    h, w = 16, 24
+    depth, tex = nearest_depth_map(ctx, rng, h, w)
     m = ORTHO if matrix == "orthographic" else PERSPECTIVE
     n = 2000
     # texel centres jittered away from texel borders, so NEAREST picks the same texel on both sides
     uv = (rng.integers(0, [w, h], (n, 2)) + rng.uniform(0.2, 0.8, (n, 2))) / [w, h]
     z = rng.uniform(0.0, 1.0, n)
-    ndc = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, z * 2 - 1, np.ones(n)], 1)
-    world = ndc @ np.linalg.inv(m @ np.linalg.inv(CLIP_TO_TEXTURE)).T if matrix == "perspective" else ndc
-    world = world[:, :3] / world[:, 3:]
+    world = world_at(m, uv, z, matrix == "perspective")
     world[:50, 0] = 50.0  # outside the map: lit
     nol = rng.uniform(-0.2, 1.0, n)  # includes grazing and back-facing (the slope clamps)
     world, nol = world.astype(np.float32).astype(np.float64), nol.astype(np.float32).astype(np.float64)
@@ -153,18 +164,12 @@ def test_shadow_pcf_area_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
     plain PCF's test holds for every tap)."""
     rng = np.random.default_rng(11)
     h, w = 32, 48
-    depth = rng.uniform(0.2, 0.9, (h, w)).astype(np.float32)
-    tex = ctx.depth_texture((w, h), data=depth.tobytes())
-    tex.compare_func = "<="
-    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    tex.repeat_x = tex.repeat_y = False
+    depth, tex = nearest_depth_map(ctx, rng, h, w)
     m = ORTHO if matrix == "orthographic" else PERSPECTIVE
     n = 1500
     uv = rng.uniform(0.1, 0.9, (n, 2))
     z = rng.uniform(0.0, 1.0, n)
-    ndc = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, z * 2 - 1, np.ones(n)], 1)
-    world = ndc @ np.linalg.inv(m @ np.linalg.inv(CLIP_TO_TEXTURE)).T if matrix == "perspective" else ndc
-    world = world[:, :3] / world[:, 3:]
+    world = world_at(m, uv, z, matrix == "perspective")
     texel = shadow.shadow_texel_scale(m, world, (w, h))[0]  # world units per map texel there
     ang = rng.uniform(0, np.pi, n)
     la, lb = (texel * 10 ** rng.uniform(-0.3, 1.6, n) for _ in range(2))

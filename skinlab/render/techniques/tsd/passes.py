@@ -588,7 +588,7 @@ class TsdBlurPass(TsdPass):
         taps_t, taps_w = blur_taps(step.taps)
         set_array(prog, "u_tap_t", taps_t.astype(np.float32), MAX_TAPS)
         set_array(prog, "u_tap_w", taps_w.astype(np.float32), MAX_TAPS)
-        set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_sigma_mm": step.sigma_mm, "u_taps": step.taps})
+        set_uniforms(prog, {"u_src": 0, "u_stretch": 1, "u_sigma_mm": step.sigma_mm})
         t.stretch.use(1)
         for axis, (a, b) in enumerate(steps):
             a.use(0)

@@ -7,11 +7,13 @@
 // (rgb = E a, a = coverage).
 #include "skinlab/constants.glsl"
 #define MAX_TAPS 31
+#ifndef TSD_TAPS
+#error "techniques/tsd/blur.glsl needs TSD_TAPS (the step's tap count, odd, at most MAX_TAPS)"
+#endif
 uniform sampler2D u_src;
 uniform sampler2D u_stretch;
 uniform int u_axis;
 uniform float u_sigma_mm;
-uniform int u_taps;
 uniform float u_tap_t[MAX_TAPS];
 uniform float u_tap_w[MAX_TAPS];
 
@@ -21,12 +23,7 @@ vec4 tsd_blur_at(ivec2 p) {
     float mm = max(texelFetch(u_stretch, p, 0)[u_axis], TSD_MIN_MM_PER_TEXEL);
     float step_texels = min(u_sigma_mm / mm, TSD_MAX_STEP_TEXELS);
     vec4 sum = vec4(0.0);
-#ifdef TSD_TAPS
-    for (int i = 0; i < TSD_TAPS; ++i) {  // a constant count: the loop unrolls
-#else
-    for (int i = 0; i < MAX_TAPS; ++i) {
-        if (i >= u_taps) break;
-#endif
+    for (int i = 0; i < TSD_TAPS; ++i) {  // the pass's tap count, a compile-time constant: the loop unrolls
         float x = u_tap_t[i] * step_texels;
         float fl = floor(x);
         float f = x - fl;
