@@ -202,10 +202,9 @@ class ShadowPass(RenderPass):
         vp = light_view_proj(light, lo, hi)
         if dist is None:
             fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        else:  # "no surface": as far as it gets
+        else:  # "no surface": as far as it gets (the first surface writes R and G = 1e30 whole, unmasked)
             fbo.color_mask = (True, True, True, True)
             fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
-            fbo.color_mask = (True, False, False, False)  # the first surface; G is the next part's entry
         fbo.use()
         # no polygon offset: its slope term (factor x the polygon's depth slope) grows without bound
         # toward an occluder's silhouette in the light's view; the lookup's bias is sized to the
@@ -273,8 +272,11 @@ class ShadowPass(RenderPass):
         exit_fbo.clear(1e30, 0.0, 0.0, 0.0, depth=1.0)
         exit_fbo.use()
         self._draw(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp, facing=AWAY)
-        second_fbo.color_mask = (False, True, False, False)  # clears and writes G only
-        second_fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
+        # G is 1e30 wherever this layer has not written (the first draw's clear and texels): only the
+        # depth buffer is cleared (a colour clear through a mask is a read-modify-write of every texel)
+        second_fbo.color_mask = (False, False, False, False)
+        second_fbo.clear(depth=1.0)
+        second_fbo.color_mask = (False, True, False, False)  # writes G only
         second_fbo.use()
         self._draw(
             frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 2}, {"u_light_eye": eye, "u_part_gap": part_gap(frame)},

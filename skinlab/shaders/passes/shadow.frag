@@ -21,7 +21,7 @@ uniform sampler2D u_exit;
 uniform float u_part_gap;
 #endif
 #else
-out float f_distance;
+out vec2 f_distance;  // the whole texel: G as cleared (no entry yet), so no colour mask's read-modify-write
 #endif
 #endif
 void main() {
@@ -41,7 +41,7 @@ void main() {
     f_layer = vec2(0.0, dist);  // the distance map's green channel (its red is masked)
 #endif
 #else
-    f_distance = dist;
+    f_distance = vec2(dist, 1e30);
 #endif
 #endif
 }
