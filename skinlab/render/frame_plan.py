@@ -41,7 +41,8 @@ def shadow_pass_name(light: LightNode) -> str:
 class ShadowParams:
     light: LightNode
     slot: int  # shadow map slot 0 or 1
-    distance: bool  # also a light-space distance map (a technique's translucency)
+    distance: bool  # also a light-space distance map of the first surface (translucency, soft shadows)
+    layers: bool = False  # and the part layers, the first part's exit and the next entry (translucency)
 
 
 @dataclass

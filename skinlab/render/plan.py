@@ -14,6 +14,7 @@ from .lights import soft_shadow
 from .registry import get_technique
 from .reuse import light_placement, scene_geometry
 from .technique import ForwardParams, PlanContext
+from .translucency import part_layer_size
 
 if TYPE_CHECKING:
     from skinlab.scene.graph import LightNode, Scene
@@ -71,6 +72,7 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
     if sky is not None:
         environment.append(sky)
     distance = tp.shadow_distance and bool(shadow_lights)
+    layer_size = part_layer_size(settings.shadow_size)
     geometry = scene_geometry(scene) if shadow_lights else ()
     plan.passes += environment
     for slot, l in enumerate(shadow_lights[:2]):
@@ -85,9 +87,10 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
                 (settings.shadow_size, settings.shadow_size),
                 f"{l.kind} light '{l.name}' casts shadows on {len(meshes)} visible mesh(es)"
                 + (f"; distance map for {' and '.join(why)}" if dist else "")
+                + (f" (the parts' exit and next entry at {layer_size}x{layer_size})" if distance else "")
                 + (f" ({soft_size(l)})" if soft else ""),
-                ShadowParams(l, slot, dist),
-                inputs=(slot, dist, light_placement(l), geometry),
+                ShadowParams(l, slot, dist, distance),
+                inputs=(slot, dist, distance, light_placement(l), geometry),
             )
         )
     for l in shadow_lights[2:]:

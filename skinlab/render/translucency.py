@@ -38,6 +38,19 @@ def plan_translucency(ctx, needed: bool, enabled: bool) -> bool:
     return use
 
 
+# The part layers (the first part's exit and the entry into the next, skinlab/shaders/passes/shadow.frag
+# SHADOW_LAYER) have this many times fewer texels per side than the shadow map and its first-surface
+# distance map: they only tell which part a point lies in and how thick the first part it crossed
+# was (a plane's exit is exact at any size; the first surface, which sets a flat part's own thickness,
+# keeps the full size), and their two draws were 60 of the pass's 100 ms on the head at 2048.
+PART_LAYER_DIVISOR = 2
+
+
+def part_layer_size(shadow_size: int) -> int:
+    """Texels per side of the part layers of a shadow map `shadow_size` texels per side."""
+    return max(int(shadow_size) // PART_LAYER_DIVISOR, 1)
+
+
 def thickness_shrink(frame) -> float:
     """How far (scene units) the thickness lookup moves the point inward along its normal: half a
     texel of the distance maps, which span the scene's bounding sphere (skinlab/render/passes/shadow.py:
@@ -51,8 +64,11 @@ def thickness_shrink(frame) -> float:
 
 
 # A surface farther along the light than the first part's exit by more than this many texels of the
-# distance maps (2 x thickness_shrink each) belongs to another part: its light crossed the first
-# part, then air (skinlab/shaders/passes/shadow.frag SHADOW_LAYER; lib/sss_translucency.glsl).
+# distance maps (2 x thickness_shrink each; PART_LAYER_DIVISOR times fewer of the part layers')
+# belongs to another part: its light crossed the first part, then air (skinlab/shaders/passes/shadow.frag
+# SHADOW_LAYER; lib/sss_translucency.glsl). Kept in distance-map texels when the layers were halved:
+# against the back-lit ear's truth the gap of four layer texels let 0.3 points more blue through
+# (docs/tsd.md "Third round").
 PART_GAP_TEXELS = 4.0
 
 
@@ -62,11 +78,11 @@ def part_gap(frame) -> float:
 
 
 def bind_translucency(prog, frame, units, fallback=None) -> None:
-    """The distance maps and their exit layers (u_distance0/1, u_exit0/1 on units from `units`), the
+    """The distance maps and their part layers (u_distance0/1, u_exit0/1, u_entry0/1 on units from `units`), the
     lights' eyes, the shrink and the part gap for lib/sss_translucency.glsl. A slot without a
     distance map gets the other slot's (never sampled: no light points at it) or `fallback` (a
     texture) when neither has one."""
-    for name in ("distance", "exit"):
+    for name in ("distance", "exit", "entry"):
         maps = [frame.targets.get(f"shadow_{name}{slot}") for slot in (0, 1)]
         present = [m for m in maps if m is not None] or [fallback]
         for slot, m in enumerate(maps):

@@ -9,6 +9,7 @@ import skinlab.render.passes.shadow as shadow_pass
 from skinlab.render.passes.shadow import ShadowPass
 from skinlab.render.settings import RenderSettings
 from skinlab.render.shadow_facing import AWAY, TOWARD, layer_triangles
+from skinlab.render.translucency import part_layer_size
 from skinlab.scene.graph import MeshNode
 from skinlab.scene.materials import Material
 from skinlab.scene.primitives import sphere_mesh
@@ -51,6 +52,9 @@ def distance_layers(renderer, scene) -> dict[str, np.ndarray]:
         if dist is not None:
             out[f"distance{slot}"] = np.frombuffer(dist.read(), np.float32).copy()
             out[f"exit{slot}"] = np.frombuffer(sp.layers[slot][0].read(), np.float32).copy()
+            out[f"entry{slot}"] = np.frombuffer(sp.layers[slot][2].read(), np.float32).copy()
+            n = part_layer_size(512)  # the part layers' own size, half the shadow map's
+            assert n == 256 and sp.layers[slot][0].size == sp.layers[slot][2].size == (n, n)
     return out
 
 

@@ -113,6 +113,10 @@ def test_a_straight_edge_casts_the_penumbra_of_a_disk_light(renderer):
     light.angular_radius = theta
     res = renderer.render(s, rs)
     assert "soft shadows (angular radius 4 deg)" in res.plan.explain()
+    shadow_pass = next(p for p in res.plan.passes if p.kind == "shadow")
+    # the first surface's distance map for the blocker search; the part layers only for translucency
+    assert shadow_pass.params.distance and not shadow_pass.params.layers
+    assert "exit and next entry" not in shadow_pass.reason
     soft = res.hdr[48, :, 0]
     x = pixel_x(96, 1.0)
     want = 2.04 * theta * disk_edge_width()

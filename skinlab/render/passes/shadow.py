@@ -18,6 +18,7 @@ from skinlab.render.lights import SOFT_KEY, soft_shadow
 from skinlab.render.shadow_facing import AWAY, TOWARD, layer_triangles
 from skinlab.render.technique import RenderPass
 from skinlab.render.texture_units import TextureUnits
+from skinlab.render.translucency import part_gap, part_layer_size
 from skinlab.scene import transform as tf
 from skinlab.scene.graph import LightNode
 
@@ -112,52 +113,53 @@ class ShadowPass(RenderPass):
         super().__init__(renderer)
         # slot -> (depth texture, framebuffer, distance texture or None)
         self.maps: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer, moderngl.Texture | None]] = {}
-        # with distance maps: per slot (exit texture, its framebuffer, the distance texture's second
-        # layer's framebuffer, their depth buffer)
+        # with part layers: per slot (exit texture, its framebuffer, next-entry texture, its
+        # framebuffer, their depth buffer), part_layer_size texels per side
         self.layers: dict[int, tuple] = {}
         # (node uid, facing) -> the triangles a layer draws (skinlab/render/shadow_facing.py), kept
         # while the light and the node hold still
         self._layer_draws: dict[tuple, LayerSubset] = {}
 
-    def target(self, slot: int, size: int, distance: bool = False):
+    def target(self, slot: int, size: int, distance: bool = False, layers: bool = False):
         """(depth texture, framebuffer, distance texture or None) for a slot. With `distance`, the
-        distance texture holds two layers (R: the first surface, G: the entry into the next part)
-        and the slot also has an exit layer (self.layers[slot], skinlab/shaders/passes/shadow.frag)."""
+        distance texture holds the first surface's distance from the light; with `layers` the slot
+        also has the part layers (self.layers[slot], skinlab/shaders/passes/shadow.frag)."""
         t = self.maps.get(slot)
         if t is None or t[0].size != (size, size) or (t[2] is not None) != distance:
             if t is not None:
                 for x in (t[1], t[0], t[2]):
                     if x is not None:
                         x.release()
-                self._release_layers(slot)
             ctx = self.r.ctx
             tex = ctx.depth_texture((size, size))
             tex.compare_func = "<="
             tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
             tex.repeat_x = tex.repeat_y = False
-            dist = None
-            if distance:
-                dist = ctx.texture((size, size), 2, dtype="f4")
-                dist.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                dist.repeat_x = dist.repeat_y = False
-                exit_tex = ctx.texture((size, size), 2, dtype="f4")
-                exit_tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-                exit_tex.repeat_x = exit_tex.repeat_y = False
-                depth = ctx.depth_renderbuffer((size, size))
-                self.layers[slot] = (
-                    exit_tex,
-                    ctx.framebuffer([exit_tex], depth_attachment=depth),
-                    ctx.framebuffer([dist], depth_attachment=depth),
-                    depth,
-                )
+            dist = _float_texture(ctx, size, 1) if distance else None
             fbo = ctx.framebuffer([dist] if dist is not None else [], depth_attachment=tex)
             t = self.maps[slot] = (tex, fbo, dist)
+        held = self.layers.get(slot)
+        n = part_layer_size(size)
+        if held is not None and (not layers or held[0].size != (n, n)):
+            self._release_layers(slot)
+            held = None
+        if layers and held is None:
+            ctx = self.r.ctx
+            exit_tex, entry_tex = _float_texture(ctx, n, 2), _float_texture(ctx, n, 1)
+            depth = ctx.depth_renderbuffer((n, n))
+            self.layers[slot] = (
+                exit_tex,
+                ctx.framebuffer([exit_tex], depth_attachment=depth),
+                entry_tex,
+                ctx.framebuffer([entry_tex], depth_attachment=depth),
+                depth,
+            )
         return t
 
     def _release_layers(self, slot: int) -> None:
         layers = self.layers.pop(slot, None)
         if layers is not None:
-            for x in (layers[1], layers[2], layers[0], layers[3]):
+            for x in (layers[1], layers[3], layers[0], layers[2], layers[4]):
                 x.release()
 
     def release(self) -> None:
@@ -172,21 +174,28 @@ class ShadowPass(RenderPass):
             subset.release()
         self._layer_draws.clear()
 
+    def _target(self, p):
+        prm: ShadowParams = p.params
+        return self.target(prm.slot, p.resolution[0], prm.distance, prm.layers)
+
     def outputs(self, frame, p) -> tuple:
         """The textures holding the pass's result (reuse across frames, skinlab/render/reuse.py)."""
-        tex, _, dist = self.target(p.params.slot, p.resolution[0], p.params.distance)
-        return (tex,) if dist is None else (tex, dist, self.layers[p.params.slot][0])
+        tex, _, dist = self._target(p)
+        layers = self.layers[p.params.slot][0:3:2] if p.params.layers else ()
+        return (tex, *(() if dist is None else (dist,)), *layers)
 
     def publish(self, frame, p) -> None:
         """Hand the slot's maps and matrices to the frame (after run, or when reused)."""
         prm: ShadowParams = p.params
         light, slot = prm.light, prm.slot
-        tex, _, dist = self.target(slot, p.resolution[0], prm.distance)
+        tex, _, dist = self._target(p)
         frame.targets[f"shadow_map{slot}"] = tex
         frame.shadow_eyes[slot] = light_eye(light)
         if dist is not None:
             frame.targets[f"shadow_distance{slot}"] = dist
+        if prm.layers:
             frame.targets[f"shadow_exit{slot}"] = self.layers[slot][0]
+            frame.targets[f"shadow_entry{slot}"] = self.layers[slot][2]
         lo, hi = frame.scene.world_bounds()
         m = CLIP_TO_TEXTURE @ light_view_proj(light, lo, hi)
         frame.shadow_matrices[slot] = m
@@ -197,13 +206,12 @@ class ShadowPass(RenderPass):
         ctx = self.r.ctx
         prm: ShadowParams = p.params
         light, slot, distance = prm.light, prm.slot, prm.distance
-        tex, fbo, dist = self.target(slot, p.resolution[0], distance)
+        tex, fbo, dist = self._target(p)
         lo, hi = frame.scene.world_bounds()
         vp = light_view_proj(light, lo, hi)
         if dist is None:
             fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-        else:  # "no surface": as far as it gets (the first surface writes R and G = 1e30 whole, unmasked)
-            fbo.color_mask = (True, True, True, True)
+        else:  # "no surface": as far as it gets
             fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
         fbo.use()
         # no polygon offset: its slope term (factor x the polygon's depth slope) grows without bound
@@ -211,7 +219,7 @@ class ShadowPass(RenderPass):
         # texel instead (skinlab/shaders/lib/shadow.glsl)
         with gl_state(ctx, moderngl.DEPTH_TEST):
             self._draw(frame, {"SHADOW_DISTANCE": 1} if distance else {}, {"u_light_eye": light_eye(light)}, vp)
-            if distance:
+            if prm.layers:
                 self._draw_layers(frame, slot, light, vp)
         self.publish(frame, p)
 
@@ -262,24 +270,25 @@ class ShadowPass(RenderPass):
         return subset if subset.partial else None
 
     def _draw_layers(self, frame, slot: int, light: LightNode, vp) -> None:
-        """The distance maps' layers for light through thin parts (skinlab/shaders/passes/shadow.frag
-        SHADOW_LAYER): the exit from the first part, then the entry into the next."""
-        from skinlab.render.translucency import part_gap
-
-        exit_tex, exit_fbo, second_fbo, _ = self.layers[slot]
+        """The part layers for light through thin parts (skinlab/shaders/passes/shadow.frag
+        SHADOW_LAYER; skinlab/render/translucency.py part_layer_size texels per side): the exit from
+        the first part, then the entry into the next."""
+        exit_tex, exit_fbo, _, entry_fbo, _ = self.layers[slot]
         eye = light_eye(light)
-        exit_fbo.color_mask = (True, True, True, True)
         exit_fbo.clear(1e30, 0.0, 0.0, 0.0, depth=1.0)
         exit_fbo.use()
         self._draw(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp, facing=AWAY)
-        # G is 1e30 wherever this layer has not written (the first draw's clear and texels): only the
-        # depth buffer is cleared (a colour clear through a mask is a read-modify-write of every texel)
-        second_fbo.color_mask = (False, False, False, False)
-        second_fbo.clear(depth=1.0)
-        second_fbo.color_mask = (False, True, False, False)  # writes G only
-        second_fbo.use()
+        entry_fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
+        entry_fbo.use()
         self._draw(
             frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 2}, {"u_light_eye": eye, "u_part_gap": part_gap(frame)},
             vp, {"u_exit": exit_tex}, facing=TOWARD,
         )  # fmt: skip
-        second_fbo.color_mask = (True, True, True, True)
+
+
+def _float_texture(ctx, size: int, components: int) -> moderngl.Texture:
+    """A size x size float32 texture read texel by texel (the distance maps and part layers)."""
+    t = ctx.texture((size, size), components, dtype="f4")
+    t.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    t.repeat_x = t.repeat_y = False
+    return t

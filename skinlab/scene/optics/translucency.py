@@ -18,10 +18,11 @@ transmittance of skinlab/scene/optics/slab.py (`slab_through`: all orders of sca
 and out). Texture-space diffusion gathers it in its irradiance pass,
 the screen-space techniques in the forward pass; both call the same GLSL functions.
 
-Distance maps are (H, W) (the first surface) or (H, W, 2) (and the next part's entry), exit layers
-(H, W, 2) (the first part's exit, its cosine), row 0 at texture v = 0 (GL order), read texel by
-texel (texelFetch: the bilinear weights are computed, not the sampler's, so the twin is exact to
-fp32)."""
+Distance maps are (H, W) (the first surface); the part layers (H', W', 2) (the first part's exit,
+its cosine) or (H', W', 3) (and the next part's entry: on the GPU a texture of its own), of any size
+(the renderer's have half the distance map's texels per side: skinlab/render/translucency.py
+part_layer_size); row 0 at texture v = 0 (GL order), read texel by texel (texelFetch: the bilinear
+weights are computed, not the sampler's, so the twin is exact to fp32)."""
 
 from __future__ import annotations
 
@@ -37,19 +38,13 @@ def _points(world) -> np.ndarray:
     return np.atleast_2d(np.asarray(world, np.float64))
 
 
-def _first_layer(distance_map) -> np.ndarray:
-    d = np.asarray(distance_map, np.float64)
-    return d[..., 0] if d.ndim == 3 else d
-
-
-def part_layers(distance_map, exit_map, shadow_matrix, world) -> np.ndarray:
-    """(N, 3) at the texel containing each point (clamped to the map): the first part's exit, its
-    cosine to the light, the entry into the next part (NO_SURFACE-like 1e30 where the maps hold
-    none). GLSL part_layers."""
+def part_layers(exit_map, shadow_matrix, world) -> np.ndarray:
+    """(N, 3) at the layers' texel containing each point (clamped to the layers): the first part's
+    exit, its cosine to the light, the entry into the next part (NO_SURFACE-like 1e30 where the
+    layers hold none). GLSL part_layers."""
     world = _points(world)
     ex = np.asarray(exit_map, np.float64)
-    dist = np.asarray(distance_map, np.float64)
-    nxt = dist[..., 1] if dist.ndim == 3 else np.full(dist.shape, 1e30)
+    nxt = ex[..., 2] if ex.shape[-1] > 2 else np.full(ex.shape[:2], 1e30)
     h, w = ex.shape[:2]
     p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -65,7 +60,7 @@ def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, 
     hold a surface, else the texel containing the point; hit False outside the map or where that
     texel holds no surface (first 0 outside). GLSL first_hit_distance."""
     world = _points(world)
-    dist = _first_layer(distance_map)
+    dist = np.asarray(distance_map, np.float64)
     h, w = dist.shape
     p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -100,8 +95,8 @@ def thickness_mm(
 ):
     """(d_mm, hit): the thickness (mm, along the normal) of matter between the light and each point;
     normal (N, 3) the outward geometric normal, back (N,) its cosine with the direction the light
-    travels, shrink and part_gap in scene units; exit_map None: one part (no layers). GLSL
-    sss_thickness_mm."""
+    travels, shrink and part_gap in scene units; exit_map (the part layers, module docstring) None:
+    one part. GLSL sss_thickness_mm."""
     p = _points(world) - float(shrink) * _points(normal)
     first, hit = first_hit_distance(distance_map, shadow_matrix, p)
     at = distance_from_light(eye, p)
@@ -109,7 +104,7 @@ def thickness_mm(
     inside = at - first
     d = np.where(inside > 0.0, (inside * back + float(shrink)) * float(mm_per_unit), 0.0)
     if exit_map is not None:
-        lay = part_layers(distance_map, exit_map, shadow_matrix, p)
+        lay = part_layers(exit_map, shadow_matrix, p)
         other = (lay[:, 0] < NO_SURFACE) & (at > lay[:, 0] + float(part_gap))
         own = np.where(lay[:, 2] < at, at - lay[:, 2], 0.0)
         through_both = np.maximum(lay[:, 0] - first, 0.0) * lay[:, 1] + own * back

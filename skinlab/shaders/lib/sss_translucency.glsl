@@ -12,12 +12,15 @@
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
 
-uniform sampler2D u_distance0;   // light-space distance (scene units), slot 0: R the first surface, G the
-                                 // entry into the next part (the first surface facing the light past R's part)
+uniform sampler2D u_distance0;   // light-space distance (scene units), slot 0: the first surface
 uniform sampler2D u_distance1;   // slot 1
+// the part layers (fewer texels than the distance maps: skinlab/render/translucency.py part_layer_size)
 uniform sampler2D u_exit0;       // slot 0: R the first surface facing away from the light (the first
                                  // part's exit), G its cosine to the light
 uniform sampler2D u_exit1;       // slot 1
+uniform sampler2D u_entry0;      // slot 0: the entry into the next part (the first surface facing the
+                                 // light past the first part's exit by more than u_part_gap)
+uniform sampler2D u_entry1;      // slot 1
 uniform vec4 u_light_eye[2];     // slot light position (w = 1) or the direction light travels (w = 0)
 uniform float u_thickness_shrink;  // scene units: about half a distance-map texel
 uniform float u_part_gap;        // scene units: past the first part's exit by more than this is another part
@@ -26,14 +29,14 @@ float distance_texel(int slot, ivec2 t) {
     return slot == 0 ? texelFetch(u_distance0, t, 0).r : texelFetch(u_distance1, t, 0).r;
 }
 
-// At the texel containing world (clamped to the map): x the first part's exit, y its cosine to the
-// light, z the entry into the next part (1e30 where there is none).
+// At the part layers' texel containing world (clamped to the layers): x the first part's exit, y its
+// cosine to the light, z the entry into the next part (1e30 where there is none).
 vec3 part_layers(int slot, vec3 world) {
     vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
     ivec2 size = slot == 0 ? textureSize(u_exit0, 0) : textureSize(u_exit1, 0);
     ivec2 t = clamp(ivec2(floor(p.xy / p.w * vec2(size))), ivec2(0), size - 1);
     vec2 e = slot == 0 ? texelFetch(u_exit0, t, 0).rg : texelFetch(u_exit1, t, 0).rg;
-    float next = slot == 0 ? texelFetch(u_distance0, t, 0).g : texelFetch(u_distance1, t, 0).g;
+    float next = slot == 0 ? texelFetch(u_entry0, t, 0).r : texelFetch(u_entry1, t, 0).r;
     return vec3(e, next);
 }
 

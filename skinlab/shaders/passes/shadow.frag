@@ -1,11 +1,12 @@
 #version 330 core
 // Depth only; with SHADOW_DISTANCE also the distance of the first surface from the light in scene
-// units (u_light_eye: position, w = 1, or the direction light travels, w = 0). The layers of the
-// distance maps for light through thin parts (lib/sss_translucency.glsl; each its own depth test):
-// SHADOW_LAYER 1, the nearest surface facing away from the light (where the light leaves the first
-// part it crossed) and its cosine to the light; SHADOW_LAYER 2, the nearest surface facing the light
-// beyond that exit by more than u_part_gap (where it enters the next part), from the exit layer
-// u_exit. NumPy twin of their use: skinlab/scene/optics/translucency.py. Variant ALPHA_MASK: a
+// units (u_light_eye: position, w = 1, or the direction light travels, w = 0). The part layers for
+// light through thin parts (lib/sss_translucency.glsl; each its own depth test, at
+// skinlab/render/translucency.py part_layer_size texels per side): SHADOW_LAYER 1, the nearest
+// surface facing away from the light (where the light leaves the first part it crossed) and its
+// cosine to the light; SHADOW_LAYER 2, the nearest surface facing the light beyond that exit by more
+// than u_part_gap (where it enters the next part), from the exit layer u_exit (the same size).
+// NumPy twin of their use: skinlab/scene/optics/translucency.py. Variant ALPHA_MASK: a
 // masked material's cut-away pixels cast no shadow (lib/alpha_mask.glsl).
 #ifdef ALPHA_MASK
 #include "lib/alpha_mask.glsl"
@@ -15,13 +16,15 @@ in vec3 v_world;
 uniform vec4 u_light_eye;
 #ifdef SHADOW_LAYER
 in vec3 v_normal;
+#if SHADOW_LAYER == 1
 out vec2 f_layer;
-#if SHADOW_LAYER == 2
+#else
+out float f_layer;
 uniform sampler2D u_exit;
 uniform float u_part_gap;
 #endif
 #else
-out vec2 f_distance;  // the whole texel: G as cleared (no entry yet), so no colour mask's read-modify-write
+out float f_distance;
 #endif
 #endif
 void main() {
@@ -38,10 +41,10 @@ void main() {
     f_layer = vec2(dist, c);
 #else
     if (c > 0.0 || dist <= texelFetch(u_exit, ivec2(gl_FragCoord.xy), 0).r + u_part_gap) discard;
-    f_layer = vec2(0.0, dist);  // the distance map's green channel (its red is masked)
+    f_layer = dist;
 #endif
 #else
-    f_distance = vec2(dist, 1e30);
+    f_distance = dist;
 #endif
 #endif
 }

@@ -119,7 +119,8 @@ def test_planned_only_where_needed(renderer, technique):
     forward = next(p for p in res.plan.passes if p.kind == "forward")
     assert "translucency through thin parts" in forward.reason
     shadow = next(p for p in res.plan.passes if p.kind == "shadow")
-    assert shadow.params.distance and "distance map for translucency" in text
+    assert shadow.params.distance and shadow.params.layers and "distance map for translucency" in text
+    assert "exit and next entry at 512x512" in shadow.reason  # half the shadow map's texels per side
     res = renderer.render(sheet(0.5, shadow=False), settings(technique))
     assert ("translucency", "no shadow-casting light") in res.plan.skipped
     assert res.hdr[24, 24, :3].max() == 0.0

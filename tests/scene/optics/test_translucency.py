@@ -22,14 +22,20 @@ def _distance_texture(ctx, dist: np.ndarray):
     return tex
 
 
+def _layer_textures(ctx, layers: np.ndarray):
+    """The part layers (H, W, 3: exit, its cosine, next entry) as the shadow pass writes them: the
+    exit layer (RG) and the next-entry layer (R)."""
+    return _distance_texture(ctx, layers[..., :2]), _distance_texture(ctx, layers[..., 2])
+
+
 def _no_exit(ctx):
-    """An exit layer with no surface: one part everywhere (the lookup as without layers)."""
-    return _distance_texture(ctx, np.array([[[1e30, 0.0]]]))
+    """Part layers with no surface: one part everywhere (the lookup as without layers)."""
+    return _layer_textures(ctx, np.array([[[1e30, 0.0, 1e30]]]))
 
 
 def _lookup_setup(maps, matrices, eyes, shrink, mm_per_unit, material=None, exits=(), part_gap=0.0):
     """A GLSLEvaluator setup binding lib/sss_translucency.glsl's uniforms, distance maps and their
-    exit layers (`exits`, one texture per slot; _no_exit's for one part)."""
+    part layers (`exits`, per slot the (exit, entry) textures of _layer_textures; _no_exit's for one part)."""
     from skinlab.gl.uniforms import set_array, set_uniforms
 
     def setup(prog):
@@ -37,10 +43,13 @@ def _lookup_setup(maps, matrices, eyes, shrink, mm_per_unit, material=None, exit
             tex.use(10 + slot)
             if f"u_distance{slot}" in prog:
                 prog[f"u_distance{slot}"].value = 10 + slot
-        for slot, tex in enumerate(exits):
+        for slot, (tex, entry) in enumerate(exits):
             tex.use(12 + slot)
+            entry.use(14 + slot)
             if f"u_exit{slot}" in prog:
                 prog[f"u_exit{slot}"].value = 12 + slot
+            if f"u_entry{slot}" in prog:
+                prog[f"u_entry{slot}"].value = 14 + slot
         if "u_shadow_matrix" in prog:
             mats = np.stack([m.T for m in matrices]).astype(np.float32)
             prog["u_shadow_matrix"].write(mats[: max(prog["u_shadow_matrix"].array_length, 1)].tobytes())
@@ -110,7 +119,7 @@ def test_thickness_lookup_matches_numpy_twin(ctx, glsl):
         assert_close_fp32(gpu[:, 1], ref, rtol=1e-4, atol=1e-4, what=f"sss_thickness_mm slot {slot}")
         clamped = hit & (ref == 0)  # points in front of the first surface
         assert clamped.sum() > 50 and (ref[hit & ~clamped] >= shrink * mm).all()
-    for t in (*texes, none):
+    for t in (*texes, *none):
         t.release()
 
 
@@ -225,24 +234,26 @@ def test_translucent_light_matches_numpy(ctx, glsl):
     assert np.all(ref[2] == 0) and np.all(ref[3] == 0)  # light in front; no surface in the map
     assert np.all(np.isfinite(ref[4])) and ref[4].max() < 1e-2 * ref[1].max()  # grazing: back ~ 0.001
     tex.release()
-    none.release()
+    for t in none:
+        t.release()
 
 
 def test_layered_thickness_lookup_matches_numpy_twin(ctx, glsl):
-    """With the exit and next-entry layers (another part in front, air between): sss_thickness_mm
-    against thickness_mm on random layered maps, points in the first part, past its exit within and
-    beyond the part gap, with and without a next entry, exit cosines down to 0; within fp32."""
+    """With the exit and next-entry layers (another part in front, air between; at half the distance
+    map's texels per side, as the renderer's): sss_thickness_mm against thickness_mm on random
+    layered maps, points in the first part, past its exit within and beyond the part gap, with and
+    without a next entry, exit cosines down to 0; within fp32."""
     rng = np.random.default_rng(21)
     h, w = 16, 24
     first = rng.uniform(5.0, 6.0, (h, w))
-    exit_d = first + rng.uniform(0.5, 1.5, (h, w))
-    exit_c = rng.uniform(0.0, 1.0, (h, w))
-    nxt = exit_d + rng.uniform(1.0, 3.0, (h, w))
-    nxt[rng.uniform(size=(h, w)) < 0.15] = 1e30  # no next entry
-    exit_d[rng.uniform(size=(h, w)) < 0.1] = 1e30  # no exit: one part
-    dist = np.stack([first, nxt], -1)
-    ex = np.stack([exit_d, exit_c], -1)
-    tex, etex = _distance_texture(ctx, dist), _distance_texture(ctx, ex)
+    exit_d = 6.0 + rng.uniform(0.5, 1.5, (h // 2, w // 2))
+    exit_c = rng.uniform(0.0, 1.0, (h // 2, w // 2))
+    nxt = exit_d + rng.uniform(1.0, 3.0, (h // 2, w // 2))
+    nxt[rng.uniform(size=nxt.shape) < 0.15] = 1e30  # no next entry
+    exit_d[rng.uniform(size=nxt.shape) < 0.1] = 1e30  # no exit: one part
+    dist = first
+    ex = np.stack([exit_d, exit_c, nxt], -1)
+    tex, etex = _distance_texture(ctx, dist), _layer_textures(ctx, ex)
     m = np.eye(4)
     m[:3, :3] *= 0.5
     m[:3, 3] = 0.5
@@ -263,31 +274,31 @@ def test_layered_thickness_lookup_matches_numpy_twin(ctx, glsl):
     ref, hit = tr.thickness_mm(dist, m, eye, world, normal, back, shrink, mm, exit_map=ex, part_gap=gap)
     assert np.array_equal(gpu[:, 0] == 1.0, hit) and hit.all()
     assert_close_fp32(gpu[:, 1], ref, rtol=1e-4, atol=1e-4, what="layered sss_thickness_mm")
-    lay = tr.part_layers(dist, ex, m, world - shrink * normal)
+    lay = tr.part_layers(ex, m, world - shrink * normal)
     at = world[:, 2] - shrink
     other = (lay[:, 0] < 1e29) & (at > lay[:, 0] + gap)
     assert 500 < other.sum() < n - 500  # both cases present
-    one = tr.thickness_mm(dist[..., 0], m, eye, world, normal, back, shrink, mm)[0]
+    one = tr.thickness_mm(dist, m, eye, world, normal, back, shrink, mm)[0]
     np.testing.assert_array_equal(ref[~other], one[~other])  # one part: as without layers
     # past the first part the air between is not counted: thinner than the whole chord where the
     # first part's exit cosine is no larger than the point's own
     less = other & (lay[:, 1] <= back)
     assert less.sum() > 200 and np.all(ref[less] < one[less])
-    for t in (tex, etex):
+    for t in (tex, *etex):
         t.release()
 
 
 def _parallel_slabs_maps(direction, size, radius, faces):
-    """Layered distance maps of parallel slabs z in [a_k, b_k] (ascending along the light, which
-    travels along `direction` with d_z > 0): first surface, next part's entry, first part's exit and
-    its cosine, as skinlab/shaders/passes/shadow.frag writes them (its part gap ignored: the gaps are
-    wide)."""
+    """The distance map and part layers of parallel slabs z in [a_k, b_k] (ascending along the light,
+    which travels along `direction` with d_z > 0): first surface; first part's exit, its cosine and
+    the next part's entry, as skinlab/shaders/passes/shadow.frag writes them (its part gap ignored:
+    the gaps are wide)."""
     first, m, eye = _slab_map(direction, size, radius, faces[0][0])
     cos = float(direction[2] / np.linalg.norm(direction))
     step = lambda z: first + (z - faces[0][0]) / cos  # the plane z's distance along each texel's ray
     nxt = step(faces[1][0]) if len(faces) > 1 else np.full(first.shape, 1e30)
-    ex = np.stack([step(faces[0][1]), np.full(first.shape, cos)], -1)
-    return np.stack([first, nxt], -1), ex, m, eye
+    ex = np.stack([step(faces[0][1]), np.full(first.shape, cos), nxt], -1)
+    return first, ex, m, eye
 
 
 def test_two_slabs_apart_are_not_one_thick_slab():
@@ -307,7 +318,7 @@ def test_two_slabs_apart_are_not_one_thick_slab():
     got, hit = tr.thickness_mm(dist, m, eye, front, nrm, back, shrink, 1.0, exit_map=ex, part_gap=gap)
     assert hit.all()
     np.testing.assert_allclose(got, 6.0, atol=1e-6)
-    air, _ = tr.thickness_mm(dist[..., 0], m, eye, front, nrm, back, shrink, 1.0)  # no layers: as before
+    air, _ = tr.thickness_mm(dist, m, eye, front, nrm, back, shrink, 1.0)  # no layers: as before
     np.testing.assert_allclose(air, 16.0, atol=1e-6)
     back_face = np.column_stack([xy, np.full(2000, -13.0)])
     got, _ = tr.thickness_mm(dist, m, eye, back_face, nrm, back, shrink, 1.0, exit_map=ex, part_gap=gap)
