@@ -413,9 +413,12 @@ class TsdIrradiancePass(TsdPass):
         surface = []
         if prm.deferred:  # the mesh's vertex outputs rasterised into the G-buffer, then shaded per texel
             surface = t.surface_buffer(ctx, "BOUNCE" in carried, "SKY_OCCLUSION" in carried)
-            gbuf = t.fbo(ctx, *surface, depth=t.coverage_mask(ctx, "irradiance"))
+            mask = t.coverage_mask(ctx, "irradiance")
+            # only the coverage (surface0's a) is read where no triangle wrote: the rest is cleared
+            # by the raster wherever it is read (techniques/tsd/surface.glsl load_surface)
+            t.fbo(ctx, surface[0], depth=mask).clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            gbuf = t.fbo(ctx, *surface, depth=mask)
             _uv_raster_setup(ctx, gbuf, size)
-            gbuf.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
             raster = self.r.programs.get("techniques/tsd/uv.vert", "techniques/tsd/surface.frag", carried)
             set_uniforms(raster, node_uniforms(node))
             bind_ambient(frame, node, raster, TextureUnits(ctx))
@@ -423,7 +426,10 @@ class TsdIrradiancePass(TsdPass):
                 self.r.resources.mesh(node.mesh).vao(raster).render(moderngl.TRIANGLES)
         elif "irradiance" in t.masks:
             t.masks["irradiance"][1] = False
-        fbo = t.fbo(ctx, t.raw, *(t.through_raw_record(ctx) if prm.translucency else ()))
+        slots = min(len(prm.shadow_lights), SHADOW_SLOTS)
+        # the light-through record: slot 1's only where two slots are filled (irradiance.frag's outputs)
+        record = t.through_raw_record(ctx) if prm.translucency else []
+        fbo = t.fbo(ctx, t.raw, *(record if slots > 1 else record[0::2]))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
         defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **ambient}
@@ -459,7 +465,6 @@ class TsdIrradiancePass(TsdPass):
             self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
         self.r.resources.unbind_samplers()
         if prm.translucency:  # the record's gutter by the chart borders: across the seams, else dilated
-            slots = min(len(prm.shadow_lights), SHADOW_SLOTS)
             through_fill(self.r, t, prm.seams is not None, node_border_strips(node.mesh, size), slots)
         self.publish(frame, p)
 

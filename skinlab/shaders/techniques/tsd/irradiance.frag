@@ -59,10 +59,15 @@ out vec4 f_irradiance;
 #ifdef TSD_TRANSLUCENCY
 // the light through thin parts per shadow slot, unblurred, for the gather's exit factor
 // (techniques/tsd/forward.glsl): rgb the light entering through, a the thickness (mm); f_through_cos
-// each slot's cosine on the far face
+// each slot's cosine on the far face. Slot 1's record only where the frame fills two slots (the pass
+// attaches it only then).
 layout(location = 1) out vec4 f_through0;
+#if SHADOW_SLOTS > 1
 layout(location = 2) out vec4 f_through1;
 layout(location = 3) out vec2 f_through_cos;
+#else
+layout(location = 2) out vec2 f_through_cos;
+#endif
 vec4 through_rec[2] = vec4[2](vec4(0.0), vec4(0.0));
 vec2 through_back = vec2(0.0);
 #endif
@@ -135,7 +140,9 @@ void main() {
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 #ifdef TSD_TRANSLUCENCY
     f_through0 = through_rec[0];
+#if SHADOW_SLOTS > 1
     f_through1 = through_rec[1];
+#endif
     f_through_cos = through_back;
 #endif
 }
