@@ -34,8 +34,11 @@ def _maps(ctx, rng, h=32, w=32):
     return depth, dist, dtex, ftex
 
 
+@pytest.mark.parametrize("area", [False, True])
 @pytest.mark.parametrize("local", [False, True])
-def test_shadow_soft_matches_numpy_with_nearest_filtering(ctx, glsl, local):
+def test_shadow_soft_matches_numpy_with_nearest_filtering(ctx, glsl, local, area):
+    """shadow_soft (and with `area` shadow_soft_area: a receiver's footprint, the texture-space
+    texel's, random parallelograms up to a few map texels, some of none) against the NumPy twin."""
     rng = np.random.default_rng(11)
     depth, dist, dtex, ftex = _maps(ctx, rng)
     try:
@@ -55,6 +58,8 @@ def test_shadow_soft_matches_numpy_with_nearest_filtering(ctx, glsl, local):
             dist_l = np.where(dist > 1e29, dist, dist + 100.0).astype(np.float32)
             ftex.write(dist_l.tobytes())
         world, nol = world.astype(np.float32).astype(np.float64), nol.astype(np.float32).astype(np.float64)
+        du, dv = (rng.uniform(-0.15, 0.15, (n, 3)).astype(np.float32).astype(np.float64) for _ in range(2))
+        du[:100] = dv[:100] = 0.0  # no footprint: the point's filter
 
         def setup(prog):
             prog["u_depth"].value = 12
@@ -62,13 +67,18 @@ def test_shadow_soft_matches_numpy_with_nearest_filtering(ctx, glsl, local):
             dtex.use(12)
             ftex.use(13)
 
-        expr = "shadow_soft(u_depth, u_dist, u_m, u_soft, u_eye, w, nol)"
+        args = "u_depth, u_dist, u_m, u_soft, u_eye, w, nol"
+        expr = f"shadow_soft_area({args}, du, dv)" if area else f"shadow_soft({args})"
         gpu = glsl.evaluate(
-            "lib/shadow_soft.glsl", expr, {"w": world, "nol": nol},
+            "lib/shadow_soft.glsl", expr, {"w": world, "nol": nol, "du": du, "dv": dv},
             uniforms={"u_m": ("mat4", m), "u_soft": ("vec4", soft), "u_eye": ("vec4", eye)},
             prelude="uniform sampler2DShadow u_depth; uniform sampler2D u_dist;", setup=setup,
         )[:, 0]  # fmt: skip
-        ref = shadow.shadow_soft(depth, dist_l if local else dist, m, soft, eye, world, nol)
+        maps = (depth, dist_l if local else dist, m, soft, eye, world, nol)
+        ref = shadow.shadow_soft_area(*maps, du, dv) if area else shadow.shadow_soft(*maps)
+        if area:  # a footprint widens the filter: a point's own filter where there is none
+            point = shadow.shadow_soft(*maps)
+            assert np.array_equal(ref[:100], point[:100]) and (ref != point).mean() > 0.05
         # taps within fp32 rounding of a texel border may pick the neighbour: a few points, a tap each
         diff = np.abs(gpu - ref)
         assert (diff > 1e-6).mean() < 0.05 and diff.max() <= 3 / 16 + 1e-6, (diff > 1e-6).mean()

@@ -123,9 +123,10 @@ def _nearest(img: np.ndarray, u, v) -> np.ndarray:
     return img[j, i]
 
 
-def shadow_soft(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL) -> np.ndarray:
-    """Twin of lib/shadow_soft.glsl shadow_soft with NEAREST filtering of both maps (each compare
-    tap exactly 0 or 1): maps (H, W) with row 0 at v = 0; soft and eye (4,); world (N, 3)."""
+def shadow_soft(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL, spread2=0.0) -> np.ndarray:
+    """Twin of lib/shadow_soft.glsl shadow_soft (shadow_soft_spread with `spread2`, (N,) or a scalar:
+    the squared uv radius the filter grows by in quadrature) with NEAREST filtering of both maps
+    (each compare tap exactly 0 or 1): maps (H, W) with row 0 at v = 0; soft and eye (4,); world (N, 3)."""
     world = np.atleast_2d(np.asarray(world, np.float64))
     soft, eye = np.asarray(soft, np.float64), np.asarray(eye, np.float64)
     p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
@@ -140,7 +141,8 @@ def shadow_soft(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL) -> np
         widest = 2.0 * soft[0] * (d_r - nearest) / nearest
     else:
         widest = np.full(len(world), 2.0 * soft[0] * soft[3])
-    search = np.clip(0.5 * widest * k, texel, SOFT_SEARCH_TEXELS * texel)
+    spread2 = np.broadcast_to(np.asarray(spread2, np.float64), (len(world),))
+    search = np.maximum(np.clip(0.5 * widest * k, texel, SOFT_SEARCH_TEXELS * texel), np.sqrt(spread2))
     bias = 2.0 * texel / k
     total = np.zeros(len(world))
     count = np.zeros(len(world))
@@ -152,7 +154,7 @@ def shadow_soft(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL) -> np
         count += hit
     d_b = np.where(count > 0, total / np.maximum(count, 1), d_r)  # no blocker: lit (below)
     w = 2.0 * soft[0] * (d_r - d_b) / np.maximum(d_b, 1e-20) if local else 2.0 * soft[0] * (d_r - d_b)
-    radius = np.maximum(0.5 * w * k, 1.5 * texel)
+    radius = np.sqrt(np.maximum(0.5 * w * k, 1.5 * texel) ** 2 + spread2)
     ref = c[:, 2] - shadow_bias(NoL, shadow_matrix, world, depth_map.shape[::-1]) * np.maximum(
         1.0, radius / (1.5 * texel)
     )
@@ -161,3 +163,18 @@ def shadow_soft(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL) -> np
         o = vogel_tap(t)
         lit += (ref <= _nearest(depth_map, c[:, 0] + o[0] * radius, c[:, 1] + o[1] * radius)).astype(np.float64)
     return np.where(outside | (count == 0), 1.0, lit / SOFT_TAPS)
+
+
+def shadow_soft_area(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL, du, dv) -> np.ndarray:
+    """Twin of lib/shadow_soft.glsl shadow_soft_area: shadow_soft with the receiver's footprint (the
+    parallelogram of the world vectors du, dv (N, 3) centred on world) as spread2 = (|a|^2 + |b|^2) / 6,
+    a and b its sides in the map's uv (the disk with the footprint's second moments)."""
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    _, p = _light_space(shadow_matrix, world)
+    _, pa = _light_space(shadow_matrix, world + np.atleast_2d(np.asarray(du, np.float64)))
+    _, pb = _light_space(shadow_matrix, world + np.atleast_2d(np.asarray(dv, np.float64)))
+    c = p[:, :2] / p[:, 3:4]
+    a = pa[:, :2] / pa[:, 3:4] - c
+    b = pb[:, :2] / pb[:, 3:4] - c
+    spread2 = ((a * a).sum(1) + (b * b).sum(1)) / 6.0
+    return shadow_soft(depth_map, dist_map, shadow_matrix, soft, eye, world, NoL, spread2)

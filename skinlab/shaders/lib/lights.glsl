@@ -89,19 +89,19 @@ float light_visibility(int i, vec3 world, float NoL_geom) {
 }
 
 // light_visibility averaged over a receiver's footprint (world vectors du, dv: one texture-space
-// texel along u and v; lib/shadow.glsl shadow_pcf_area). A soft slot's filter (its penumbra, at least
-// the 3x3 PCF's width) as light_visibility's.
+// texel along u and v; lib/shadow.glsl shadow_pcf_area, a soft slot's lib/shadow_soft.glsl
+// shadow_soft_area).
 float light_visibility_area(int i, vec3 world, float NoL_geom, vec3 du, vec3 dv) {
 #if SHADOW_SLOTS > 0
     int slot = u_light_shadow[i];
 #ifdef SHADOW_SOFT0
-    if (slot == 0) return shadow_soft(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom);
+    if (slot == 0) return shadow_soft_area(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom, du, dv);
 #else
     if (slot == 0) return shadow_pcf_area(u_shadow0, u_shadow_matrix[0], world, NoL_geom, du, dv);
 #endif
 #if SHADOW_SLOTS > 1
 #ifdef SHADOW_SOFT1
-    if (slot == 1) return shadow_soft(u_shadow1, u_shadow_distance1, u_shadow_matrix[1], u_shadow_soft[1], u_shadow_eye[1], world, NoL_geom);
+    if (slot == 1) return shadow_soft_area(u_shadow1, u_shadow_distance1, u_shadow_matrix[1], u_shadow_soft[1], u_shadow_eye[1], world, NoL_geom, du, dv);
 #else
     if (slot == 1) return shadow_pcf_area(u_shadow1, u_shadow_matrix[1], world, NoL_geom, du, dv);
 #endif

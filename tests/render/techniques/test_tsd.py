@@ -88,23 +88,17 @@ def test_gpu_diffusion_matches_numpy_twin_and_reports_fit_error(renderer):
     assert np.all(np.isfinite(rel_l1)) and np.all(rel_l1 < 0.03), rel_l1
 
 
-@pytest.mark.parametrize("model", ["burley", "dipole", "pbd"])
-@pytest.mark.parametrize("place", [0.0, 0.25, 0.5])
-def test_shadow_edge_follows_the_profile_edge_response(renderer, model, place, multiple_only):
-    """A slab lit across a sharp shadow edge, the edge on an irradiance texels' border or `place` of a
-    texel into one (the light tilted): the light that leaves is the light that entered, the edge where
-    the light entered: the multiply scattered radiance / its lit level summed over the row is the
-    exact profile's edge response's within a tenth of a texel, wherever the edge falls (one point's
-    shadow per texel moved the edge to the texels' grid: a quarter of a texel of light too much or
-    too little at 0 and 0.5); at every pixel within 4.5 % (absolute, of the lit level) of that edge
-    response averaged over a texel, what each texel holds (lib/shadow.glsl shadow_pcf_area; the most
-    in blue, whose profile is hardly wider than the texel, 0.21 mm: the blur's discrete taps)."""
+def _edge_row(renderer, model: str, place: float, angular_radius: float = 0.0):
+    """The shadow-edge slab (192 texels over 40 mm, the edge `place` of a texel into one): the row
+    across the edge / its lit level, the exact profile's edge response summed against it (texels of
+    light too much per channel) and its per-pixel error against that response averaged over a texel."""
     n = 192
     scene = slab_scene(occluder=True, material=skin(model))
     h = 1.02  # slab_scene's occluder height and edge (units): the light along (1 + e, 0, -1) moves it h e
     tilt = place * (2.0 / n) / h
     d = np.array([1.0 + tilt, 0.0, -1.0])
     scene.lights()[0].rotation = tf.look_at_rotation(np.zeros(3), d / np.linalg.norm(d))
+    scene.lights()[0].angular_radius = angular_radius
     res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, technique=TsdSettings(size=n)))
     t = tsd_node(renderer, scene)
     row = res.hdr[n // 2, :, :3].astype(np.float64)
@@ -116,16 +110,43 @@ def test_shadow_edge_follows_the_profile_edge_response(renderer, model, place, m
     profile = exact_profile(model, material_medium(t.material.values))
     edge = edge_response(-x_mm, profile, "profile")
     moved = (row / lit - edge).sum(axis=0)  # pixels (= texels) of light too much
-    assert np.all(np.abs(moved) < 0.1), (model, place, moved)
     within = (np.arange(16) + 0.5) / 16 - 0.5  # across a texel (midpoint rule)
     held = np.mean([edge_response(-(x_mm + w * texel_mm), profile, "profile") for w in within], axis=0)
-    err = np.abs(row / lit - held)
+    return row / lit, moved, np.abs(row / lit - held)
+
+
+@pytest.mark.parametrize("model", ["burley", "dipole", "pbd"])
+@pytest.mark.parametrize("place", [0.0, 0.25, 0.5])
+def test_shadow_edge_follows_the_profile_edge_response(renderer, model, place, multiple_only):
+    """A slab lit across a sharp shadow edge, the edge on an irradiance texels' border or `place` of a
+    texel into one (the light tilted): the light that leaves is the light that entered, the edge where
+    the light entered: the multiply scattered radiance / its lit level summed over the row is the
+    exact profile's edge response's within a tenth of a texel, wherever the edge falls (one point's
+    shadow per texel moved the edge to the texels' grid: a quarter of a texel of light too much or
+    too little at 0 and 0.5); at every pixel within 4.5 % (absolute, of the lit level) of that edge
+    response averaged over a texel, what each texel holds (lib/shadow.glsl shadow_pcf_area; the most
+    in blue, whose profile is hardly wider than the texel, 0.21 mm: the blur's discrete taps)."""
+    row, moved, err = _edge_row(renderer, model, place)
+    assert np.all(np.abs(moved) < 0.1), (model, place, moved)
     assert np.all(np.isfinite(err))
     assert err.max() < 0.045, (model, err.max(axis=0), int(err.argmax()) // 3)
     # and the edge is really there: the shadowed side is dark, the red channel bleeds furthest
-    assert row[: n // 8].max() < 0.02 * lit.max()
-    mid = row[n // 2 - 6] / lit
+    n = len(row)
+    assert row[: n // 8].max() < 0.02
+    mid = row[n // 2 - 6]
     assert mid[0] > mid[2]
+
+
+@pytest.mark.parametrize("place", [0.0, 0.5])
+def test_a_soft_light_s_narrow_penumbra_keeps_the_edge_where_it_falls(renderer, place, multiple_only):
+    """The same edge under a light with a size whose penumbra is a fifth of a texel (angular radius
+    1 mrad; lib/shadow_soft.glsl's filter at a point, a few shadow-map texels, aliased the edge to the
+    texel grid like the hard shadow's one point did): shadow_soft_area widens the filter by the texel's
+    footprint, so the light summed across the edge is the exact response's within a tenth of a texel
+    on the grid's border and half a texel into one."""
+    row, moved, err = _edge_row(renderer, "burley", place, angular_radius=1e-3)
+    assert np.all(np.abs(moved) < 0.1), (place, moved)
+    assert np.all(np.isfinite(err)) and err.max() < 0.06, err.max(axis=0)
 
 
 def test_constant_irradiance_keeps_its_mean(renderer):
