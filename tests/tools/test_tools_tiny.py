@@ -15,7 +15,7 @@ from skinlab.resources import asset_path
 TOOLS = Path(tools.__file__).parent
 TESTED_ELSEWHERE = {"truth_table", "closeup_table", "forward_cost", "irradiance_cost", "cost_variants", "gpu_reference"}
 HERE = {
-    "accuracy_table", "boundary_slab", "env_sphere", "frame_times", "full_over_plain", "make_face_parts",
+    "accuracy_table", "boundary_slab", "branch_cost", "env_sphere", "frame_times", "full_over_plain", "make_face_parts",
     "make_reference_meshes", "repair_bunny", "seam_report", "supersample_cost", "translucency_check",
 }  # fmt: skip
 
@@ -54,6 +54,15 @@ def test_boundary_slab(capsys):
         "rough 0.45 dark   sky view  0", "rough 0.45 dark   sun light  0",
     ]  # fmt: skip
     assert "model" in out[1] and "model" not in out[3]  # the boundary model for the medium under the sky only
+
+
+def test_branch_cost(capsys):
+    from tools import branch_cost
+
+    assert branch_cost.main(["--size", "64", "--rounds", "1", "--stripe", "4"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].endswith("64x64") and [line.split()[0] for line in out[1:]] == ["not", "taken", "stripes"]
+    assert all(float(line.split()[-2]) >= 0.0 for line in out[1:])
 
 
 def test_env_sphere(tmp_path, capsys):
