@@ -10,6 +10,7 @@
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_maps.glsl"
 #include "lib/sss_oblique.glsl"
+#include "lib/sss_near_light.glsl"
 
 struct Surface {
     vec3 position;            // world space
@@ -49,4 +50,11 @@ float sss_entry_visibility(Surface s, int i, vec3 l) {
     if (u_light_shadow[i] < 0) return 1.0;
     vec3 entry = sss_entry_point(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, u_sss_eta, u_mm_per_unit);
     return light_visibility(i, entry, dot(s.ng, l));
+}
+
+// Light i's irradiance feeding the diffusion at s relative to its own (a point or spot light's
+// falls off along the surface: the diffusion leaving at s entered nearer the light,
+// lib/sss_near_light.glsl); 1 for directional and area lights.
+vec3 sss_near_gain(Surface s, int i) {
+    return sss_light_near_gain(i, s.position, s.ng, u_sss_mfp * s.sss_radius_scale);
 }

@@ -95,7 +95,8 @@ void main() {
 #endif
         if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
         // the technique's diffusion: shadowed where it entered (oblique entry, lib/surface_inputs.glsl)
-        sss_add_light(s, e, sss_entry_visibility(s, i, l), NoL);
+        // and fed by the irradiance where it entered (a point or spot light's, lib/surface_inputs.glsl)
+        sss_add_light(s, e * sss_near_gain(s, i), sss_entry_visibility(s, i, l), NoL);
     }
     vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
     float kept = 1.0;

@@ -7,7 +7,7 @@ import pytest
 
 from skinlab.gl.glsl_eval import assert_close_fp32
 from skinlab.scene.optics.constants import LUMA_B, LUMA_G, LUMA_R
-from skinlab.scene.optics.oblique import LUMA, entry_offset, entry_point
+from skinlab.scene.optics.oblique import LUMA, entry_offset, entry_point, near_entry, near_entry_gain
 
 
 def _unit(v):
@@ -86,3 +86,97 @@ def test_offset_is_wang_and_jacques_shift():
     off = entry_offset(ng, l, z0, 1.0, 1.0)[0]
     across = lambda x: x - l[0] * (x @ l[0])
     assert across(p) == pytest.approx(across(off)) and (p - off) @ l[0] == pytest.approx(np.linalg.norm(off))
+
+
+def _near_cases(n=600, seed=8):
+    """Points d_mm from a light at a finite distance: any direction and distance (0.05-200 mm), with the
+    hard cases: the light straight above, in the tangent plane, below it, at the point, z0 = 0."""
+    rng = np.random.default_rng(seed)
+    ng = _unit(rng.normal(size=(n, 3)))
+    d = _unit(rng.normal(size=(n, 3))) * rng.uniform(0.05, 200.0, (n, 1))
+    z0 = rng.uniform(0.0, 3.0, (n, 3))
+    eta = rng.uniform(0.8, 1.6, n)
+    d[:10] = ng[:10] * rng.uniform(0.1, 5.0, (10, 1))
+    d[10:20] = _unit(np.cross(ng[10:20], rng.normal(size=(10, 3)))) * 2.0
+    d[20:30] = -np.abs(d[20:30] @ ng[20:30].T).diagonal()[:, None] * ng[20:30]
+    d[30:35] = 0.0
+    z0[35:45] = 0.0
+    return d, ng, z0, eta
+
+
+NEAR_OUTS = """
+vec3 near_g(vec3 d, vec3 ng, vec3 z0, float eta) { vec3 mu; return sss_near_entry(d, ng, z0, eta, mu); }
+vec3 near_mu(vec3 d, vec3 ng, vec3 z0, float eta) { vec3 mu; sss_near_entry(d, ng, z0, eta, mu); return mu; }
+"""
+
+
+def test_near_entry_twin(glsl):
+    d, ng, z0, eta = _near_cases()
+    f32 = lambda x: np.asarray(x, np.float32).astype(np.float64)
+    g_ref, mu_ref = near_entry(f32(d), f32(ng), f32(z0), f32(eta))
+    assert np.isfinite(g_ref).all() and np.isfinite(mu_ref).all()
+    assert (g_ref[10:35] == 1.0).all()  # in or below the plane, at the point: unchanged
+    assert g_ref[35:45] == pytest.approx(np.ones((10, 3)), rel=1e-6)  # no scattering: no shift
+    for expr, ref in (("near_g(d, ng, z0, eta)", g_ref), ("near_mu(d, ng, z0, eta)", mu_ref)):
+        gpu = glsl.evaluate(
+            "lib/sss_oblique.glsl",
+            expr,
+            {"d": d, "ng": ng, "z0": z0, "eta": eta},
+            out_components=3,
+            prelude=NEAR_OUTS,
+        )
+        assert_close_fp32(gpu, ref, rtol=2e-4, atol=2e-5, what=expr)
+
+
+def test_near_entry_gain_twin(glsl):
+    from skinlab.gl.uniforms import set_array, set_uniforms
+    from skinlab.scene.optics import boundary as b
+
+    d, ng, z0, _ = _near_cases(seed=9)
+    for eta in (1.0, 1.3):
+        t = b.boundary_tables((0.894, 0.687, 0.494), (0.46, 0.23, 0.126), eta)
+
+        def setup(prog, t=t, eta=eta):
+            set_array(prog, "u_sss_entry", t.entry, b.ANGULAR_NODES)
+            set_uniforms(prog, {"u_sss_eta": eta})
+
+        gpu = glsl.evaluate(
+            "lib/sss_near_light.glsl", "sss_near_entry_gain(d, ng, z0)", {"d": d, "ng": ng, "z0": z0}, 3, setup=setup
+        )
+        f32 = lambda x: np.asarray(x, np.float32).astype(np.float64)
+        ref = near_entry_gain(f32(d), f32(ng), f32(z0), eta, t.entry)
+        assert np.isfinite(ref).all()
+        assert_close_fp32(gpu, ref, rtol=3e-4, atol=3e-5, what="sss_near_entry_gain")
+
+
+def test_near_entry_keeps_the_flux_and_moves_it_away():
+    """Under a point light h above a plane the diffusion's irradiance E(s) mu_s / J integrates to the
+    flux that entered (the Jacobian of the shift), and its mean distance from the light's foot grows
+    by about the Wang & Jacques shift k sin(theta) (here its flux-weighted mean)."""
+    h, k = 2.0, np.array([1.3, 0.95, 0.67])
+    rho = np.concatenate([np.linspace(0.0, 20.0, 40001)[1:], np.geomspace(20.0, 2e5, 20000)[1:]])
+    d = np.stack([rho, np.zeros_like(rho), np.full_like(rho, h)], -1)
+    ng = np.tile([0.0, 0.0, 1.0], (len(rho), 1))
+    g, mu_s = near_entry(d, ng, k, 1.0)
+    e_mu = h / (rho**2 + h * h) ** 1.5  # E mu of a unit-intensity point light
+    ring = np.gradient(rho) * 2 * np.pi * rho
+    flux = np.sum(e_mu * ring)  # 2 pi (1 - h / d_max): the whole plane's
+    assert flux == pytest.approx(2 * np.pi, rel=1e-3)
+    moved = (e_mu[:, None] * g * ring[:, None]).sum(0)
+    assert moved == pytest.approx(np.full(3, flux), rel=2e-3)
+    # each point's entry lies nearer the foot, at the cosine the map says
+    rs = np.sqrt(np.maximum(h * h / mu_s**2 - h * h, 0.0))
+    assert (rs <= rho[:, None] + 1e-9).all()
+    on = rho < 1e3  # past that the cosine is under NEAR_MIN_COS's reach of float precision in this check
+    want = np.broadcast_to(rho[on, None], rs[on].shape)
+    assert rs[on] + k * rs[on] / np.sqrt(rs[on] ** 2 + h * h) == pytest.approx(want, rel=1e-6, abs=1e-6)
+    # the light moves away from the foot: within 20 mm its mean distance grows, red (longest z0) most
+    near = rho < 20.0
+    w0 = e_mu[near] * ring[near]
+    mean0 = np.sum(w0 * rho[near]) / w0.sum()
+    w1 = (e_mu * g.T).T[near] * ring[near, None]
+    mean1 = (w1 * rho[near, None]).sum(0) / w1.sum(0)
+    assert (mean1 > mean0).all() and mean1[0] > mean1[1] > mean1[2]
+    # a light far away (directional-like within a small patch): no change
+    far = near_entry(np.array([[0.3, 0.0, 1e6]]), ng[:1], k, 1.0)[0]
+    assert far == pytest.approx(np.ones((1, 3)), abs=1e-5)

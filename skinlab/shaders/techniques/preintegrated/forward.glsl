@@ -59,7 +59,7 @@ vec3 sss_radiance(Surface s) {
         vec3 D = pis_lookup(u_pis_lut, u_pis_lut_size, nlg, t);  // one normal: one lookup
 #endif
         float flat_nl = max(nlg, 0.0);
-        entering += e * vis * (flat_nl * sss_entry(flat_nl) + (D - flat_nl) * u_sss_entry_diffuse);
+        entering += e * sss_near_gain(s, i) * vis * (flat_nl * sss_entry(flat_nl) + (D - flat_nl) * u_sss_entry_diffuse);
 #ifdef SSS_TRANSLUCENCY
         vec3 te;  // light through thin parts leaves with its own angular distribution
         sss_translucent_light_toward(i, s.position, ng, l, e, abs(s.NoV), te);

@@ -19,6 +19,7 @@
 #include "lib/sss_boundary.glsl"
 #include "lib/ambient_entering.glsl"
 #include "lib/sss_oblique.glsl"
+#include "lib/sss_near_light.glsl"
 #include "skinlab/material.glsl"
 #include "lib/sss_maps.glsl"
 #include "lib/material_sample.glsl"
@@ -88,7 +89,9 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
         vec3 entry = sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit);
         // averaged over the texel's footprint (lib/shadow.glsl shadow_pcf_area): the texel holds its
         // square's mean, not its centre's, so a shadow edge along the layout's grid does not alias
-        sum += e * (light_visibility_area(i, entry, dot(ng, l), v_du, v_dv) * NoL) * sss_entry(NoL);
+        // a point or spot light's irradiance there too (lib/sss_near_light.glsl)
+        sum += e * (light_visibility_area(i, entry, dot(ng, l), v_du, v_dv) * NoL) * sss_entry(NoL)
+               * sss_light_near_gain(i, v_world, ng, z0);
     }
 #ifdef TSD_TRANSLUCENCY
     float back = -dot(ng, l);
@@ -128,7 +131,8 @@ void main() {
         vec3 l, e;
         light_incidence(i, v_world, n, l, e);
         float NoL = dot(n, l);
-        if (NoL > 0.0) e_in += e * NoL * sss_entry(NoL);
+        // a point or spot light's irradiance where this texel's diffusion entered (lib/sss_near_light.glsl)
+        if (NoL > 0.0) e_in += e * NoL * sss_entry(NoL) * sss_light_near_gain(i, v_world, ng, u_sss_mfp * sss_radius_scale_at(v_uv));
     }
 #if SHADOW_SLOTS > 0
     e_in += shadowed_light(0, n, ng);

@@ -1,0 +1,28 @@
+// The diffusion's entering light under a light at a finite distance (point and spot lights): fed by
+// the irradiance where it entered, nearer the light's foot (oblique entry, lib/sss_oblique.glsl
+// sss_near_entry), with the entry factor at that point's incidence. NumPy twin:
+// skinlab/scene/optics/oblique.py near_entry_gain.
+#include "lib/lights.glsl"
+#include "lib/sss_boundary.glsl"
+#include "lib/sss_oblique.glsl"
+
+// Per channel, the factor on e NoL sss_entry(NoL) at a point d_mm (millimetres) from the light:
+// sss_near_entry's g x entry(mu_s) / entry(mu_x), mu the cosines to the geometric normal ng, at most
+// SSS_NEAR_MAX_GAIN (a dielectric's entry falls to 0 at grazing incidence: the ratio is large only
+// where the light entering is nearly none); 1 where sss_near_entry is.
+vec3 sss_near_entry_gain(vec3 d_mm, vec3 ng, vec3 z0_mm) {
+    float mu_x = clamp(dot(d_mm, ng) / max(length(d_mm), 1e-30), 0.0, 1.0);
+    if (mu_x <= SSS_NEAR_MIN_COS) return vec3(1.0);
+    vec3 mu_s;
+    vec3 g = sss_near_entry(d_mm, ng, z0_mm, u_sss_eta, mu_s);
+    vec3 at_s = vec3(sss_entry(mu_s.r).r, sss_entry(mu_s.g).g, sss_entry(mu_s.b).b);
+    return min(g * at_s / max(sss_entry(mu_x), vec3(1e-6)), vec3(SSS_NEAR_MAX_GAIN));
+}
+
+// That factor for light i at world (z0_mm the mean free path x the radius map): 1 for directional
+// and area lights (a directional light's irradiance does not change along the surface: its entry
+// is a shift, which only the shadow lookup needs, lib/sss_oblique.glsl sss_entry_point).
+vec3 sss_light_near_gain(int i, vec3 world, vec3 ng, vec3 z0_mm) {
+    if (u_light_vec[i].w == 0.0 || u_light_axis[i].w > 1.5) return vec3(1.0);
+    return sss_near_entry_gain((u_light_vec[i].xyz - world) * u_mm_per_unit, ng, z0_mm);
+}
