@@ -15,8 +15,9 @@ from skinlab.resources import asset_path
 TOOLS = Path(tools.__file__).parent
 TESTED_ELSEWHERE = {"truth_table", "closeup_table", "forward_cost", "irradiance_cost", "cost_variants", "gpu_reference"}
 HERE = {
-    "accuracy_table", "boundary_slab", "branch_cost", "env_sphere", "frame_times", "full_over_plain", "make_face_parts",
-    "make_reference_meshes", "repair_bunny", "seam_report", "supersample_cost", "translucency_check",
+    "accuracy_table", "boundary_slab", "branch_cost", "env_sphere", "frame_times", "full_over_plain",
+    "make_face_parts", "make_reference_meshes", "near_light_check", "repair_bunny", "seam_report",
+    "supersample_cost", "translucency_check",
 }  # fmt: skip
 
 
@@ -184,3 +185,26 @@ def test_translucency_check(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "frame " in out and "chord  model" in out and "normal model" in out
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["chord.png", "normal.png", "truth.png"]
+
+
+def test_near_light_check_monte_carlo_is_the_half_space(capsys):
+    """The tool's Monte Carlo against Chandrasekhar's half-space: a view wide enough to hold the light
+    that enters within its radius sees int E(r) f(1, mu0(r)) dA, f = a/(4 pi) H(1) H(mu0) / (1 + mu0);
+    and the tool runs against it (no truth) with one technique."""
+    from skinlab.scene.optics.boundary import chandrasekhar_h
+    from tools import near_light_check as nl
+
+    h, albedo, mfp, i0, radius = 2.0, (0.89, 0.69, 0.49), (1.3, 0.95, 0.67), 1e-5, 10.0
+    img = nl.half_space_mc(h, albedo, mfp, i0, 16, 40.0, 150_000, radius_mm=radius)
+    got = img.sum((0, 1)) * (40.0 / 16 * 1e-3) ** 2  # W/sr leaving straight up
+    r = np.linspace(0.0, radius, 4001)
+    mu0 = h / np.hypot(r, h)
+    e = i0 * 1e6 * h / (r * r + h * h) ** 1.5  # W/m^2 on the surface
+    for c, a in enumerate(albedo):
+        f = a / (4 * np.pi) * chandrasekhar_h(a, 1.0) * chandrasekhar_h(a, mu0) / (1 + mu0)
+        want = np.trapezoid(e * f * 2 * np.pi * r, r) * 1e-6  # mm^2 -> m^2
+        assert got[c] == pytest.approx(want, rel=0.03), c
+    assert nl.main(["--photons", "3000", "--techniques", "none", "--no-truth"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[1].startswith("point-light-skin1: light 2 mm above the slab") and "Monte Carlo" in out[1]
+    assert out[2].startswith("none ") and out[2].count(" rings (mm):") == 1 and "8.65-13" in out[2]
