@@ -53,6 +53,14 @@ def test_seam_fill_and_the_blur_with_seams_match_their_numpy_twins(renderer):
     np.testing.assert_allclose(gpu, ref, rtol=1e-4, atol=1e-5)
     np.testing.assert_array_equal(gpu[real], img[real])  # real texels are kept
     assert (ref[ext, 3] > 0).mean() > 0.2  # the fill did reach across into the charts
+    # with the seam map's mask (as the seams pass leaves it): a copy, then only the marked texels
+    # filled; the same texels bit for bit, whatever the target held
+    seam_map = t.seam_map(renderer.ctx)
+    seam_map.mark(renderer, renderer.programs.get("passes/fullscreen.vert", "techniques/tsd/seam_mark.frag"))
+    assert seam_map.mask is not None
+    t.scratch.write(np.full((n, n, 4), 7.0, np.float32).tobytes())
+    seam_fill(renderer, t, t.raw, t.scratch)
+    np.testing.assert_array_equal(read_texture(t.scratch), gpu)
 
     stretch = np.zeros((n, n, 4), np.float32)
     stretch[..., :2] = np.linspace(0.2, 0.5, n)[None, :, None]

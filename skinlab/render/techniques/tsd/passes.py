@@ -546,7 +546,9 @@ class TsdSeamPass(TsdPass):
     def run(self, frame, p) -> None:
         t = self.node_targets(p)
         prog = self.r.programs.get("techniques/tsd/seam.vert", "techniques/tsd/seam.frag")
-        t.seam_map(self.r.ctx).draw(prog, p.params.seams, p.params.node.mesh)
+        seam = t.seam_map(self.r.ctx)
+        seam.draw(prog, p.params.seams, p.params.node.mesh)
+        seam.mark(self.r, self.r.programs.get("passes/fullscreen.vert", "techniques/tsd/seam_mark.frag"))
         self.publish(frame, p)
 
 
@@ -563,12 +565,19 @@ def seam_fill(renderer, t: TsdNodeTargets, src: moderngl.Texture, dst: moderngl.
         dispatch(cs, (t.size, t.size))
         return
     prog = renderer.programs.get("passes/fullscreen.vert", "techniques/tsd/seam_fill.frag")
-    t.fbo(ctx, dst).use()
+    seam = t.seam_map(ctx)
+    # every texel but the marked ones is a copy: a blit, then the fill over the marked texels alone
+    # (an early depth test against the seam map's mask; 0.5 <= 0.5 there, 0 elsewhere)
+    ctx.copy_framebuffer(t.fbo(ctx, dst), t.fbo(ctx, src))
+    fbo = t.fbo(ctx, dst, depth=seam.mask)
+    fbo.depth_mask = False
+    fbo.use()
     ctx.viewport = (0, 0, t.size, t.size)
     src.use(0)
-    t.seam_map(ctx).texture.use(1)
+    seam.texture.use(1)
     set_uniforms(prog, {"u_src": 0, "u_seam": 1})
-    renderer.fullscreen(prog)
+    with gl_state(ctx, enable=moderngl.DEPTH_TEST if seam.mask is not None else 0, depth_func="<="):
+        renderer.fullscreen(prog)
 
 
 class TsdBlurPass(TsdPass):

@@ -106,6 +106,27 @@ class SeamMap:
         self.fbo = ctx.framebuffer([self.texture], self.depth)
         self.vertices: tuple[moderngl.Buffer, moderngl.VertexArray] | None = None  # the extension's
         self.source: tuple | None = None  # (id of the extension, id of the program) the vertices are for
+        # the marked texels as a depth mask (mark): 0.5 where marked, 0 elsewhere; None until marked
+        self.mask: moderngl.Renderbuffer | None = None
+        self._mask_fbo: moderngl.Framebuffer | None = None
+        self._mask_color: moderngl.Renderbuffer | None = None
+
+    def mark(self, renderer, prog) -> None:
+        """The mask of the marked texels for seam_fill's early depth test (prog: techniques/tsd/
+        seam_mark.frag over a fullscreen triangle); after every draw of the map."""
+        size = self.texture.size
+        if self.mask is None:
+            self.mask = self.ctx.depth_renderbuffer(size)
+            self._mask_color = self.ctx.renderbuffer(size, 1, dtype="f1")
+            self._mask_fbo = self.ctx.framebuffer([self._mask_color], self.mask)
+        assert self._mask_fbo is not None
+        self._mask_fbo.use()
+        self.ctx.viewport = (0, 0, *size)
+        self._mask_fbo.clear(0.0, 0.0, 0.0, 0.0, depth=0.0)
+        self.texture.use(0)
+        set_uniforms(prog, {"u_seam": 0})
+        with gl_state(self.ctx, moderngl.DEPTH_TEST, depth_func="1"):  # always: write 0.5 where kept
+            renderer.fullscreen(prog)
 
     def draw(self, prog, ext: SeamExtension, mesh) -> None:
         key = (id(ext), id(prog), mesh.uid, mesh.version)
@@ -146,6 +167,9 @@ class SeamMap:
 
     def release(self) -> None:
         self.release_vertices()
+        for x in (self._mask_fbo, self._mask_color, self.mask):
+            if x is not None:
+                x.release()
         self.fbo.release()
         self.depth.release()
         self.texture.release()
