@@ -48,11 +48,11 @@ def distance_layers(renderer, scene) -> dict[str, np.ndarray]:
     renderer.render(scene, RenderSettings(64, 64, shadow_size=512), readback=False)
     sp = next(p for p in renderer.passes.values() if isinstance(p, ShadowPass))
     out = {}
-    for slot, (_, _, dist) in sp.maps.items():
-        if dist is not None:
-            out[f"distance{slot}"] = np.frombuffer(dist.read(), np.float32).copy()
-            out[f"exit{slot}"] = np.frombuffer(sp.layers[slot][0].read(), np.float32).copy()
-            out[f"entry{slot}"] = np.frombuffer(sp.layers[slot][2].read(), np.float32).copy()
+    for slot, shadow_map in sp.maps.items():
+        if shadow_map.distance is not None:
+            out[f"distance{slot}"] = np.frombuffer(shadow_map.distance.read(), np.float32).copy()
+            out[f"exit{slot}"] = np.frombuffer(sp.layers[slot].exit.read(), np.float32).copy()
+            out[f"entry{slot}"] = np.frombuffer(sp.layers[slot].entry.read(), np.float32).copy()
             n = part_layer_size(512)  # the part layers' own size, half the shadow map's
             assert n == 256 and sp.layers[slot][0].size == sp.layers[slot][2].size == (n, n)
     return out

@@ -5,6 +5,7 @@ small as the box allows; a point light's perspective map is fitted to the boundi
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import moderngl
 import numpy as np
@@ -21,6 +22,37 @@ from skinlab.render.texture_units import TextureUnits
 from skinlab.render.translucency import part_gap, part_layer_size
 from skinlab.scene import transform as tf
 from skinlab.scene.graph import LightNode
+
+
+class ShadowMap(NamedTuple):
+    """A slot's depth map: the depth texture (compared), its framebuffer and, for lights whose
+    translucency reads it, the first surface's distance from the light (R32F)."""
+
+    depth: moderngl.Texture
+    fbo: moderngl.Framebuffer
+    distance: moderngl.Texture | None
+
+    def release(self) -> None:
+        for x in (self.fbo, self.depth, self.distance):
+            if x is not None:
+                x.release()
+
+
+class PartLayers(NamedTuple):
+    """A slot's part layers for light through thin parts (skinlab/render/translucency.py
+    part_layer_size texels per side): the exit from the first part (RG32F) and the entry into the
+    next (R32F), each with its framebuffer, and the depth buffer the two share."""
+
+    exit: moderngl.Texture
+    exit_fbo: moderngl.Framebuffer
+    entry: moderngl.Texture
+    entry_fbo: moderngl.Framebuffer
+    depth: moderngl.Renderbuffer
+
+    def release(self) -> None:
+        for x in (self.exit_fbo, self.entry_fbo, self.exit, self.entry, self.depth):
+            x.release()
+
 
 # maps clip space [-1, 1] to texture space [0, 1]
 CLIP_TO_TEXTURE = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5], [0, 0, 0, 1.0]])
@@ -111,25 +143,20 @@ class LayerSubset:
 class ShadowPass(RenderPass):
     def __init__(self, renderer):
         super().__init__(renderer)
-        # slot -> (depth texture, framebuffer, distance texture or None)
-        self.maps: dict[int, tuple[moderngl.Texture, moderngl.Framebuffer, moderngl.Texture | None]] = {}
-        # with part layers: per slot (exit texture, its framebuffer, next-entry texture, its
-        # framebuffer, their depth buffer), part_layer_size texels per side
-        self.layers: dict[int, tuple] = {}
+        self.maps: dict[int, ShadowMap] = {}  # per slot
+        self.layers: dict[int, PartLayers] = {}  # per slot whose light has part layers
         # (node uid, facing) -> the triangles a layer draws (skinlab/render/shadow_facing.py), kept
         # while the light and the node hold still
         self._layer_draws: dict[tuple, LayerSubset] = {}
 
-    def target(self, slot: int, size: int, distance: bool = False, layers: bool = False):
-        """(depth texture, framebuffer, distance texture or None) for a slot. With `distance`, the
+    def target(self, slot: int, size: int, distance: bool = False, layers: bool = False) -> ShadowMap:
+        """A slot's ShadowMap, made or remade at `size`. With `distance`, the
         distance texture holds the first surface's distance from the light; with `layers` the slot
         also has the part layers (self.layers[slot], skinlab/shaders/passes/shadow.frag)."""
         t = self.maps.get(slot)
-        if t is None or t[0].size != (size, size) or (t[2] is not None) != distance:
+        if t is None or t.depth.size != (size, size) or (t.distance is not None) != distance:
             if t is not None:
-                for x in (t[1], t[0], t[2]):
-                    if x is not None:
-                        x.release()
+                t.release()
             ctx = self.r.ctx
             tex = ctx.depth_texture((size, size))
             tex.compare_func = "<="
@@ -137,17 +164,17 @@ class ShadowPass(RenderPass):
             tex.repeat_x = tex.repeat_y = False
             dist = _float_texture(ctx, size, 1) if distance else None
             fbo = ctx.framebuffer([dist] if dist is not None else [], depth_attachment=tex)
-            t = self.maps[slot] = (tex, fbo, dist)
+            t = self.maps[slot] = ShadowMap(tex, fbo, dist)
         held = self.layers.get(slot)
         n = part_layer_size(size)
-        if held is not None and (not layers or held[0].size != (n, n)):
+        if held is not None and (not layers or held.exit.size != (n, n)):
             self._release_layers(slot)
             held = None
         if layers and held is None:
             ctx = self.r.ctx
             exit_tex, entry_tex = _float_texture(ctx, n, 2), _float_texture(ctx, n, 1)
             depth = ctx.depth_renderbuffer((n, n))
-            self.layers[slot] = (
+            self.layers[slot] = PartLayers(
                 exit_tex,
                 ctx.framebuffer([exit_tex], depth_attachment=depth),
                 entry_tex,
@@ -159,14 +186,11 @@ class ShadowPass(RenderPass):
     def _release_layers(self, slot: int) -> None:
         layers = self.layers.pop(slot, None)
         if layers is not None:
-            for x in (layers[1], layers[3], layers[0], layers[2], layers[4]):
-                x.release()
+            layers.release()
 
     def release(self) -> None:
-        for tex, fbo, dist in self.maps.values():
-            for x in (fbo, tex, dist):
-                if x is not None:
-                    x.release()
+        for m in self.maps.values():
+            m.release()
         self.maps.clear()
         for slot in list(self.layers):
             self._release_layers(slot)
@@ -174,14 +198,15 @@ class ShadowPass(RenderPass):
             subset.release()
         self._layer_draws.clear()
 
-    def _target(self, p):
+    def _target(self, p) -> ShadowMap:
         prm: ShadowParams = p.params
         return self.target(prm.slot, p.resolution[0], prm.distance, prm.layers)
 
     def outputs(self, frame, p) -> tuple:
         """The textures holding the pass's result (reuse across frames, skinlab/render/reuse.py)."""
         tex, _, dist = self._target(p)
-        layers = self.layers[p.params.slot][0:3:2] if p.params.layers else ()
+        held = self.layers[p.params.slot] if p.params.layers else None
+        layers = () if held is None else (held.exit, held.entry)
         return (tex, *(() if dist is None else (dist,)), *layers)
 
     def publish(self, frame, p) -> None:
@@ -194,8 +219,9 @@ class ShadowPass(RenderPass):
         if dist is not None:
             frame.targets[f"shadow_distance{slot}"] = dist
         if prm.layers:
-            frame.targets[f"shadow_exit{slot}"] = self.layers[slot][0]
-            frame.targets[f"shadow_entry{slot}"] = self.layers[slot][2]
+            held = self.layers[slot]
+            frame.targets[f"shadow_exit{slot}"] = held.exit
+            frame.targets[f"shadow_entry{slot}"] = held.entry
         lo, hi = frame.scene.world_bounds()
         m = CLIP_TO_TEXTURE @ light_view_proj(light, lo, hi)
         frame.shadow_matrices[slot] = m
@@ -273,7 +299,8 @@ class ShadowPass(RenderPass):
         """The part layers for light through thin parts (skinlab/shaders/passes/shadow.frag
         SHADOW_LAYER; skinlab/render/translucency.py part_layer_size texels per side): the exit from
         the first part, then the entry into the next."""
-        exit_tex, exit_fbo, _, entry_fbo, _ = self.layers[slot]
+        held = self.layers[slot]
+        exit_tex, exit_fbo, entry_fbo = held.exit, held.exit_fbo, held.entry_fbo
         eye = light_eye(light)
         exit_fbo.clear(1e30, 0.0, 0.0, 0.0, depth=1.0)
         exit_fbo.use()
