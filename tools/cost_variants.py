@@ -15,11 +15,14 @@ from skinlab.gl.shader_source import ShaderLibrary
 from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK
 
 
-def measure_library(pass_file: str, defines: Mapping[str, object]) -> ShaderLibrary:
+def measure_library(
+    pass_file: str, defines: Mapping[str, object], hook: str = PLAIN_HOOK, variant: Mapping[str, object] | None = None
+) -> ShaderLibrary:
     """A ShaderLibrary adding `defines` to every expansion of `pass_file` (ShaderLibrary.defines);
-    SystemExit naming the file and the define when the pass (its includes too) does not read one."""
+    SystemExit naming the file and the define when the pass (its includes too, the forward pass
+    with technique hook `hook` and the defines of `variant`) does not read one."""
     library = ShaderLibrary(defines={pass_file: dict(defines)})
-    flat = ShaderLibrary().expand(pass_file, aliases={HOOK_INCLUDE: PLAIN_HOOK}).flat  # (the forward pass's hook)
+    flat = ShaderLibrary().expand(pass_file, dict(variant or {}), aliases={HOOK_INCLUDE: hook}).flat
     for name in defines:
         if name not in flat:
             raise SystemExit(f"{pass_file}: no shader of the pass reads {name} any more; update this tool")

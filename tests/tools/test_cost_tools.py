@@ -57,3 +57,34 @@ def test_irradiance_cost_runs_tiny(capsys):
     assert irradiance_cost.main(["--coverage", "--tsd-size", "128", "--rounds", "1"]) == 0
     shares = [float(line.split("%")[0].split()[-1]) for line in capsys.readouterr().out.splitlines() if "UVs x" in line]
     assert len(shares) == 4 and shares == sorted(shares, reverse=True) and shares[-1] < shares[0] / 10
+
+
+def test_forward_cost_times_a_technique_s_translucency_by_its_parts(ctx, capsys):
+    from skinlab.render.translucency import DEFINE
+
+    hook = "techniques/ssss/forward.glsl"
+    for defines in forward_cost.TRANSLUCENCY_PARTS.values():  # each part's define is read with the hook's translucency
+        measure_library(forward_cost.FWD, defines, hook, {DEFINE: 1})
+    with pytest.raises(SystemExit, match="no shader of the pass reads MEASURE_NO_SLAB_EXIT"):
+        measure_library(forward_cost.FWD, forward_cost.TRANSLUCENCY_PARTS["no_slab_exit"])  # not with the plain hook
+    # taking the slab tables out changes the back-lit slab's frame (the variant is what it says)
+    scene = load_scene("reference/slab-thin-backlit-skin1")
+    st = RenderSettings.for_technique("ssss", 24, 24, shadow_size=256)
+    parts = forward_cost.TRANSLUCENCY_PARTS
+    runs = [
+        Renderer(ctx),
+        Renderer(ctx, measure_library(forward_cost.FWD, parts["no_slab_through"], hook, {DEFINE: 1})),
+    ]
+    a, b = (r.render(scene, st, readback=("hdr",)).hdr for r in runs)
+    assert not np.allclose(a, b)
+    for r in runs:
+        r.release()
+    argv = ["--translucency", "ssss", "--size", "16", "--rounds", "1", "--scene", "reference/slab-thin-backlit-skin1"]
+    assert forward_cost.main(argv) == 0
+    out = capsys.readouterr().out
+    for name in ("base", "off", *parts, "all_three"):
+        assert f"  {name:<16}" in out
+    with pytest.raises(SystemExit, match="tsd's forward pass adds no light through thin parts here"):
+        forward_cost.main(["--translucency", "tsd", "--size", "16", "--rounds", "1"])  # its irradiance pass does
+    with pytest.raises(SystemExit, match="'tint' has no translucency setting"):
+        forward_cost.main(["--translucency", "tint", "--size", "16", "--rounds", "1"])

@@ -128,9 +128,22 @@ vec3 sss_translucent_light_toward(int i, vec3 world, vec3 ng, vec3 l, vec3 e, fl
     float back = -dot(ng, l);
     float d_mm;
     through_exit = vec3(0.0);
+#ifdef MEASURE_NO_THICKNESS  // measurement variants (tools/forward_cost.py --translucency): a part taken out
+    d_mm = 3.0;
+    if (slot < 0 || back <= 0.0) return vec3(0.0);
+#else
     if (slot < 0 || back <= 0.0 || !sss_thickness_mm(slot, world, ng, back, d_mm)) return vec3(0.0);
+#endif
+#ifdef MEASURE_NO_SLAB_THROUGH
+    vec3 entering = e * (back * d_mm);
+#else
     vec3 entering = e * back * sss_through(back, d_mm);
+#endif
+#ifdef MEASURE_NO_SLAB_EXIT
+    through_exit = entering * mu;
+#else
     through_exit = entering * sss_slab_exit(mu, back, d_mm);
+#endif
     return entering;
 }
 
