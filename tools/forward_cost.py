@@ -62,7 +62,7 @@ def translucency_cost(technique: str, size: int, rounds: int, scene_name: str | 
     scene = load_scene(scene_name)
     on = RenderSettings.for_technique(technique, size, size)
     off = RenderSettings.for_technique(technique, size, size, translucency=False)
-    variants = {"base": (None, on), "off": (None, off)}
+    variants: dict[str, tuple[dict | None, RenderSettings]] = {"base": (None, on), "off": (None, off)}
     variants.update({k: (d, on) for k, d in parts.items()})
     runs = {}
     try:
@@ -79,7 +79,7 @@ def translucency_cost(technique: str, size: int, rounds: int, scene_name: str | 
                 f"--translucency: {technique}'s forward pass adds no light through thin parts here "
                 "(a technique whose forward hook does: ssss, disk, preintegrated; a scene with a shadow-casting light)"
             )
-        hook = hooks.pop()
+        hook = str(hooks.pop())
         for name, (defines, st) in variants.items():
             lib = measure_library(FWD, defines, hook, {DEFINE: 1}) if defines else None
             r = Renderer(ctx, lib) if lib is not None else Renderer(ctx)
