@@ -48,8 +48,9 @@ def renderer(ctx):
 
 @pytest.fixture
 def multiple_only(monkeypatch):
-    """Frames without Jensen's single-scattering term (it is local, unblurred): what is left is the
-    multiple scattering the profile spreads."""
+    """Frames without Jensen's single-scattering term (it is local, unblurred) and without the
+    multiple scattering's non-separable rest (lib/sss_boundary.glsl sss_ms_rest: local too, or spread
+    by a screen-space hook): what is left is the separable multiple scattering the profile spreads."""
     import dataclasses
 
     import numpy as np
@@ -63,3 +64,5 @@ def multiple_only(monkeypatch):
         return None if t is None else dataclasses.replace(t, single=np.zeros(3))
 
     monkeypatch.setattr(render_boundary, "material_boundary", without_single)
+    rest = render_boundary.material_ms_rest
+    monkeypatch.setattr(render_boundary, "material_ms_rest", lambda material: np.zeros_like(rest(material)))

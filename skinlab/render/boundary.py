@@ -9,13 +9,15 @@ import numpy as np
 
 from skinlab.cache import table
 from skinlab.gl.uniforms import set_array, set_uniforms
-from skinlab.scene.optics.boundary import ANGULAR_NODES, BoundaryTables, boundary_tables
+from skinlab.scene.optics.boundary import ANGULAR_NODES, MS_REST_NODES, BoundaryTables, boundary_tables, ms_rest_table
 from skinlab.scene.optics.fresnel import fdr
 from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
 from skinlab.scene.optics.similarity import real_albedo
 from skinlab.scene.optics.slab import LN_FLOOR, SLAB_MU_NODES, SLAB_TAU_NODES, slab_decay, slab_exit_tables, slab_table
 
 _ZERO_TABLE = np.zeros((ANGULAR_NODES, 3))
+_MS_REST_ROWS = MS_REST_NODES * MS_REST_NODES
+_ZERO_REST = np.zeros((_MS_REST_ROWS, 3))
 _SLAB_ROWS = SLAB_MU_NODES * SLAB_TAU_NODES
 _DARK_SLAB = np.full((_SLAB_ROWS, 3), LN_FLOOR)
 _DARK_NORM = np.full((SLAB_TAU_NODES, 3), LN_FLOOR)
@@ -40,6 +42,13 @@ def material_boundary(material) -> BoundaryTables | None:
     return boundary_tables(medium.alpha_arr, colour, medium.eta, boundary_ggx_alpha(material))
 
 
+def material_ms_rest(material) -> np.ndarray:
+    """The non-separable rest of the multiple-scattering BRDF of a material that scatters
+    (skinlab/scene/optics/boundary.py ms_rest_table: (N, N, 3), zero at eta > 1)."""
+    medium = material_medium(material.values)
+    return ms_rest_table(medium.alpha_arr, subsurface_albedo(material.values), medium.eta, boundary_ggx_alpha(material))
+
+
 def boundary_data(material) -> None:
     """Make (or read) everything :func:`bind_boundary` binds for `material`: its boundary tables and
     its slab tables (both memoised: a later bind finds them)."""
@@ -47,6 +56,7 @@ def boundary_data(material) -> None:
         medium = material_medium(material.values)
         colour = subsurface_albedo(material.values)
         _slab_tables(tuple(medium.alpha_arr), tuple(float(x) for x in colour), float(medium.eta))
+        material_ms_rest(material)
 
 
 def prefetch_boundaries(meshes, settings) -> None:
@@ -91,6 +101,7 @@ def bind_boundary(prog, material) -> None:
         set_array(prog, "u_sss_entry", _ZERO_TABLE, ANGULAR_NODES)
         set_array(prog, "u_sss_exit", _ZERO_TABLE, ANGULAR_NODES)
         set_array(prog, "u_sss_single_ambient", _ZERO_TABLE, ANGULAR_NODES)
+        set_array(prog, "u_sss_ms_rest", _ZERO_REST, _MS_REST_ROWS)
         zero = (0.0, 0.0, 0.0)
         set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0, "u_sss_g": 0.0})
         set_array(prog, "u_sss_slab", _DARK_SLAB, _SLAB_ROWS)
@@ -102,6 +113,7 @@ def bind_boundary(prog, material) -> None:
     set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
     set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
     set_array(prog, "u_sss_single_ambient", t.single_ambient, ANGULAR_NODES)
+    set_array(prog, "u_sss_ms_rest", material_ms_rest(material).reshape(_MS_REST_ROWS, 3), _MS_REST_ROWS)
     g = float(material.values.get("subsurface_scatter_anisotropy", 0.0))
     single = single_scattering_factor(material, t)
     set_uniforms(

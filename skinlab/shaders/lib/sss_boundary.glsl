@@ -24,6 +24,27 @@ vec3 sss_entry(float mu) {
     return mix(u_sss_entry[i], u_sss_entry[i + 1], x - float(i));
 }
 
+// What the separable multiple-scattering BRDF misses, per unit base colour (NumPy twin:
+// skinlab/scene/optics/boundary.py ms_rest_table, ms_rest_lookup): at eta = 1 Chandrasekhar's exact
+// f_ms(mu, mu0) less entry(mu0) exit(mu) / pi, rows the view's cosine mu_i, columns the light's mu0_j,
+// at i / (SSS_MS_REST_NODES - 1), bilinear in between; zero at eta > 1. Added per light where the
+// light lands, as single scattering is (passes/forward.frag): it moves light between directions
+// only (for every mu0 it integrates to 0 over the exit).
+#define SSS_MS_REST_NODES 9
+uniform vec3 u_sss_ms_rest[SSS_MS_REST_NODES * SSS_MS_REST_NODES];
+
+vec3 sss_ms_rest(float mu, float mu0) {
+    float x = clamp(mu, 0.0, 1.0) * float(SSS_MS_REST_NODES - 1);
+    float y = clamp(mu0, 0.0, 1.0) * float(SSS_MS_REST_NODES - 1);
+    int i = min(int(floor(x)), SSS_MS_REST_NODES - 2);
+    int j = min(int(floor(y)), SSS_MS_REST_NODES - 2);
+    float fx = x - float(i), fy = y - float(j);
+    int r = i * SSS_MS_REST_NODES + j;
+    vec3 lo = mix(u_sss_ms_rest[r], u_sss_ms_rest[r + 1], fy);
+    vec3 hi = mix(u_sss_ms_rest[r + SSS_MS_REST_NODES], u_sss_ms_rest[r + SSS_MS_REST_NODES + 1], fy);
+    return mix(lo, hi, fx);
+}
+
 vec3 sss_exit(float mu) {
     float x = clamp(mu, 0.0, 1.0) * float(SSS_ANGULAR_NODES - 1);
     int i = min(int(floor(x)), SSS_ANGULAR_NODES - 2);

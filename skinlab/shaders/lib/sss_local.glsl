@@ -15,16 +15,22 @@
 #endif
 
 vec3 sss_in = vec3(0.0);  // irradiance entering the medium (this fragment)
+// The multiple scattering's non-separable rest (lib/sss_boundary.glsl sss_ms_rest) goes with the light
+// into the technique's diffusion (for a screen-space blur: spread with it), so the forward pass does
+// not add it where the light lands (passes/forward.frag).
+#define SSS_HOOK_MS_REST
+vec3 sss_rest = vec3(0.0);  // sum of e NoL rest(mu, mu0) over the lights (radiance x pi per base colour)
 
 void sss_add_light(Surface s, vec3 e, float vis, float NoL) {
     sss_in += e * (vis * NoL) * sss_entry(NoL);
+    sss_rest += e * (vis * NoL) * sss_ms_rest(abs(s.NoV), NoL);
 }
 
 // The radiance leaving the medium toward the viewer at s for subsurface weight sss_w (ambient
 // included), with the subsurface albedo s.m.sss_albedo.
 vec3 sss_local_radiance(Surface s, float sss_w) {
     vec3 entering = sss_in + ambient_entering(s.m.occlusion);
-    vec3 leaving = entering * sss_exit(abs(s.NoV));
+    vec3 leaving = entering * sss_exit(abs(s.NoV)) + PI * sss_rest;
 #ifdef SSS_TRANSLUCENCY
     // light through thin parts leaves with its own angular distribution (lib/sss_boundary.glsl sss_slab_exit)
     vec3 through_in;

@@ -202,9 +202,9 @@ def test_bunny_preset_scene_generates_uvs_and_scatters(renderer, tmp_path):
 def test_sub_texel_profile_is_scattered_locally_with_the_boundary(renderer, technique):
     """A profile narrower than a texel needs no blur, but the light still enters and leaves through
     the medium's boundary: the slab lit at 45 degrees and seen from above reads
-    E mu0 albedo (entry(mu0) exit(mu) / pi + Jensen's single scattering), from the NumPy tables (not
-    the plain Burley diffuse the planner used to fall back to)."""
-    from skinlab.scene.optics.boundary import boundary_tables, table_lookup
+    E mu0 albedo (entry(mu0) exit(mu) / pi + the non-separable rest + Jensen's single scattering),
+    from the NumPy tables (not the plain Burley diffuse the planner used to fall back to)."""
+    from skinlab.scene.optics.boundary import boundary_tables, ms_rest_lookup, ms_rest_table, table_lookup
     from skinlab.scene.optics.single_scattering import single_scatter_brdf
 
     mat = skin(radius=(0.05, 0.05, 0.05), color=(0.8, 0.5, 0.2))
@@ -219,7 +219,8 @@ def test_sub_texel_profile_is_scattered_locally_with_the_boundary(renderer, tech
     n, l, v = np.array([0.0, 0.0, 1.0]), np.array([-mu0, 0.0, mu0]), np.array([0.0, 0.0, 1.0])
     ss = single_scatter_brdf(n, l, v, t.single, m.eta, 0.0)
     colour = np.asarray(mat["subsurface_color"])  # the subsurface albedo (the colour rule, docs/scenes.md)
-    want = colour * mu0 * (table_lookup(t.entry, mu0) * table_lookup(t.exit, 1.0) / np.pi + ss)
+    rest = ms_rest_lookup(ms_rest_table(m.alpha_arr, mat["subsurface_color"], m.eta), 1.0, mu0)
+    want = colour * mu0 * (table_lookup(t.entry, mu0) * table_lookup(t.exit, 1.0) / np.pi + rest + ss)
     got = res.hdr[23:25, 23:25, :3].reshape(-1, 3).mean(0)
     np.testing.assert_allclose(got, want, rtol=2e-3)
     plain = renderer.render(scene, RenderSettings.for_technique("none", 48, 48)).hdr[23:25, 23:25, :3]
