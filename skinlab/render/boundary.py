@@ -104,6 +104,7 @@ def bind_boundary(prog, material) -> None:
         set_array(prog, "u_sss_ms_rest", _ZERO_REST, _MS_REST_ROWS)
         zero = (0.0, 0.0, 0.0)
         set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0, "u_sss_g": 0.0})
+        set_uniforms(prog, {"u_sss_ms_rest_on": 0.0})
         set_array(prog, "u_sss_slab", _DARK_SLAB, _SLAB_ROWS)
         set_array(prog, "u_sss_slab_norm", _DARK_NORM, SLAB_TAU_NODES)
         set_array(prog, "u_sss_slab_h", _ZERO_H, _SLAB_ROWS)
@@ -113,7 +114,9 @@ def bind_boundary(prog, material) -> None:
     set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
     set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
     set_array(prog, "u_sss_single_ambient", t.single_ambient, ANGULAR_NODES)
-    set_array(prog, "u_sss_ms_rest", material_ms_rest(material).reshape(_MS_REST_ROWS, 3), _MS_REST_ROWS)
+    rest = material_ms_rest(material)
+    set_array(prog, "u_sss_ms_rest", rest.reshape(_MS_REST_ROWS, 3), _MS_REST_ROWS)
+    set_uniforms(prog, {"u_sss_ms_rest_on": 1.0 if np.any(rest != 0) else 0.0})
     g = float(material.values.get("subsurface_scatter_anisotropy", 0.0))
     single = single_scattering_factor(material, t)
     set_uniforms(

@@ -13,6 +13,9 @@ A_ms(mu0) the directional albedo of multiple scattering (the fraction of light a
 leaves after two or more events), A_ms_d = 2 int A_ms(mu) mu dmu its hemispherical (diffuse) mean.
 It integrates to exactly A_ms(mu0) over the exit hemisphere, and is reciprocal. Single scattering
 is not separable and is added exactly per light (Jensen 2001's term, skinlab/scene/optics/single_scattering.py).
+At eta = 1 what the separable form misses of the exact BRDF below (4-5.5 % dark for normal light and
+view, 9-10 % bright for light at cosine 0.2) is added per light too (ms_rest_table): it moves light
+between directions and keeps the energy.
 
 Index-matched boundary (eta = 1), isotropic scattering, single-scattering albedo a: Chandrasekhar's
 exact solution (Radiative Transfer 1960, ch. V; docs/references.md#chandrasekhar-1960):

@@ -6,6 +6,7 @@
 // Multiple scattering, separable and reciprocal: f_ms = A_ms(mu0) A_ms(mu) / (pi A_ms_d).
 //   entry(mu0) = A_ms(mu0) / A_colour  multiplies base colour x irradiance entering the profile
 //   exit(mu)   = A_ms(mu) / A_ms_d     the angular distribution of what leaves (hemispherical mean 1)
+//   at eta = 1 plus its non-separable rest (sss_ms_rest), the exact BRDF's, added per light
 // Single scattering (Jensen 2001): alpha F_t F_t p / (|n.T_i| + |n.T_o|), added per light, unblurred.
 #include "lib/profiles_single.glsl"
 
@@ -32,6 +33,7 @@ vec3 sss_entry(float mu) {
 // only (for every mu0 it integrates to 0 over the exit).
 #define SSS_MS_REST_NODES 9
 uniform vec3 u_sss_ms_rest[SSS_MS_REST_NODES * SSS_MS_REST_NODES];
+uniform float u_sss_ms_rest_on;  // 1 where the table is not all zero (the material's own: no divergence)
 
 vec3 sss_ms_rest(float mu, float mu0) {
     float x = clamp(mu, 0.0, 1.0) * float(SSS_MS_REST_NODES - 1);

@@ -59,7 +59,6 @@ void main() {
     float NoV = s.NoV;
     vec3 color = vec3(0.0);
     bool single = any(greaterThan(u_sss_single, vec3(0.0)));
-    bool scatters = any(greaterThan(u_sss_entry_diffuse, vec3(0.0)));  // (the material's own uniforms: no divergence)
     vec3 single_w = s.m.sss_albedo * ((1.0 - metal) * s.sss_weight);  // x the weight map
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
@@ -98,7 +97,7 @@ void main() {
         // rest (lib/sss_boundary.glsl sss_ms_rest) unless the hook spreads it with its diffusion
         if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
 #ifndef SSS_HOOK_MS_REST
-        if (scatters) color += e * (vis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
+        if (u_sss_ms_rest_on > 0.0) color += e * (vis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
 #endif
         // the technique's diffusion: shadowed where it entered (oblique entry, lib/surface_inputs.glsl)
         // and fed by the irradiance where it entered (a point or spot light's, lib/surface_inputs.glsl)
