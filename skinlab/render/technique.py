@@ -28,6 +28,11 @@ position, normals, tangent frame, view, uv, the material sample ``m``, the subsu
 
 ``s.m.sss_albedo`` is the subsurface albedo at the fragment: subsurface_color x the colour map x the
 vertex colour (the colour rule, docs/scenes.md), not the plain part's base colour (``s.m.base``).
+The forward pass adds Jensen's single scattering for every mesh that scatters; a hook whose light
+enters and leaves through the shared separable boundary (lib/sss_boundary.glsl sss_entry, sss_exit)
+without spreading the boundary's non-separable rest itself defines ``SSS_MS_REST_LANDS``, and the
+forward pass adds that rest where the light lands (tsd, exact, preintegrated; lib/sss_local.glsl
+spreads it with its light).
 """
 
 from __future__ import annotations

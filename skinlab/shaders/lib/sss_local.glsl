@@ -16,9 +16,9 @@
 
 vec3 sss_in = vec3(0.0);  // irradiance entering the medium (this fragment)
 // The multiple scattering's non-separable rest (lib/sss_boundary.glsl sss_ms_rest) goes with the light
-// into the technique's diffusion (for a screen-space blur: spread with it), so the forward pass does
-// not add it where the light lands (passes/forward.frag).
-#define SSS_HOOK_MS_REST
+// into the technique's diffusion (for a screen-space blur: spread with it); a hook of the separable
+// boundary that cannot spread it has the forward pass add it where the light lands instead
+// (SSS_MS_REST_LANDS, passes/forward.frag).
 vec3 sss_rest = vec3(0.0);  // sum of e NoL rest(mu, mu0) over the lights (radiance x pi per base colour)
 
 void sss_add_light(Surface s, vec3 e, float vis, float NoL) {

@@ -10,6 +10,9 @@
 // around it, so by the diffuse entry factor. Variant SSS_TRANSLUCENCY: plus the light through thin
 // parts per light (lib/sss_translucency.glsl, as texture-space diffusion gathers it). Contract:
 // skinlab/render/technique.py.
+// The separable boundary's non-separable rest is added by the forward pass where the light lands
+// (passes/forward.frag): this hook does not spread it with its diffusion.
+#define SSS_MS_REST_LANDS
 #include "lib/sss_boundary.glsl"
 #include "lib/ambient.glsl"
 #include "lib/ambient_entering.glsl"

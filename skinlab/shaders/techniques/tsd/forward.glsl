@@ -10,6 +10,9 @@
 // exact where that light varies slowly across the profile (a flat part), linear in the lights; at a
 // sharp edge of the light through (a rim where the thickness drops) it can take a little more than
 // the blur brought there (at least 0). Contract: skinlab/render/technique.py.
+// The separable boundary's non-separable rest is added by the forward pass where the light lands
+// (passes/forward.frag): this hook does not spread it with its diffusion.
+#define SSS_MS_REST_LANDS
 #include "lib/sss_boundary.glsl"
 #include "skinlab/constants.glsl"
 #include "lib/surface_inputs.glsl"
