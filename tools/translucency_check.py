@@ -7,7 +7,7 @@ by casting rays through the mesh (Embree, through trimesh), and the light throug
 the exact slab transmittance (skinlab/scene/optics/slab.py slab_through) under two readings of the
 thickness:
 
-- ``chord``: the renderer's (lib/sss_translucency.glsl): the matter the light crosses on its way to
+- ``chord``: the renderer's before issue 21's ``sheet``: the matter the light crosses on its way to
   the point (every entry and exit along the ray to the light), times the cosine of the point's normal
   with the light, lit at that cosine;
 - ``normal``: the distance through the mesh along the inward normal to the far face, lit at the far
@@ -15,6 +15,9 @@ thickness:
 - ``entry``: the chord times the cosine of the face where the light entered the point's part (the
   back face's, not the front's; the same on a flat slab), lit at that cosine;
 - ``max``: the chord times the larger of the two cosines, lit at it;
+- ``sheet``: the renderer's since issue 21 (lib/sss_translucency.glsl sss_through_cosine): ``max``
+  where the entry face faces away from the point's own (their normals opposed: a sheet), the chord
+  times the point's cosine where both face one side (the light skims through a bulge);
 - ``normal-flux``: the normal thickness at the far face's cosine, its irradiance not projected on the
   far face (lit at 1): not a model that keeps energy but a measure of how much of the truth's level the
   light travelling along a curved sheet adds (issue 21).
@@ -110,8 +113,10 @@ def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
     rank = np.arange(len(r2)) - np.searchsorted(r2, r2)  # the hit's place along its ray
     # the cosine to the light of the face where the light entered the point's part (the first hit)
     first = rank == 0
-    cos_entry = np.zeros(k)
-    cos_entry[r2[first]] = np.clip(normal_at(tri2[first], l2[first]) @ to_light, 0.0, 1.0)
+    n_entry = np.zeros((k, 3))
+    n_entry[r2[first]] = normal_at(tri2[first], l2[first])
+    cos_entry = np.clip(n_entry @ to_light, 0.0, 1.0)
+    sheet = (nrm * n_entry).sum(1) < 0.0
     prev = np.where(rank > 0, np.concatenate([[0.0], dist[:-1]]), 0.0)
     chord = np.bincount(r2, np.where(rank % 2 == 0, dist - prev, 0.0), minlength=k)
     back = np.clip(-(nrm @ to_light), 0.0, 1.0)  # the light reaches the point from behind its surface
@@ -144,6 +149,7 @@ def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
         ("normal", through_normal),
         ("entry", chord_at(cos_entry)),
         ("max", chord_at(np.maximum(back, cos_entry))),
+        ("sheet", chord_at(np.where(sheet, np.maximum(back, cos_entry), back))),
         ("normal-flux", flux),
     )
     for name, v in models:
@@ -153,7 +159,7 @@ def predictions(scene, w: int, h: int) -> dict[str, np.ndarray]:
     return out
 
 
-MODELS = ("chord", "normal", "entry", "max", "normal-flux")
+MODELS = ("chord", "normal", "entry", "max", "sheet", "normal-flux")
 
 
 def _scale(pred: np.ndarray, truth: np.ndarray) -> float:
