@@ -13,9 +13,13 @@ texel, where the light leaves the first part it crosses (the nearest surface fac
 with the cosine there, and where it enters the next part (the nearest surface facing it beyond that
 exit by more than the part gap); a point past the first part's exit by more than the gap gets the
 first part's thickness (its chord times the exit cosine) plus its own part's (from the next entry,
-times its own cosine), not the air between them. What crosses that thickness is the exact slab
-transmittance of skinlab/scene/optics/slab.py (`slab_through`: all orders of scattering, Fresnel in
-and out). Texture-space diffusion gathers it in its irradiance pass,
+times its own cosine), not the air between them. The cosine (through_cosine) is, where the part is
+a sheet (the face where the light entered it faces away from the point's own), the larger of the
+point's own and the entry face's (from the distance map's slope): on a curved sheet the point's own
+face grazes the light where the entry face does not, and the chord times the point's cosine alone
+read the sheet thin there (the back-lit ear, issue 21; docs/ground-truth.md). What crosses that
+thickness is the exact slab transmittance of skinlab/scene/optics/slab.py (`slab_through`: all
+orders of scattering, Fresnel in and out). Texture-space diffusion gathers it in its irradiance pass,
 the screen-space techniques in the forward pass; both call the same GLSL functions.
 
 Distance maps are (H, W) (the first surface); the part layers (H', W', 2) (the first part's exit,
@@ -80,6 +84,68 @@ def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, 
     nearest = dist[j, i]
     first = np.where(inside, np.where(all4, bilinear, nearest), 0.0)
     return first, inside & (all4 | (nearest < NO_SURFACE))
+
+
+def entry_face(distance_map, shadow_matrix, eye, world) -> np.ndarray:
+    """(N, 4) the face where a directional light (eye w = 0) entered the part in front of each point
+    (the first surface it meets on the way there): its outward normal (toward the light) and its cosine
+    to the light, from the distance map's slope across the four texel centres first_hit_distance
+    interpolates (the bilinear's gradient, scene units per scene unit across the light's orthographic
+    view: the matrix's rows scale world to uv): (grad z, -1) / sqrt(1 + |grad z|^2) in the view's frame;
+    no slope across a clamped neighbour (the map's border). 0 where unknown: a point light, outside
+    the map, or one of the four texels without a surface. GLSL entry_face."""
+    world = _points(world)
+    eye = np.asarray(eye, np.float64).reshape(4)
+    if eye[3] != 0.0:
+        return np.zeros((len(world), 4))
+    m = np.asarray(shadow_matrix, np.float64)
+    dist = np.asarray(distance_map, np.float64)
+    h, w = dist.shape
+    p = np.concatenate([world, np.ones((len(world), 1))], 1) @ m.T
+    uv = p[:, :2] / p[:, 3:4]
+    inside = np.all((uv >= 0.0) & (uv <= 1.0), axis=1)
+    uv = np.where(inside[:, None], uv, 0.0)
+    x, y = uv[:, 0] * w - 0.5, uv[:, 1] * h - 0.5
+    i0, j0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
+    fx, fy = x - i0, y - j0
+    ia, ib = np.clip(i0, 0, w - 1), np.clip(i0 + 1, 0, w - 1)
+    ja, jb = np.clip(j0, 0, h - 1), np.clip(j0 + 1, 0, h - 1)
+    d00, d10, d01, d11 = dist[ja, ia], dist[ja, ib], dist[jb, ia], dist[jb, ib]
+    all4 = np.maximum(np.maximum(d00, d10), np.maximum(d01, d11)) < NO_SURFACE
+    rows = m[:2, :3]
+    texel = 1.0 / (np.array([w, h], np.float64) * np.linalg.norm(rows, axis=1))
+    with np.errstate(invalid="ignore", over="ignore"):
+        gx = ((d10 - d00) * (1 - fy) + (d11 - d01) * fy) / texel[0]
+        gy = ((d01 - d00) * (1 - fx) + (d11 - d10) * fx) / texel[1]
+        gx, gy = np.where(ib > ia, gx, 0.0), np.where(jb > ja, gy, 0.0)
+        c = 1.0 / np.sqrt(1.0 + gx * gx + gy * gy)
+        axes = rows / np.linalg.norm(rows, axis=1, keepdims=True)
+        n = (gx[:, None] * axes[0] + gy[:, None] * axes[1] - eye[:3]) * c[:, None]
+    ok = (inside & all4)[:, None]
+    return np.where(ok, np.concatenate([n, c[:, None]], 1), 0.0)
+
+
+def through_cosine(
+    distance_map, shadow_matrix, eye, world, normal, back, shrink, exit_map=None, part_gap=0.0
+) -> np.ndarray:
+    """(N,) the cosine at which light through the part in front of each point is taken to cross it:
+    where the part is a sheet (the entry face, entry_face at the lookup point world - shrink normal,
+    faces away from the point's own: their normals opposed) the larger of the point's own (`back`) and
+    the entry face's; `back` where the light skims through a bulge (the normals on one side), where the
+    entry face is unknown and where the point lies past the first part's exit (the layered case). The
+    thickness is the chord times it and the light enters at it (thickness_mm, translucent_irradiance,
+    translucent_exit with it as `back`). GLSL sss_through_cosine."""
+    normal = _points(normal)
+    p = _points(world) - float(shrink) * normal
+    back = np.asarray(back, np.float64).reshape(-1)
+    f = entry_face(distance_map, shadow_matrix, eye, p)
+    sheet = (f[:, 3] > 0.0) & ((normal * f[:, :3]).sum(1) < 0.0)
+    c = np.where(sheet, np.maximum(f[:, 3], back), back)
+    if exit_map is not None:
+        lay = part_layers(exit_map, shadow_matrix, p)
+        other = (lay[:, 0] < NO_SURFACE) & (distance_from_light(eye, p) > lay[:, 0] + float(part_gap))
+        c = np.where(other, back, c)
+    return c
 
 
 def distance_from_light(eye, world) -> np.ndarray:

@@ -5,7 +5,8 @@
 // the distance the light travelled inside the object is its distance from the light minus the
 // distance of the first surface it met there (the shadow pass's distance map, passes/shadow.frag),
 // looked up at the position shrunk a little along the normal; what comes through is the exact slab
-// transmittance of lib/sss_boundary.glsl (sss_slab_through). Only matter counts: where the point lies
+// transmittance of lib/sss_boundary.glsl (sss_slab_through), a sheet crossed at the larger of the
+// point's cosine to the light and its entry face's (sss_through_cosine). Only matter counts: where the point lies
 // beyond the first part the light crossed (its exit, the map's exit layer), the air between that part
 // and the point's own part is left out (passes/shadow.frag SHADOW_LAYER).
 // NumPy twin: skinlab/scene/optics/translucency.py. Bound by skinlab/render/translucency.py.
@@ -66,6 +67,39 @@ bool first_hit_distance(int slot, vec3 world, out float first) {
     return first < 1e29;  // cleared texels: no surface
 }
 
+// The face where a directional light entered the part in front of world (the first surface it meets
+// on the way there): xyz its outward normal (toward the light), w its cosine to the light; from the
+// distance map's slope across the four texel centres first_hit_distance interpolates (the bilinear's
+// gradient; a plane's exactly): the distance z over the light's orthographic view (x, y) is a surface
+// z(x, y) with normal (grad z, -1) / sqrt(1 + |grad z|^2) in the view's frame (x, y, the direction
+// the light travels). w = 0 where it is not known: a point or spot light, outside the map, or one of
+// the four texels without a surface (a silhouette in the light's view).
+vec4 entry_face(int slot, vec3 world) {
+    if (u_light_eye[slot].w != 0.0) return vec4(0.0);
+    mat4 m = u_shadow_matrix[slot];
+    vec4 p = m * vec4(world, 1.0);
+    vec2 uv = p.xy / p.w;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return vec4(0.0);
+    ivec2 size = slot == 0 ? textureSize(u_distance0, 0) : textureSize(u_distance1, 0);
+    vec2 x = uv * vec2(size) - 0.5;
+    ivec2 i0 = ivec2(floor(x));
+    vec2 f = x - vec2(i0);
+    ivec2 hi = size - 1;
+    ivec2 a = clamp(i0, ivec2(0), hi), b = clamp(i0 + 1, ivec2(0), hi);
+    float d00 = distance_texel(slot, a), d10 = distance_texel(slot, ivec2(b.x, a.y));
+    float d01 = distance_texel(slot, ivec2(a.x, b.y)), d11 = distance_texel(slot, b);
+    if (max(max(d00, d10), max(d01, d11)) >= 1e29) return vec4(0.0);
+    // the view's x and y in the world, and scene units per texel along them: the matrix's rows
+    // scale world to uv
+    vec3 r0 = vec3(m[0][0], m[1][0], m[2][0]), r1 = vec3(m[0][1], m[1][1], m[2][1]);
+    vec2 texel = 1.0 / (vec2(size) * vec2(length(r0), length(r1)));
+    vec2 g = vec2(mix(d10 - d00, d11 - d01, f.y), mix(d01 - d00, d11 - d10, f.x)) / texel;
+    g = mix(vec2(0.0), g, greaterThan(b, a));  // a clamped neighbour (the map's border): no slope
+    float c = inversesqrt(1.0 + dot(g, g));
+    vec3 n = (g.x * normalize(r0) + g.y * normalize(r1) - u_light_eye[slot].xyz) * c;
+    return vec4(n, c);
+}
+
 float distance_from_light(int slot, vec3 world) {
     vec4 e = u_light_eye[slot];
     return e.w == 0.0 ? dot(world, e.xyz) : length(world - e.xyz);
@@ -99,6 +133,29 @@ bool sss_thickness_mm(int slot, vec3 world, vec3 ng, float back, out float d_mm)
     return true;
 }
 
+// The cosine at which light through the part in front of world is taken to cross it, for a surface
+// whose own normal ng makes cosine `back` with the direction the light travels. Where the part is a
+// sheet (the face where the light entered it, entry_face at the lookup point sss_thickness_mm uses,
+// faces away from the point's own face: their normals opposed), the larger of `back` and the entry
+// face's cosine: of the two local slabs (parallel to the point's face, parallel to the entry face) the
+// thicker, lit at its cosine; the thickness is the chord times it and the light enters at it (the
+// irradiance projected on that face, the slab transmittance and its exit at that cosine). The two are
+// the same on a flat part. On a curved sheet the point's own face grazes the light where the entry
+// face does not, and the chord times the point's cosine alone read the sheet thin there: the back-lit
+// ear's blue 3.8 times the truth's (issue 21, docs/ground-truth.md; tools/translucency_check.py). Where
+// the light skims through a bulge instead (the two normals on one side: the nose's and the head's
+// shadowed sides), a thicker reading took light the truth has, so `back` itself; and where the entry
+// face is not known (entry_face's w = 0) or the point lies past the first part's exit (the layered
+// case: its own part's entry is not in the map). NumPy twin: translucency.py through_cosine.
+float sss_through_cosine(int slot, vec3 world, vec3 ng, float back) {
+    vec3 p = world - u_thickness_shrink * ng;
+    vec3 layers = part_layers(slot, p);
+    if (layers.x < 1e29 && distance_from_light(slot, p) > layers.x + u_part_gap) return back;
+    vec4 entry = entry_face(slot, p);
+    if (entry.w <= 0.0 || dot(ng, entry.xyz) >= 0.0) return back;
+    return max(entry.w, back);
+}
+
 // What crosses a slab d_mm thick from its far side, lit there at cosine `back`, and leaves through
 // this side, per unit irradiance on a surface facing the light and per unit base colour: the exact
 // slab transmittance (lib/sss_boundary.glsl sss_slab_through: all orders of scattering, Fresnel in
@@ -108,14 +165,17 @@ vec3 sss_through(float back, float d_mm) {
 }
 
 // Irradiance entering the medium at world through thin parts from light i (direction to it l, its
-// irradiance e on a surface facing it); ng: the surface's outward geometric normal. Zero for a light
+// irradiance e on a surface facing it); ng: the surface's outward geometric normal; the part crossed
+// at sss_through_cosine's cosine. Zero for a light
 // without a distance map (no shadow slot) or in front of the surface.
 vec3 sss_translucent_light(int i, vec3 world, vec3 ng, vec3 l, vec3 e) {
     int slot = u_light_shadow[i];
     float back = -dot(ng, l);
     float d_mm;
-    if (slot < 0 || back <= 0.0 || !sss_thickness_mm(slot, world, ng, back, d_mm)) return vec3(0.0);
-    return e * back * sss_through(back, d_mm);
+    if (slot < 0 || back <= 0.0) return vec3(0.0);
+    float c = sss_through_cosine(slot, world, ng, back);
+    if (!sss_thickness_mm(slot, world, ng, c, d_mm)) return vec3(0.0);
+    return e * c * sss_through(c, d_mm);
 }
 
 // The same light leaving toward a viewer at cosine mu, times the exit factor of light that came
@@ -128,21 +188,23 @@ vec3 sss_translucent_light_toward(int i, vec3 world, vec3 ng, vec3 l, vec3 e, fl
     float back = -dot(ng, l);
     float d_mm;
     through_exit = vec3(0.0);
-#ifdef MEASURE_NO_THICKNESS  // measurement variants (tools/forward_cost.py --translucency): a part taken out
-    d_mm = 3.0;
     if (slot < 0 || back <= 0.0) return vec3(0.0);
+#ifdef MEASURE_NO_THICKNESS  // measurement variants (tools/forward_cost.py --translucency): a part taken out
+    float c = back;
+    d_mm = 3.0;
 #else
-    if (slot < 0 || back <= 0.0 || !sss_thickness_mm(slot, world, ng, back, d_mm)) return vec3(0.0);
+    float c = sss_through_cosine(slot, world, ng, back);
+    if (!sss_thickness_mm(slot, world, ng, c, d_mm)) return vec3(0.0);
 #endif
 #ifdef MEASURE_NO_SLAB_THROUGH
-    vec3 entering = e * (back * d_mm);
+    vec3 entering = e * (c * d_mm);
 #else
-    vec3 entering = e * back * sss_through(back, d_mm);
+    vec3 entering = e * c * sss_through(c, d_mm);
 #endif
 #ifdef MEASURE_NO_SLAB_EXIT
     through_exit = entering * mu;
 #else
-    through_exit = entering * sss_slab_exit(mu, back, d_mm);
+    through_exit = entering * sss_slab_exit(mu, c, d_mm);
 #endif
     return entering;
 }

@@ -227,12 +227,18 @@ def test_translucent_light_matches_numpy(ctx, glsl):
         setup=setup,
     )
     back = -(ng @ l)
-    d_mm, hit = tr.thickness_mm(dist, m, eye, world, ng, back, shrink, mm)
-    ref = tr.translucent_irradiance(e, back, d_mm, hit, tabs, med, mat["subsurface_color"])
+    # the part crossed at the larger of the point's cosine and the entry face's (1 on this flat map)
+    c = tr.through_cosine(dist, m, eye, world, ng, back, shrink)
+    assert np.allclose(c[[0, 1, 4]], 1.0) and c[3] == back[3]  # no surface at [3]: its own cosine
+    d_mm, hit = tr.thickness_mm(dist, m, eye, world, ng, c, shrink, mm)
+    ref = tr.translucent_irradiance(e, np.where(back > 0, c, back), d_mm, hit, tabs, med, mat["subsurface_color"])
     assert_close_fp32(gpu, ref, atol=1e-4, what="sss_translucent_light")
     assert ref[0].min() > 0 and ref[1].min() > 0 and ref[0, 2] > ref[1, 2]  # thinner passes more (blue)
     assert np.all(ref[2] == 0) and np.all(ref[3] == 0)  # light in front; no surface in the map
-    assert np.all(np.isfinite(ref[4])) and ref[4].max() < 1e-2 * ref[1].max()  # grazing: back ~ 0.001
+    # a face grazing the light behind a flat entry face: the slab parallel to the entry, 10 mm of it
+    # (11.0 - 10.0 scene units x 10 mm, and the shrink added back)
+    assert np.isclose(d_mm[4], 10.0 + shrink * mm, rtol=1e-4)
+    assert np.all(np.isfinite(ref[4])) and 0 < ref[4].max() < ref[1].max()
     tex.release()
     for t in none:
         t.release()
@@ -326,3 +332,71 @@ def test_two_slabs_apart_are_not_one_thick_slab():
     dist, ex, m, eye = _parallel_slabs_maps(d, size, radius, [(-16.0, 0.0)])
     got, _ = tr.thickness_mm(dist, m, eye, front, nrm, back, shrink, 1.0, exit_map=ex, part_gap=gap)
     np.testing.assert_allclose(got, 16.0, atol=1e-6)
+
+
+ENTRY = """vec4 entry(int slot, vec3 p, vec3 n, float c) {
+    vec4 f = entry_face(slot, p);
+    return vec4(f.xz, f.w, sss_through_cosine(slot, p, n, c));
+}"""
+
+
+def test_entry_face_matches_numpy_twin_and_reads_a_plane(ctx, glsl):
+    """entry_face and sss_through_cosine against their twins on a random map (silhouettes, points
+    outside it, a point light: 0, the point's own cosine) and on a tilted plane's distances, whose
+    slope they read exactly: the entry face's normal (0.6, 0, -0.8), its cosine 0.8; the sheet's
+    cosine the larger of it and the point's where the point's face faces away from the entry face,
+    the point's own where both face one side (issue 21's model)."""
+    rng = np.random.default_rng(21)
+    h, w = 16, 24
+    m = np.eye(4)
+    m[:3, :3] *= 0.5
+    m[:3, 3] = 0.5  # world [-1, 1]^3 -> texture [0, 1]^3: a texel 2 / 24 x 2 / 16 scene units
+    eyes = np.array([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, -5.0, 1.0]])
+    rand = rng.uniform(5.0, 6.0, (h, w))
+    rand[rng.uniform(size=(h, w)) < 0.1] = 1e30
+    xs = (np.arange(w) + 0.5) / w * 2 - 1
+    slope = 0.75
+    plane = np.tile(8.0 + slope * xs, (h, 1))  # z = 8 + 0.75 x: the normal toward the light (0.6, 0, -0.8)
+    n = 2000
+    off = rng.uniform(0.12, 0.38, (n, 2)) + 0.5 * rng.integers(0, 2, (n, 2))
+    uv = (rng.integers(0, [w, h], (n, 2)) + off) / [w, h]
+    world = np.stack([uv[:, 0] * 2 - 1, uv[:, 1] * 2 - 1, rng.uniform(3.0, 12.0, n)], 1)
+    world[:40, 0] = 1.5  # outside the map
+    normal = np.column_stack([rng.normal(0, 0.2, (n, 2)), np.ones(n)])
+    normal[n // 2 :] *= -1  # half facing the light's side: with the plane's normal, not a sheet
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    back = rng.uniform(0.0, 1.0, n)
+    shrink = 0.004
+    world, normal, back = (x.astype(np.float32).astype(np.float64) for x in (world, normal, back))
+    none = _no_exit(ctx)
+    for dist in (rand, plane):
+        tex = _distance_texture(ctx, dist)
+        setup = _lookup_setup([tex, tex], [m, m], eyes, shrink, 20.0, exits=(none, none))
+        for slot in (0, 1):
+            gpu = glsl.evaluate(
+                "lib/sss_translucency.glsl",
+                f"entry({slot}, pos, nrm, c)",
+                {"pos": world, "nrm": normal, "c": back},
+                4,
+                prelude=ENTRY,
+                setup=setup,
+            )
+            face = tr.entry_face(dist, m, eyes[slot], world)
+            ct = tr.through_cosine(dist, m, eyes[slot], world, normal, back, shrink)
+            assert_close_fp32(gpu[:, :3], face[:, [0, 2, 3]], rtol=1e-4, atol=1e-5, what=f"entry_face slot {slot}")
+            assert_close_fp32(gpu[:, 3], ct, rtol=1e-4, atol=1e-5, what=f"sss_through_cosine slot {slot}")
+            assert not face[:40].any() and np.array_equal(ct[:40], back[:40])  # outside: its own cosine
+            if slot == 1:
+                assert not face.any() and np.array_equal(ct, back)  # a point light: its own cosine
+            elif dist is plane:
+                inner = (uv[:, 0] > 1.0 / w) & (uv[:, 0] < 1 - 1.0 / w) & (world[:, 0] < 1)
+                assert np.allclose(face[inner], [0.6, 0.0, -0.8, 0.8], atol=1e-6)
+                sheet = inner & (normal @ [0.6, 0.0, -0.8] < 0)
+                assert sheet[: n // 2].sum() > 0.95 * inner[: n // 2].sum() and not sheet[n // 2 :].any()
+                assert np.array_equal(ct[sheet], np.maximum(back[sheet], 0.8))
+                assert np.array_equal(ct[inner & ~sheet], back[inner & ~sheet])
+            else:
+                assert 0.2 < (face[:, 3] > 0).mean() < 0.9  # silhouettes (a cleared texel among the four): 0
+        tex.release()
+    for t in none:
+        t.release()

@@ -96,6 +96,7 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
 #ifdef TSD_TRANSLUCENCY
     float back = -dot(ng, l);
     float d_mm;
+    if (back > 0.0) back = sss_through_cosine(slot, v_world, ng, back);  // the part's (lib/sss_translucency.glsl)
     if (back > 0.0 && sss_thickness_mm(slot, v_world, ng, back, d_mm)) {
         vec3 through = e * back * sss_through(back, d_mm);
         sum += through;
