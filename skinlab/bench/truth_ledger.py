@@ -472,7 +472,7 @@ def _closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict) -
         for s, k in cols:
             tv = ((per_scene.get(s) or {}).get("closeup") or {}).get(k)
             name = s if len(keys) == 1 else f"{s} > {k.removeprefix('truth_tail_')}"
-            head.append(name + (f" (truth {_pct(tv[0])} +- {_pct(tv[1])})" if tv else ""))
+            head.append(name + (f" (truth {100 * tv[0]:.2f} +- {100 * tv[1]:.2f} %)" if tv and finite(tv[0]) else ""))
         L += ["| setting | " + " | ".join(head) + " |", "|---|" + "---|" * len(cols)]
         for labl, per in _by_label(rows).items():
             cells = []
