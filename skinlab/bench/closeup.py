@@ -235,8 +235,10 @@ class CloseupRegions:
         mine = self.values(img)
         out = {k: (lambda t, k=k, v=v: v - self.values(t)[k]) for k, v in mine.items()}
         if self.meshes:
-            out["truth_mesh_energy"] = lambda t: largest(
-                [x for e in mesh_energies(img, t, self.meshes).values() for x in e]
+            # the magnitude (not signed): a signed largest flips between two channels of about equal and
+            # opposite difference from one group of the truth's passes to the next (a spurious uncertainty)
+            out["truth_mesh_energy"] = lambda t: abs(
+                largest([x for e in mesh_energies(img, t, self.meshes).values() for x in e])
             )
         return out
 

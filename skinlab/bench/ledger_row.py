@@ -112,8 +112,8 @@ class LedgerRow:
                                       "(deep_shadow = true)")  # fmt: skip
     truth_deep_shadow_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
     truth_mesh_energy: float = column(NAN, "float", "fraction", "the largest relative difference of one "
-                                      "visible mesh's per-channel sum against the truth's "
-                                      "(signed; mesh_energy = true)")  # fmt: skip
+                                      "visible mesh's per-channel sum against the truth's, "
+                                      "its magnitude (mesh_energy = true)")  # fmt: skip
     truth_mesh_energy_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
     truth_mesh_energy_each: str = column("", "str", "", "each visible mesh's per-channel energy difference (R/G/B)")
     truth_noise: float = column(NAN, "float", "fraction", "the truth's own noise floor per pixel (between the halves "

@@ -493,7 +493,7 @@ def _closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict) -
     have = [s for s in scenes if any(finite(r.truth_mesh_energy) for r in rows if r.scene == s)]
     if have:
         L += ["**Close-ups: each visible mesh's energy** (relative difference of its R/G/B sums against the truth's; "
-              "the largest +- its standard error):", "",
+              "the largest magnitude +- its standard error):", "",
               "| setting | " + " | ".join(have) + " |", "|---|" + "---|" * len(have)]  # fmt: skip
         for labl, per in _by_label(rows).items():
             cells = [

@@ -77,6 +77,7 @@ def test_closeups_in_the_ledger_at_their_own_truth_size(ctx, tmp_path, monkeypat
             assert all(math.isfinite(r[f"{k}_sigma"]) for k in closeup.TAIL_KEYS)
             assert len(r["jackknife"]["truth_tail_2mm"]) == 2  # a 2-pass truth: two groups
     slabs = next(r for (s, _), r in rows.items() if s == "slabs-gap-backlit-skin1")
+    assert slabs["truth_mesh_energy"] >= 0 and math.isfinite(slabs["truth_mesh_energy_sigma"])
     assert slabs["truth_mesh_energy_each"].startswith("front ") and "; back " in slabs["truth_mesh_energy_each"]
     assert set(truths["slit-skin1"]["closeup"]) == set(closeup.TAIL_KEYS)
     md = (tmp_path / "out" / "ledger.md").read_text()
