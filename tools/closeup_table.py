@@ -14,7 +14,8 @@ measure, each with the truth's own noise (the same measure between the halves of
   both slabs and through one).
 
 Nothing is path-traced here: the references must be cached (the commands are in CLOSEUPS and
-docs/ground-truth.md). Frames are supersampled like the truth's pixels (TRUTH_SUPERSAMPLE).
+docs/ground-truth.md). Frames are supersampled like the truth's pixels (TRUTH_SUPERSAMPLE). The
+measures are skinlab/bench/closeup.py's, the accuracy ledger's (docs/ledger.md "Close-ups in the ledger").
 
     python -m tools.closeup_table [SCENES] [TECHNIQUES] [--profiles OUT.npz] [--bounces N]
         [--sss-model MODEL] [--no-translucency] [--size WxH --spp N]
@@ -35,6 +36,16 @@ from typing import Any
 
 import numpy as np
 
+from skinlab.bench.closeup import (
+    TAIL_MM,
+    line_profile,
+    profile_error,
+    ray_geometry,
+    region_error,
+    region_level,
+    shadow_regions,
+    tail_fractions,
+)
 from skinlab.bench.truth_ledger import REFERENCE_SCENES, TRUTH_SUPERSAMPLE
 from skinlab.truth.compare import image_error
 from skinlab.truth.metrics import flip_mean
@@ -76,9 +87,6 @@ CLOSEUPS = {
     "point-light-skin1": Closeup((64, 64), 128),
     "slabs-gap-backlit-skin1": Closeup((64, 64), 512, kind="slabs"),
 }
-TAIL_MM = (2.0, 5.0, 10.0)
-DEEP_SHADOW_MM = 2.0  # deep shadow: more than this from any lit point (the red diffusion length is 2.3 mm)
-EDGE_MM = 3.0  # edge region: within this of the shadow's edge, both sides
 
 
 def load_closeup_truth(scene, spec: Closeup):
@@ -90,130 +98,6 @@ def load_closeup_truth(scene, spec: Closeup):
         return render_reference(scene, req, progress=False, render=False)
     except ReferenceUnavailable:
         return None
-
-
-def line_profile(img: np.ndarray) -> np.ndarray:
-    """(W, 3): the image averaged along the slit (its rows)."""
-    return np.asarray(img[..., :3], np.float64).mean(axis=0)
-
-
-def profile_error(a: np.ndarray, b: np.ndarray) -> float:
-    return float(np.abs(a - b).sum() / max(np.abs(b).sum(), 1e-30))
-
-
-def tail_fractions(profile: np.ndarray, mm_per_px: float) -> np.ndarray:
-    """(len(TAIL_MM), 3): the fraction of each channel's light in view farther than each distance
-    from the slit (the middle of the image)."""
-    w = profile.shape[0]
-    x = np.abs((np.arange(w) + 0.5 - w / 2) * mm_per_px)
-    tot = np.maximum(profile.sum(axis=0), 1e-30)
-    return np.array([profile[x > t].sum(axis=0) / tot for t in TAIL_MM])
-
-
-def camera_rays(scene, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
-    """Origins and unit directions (H*W, 3) through the pixels' centres, row 0 at the top."""
-    cam = scene.camera
-    m = np.asarray(cam.world_matrix, np.float64)
-    t = math.tan(cam.yfov / 2)
-    aspect = width / height
-    jj, ii = np.meshgrid(np.arange(height), np.arange(width), indexing="ij")
-    x = ((ii + 0.5) / width * 2 - 1) * t * aspect
-    y = (1 - (jj + 0.5) / height * 2) * t
-    d = np.stack([x, y, -np.ones_like(x)], -1).reshape(-1, 3) @ m[:3, :3].T
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
-    return np.broadcast_to(m[:3, 3], d.shape).copy(), d
-
-
-def ray_geometry(scene, width: int, height: int):
-    """Per pixel: the index of the visible mesh node its centre sees (-1: none) and whether the
-    first light reaches that point (shadow ray toward it; Embree through trimesh)."""
-    import trimesh
-    from trimesh.ray.ray_pyembree import RayMeshIntersector
-
-    from skinlab.scene.interreflection import world_geometry
-
-    nodes = scene.mesh_nodes()
-    pos, faces, owner, start = [], [], [], 0
-    for k, node in enumerate(nodes):
-        p, _ = world_geometry(node)
-        pos.append(p)
-        faces.append(node.mesh.indices.astype(np.int64) + start)
-        owner.append(np.full(len(node.mesh.indices), k))
-        start += len(p)
-    mesh = trimesh.Trimesh(np.concatenate(pos), np.concatenate(faces), process=False)
-    owners = np.concatenate(owner)
-    ray = RayMeshIntersector(mesh)
-    o, d = camera_rays(scene, width, height)
-    tri, idx, loc = ray.intersects_id(o, d, multiple_hits=False, return_locations=True)
-    node = np.full(len(o), -1)
-    node[idx] = owners[tri]
-    light = scene.lights()[0]
-    lit = np.zeros(len(o), bool)
-    if len(idx):
-        nrm = mesh.face_normals[tri]
-        nrm = np.where((np.einsum("ij,ij->i", nrm, d[idx]) > 0)[:, None], -nrm, nrm)
-        if light.kind == "directional":
-            to = np.broadcast_to(-light.direction, loc.shape)
-            far = np.full(len(loc), np.inf)
-        else:
-            v = light.world_position - loc
-            far = np.linalg.norm(v, axis=1)
-            to = v / far[:, None]
-        facing = np.einsum("ij,ij->i", nrm, to) > 0
-        eps = 1e-4 * float(np.linalg.norm(mesh.bounds[1] - mesh.bounds[0]))
-        t2, i2, l2 = ray.intersects_id(loc + nrm * eps, to, multiple_hits=False, return_locations=True)
-        blocked = np.zeros(len(loc), bool)
-        if len(i2):
-            blocked[i2] = np.linalg.norm(l2 - loc[i2], axis=1) < far[i2]
-        lit[idx] = facing & ~blocked
-    return node.reshape(height, width), lit.reshape(height, width)
-
-
-def mm_per_pixel(scene, width: int, height: int) -> np.ndarray:
-    """Approximate millimetres per pixel at each pixel's visible point (distance x pixel angle)."""
-    import trimesh
-    from trimesh.ray.ray_pyembree import RayMeshIntersector
-
-    from skinlab.scene.interreflection import world_geometry
-
-    pos, faces, start = [], [], 0
-    for node in scene.mesh_nodes():
-        p, _ = world_geometry(node)
-        pos.append(p)
-        faces.append(node.mesh.indices.astype(np.int64) + start)
-        start += len(p)
-    mesh = trimesh.Trimesh(np.concatenate(pos), np.concatenate(faces), process=False)
-    o, d = camera_rays(scene, width, height)
-    _, idx, loc = RayMeshIntersector(mesh).intersects_id(o, d, multiple_hits=False, return_locations=True)
-    dist = np.full(len(o), np.nan)
-    dist[idx] = np.linalg.norm(loc - o[idx], axis=1)
-    return (dist * 2 * math.tan(scene.camera.yfov / 2) / height * scene.mm_per_unit).reshape(height, width)
-
-
-def region_error(img, ref, mask) -> float:
-    a, b = np.asarray(img[..., :3], np.float64)[mask], np.asarray(ref[..., :3], np.float64)[mask]
-    return float(np.abs(a - b).sum() / max(b.sum(), 1e-30))
-
-
-def region_level(img, mask, lit) -> float:
-    """Mean luminance over `mask` relative to the mean over `lit`."""
-    lum = np.asarray(img[..., :3], np.float64) @ np.array([0.2126, 0.7152, 0.0722])
-    return float(lum[mask].mean() / max(lum[lit].mean(), 1e-30))
-
-
-def shadow_regions(scene, size):
-    """(deep shadow, lit, edge region) masks for a shadow scene."""
-    from scipy.ndimage import distance_transform_edt
-
-    node, lit = ray_geometry(scene, *size)
-    mm = np.nanmedian(mm_per_pixel(scene, *size))
-    seen = node >= 0
-    to_lit = distance_transform_edt(~lit) * mm
-    to_shadow = distance_transform_edt(lit | ~seen) * mm
-    deep = seen & ~lit & (to_lit > DEEP_SHADOW_MM)
-    lit_far = lit & (to_shadow > DEEP_SHADOW_MM)
-    edge = seen & (np.where(lit, to_shadow, to_lit) <= EDGE_MM)
-    return deep, lit_far, edge
 
 
 def _size(text: str) -> tuple[int, int]:

@@ -76,8 +76,10 @@ from .sweep import (
     sweep_settings,
 )
 from .truth_ledger import (
+    closeup_truth,
     error_map_sheet,
     load_truth,
+    scene_truth_spec,
     truth_context,
     truth_errors,
     write_error_map,
@@ -250,10 +252,11 @@ class LedgerRun:
         return refs
 
     def load_truth(self, scene, label: str):
-        """The scene's path-traced reference at the sweep's truth size, or None (the reason noted)."""
-        spec = self.sweep.truth
-        if spec is None:
+        """The scene's path-traced reference at the sweep's truth size (the scene's own where its [measure]
+        declares one: scene_truth_spec), or None (the reason noted)."""
+        if self.sweep.truth is None:
             return None
+        spec = scene_truth_spec(scene, self.sweep.truth)
         self.say(f"{label}: path-traced reference")
         truth = None
         try:
@@ -267,8 +270,9 @@ class LedgerRun:
             )
         if truth is None and label not in self.truth_notes:
             self.truth_notes[label] = (
-                f"no cached path-traced reference at {spec.size[0]}x{spec.size[1]}, {spec.spp} spp: "
-                "run with --references"
+                f"no cached path-traced reference at {spec.size[0]}x{spec.size[1]}, {spec.spp} spp"
+                + (f", rr_depth {spec.rr_depth}" if spec.rr_depth != 64 else "")
+                + f": run with --references (or `skinlab reference SCENE {spec.command_options}`)"
             )
         return truth
 
@@ -286,6 +290,9 @@ class LedgerRun:
         tctx = truth_context(scene, truth, plain)
         spec = tctx.spec
         self.truth_scenes[label] = {
+            "size": [tw, th],
+            "rr_depth": scene_truth_spec(scene, sw.truth).rr_depth,
+            "closeup": closeup_truth(tctx),
             "spp": truth.meta.get("spp"),
             "passes": truth.pass_set.count,
             "seconds": truth.meta.get("seconds"),

@@ -99,6 +99,23 @@ class LedgerRow:
     truth_profile_err: float = column(NAN, "float", "fraction", "relative L1 of the profile across the declared line "
                                       "or edge against the truth's", html="profile", show="pm")  # fmt: skip
     truth_profile_err_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    # the close-up measures a scene's [measure] declares (skinlab/bench/closeup.py), frame minus truth
+    truth_tail_2mm: float = column(NAN, "float", "fraction", "share of the light (luminance) in view farther than 2 mm "
+                                   "from the declared line, frame minus truth (a line profile)")  # fmt: skip
+    truth_tail_2mm_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_5mm: float = column(NAN, "float", "fraction", "the same beyond 5 mm")
+    truth_tail_5mm_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_10mm: float = column(NAN, "float", "fraction", "the same beyond 10 mm")
+    truth_tail_10mm_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_deep_shadow: float = column(NAN, "float", "fraction", "the deep shadow's mean luminance as a share of "
+                                      "the lit surface's (ray-cast regions), frame minus truth "
+                                      "(deep_shadow = true)")  # fmt: skip
+    truth_deep_shadow_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_mesh_energy: float = column(NAN, "float", "fraction", "the largest relative difference of one "
+                                      "visible mesh's per-channel sum against the truth's, "
+                                      "its magnitude (mesh_energy = true)")  # fmt: skip
+    truth_mesh_energy_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_mesh_energy_each: str = column("", "str", "", "each visible mesh's per-channel energy difference (R/G/B)")
     truth_noise: float = column(NAN, "float", "fraction", "the truth's own noise floor per pixel (between the halves "
                                 "of its passes)")  # fmt: skip
     truth_noise_block: float = column(NAN, "float", "fraction", "the truth's own noise floor on 4x4 blocks",

@@ -1,8 +1,10 @@
 """The accuracy ledger against the path-traced truth (`skinlab bench accuracy`, docs/ground-truth.md).
 
 For each reference scene the ledger loads the scene's Mitsuba reference (skinlab/truth) at the sweep's
-truth size from the cache (``--references`` renders the missing ones first), renders every setting
-once more at that size (untimed), and records:
+truth size and samples, or the scene's own where its ``[measure]`` declares them (``truth_size``,
+``truth_spp``, ``truth_rr_depth``: the close-ups, ``scene_truth_spec``), from the cache
+(``--references`` renders the missing ones first), renders every setting once more at that size
+(untimed), and records:
 
 * ``truth_rel_l1`` / ``truth_rel_l1_block``: relative L1 of linear radiance over the object against
   the truth, per pixel and on 4 x 4 pixel blocks (skinlab/truth/compare.py); the block figure is the
@@ -18,6 +20,8 @@ once more at that size (untimed), and records:
   ``TRUTH_SUPERSAMPLE``; ``RenderSettings.supersample``): the truth averages each pixel over its area
   (Mitsuba's box pixel filter), a frame without antialiasing samples each pixel's centre, which
   differs on the object's outline by far more than the scattering errors the ledger is for;
+* the close-up measures a scene declares (skinlab/bench/closeup.py): ``truth_tail_2mm`` ... for a line
+  profile, ``truth_deep_shadow``, ``truth_mesh_energy`` (frame minus truth, with their standard errors);
 * a signed relative-difference image per setting (red: brighter than the truth, blue: darker, one
   scale for all), and a contact sheet of them.
 """
@@ -41,11 +45,14 @@ from skinlab.truth.compare import (
     judged_blocks,
 )
 
+from .closeup import CLOSEUP_KEYS, TAIL_MM, CloseupRegions, tail_key
 from .ledger_row import LedgerRow, finite
 
 REFERENCE_SCENES = scenes_root() / "reference"
 # the errors measured with their uncertainty (the jackknife over the truth's passes, skinlab/truth/metrics.py)
-JACKKNIFED = ("truth_rel_l1", "truth_rel_l1_block", "truth_flip", "truth_edge_rel_l1", "truth_profile_err")
+JACKKNIFED = (
+    "truth_rel_l1", "truth_rel_l1_block", "truth_flip", "truth_edge_rel_l1", "truth_profile_err", *CLOSEUP_KEYS,
+)  # fmt: skip
 
 
 # samples per pixel side of the frames compared with the truth (box-filtered like the truth's pixels;
@@ -62,13 +69,38 @@ class TruthSpec:
     supersample: int = TRUTH_SUPERSAMPLE
     variant: str = "scalar_rgb"  # Mitsuba variant it was rendered with (cuda_ad_rgb: tools/gpu_reference.py)
     seed: int = 0
+    rr_depth: int = 64  # ReferenceRequest.rr_depth (part of the cache key)
 
     def request(self):
         from skinlab.truth.reference import ReferenceRequest
 
         return ReferenceRequest(
-            self.size[0], self.size[1], spp=self.spp, passes=self.passes, seed=self.seed, variant=self.variant
-        )
+            self.size[0], self.size[1], spp=self.spp, passes=self.passes, seed=self.seed, variant=self.variant,
+            rr_depth=self.rr_depth,
+        )  # fmt: skip
+
+    @property
+    def command_options(self) -> str:
+        """`skinlab reference`'s options for this truth."""
+        rr = f" --rr-depth {self.rr_depth}" if self.rr_depth != 64 else ""
+        passes = f" --passes {self.passes}" if self.passes != 4 else ""
+        return f"--size {self.size[0]}x{self.size[1]} --spp {self.spp}{passes}{rr}"
+
+
+def scene_truth_spec(scene, spec: TruthSpec) -> TruthSpec:
+    """The sweep's truth `spec` with the scene's own size, spp and Russian roulette depth where its
+    ``[measure]`` declares them (the close-ups: a slit's 256x16, marble's depth 1024)."""
+    from dataclasses import replace
+
+    m = getattr(scene, "measure", None)
+    if m is None:
+        return spec
+    return replace(
+        spec,
+        size=m.truth_size or spec.size,
+        spp=m.truth_spp or spec.spp,
+        rr_depth=m.truth_rr_depth or spec.rr_depth,
+    )
 
 
 def reference_scene_names(every: bool = False) -> list[str]:
@@ -132,6 +164,7 @@ class TruthContext:
     points: object = None  # skinlab.truth.regions.PixelPoints
     profile: object = None  # the truth's Profile
     group_profiles: list = None
+    closeup: object = None  # skinlab.bench.closeup.CloseupRegions, where the scene declares close-up measures
 
 
 def truth_context(scene, truth, plain: np.ndarray | None) -> TruthContext:
@@ -159,7 +192,29 @@ def truth_context(scene, truth, plain: np.ndarray | None) -> TruthContext:
     if declared:
         ctx.profile = regions.profile(truth.image, px, spec, mask)
         ctx.group_profiles = [regions.profile(g, px, spec, mask) for g in ctx.groups]
+    across = regions.across(px, spec)[0] if declared and spec.has_tails else None
+    cu = CloseupRegions(scene, spec, (w, h), across, mask)
+    ctx.closeup = cu if cu.any or cu.notes else None
     return ctx
+
+
+def closeup_truth(tc: TruthContext) -> dict:
+    """The truth's own close-up measures, each (value, standard error from its passes), and the notes
+    on what could not be measured."""
+    from skinlab.truth import metrics
+
+    cu = tc.closeup
+    if cu is None:
+        return {}
+    out: dict = {}
+    for key in cu.values(tc.truth.image):
+        v, sigma, _ = metrics.jackknife(lambda t, key=key: cu.values(t)[key], tc.truth.image, tc.groups)
+        out[key] = [v, sigma]
+    if cu.meshes:
+        out["meshes"] = sorted(cu.meshes)
+    if cu.notes:
+        out["notes"] = list(cu.notes)
+    return out
 
 
 def truth_errors(img: np.ndarray, tc) -> dict:
@@ -193,6 +248,10 @@ def truth_errors(img: np.ndarray, tc) -> dict:
     }
     if tc.edge.any():
         measures["truth_edge_rel_l1"] = lambda t: metrics.rel_l1(img, t, tc.edge)
+    if tc.closeup is not None:
+        measures.update(tc.closeup.measures(img))
+        if tc.closeup.meshes:
+            out["truth_mesh_energy_each"] = tc.closeup.mesh_text(img, truth.image)
     jk = {}
     for key, fn in measures.items():
         v, sigma, loo = metrics.jackknife(fn, truth.image, tc.groups)
@@ -310,7 +369,8 @@ def _intro_lines(t: dict) -> list[str]:
     L = [
         "## Against the path-traced truth",
         "",
-        f"Each setting rendered once more at {t['size'][0]}x{t['size'][1]} (untimed; "
+        f"Each setting rendered once more at {t['size'][0]}x{t['size'][1]} (a scene's own truth size where its "
+        "`[measure]` declares one: the truths table has each; untimed; "
         + (
             f"{t['supersample']} x {t['supersample']} samples per pixel, box-filtered like the truth's pixels"
             if t.get("supersample", 1) > 1
@@ -344,8 +404,8 @@ def _truths_table(per_scene: dict) -> list[str]:
         "The truths (each the mean of its passes; spp and path-tracing time are what the cached reference took, "
         "summed over the runs that rendered its passes; the edge region is where the edge errors are measured):",
         "",
-        "| scene | tests | spp | passes | path tracing s | noise px | noise 4x4 | edge region |",
-        "|---|---|---|---|---|---|---|---|",
+        "| scene | tests | size | spp | passes | path tracing s | noise px | noise 4x4 | edge region |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     for sc, d in per_scene.items():
         edge = (
@@ -354,8 +414,11 @@ def _truths_table(per_scene: dict) -> list[str]:
             else "none found"
         )
         sec = d.get("seconds")
+        size = "x".join(str(x) for x in d["size"]) if d.get("size") else ""
+        if d.get("rr_depth", 64) != 64:
+            size += f" (rr_depth {d['rr_depth']})"
         L.append(
-            f"| {sc} | {d.get('tests') or ''} | {d.get('spp')} | {d.get('passes')} | "
+            f"| {sc} | {d.get('tests') or ''} | {size} | {d.get('spp')} | {d.get('passes')} | "
             f"{'' if sec is None else f'{sec:.0f}'} | {_pct(d.get('noise'))} | {_pct(d.get('noise_block'))} | "
             f"{edge} |"
         )
@@ -384,6 +447,65 @@ def _error_table(rows: list[LedgerRow], scenes: list[str], key: str, what: str, 
         mean_ms = f"{sum(ms) / len(ms):.1f}" if ms else ""
         L.append(f"| {labl} | " + " | ".join(cells) + f" | {mean_ms} |")
     return [*L, ""]
+
+
+CLOSEUP_TABLES = (  # ledger.md's close-up tables (skinlab/bench/closeup.py): the columns, what they measure
+    (tuple(tail_key(d) for d in TAIL_MM), "the share of the light (luminance) in view beyond "
+     + ", ".join(f"{d:g}" for d in TAIL_MM) + " mm from the line"),
+    (("truth_deep_shadow",), "the deep shadow's level: its mean luminance as a share of the lit surface's "
+     "(regions found by ray casting)"),
+)  # fmt: skip
+
+
+def _closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict) -> list[str]:
+    """Per declared close-up measure a table of settings x (scene, measure): the frame's value and, in
+    brackets, frame minus truth +- its standard error; the truth's value +- its own in the header. The
+    per-mesh energies as text."""
+    L: list[str] = []
+    for keys, what in CLOSEUP_TABLES:
+        cols = [(s, k) for s in scenes for k in keys if any(finite(r[k]) for r in rows if r.scene == s)]
+        if not cols:
+            continue
+        L += [f"**Close-ups: {what}** (the frame's; in brackets frame minus truth +- its standard error from the "
+              "truth's passes, in percentage points; the truth's in the header):", ""]  # fmt: skip
+        head = []
+        for s, k in cols:
+            tv = ((per_scene.get(s) or {}).get("closeup") or {}).get(k)
+            name = s if len(keys) == 1 else f"{s} > {k.removeprefix('truth_tail_')}"
+            head.append(name + (f" (truth {100 * tv[0]:.2f} +- {100 * tv[1]:.2f} %)" if tv and finite(tv[0]) else ""))
+        L += ["| setting | " + " | ".join(head) + " |", "|---|" + "---|" * len(cols)]
+        for labl, per in _by_label(rows).items():
+            cells = []
+            for s, k in cols:
+                r = per.get(s)
+                tv = ((per_scene.get(s) or {}).get("closeup") or {}).get(k)
+                if r is None or not finite(r[k]) or not tv:
+                    cells.append("")
+                    continue
+                sig = r.get(f"{k}_sigma")
+                cells.append(
+                    f"{100 * (tv[0] + r[k]):.2f} % ({100 * r[k]:+.2f}"
+                    + (f" +- {100 * sig:.2f}" if finite(sig) else "")
+                    + ")"
+                )
+            L.append(f"| {labl} | " + " | ".join(cells) + " |")
+        L.append("")
+    have = [s for s in scenes if any(finite(r.truth_mesh_energy) for r in rows if r.scene == s)]
+    if have:
+        L += ["**Close-ups: each visible mesh's energy** (relative difference of its R/G/B sums against the truth's; "
+              "the largest magnitude +- its standard error):", "",
+              "| setting | " + " | ".join(have) + " |", "|---|" + "---|" * len(have)]  # fmt: skip
+        for labl, per in _by_label(rows).items():
+            cells = [
+                f"{per[s].truth_mesh_energy_each} (largest {_pm(per[s], 'truth_mesh_energy', True)})"
+                if s in per and finite(per[s].truth_mesh_energy) else ""
+                for s in have
+            ]  # fmt: skip
+            L.append(f"| {labl} | " + " | ".join(cells) + " |")
+        L.append("")
+    notes = {s: d["closeup"]["notes"] for s, d in per_scene.items() if (d.get("closeup") or {}).get("notes")}
+    L += [f"- **{s}**: not measured: {'; '.join(n)}" for s, n in notes.items()]
+    return [*L, ""] if notes else L
 
 
 def _blocks_table(rows: list[LedgerRow], scenes: list[str]) -> list[str]:
@@ -433,4 +555,5 @@ def truth_markdown(rows: list[LedgerRow], meta: dict) -> list[str]:
     L += _truths_table(t.get("scenes") or {})
     for key, what, pct in TRUTH_TABLES:
         L += _error_table(rows, scenes, key, what, pct)
+    L += _closeup_tables(rows, scenes, t.get("scenes") or {})
     return [*L, *_blocks_table(rows, scenes), "", ERROR_MAPS, ""]

@@ -140,7 +140,8 @@ def accuracy_options() -> tuple[Field, ...]:
             "bool",
             False,
             doc="path-trace the scenes' references that are not cached yet (skinlab reference; minutes per scene "
-            "on 2 cores: full 192x192 at 1024 spp, --quick 96x96 at 256 spp); without it a scene whose reference "
+            "on 2 cores: full 192x192 at 1024 spp, --quick 96x96 at 256 spp, or a scene's own [measure] truth_size, "
+            "truth_spp and truth_rr_depth); without it a scene whose reference "
             "is not cached is measured without the truth",
         ),
         Field(

@@ -12,6 +12,7 @@ from typing import Any
 from skinlab.declare import Field
 
 from .graph import LightNode
+from .measure import RR_DEPTH_RANGE, SIZE_LIMIT, SPP_RANGE
 
 INF = math.inf
 
@@ -335,8 +336,51 @@ SCENE_FILE_KEYS: dict[str, tuple[Field, ...]] = {
             "ledger",
             "bool",
             True,
-            doc="false: left out of the ledger's default scene list (a scene whose truth needs its own frame shape or "
-            "path depth, such as the 16:1 slits; `--scenes` still takes it)",
+            doc="false: left out of the ledger's default scene list (`--scenes` still takes it)",
+        ),
+        _key(
+            "truth_size",
+            "string",
+            None,
+            shown="the sweep's truth size",
+            type_text=f'"WxH" or [W, H], integers in [1, {SIZE_LIMIT}]',
+            unit="px",
+            doc="the size of this scene's path-traced truth in the ledger (and of the frames compared with it), "
+            "instead of the sweep's square one: a close-up's own frame shape (\"256x16\" for a slit)",
+        ),
+        _key(
+            "truth_spp",
+            "int",
+            None,
+            SPP_RANGE,
+            type_text=f"integer in [{SPP_RANGE[0]}, {SPP_RANGE[1]}]",
+            shown="the sweep's truth spp",
+            doc="samples per pixel of this scene's truth in the ledger (every cached pass counts)",
+        ),
+        _key(
+            "truth_rr_depth",
+            "int",
+            None,
+            RR_DEPTH_RANGE,
+            type_text=f"integer in [{RR_DEPTH_RANGE[0]}, {RR_DEPTH_RANGE[1]}]",
+            shown="64 (`skinlab reference`'s)",
+            doc="path depth from which Russian roulette ends the truth's paths (a medium of single-scattering albedo "
+            "near 1 needs about 1 / (1 - albedo) or more: slit-marble takes 1024); part of the truth's cache key",
+        ),
+        _key(
+            "deep_shadow",
+            "bool",
+            False,
+            doc="true: the ledger measures the deep shadow's level (camera-visible points the first light does not "
+            "reach, more than 2 mm from a lit one, found by ray casting, not by the shadow maps) as a share of the "
+            "lit surface's, against the truth's (skinlab/bench/closeup.py)",
+        ),
+        _key(
+            "mesh_energy",
+            "bool",
+            False,
+            doc="true: the ledger measures the energy of each visible mesh apart (its pixels found by ray casting) "
+            "against the truth's: light through one part and through another (skinlab/bench/closeup.py)",
         ),
     ),  # fmt: skip
 }

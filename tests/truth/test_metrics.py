@@ -101,6 +101,16 @@ def test_measure_table_reads_and_names_bad_keys(tmp_path):
         ("profile_range_mm = 0", "[measure].profile_range_mm"),
         ("colour = 3", "[measure]: unknown key(s) colour"),
         ('ledger = "no"', "[measure].ledger"),
+        ('truth_size = "256by16"', '[measure].truth_size: expected "WxH" or [W, H], integers in [1, 16384], got'),
+        ("truth_size = [256, 16.5]", "[measure].truth_size: expected"),
+        ('truth_size = "0x16"', "[measure].truth_size: expected"),
+        ("truth_size = [1, 2, 3]", "[measure].truth_size: expected"),
+        ("truth_spp = 1", "[measure].truth_spp: expected an integer in [2, 16777216], got 1"),
+        ("truth_spp = 64.0", "[measure].truth_spp: expected an integer"),
+        ("truth_rr_depth = 0", "[measure].truth_rr_depth: expected an integer in [1, 1048576], got 0"),
+        ("truth_rr_depth = true", "[measure].truth_rr_depth: expected an integer"),
+        ("deep_shadow = 1", "[measure].deep_shadow: expected true or false"),
+        ('mesh_energy = "yes"', "[measure].mesh_energy: expected true or false"),
     ):
         p = tmp_path / "s.toml"
         meshes = str(SLAB_EDGE.parent.parent.parent / "meshes")
@@ -108,19 +118,31 @@ def test_measure_table_reads_and_names_bad_keys(tmp_path):
         with pytest.raises(SceneFileError) as exc:
             load_scene(p)
         assert str(exc.value).startswith(str(p)) and says in str(exc.value), str(exc.value)
+        assert "\n" not in str(exc.value)
+    for table, size in (('truth_size = "256x16"', (256, 16)), ("truth_size = [64, 32]", (64, 32))):
+        p.write_text(base.replace("../../meshes", meshes) + f"[measure]\n{table}\ntruth_spp = 8\ntruth_rr_depth = 9\n")
+        m = load_scene(p).measure
+        assert (m.truth_size, m.truth_spp, m.truth_rr_depth) == (size, 8, 9)
 
 
-def test_scenes_that_say_ledger_false_are_left_out_of_the_default_list():
-    """The slits (16:1 frames, marble's path depth) say `ledger = false`: the ledger's default scene list
-    leaves them out, the full list and the scene itself keep them."""
-    from skinlab.bench.truth_ledger import reference_scene_names
+def test_scenes_that_say_ledger_false_are_left_out_of_the_default_list(tmp_path, monkeypatch):
+    """A scene whose [measure] says `ledger = false` is left out of the ledger's default scene list; the full
+    list keeps it. The six close-ups (issue 21) are in the default list, each with its own truth's settings."""
+    from skinlab.bench import truth_ledger
+    from skinlab.bench.sweep import FULL
+    from skinlab.bench.truth_ledger import reference_scene_names, scene_truth_spec
     from skinlab.scene.scenefile import load_scene
 
-    default, every = reference_scene_names(), reference_scene_names(every=True)
-    assert {"slit-skin1", "slit-marble"} <= set(every) - set(default)
-    assert {"head-skin1-matched", "slab-edge-skin1", "nose-shadow-skin1"} <= set(default)
-    assert load_scene("slit-skin1").measure.ledger is False
-    assert load_scene("slab-edge-skin1").measure.ledger is True
+    closeups = {"slit-skin1", "slit-marble", "nose-shadow-skin1", "ear-backlit-skin1", "point-light-skin1",
+                "slabs-gap-backlit-skin1"}  # fmt: skip
+    assert closeups | {"head-skin1-matched", "slab-edge-skin1"} <= set(reference_scene_names())
+    marble = scene_truth_spec(load_scene("slit-marble"), FULL.truth)
+    assert (marble.size, marble.spp, marble.rr_depth, marble.passes) == ((256, 16), 64, 1024, 4)
+    assert scene_truth_spec(load_scene("slab-edge-skin1"), FULL.truth) == FULL.truth  # no truth settings of its own
+    for name, text in (("a", "[measure]\nledger = false\n"), ("b", "[measure]\nledger = true\n"), ("c", "")):
+        (tmp_path / f"{name}.toml").write_text(text)
+    monkeypatch.setattr(truth_ledger, "REFERENCE_SCENES", tmp_path)
+    assert reference_scene_names() == ["b", "c"] and reference_scene_names(every=True) == ["a", "b", "c"]
 
 
 def test_pixel_points_see_the_declared_edge_where_the_truth_has_it():
