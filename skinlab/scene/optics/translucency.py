@@ -58,13 +58,11 @@ def part_layers(exit_map, shadow_matrix, world) -> np.ndarray:
     return np.stack([ex[j, i, 0], ex[j, i, 1], nxt[j, i]], 1)
 
 
-def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
-    """(first, hit) per point of world (N, 3): the map's distance at the point's light-space
-    position, bilinear between the four nearest texel centres (clamped to the map) where all four
-    hold a surface, else the texel containing the point; hit False outside the map or where that
-    texel holds no surface (first 0 outside). GLSL first_hit_distance."""
-    world = _points(world)
-    dist = np.asarray(distance_map, np.float64)
+def _distance_quad(dist: np.ndarray, shadow_matrix, world: np.ndarray):
+    """The four texel centres of the distance map `dist` (H, W) around each point's light-space
+    position, clamped to the map (GLSL distance_quad): inside (the position in the map), uv (0 where
+    outside), the bilinear fractions (fx, fy), the texel indices (ia, ib, ja, jb) and their distances
+    (d00, d10, d01, d11)."""
     h, w = dist.shape
     p = np.concatenate([world, np.ones((len(world), 1))], 1) @ np.asarray(shadow_matrix, np.float64).T
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -76,7 +74,18 @@ def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, 
     fx, fy = x - i0, y - j0
     ia, ib = np.clip(i0, 0, w - 1), np.clip(i0 + 1, 0, w - 1)
     ja, jb = np.clip(j0, 0, h - 1), np.clip(j0 + 1, 0, h - 1)
-    d00, d10, d01, d11 = dist[ja, ia], dist[ja, ib], dist[jb, ia], dist[jb, ib]
+    corners = (dist[ja, ia], dist[ja, ib], dist[jb, ia], dist[jb, ib])
+    return inside, uv, (fx, fy), (ia, ib, ja, jb), corners
+
+
+def first_hit_distance(distance_map, shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
+    """(first, hit) per point of world (N, 3): the map's distance at the point's light-space
+    position, bilinear between the four nearest texel centres (clamped to the map) where all four
+    hold a surface, else the texel containing the point; hit False outside the map or where that
+    texel holds no surface (first 0 outside). GLSL first_hit_distance."""
+    dist = np.asarray(distance_map, np.float64)
+    h, w = dist.shape
+    inside, uv, (fx, fy), _, (d00, d10, d01, d11) = _distance_quad(dist, shadow_matrix, _points(world))
     bilinear = (d00 * (1 - fx) + d10 * fx) * (1 - fy) + (d01 * (1 - fx) + d11 * fx) * fy
     all4 = np.maximum(np.maximum(d00, d10), np.maximum(d01, d11)) < NO_SURFACE
     i = np.clip(np.floor(uv[:, 0] * w).astype(np.int64), 0, w - 1)
@@ -101,16 +110,7 @@ def entry_face(distance_map, shadow_matrix, eye, world) -> np.ndarray:
     m = np.asarray(shadow_matrix, np.float64)
     dist = np.asarray(distance_map, np.float64)
     h, w = dist.shape
-    p = np.concatenate([world, np.ones((len(world), 1))], 1) @ m.T
-    uv = p[:, :2] / p[:, 3:4]
-    inside = np.all((uv >= 0.0) & (uv <= 1.0), axis=1)
-    uv = np.where(inside[:, None], uv, 0.0)
-    x, y = uv[:, 0] * w - 0.5, uv[:, 1] * h - 0.5
-    i0, j0 = np.floor(x).astype(np.int64), np.floor(y).astype(np.int64)
-    fx, fy = x - i0, y - j0
-    ia, ib = np.clip(i0, 0, w - 1), np.clip(i0 + 1, 0, w - 1)
-    ja, jb = np.clip(j0, 0, h - 1), np.clip(j0 + 1, 0, h - 1)
-    d00, d10, d01, d11 = dist[ja, ia], dist[ja, ib], dist[jb, ia], dist[jb, ib]
+    inside, _, (fx, fy), (ia, ib, ja, jb), (d00, d10, d01, d11) = _distance_quad(dist, m, world)
     all4 = np.maximum(np.maximum(d00, d10), np.maximum(d01, d11)) < NO_SURFACE
     rows = m[:2, :3]
     texel = 1.0 / (np.array([w, h], np.float64) * np.linalg.norm(rows, axis=1))

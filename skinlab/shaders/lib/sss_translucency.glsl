@@ -41,29 +41,50 @@ vec3 part_layers(int slot, vec3 world) {
     return vec3(e, next);
 }
 
+// The four distance-map texel centres around world's light-space position (clamped to the map),
+// shared by first_hit_distance and entry_face: uv the position in the map (false outside it), f
+// the bilinear fractions, a / b the lower / upper texel (b == a where clamped at the border), d their
+// distances (d00, d10, d01, d11).
+struct DistanceQuad {
+    bool inside;
+    vec2 uv;
+    vec2 f;
+    ivec2 a, b, size;
+    vec4 d;
+};
+
+DistanceQuad distance_quad(int slot, vec3 world) {
+    DistanceQuad q;
+    vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
+    q.uv = p.xy / p.w;
+    q.inside = !(any(lessThan(q.uv, vec2(0.0))) || any(greaterThan(q.uv, vec2(1.0))));
+    q.size = slot == 0 ? textureSize(u_distance0, 0) : textureSize(u_distance1, 0);
+    vec2 x = q.uv * vec2(q.size) - 0.5;
+    ivec2 i0 = ivec2(floor(x));
+    q.f = x - vec2(i0);
+    ivec2 hi = q.size - 1;
+    q.a = clamp(i0, ivec2(0), hi);
+    q.b = clamp(i0 + 1, ivec2(0), hi);
+    q.d = vec4(distance_texel(slot, q.a), distance_texel(slot, ivec2(q.b.x, q.a.y)),
+               distance_texel(slot, ivec2(q.a.x, q.b.y)), distance_texel(slot, q.b));
+    return q;
+}
+
 // Distance from the light of the first surface it meets on the way to world; false outside the map
 // or where the map holds no surface. Bilinear between the four nearest texel centres (a plane's
 // distance exactly; the nearest texel alone is off by up to half a texel times the surface's slope,
 // which through 3 mm of skin is +-3 % of the blue light), or the texel containing the point where
 // one of the four holds no surface (a silhouette in the light's view).
 bool first_hit_distance(int slot, vec3 world, out float first) {
-    vec4 p = u_shadow_matrix[slot] * vec4(world, 1.0);
-    vec2 uv = p.xy / p.w;
     first = 0.0;
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return false;
-    ivec2 size = slot == 0 ? textureSize(u_distance0, 0) : textureSize(u_distance1, 0);
-    vec2 x = uv * vec2(size) - 0.5;
-    ivec2 i0 = ivec2(floor(x));
-    vec2 f = x - vec2(i0);
-    ivec2 hi = size - 1;
-    ivec2 a = clamp(i0, ivec2(0), hi), b = clamp(i0 + 1, ivec2(0), hi);
-    float d00 = distance_texel(slot, a), d10 = distance_texel(slot, ivec2(b.x, a.y));
-    float d01 = distance_texel(slot, ivec2(a.x, b.y)), d11 = distance_texel(slot, b);
-    if (max(max(d00, d10), max(d01, d11)) < 1e29) {
-        first = mix(mix(d00, d10, f.x), mix(d01, d11, f.x), f.y);
+    DistanceQuad q = distance_quad(slot, world);
+    if (!q.inside) return false;
+    vec4 d = q.d;
+    if (max(max(d.x, d.y), max(d.z, d.w)) < 1e29) {
+        first = mix(mix(d.x, d.y, q.f.x), mix(d.z, d.w, q.f.x), q.f.y);
         return true;
     }
-    first = distance_texel(slot, clamp(ivec2(floor(uv * vec2(size))), ivec2(0), hi));
+    first = distance_texel(slot, clamp(ivec2(floor(q.uv * vec2(q.size))), ivec2(0), q.size - 1));
     return first < 1e29;  // cleared texels: no surface
 }
 
@@ -77,17 +98,11 @@ bool first_hit_distance(int slot, vec3 world, out float first) {
 vec4 entry_face(int slot, vec3 world) {
     if (u_light_eye[slot].w != 0.0) return vec4(0.0);
     mat4 m = u_shadow_matrix[slot];
-    vec4 p = m * vec4(world, 1.0);
-    vec2 uv = p.xy / p.w;
-    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) return vec4(0.0);
-    ivec2 size = slot == 0 ? textureSize(u_distance0, 0) : textureSize(u_distance1, 0);
-    vec2 x = uv * vec2(size) - 0.5;
-    ivec2 i0 = ivec2(floor(x));
-    vec2 f = x - vec2(i0);
-    ivec2 hi = size - 1;
-    ivec2 a = clamp(i0, ivec2(0), hi), b = clamp(i0 + 1, ivec2(0), hi);
-    float d00 = distance_texel(slot, a), d10 = distance_texel(slot, ivec2(b.x, a.y));
-    float d01 = distance_texel(slot, ivec2(a.x, b.y)), d11 = distance_texel(slot, b);
+    DistanceQuad q = distance_quad(slot, world);
+    if (!q.inside) return vec4(0.0);
+    float d00 = q.d.x, d10 = q.d.y, d01 = q.d.z, d11 = q.d.w;
+    vec2 f = q.f;
+    ivec2 a = q.a, b = q.b, size = q.size;
     if (max(max(d00, d10), max(d01, d11)) >= 1e29) return vec4(0.0);
     // the view's x and y in the world, and scene units per texel along them: the matrix's rows
     // scale world to uv
