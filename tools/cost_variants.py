@@ -49,3 +49,13 @@ def finished_ms(ctx, run: Callable[..., object], *args) -> float:
 def load_line(start: tuple[float, ...]) -> str:
     """The load average at the start and now, for the printout."""
     return f"load average {tuple(round(x, 2) for x in start)} -> {tuple(round(x, 2) for x in os.getloadavg())}"
+
+
+def print_medians(times: Mapping[str, list[float]], width: int) -> None:
+    """Each variant's median milliseconds and its share of the first variant's (the base)."""
+    import statistics
+
+    base = statistics.median(next(iter(times.values())))
+    for name, v in times.items():
+        m = statistics.median(v)
+        print(f"  {name:<{width}} {m:8.1f} ms  ({m / base:5.0%} of base)")

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
 import sys
 import time
 
@@ -52,7 +51,7 @@ def translucency_cost(technique: str, size: int, rounds: int, scene_name: str | 
     from skinlab.render.translucency import DEFINE
     from skinlab.scene.scenefile import load_scene
 
-    from .cost_variants import finished_ms, load_line, measure_library
+    from .cost_variants import finished_ms, load_line, measure_library, print_medians
 
     if "translucency" not in technique_settings(technique).options():
         raise SystemExit(f"--translucency: {technique!r} has no translucency setting")
@@ -94,10 +93,7 @@ def translucency_cost(technique: str, size: int, rounds: int, scene_name: str | 
                 times[name].append(finished_ms(ctx, r.pass_for("forward").run, frame, fwd))
         print(f"{describe(ctx)}; the forward pass of {technique} alone, {size}x{size}, median of {rounds}")
         print(load_line(load0))
-        base = statistics.median(times["base"])
-        for name, v in times.items():
-            m = statistics.median(v)
-            print(f"  {name:<16} {m:8.1f} ms  ({m / base:5.0%} of base)")
+        print_medians(times, 16)
     finally:
         for r, *_ in runs.values():
             r.release()
@@ -124,7 +120,7 @@ def main(argv=None) -> int:
     from skinlab.render.settings import RenderSettings
     from skinlab.scene.scenefile import load_scene
 
-    from .cost_variants import load_line, measure_library, without_maps
+    from .cost_variants import load_line, measure_library, print_medians, without_maps
 
     def scene_without_shadows(maps=True):
         scene = load_scene(args.scene)
@@ -165,10 +161,7 @@ def main(argv=None) -> int:
                 times[name].append((time.perf_counter() - t0) * 1e3)
         print(f"{describe(ctx)}; plain frame {n}x{n} (sss_model none, no shadows), median of {args.rounds}")
         print(load_line(load0))
-        base = statistics.median(times["base"])
-        for name, v in times.items():
-            m = statistics.median(v)
-            print(f"  {name:<12} {m:8.1f} ms  ({m / base:5.0%} of base)")
+        print_medians(times, 12)
         d = np.abs(hdr["aniso1"][..., :3] - hdr["base"][..., :3])
         print(
             f"aniso1 vs base, HDR: max |difference| {d.max():.4f}, mean {d.mean():.2e} "
