@@ -103,8 +103,16 @@ def bind_boundary(prog, material) -> None:
         set_array(prog, "u_sss_single_ambient", _ZERO_TABLE, ANGULAR_NODES)
         set_array(prog, "u_sss_ms_rest", _ZERO_REST, _MS_REST_ROWS)
         zero = (0.0, 0.0, 0.0)
-        set_uniforms(prog, {"u_sss_entry_diffuse": zero, "u_sss_single": zero, "u_sss_eta": 1.0, "u_sss_g": 0.0})
-        set_uniforms(prog, {"u_sss_ms_rest_on": 0.0})
+        set_uniforms(
+            prog,
+            {
+                "u_sss_entry_diffuse": zero,
+                "u_sss_single": zero,
+                "u_sss_eta": 1.0,
+                "u_sss_g": 0.0,
+                "u_sss_ms_rest_on": 0.0,
+            },
+        )
         set_array(prog, "u_sss_slab", _DARK_SLAB, _SLAB_ROWS)
         set_array(prog, "u_sss_slab_norm", _DARK_NORM, SLAB_TAU_NODES)
         set_array(prog, "u_sss_slab_h", _ZERO_H, _SLAB_ROWS)
