@@ -1,7 +1,7 @@
 """ledger.html: the ledger as one self-contained page (every figure inlined as a PNG data URI): per scene
 what it tests and its truth, the Pareto front, a table of at most ten columns, the error and FLIP maps
-of one setting per technique, the profiles across a declared line or edge; the recommendations and
-the cost slopes. ledger.md keeps the full tables."""
+of one setting per technique, the close-up measures it declares, the profiles across a declared line or
+edge; the recommendations and the cost slopes. ledger.md keeps the full tables."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ from pathlib import Path
 
 from .ledger_analysis import ERROR_LABELS, TRUTH_KEY, error_key
 from .ledger_row import Column, LedgerRow, columns, finite
+from .truth_ledger import closeup_notes, closeup_tables
 
 CSS = """
 body { font: 14px/1.45 system-ui, sans-serif; margin: 2em auto; max-width: 1200px; color: #222; }
@@ -105,6 +106,21 @@ def conditions(meta: dict, key: str) -> list[str]:
     return P
 
 
+def closeup_section(scene: str, srows: list[LedgerRow], meta: dict) -> list[str]:
+    """The close-up measures one scene declares (the tables ledger.md has, truth_ledger.closeup_tables, for
+    this scene alone: a column per measure, at most four), and those it could not measure; nothing for a
+    scene that declares none."""
+    esc = html.escape
+    per_scene = (meta.get("truth") or {}).get("scenes") or {}
+    P = []
+    for (what, how), head, body in closeup_tables(srows, [scene], per_scene, pm="\u00b1"):
+        P.append(f"<p><b>{esc(what)}</b>{esc(how)}:</p>")
+        P.append(_table([esc(h) for h in head], [[esc(c) for c in b] for b in body]))
+    P += [f"<p class='note'>Close-ups not measured: {esc('; '.join(n))}</p>"
+          for s, n in closeup_notes(per_scene).items() if s == scene]  # fmt: skip
+    return P
+
+
 def scene_section(scene: str, rows: list[LedgerRow], meta: dict, fronts: dict, key: str, out: Path) -> list[str]:
     """One scene: what it tests and its truth, its Pareto figure, its table, its error and FLIP maps."""
     from .ledger_plots import pareto_plot
@@ -126,6 +142,7 @@ def scene_section(scene: str, rows: list[LedgerRow], meta: dict, fronts: dict, k
     pareto_plot(srows, {scene: fronts.get(scene, [])}, fig, key=key, label=ERROR_LABELS[key])
     P.append(_img(fig, alt=f"Pareto front of {scene}"))
     P.append(scene_table(srows))
+    P += closeup_section(scene, srows, meta)
     figs = []
     for labl in sheet_settings_of_rows(rows).get(scene, []):
         safe = labl.replace(" ", "-")

@@ -337,14 +337,14 @@ def _pct(v) -> str:
 TRUTH_BLOCK_KEY = "truth_rel_l1_block"
 
 
-def _pm(r: LedgerRow, key: str, pct: bool) -> str:
+def _pm(r: LedgerRow, key: str, pct: bool, pm: str = "+-") -> str:
     v, s = r.get(key), r.get(f"{key}_sigma")
     if not finite(v):
         return ""
     mark = "= " if r.ties_best in ("best", "tie") and key == TRUTH_BLOCK_KEY else ""
     if pct:
-        return mark + f"{100 * v:.1f}" + (f" +- {100 * s:.1f}" if finite(s) else "") + " %"
-    return mark + f"{v:.3f}" + (f" +- {s:.3f}" if finite(s) else "")
+        return mark + f"{100 * v:.1f}" + (f" {pm} {100 * s:.1f}" if finite(s) else "") + " %"
+    return mark + f"{v:.3f}" + (f" {pm} {s:.3f}" if finite(s) else "")
 
 
 def _blocks(r: LedgerRow) -> str:
@@ -457,23 +457,24 @@ CLOSEUP_TABLES = (  # ledger.md's close-up tables (skinlab/bench/closeup.py): th
 )  # fmt: skip
 
 
-def _closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict) -> list[str]:
-    """Per declared close-up measure a table of settings x (scene, measure): the frame's value and, in
-    brackets, frame minus truth +- its standard error; the truth's value +- its own in the header. The
-    per-mesh energies as text."""
-    L: list[str] = []
+def closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict, pm: str = "+-") -> list[tuple]:
+    """Per declared close-up measure one table of settings x (scene, measure), as (title, header, body):
+    the frame's value and, in brackets, frame minus truth `pm` its standard error, the truth's value `pm` its
+    own in the header; the per-mesh energies as text. Shared by ledger.md and ledger.html (which passes
+    one scene at a time); nothing for a measure no scene here declares."""
+    out: list[tuple] = []
     for keys, what in CLOSEUP_TABLES:
         cols = [(s, k) for s in scenes for k in keys if any(finite(r[k]) for r in rows if r.scene == s)]
         if not cols:
             continue
-        L += [f"**Close-ups: {what}** (the frame's; in brackets frame minus truth +- its standard error from the "
-              "truth's passes, in percentage points; the truth's in the header):", ""]  # fmt: skip
+        title = (f"Close-ups: {what}", f" (the frame's; in brackets frame minus truth {pm} its standard error from "
+                 "the truth's passes, in percentage points; the truth's in the header)")  # fmt: skip
         head = []
         for s, k in cols:
             tv = ((per_scene.get(s) or {}).get("closeup") or {}).get(k)
             name = s if len(keys) == 1 else f"{s} > {k.removeprefix('truth_tail_')}"
-            head.append(name + (f" (truth {100 * tv[0]:.2f} +- {100 * tv[1]:.2f} %)" if tv and finite(tv[0]) else ""))
-        L += ["| setting | " + " | ".join(head) + " |", "|---|" + "---|" * len(cols)]
+            head.append(name + (f" (truth {100 * tv[0]:.2f} {pm} {100 * tv[1]:.2f} %)" if tv and finite(tv[0]) else ""))
+        body = []
         for labl, per in _by_label(rows).items():
             cells = []
             for s, k in cols:
@@ -485,25 +486,40 @@ def _closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict) -
                 sig = r.get(f"{k}_sigma")
                 cells.append(
                     f"{100 * (tv[0] + r[k]):.2f} % ({100 * r[k]:+.2f}"
-                    + (f" +- {100 * sig:.2f}" if finite(sig) else "")
+                    + (f" {pm} {100 * sig:.2f}" if finite(sig) else "")
                     + ")"
                 )
-            L.append(f"| {labl} | " + " | ".join(cells) + " |")
-        L.append("")
+            body.append([labl, *cells])
+        out.append((title, ["setting", *head], body))
     have = [s for s in scenes if any(finite(r.truth_mesh_energy) for r in rows if r.scene == s)]
     if have:
-        L += ["**Close-ups: each visible mesh's energy** (relative difference of its R/G/B sums against the truth's; "
-              "the largest magnitude +- its standard error):", "",
-              "| setting | " + " | ".join(have) + " |", "|---|" + "---|" * len(have)]  # fmt: skip
+        title = ("Close-ups: each visible mesh's energy", " (relative difference of its R/G/B sums against the "
+                 f"truth's; the largest magnitude {pm} its standard error)")  # fmt: skip
+        body = []
         for labl, per in _by_label(rows).items():
             cells = [
-                f"{per[s].truth_mesh_energy_each} (largest {_pm(per[s], 'truth_mesh_energy', True)})"
+                f"{per[s].truth_mesh_energy_each} (largest {_pm(per[s], 'truth_mesh_energy', True, pm)})"
                 if s in per and finite(per[s].truth_mesh_energy) else ""
                 for s in have
             ]  # fmt: skip
-            L.append(f"| {labl} | " + " | ".join(cells) + " |")
+            body.append([labl, *cells])
+        out.append((title, ["setting", *have], body))
+    return out
+
+
+def closeup_notes(per_scene: dict) -> dict[str, list[str]]:
+    """Per scene the close-up measures it declares but could not measure, and why."""
+    return {s: d["closeup"]["notes"] for s, d in per_scene.items() if (d.get("closeup") or {}).get("notes")}
+
+
+def _closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict) -> list[str]:
+    """ledger.md's close-up tables (closeup_tables) and the measures not measured."""
+    L: list[str] = []
+    for (what, how), head, body in closeup_tables(rows, scenes, per_scene):
+        L += [f"**{what}**{how}:", "", "| " + " | ".join(head) + " |", "|---" * len(head) + "|"]
+        L += ["| " + " | ".join(b) + " |" for b in body]
         L.append("")
-    notes = {s: d["closeup"]["notes"] for s, d in per_scene.items() if (d.get("closeup") or {}).get("notes")}
+    notes = closeup_notes(per_scene)
     L += [f"- **{s}**: not measured: {'; '.join(n)}" for s, n in notes.items()]
     return [*L, ""] if notes else L
 

@@ -85,6 +85,13 @@ def test_closeups_in_the_ledger_at_their_own_truth_size(ctx, tmp_path, monkeypat
                  "Close-ups: each visible mesh's energy"):  # fmt: skip
         assert says in md, says
     assert "Close-ups: the deep shadow's level" not in md  # no scene here declares it
+    page = (tmp_path / "out" / "ledger.html").read_text()
+    sections = {s.split("</h2>", 1)[0]: s for s in page.split("<h2>")[1:]}
+    slit = next(v for k, v in sections.items() if k.startswith("slit-skin1"))
+    slabs = next(v for k, v in sections.items() if k.startswith("slabs-gap-backlit-skin1"))
+    assert "Close-ups: the share of the light" in slit and "slit-skin1 &gt; 2mm (truth" in slit
+    assert "each visible mesh&#x27;s energy" in slabs and "Close-ups: the share of the light" not in slabs
+    assert "the deep shadow&#x27;s level" not in page
 
 
 def test_the_deep_shadow_against_a_tiny_truth(tmp_path, monkeypatch):
