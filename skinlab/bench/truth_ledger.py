@@ -21,7 +21,8 @@ truth size and samples, or the scene's own where its ``[measure]`` declares them
   (Mitsuba's box pixel filter), a frame without antialiasing samples each pixel's centre, which
   differs on the object's outline by far more than the scattering errors the ledger is for;
 * the close-up measures a scene declares (skinlab/bench/closeup.py): ``truth_tail_2mm`` ... for a line
-  profile, ``truth_deep_shadow``, ``truth_mesh_energy`` (frame minus truth, with their standard errors);
+  profile (of luminance, and ``truth_tail_2mm_r`` ... of each channel alone), ``truth_deep_shadow``,
+  ``truth_mesh_energy`` (frame minus truth, with their standard errors);
 * a signed relative-difference image per setting (red: brighter than the truth, blue: darker, one
   scale for all), and a contact sheet of them.
 """

@@ -34,6 +34,50 @@ def test_tail_shares_on_a_profile_and_per_pixel_agree():
     assert math.isnan(closeup.region_level(img, np.zeros((4, 10), bool), np.ones((4, 10), bool)))
 
 
+def _slit_regions(w: int = 41, h: int = 4, mask=None):
+    """CloseupRegions of a slit down the middle of a w x h image, columns 1 mm apart (no scene needed)."""
+    from skinlab.scene.measure import MeasureSpec
+
+    spec = MeasureSpec(profile="line", profile_origin=(0.0, 0.0, 0.0), profile_axis=(1.0, 0.0, 0.0))
+    across = np.repeat((np.arange(w) - w // 2.0)[None], h, axis=0)
+    return closeup.CloseupRegions(None, spec, (w, h), across, np.ones((h, w), bool) if mask is None else mask)
+
+
+def test_each_channel_tail_is_its_own():
+    """Red wide, blue narrow (skin's): red's tail beyond each distance is larger than blue's, luminance's
+    between them; a one-channel image's other channels, an empty mask and a black image stay finite."""
+    import warnings
+
+    cu = _slit_regions()
+    x = np.abs(np.arange(41) - 20.0)
+    img = np.zeros((4, 41, 4))  # an alpha channel too: not a colour
+    img[..., 0] = np.exp(-x / 4.0)  # red: 4 mm
+    img[..., 1] = np.exp(-x / 2.0)
+    img[..., 2] = np.exp(-x / 0.8)  # blue: 0.8 mm
+    img[..., 3] = 1.0
+    v = cu.values(img)
+    assert set(v) == {*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS}
+    assert closeup.tail_key(2.0) == "truth_tail_2mm" and closeup.tail_key(10.0, "b") == "truth_tail_10mm_b"
+    for d in closeup.TAIL_MM:
+        r, g, b = (v[closeup.tail_key(d, c)] for c in closeup.CHANNELS)
+        assert r > g > b >= 0
+        assert b < v[closeup.tail_key(d)] < r
+        assert r == pytest.approx(float((img[..., 0] * (x > d)).sum() / img[..., 0].sum()))  # red's own share
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        red = img.copy()
+        red[..., 1:3] = 0.0  # light in red alone: the others have no tail (0, not NaN)
+        v = cu.values(red)
+        assert all(v[closeup.tail_key(d, c)] == 0.0 for d in closeup.TAIL_MM for c in "gb")
+        assert v[closeup.tail_key(2.0, "r")] > 0  # and luminance's is red's
+        assert all(v[closeup.tail_key(d, "r")] == pytest.approx(v[closeup.tail_key(d)]) for d in closeup.TAIL_MM)
+        for got in (cu.values(np.zeros_like(img)), _slit_regions(mask=np.zeros((4, 41), bool)).values(img)):
+            assert set(got) == {*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS}
+            assert all(math.isfinite(x) for x in got.values())
+        diff = {k: fn(img) for k, fn in cu.measures(img * 2.0).items()}  # twice as bright: the same shares
+        assert diff.keys() == v.keys() and max(map(abs, diff.values())) < 1e-12
+
+
 def test_a_scene_without_truth_settings_keeps_the_sweeps():
     from skinlab.scene.scenefile import load_scene
 
@@ -69,20 +113,23 @@ def test_closeups_in_the_ledger_at_their_own_truth_size(ctx, tmp_path, monkeypat
     for (scene, _), r in rows.items():
         assert r["status"] == "ok", r["error"]
         assert math.isfinite(r["truth_rel_l1_block"])
-        tails = [r[k] for k in closeup.TAIL_KEYS]
+        tails = [r[k] for k in (*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS)]
         assert all(map(math.isfinite, tails)) == (scene == "slit-skin1")
+        assert any(map(math.isfinite, tails)) == (scene == "slit-skin1")
         assert math.isnan(r["truth_deep_shadow"])
         assert math.isfinite(r["truth_mesh_energy"]) == (scene == "slabs-gap-backlit-skin1")
         if scene == "slit-skin1":
-            assert all(math.isfinite(r[f"{k}_sigma"]) for k in closeup.TAIL_KEYS)
+            assert all(math.isfinite(r[f"{k}_sigma"]) for k in (*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS))
             assert len(r["jackknife"]["truth_tail_2mm"]) == 2  # a 2-pass truth: two groups
+            assert len(r["jackknife"]["truth_tail_2mm_r"]) == 2
     slabs = next(r for (s, _), r in rows.items() if s == "slabs-gap-backlit-skin1")
     assert slabs["truth_mesh_energy"] >= 0 and math.isfinite(slabs["truth_mesh_energy_sigma"])
     assert slabs["truth_mesh_energy_each"].startswith("front ") and "; back " in slabs["truth_mesh_energy_each"]
-    assert set(truths["slit-skin1"]["closeup"]) == set(closeup.TAIL_KEYS)
+    assert set(truths["slit-skin1"]["closeup"]) == {*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS}
+    assert "truth_tail_2mm_r" in (tmp_path / "out" / "ledger.csv").read_text().splitlines()[0].split(",")
     md = (tmp_path / "out" / "ledger.md").read_text()
     for says in ("| slit-skin1 |", "32x4", "Close-ups: the share of the light", "slit-skin1 > 2mm (truth",
-                 "Close-ups: each visible mesh's energy"):  # fmt: skip
+                 "Close-ups: each visible mesh's energy", "`truth_tail_5mm_g_sigma`"):  # fmt: skip
         assert says in md, says
     assert "Close-ups: the deep shadow's level" not in md  # no scene here declares it
     page = (tmp_path / "out" / "ledger.html").read_text()
