@@ -4,6 +4,7 @@ the tails of a line profile, the deep shadow, each mesh's energy), on tiny copie
 against tiny truths path-traced here (a few seconds), and the measures on arrays."""
 
 import math
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -129,8 +130,14 @@ def test_closeups_in_the_ledger_at_their_own_truth_size(ctx, tmp_path, monkeypat
     assert "truth_tail_2mm_r" in (tmp_path / "out" / "ledger.csv").read_text().splitlines()[0].split(",")
     md = (tmp_path / "out" / "ledger.md").read_text()
     for says in ("| slit-skin1 |", "32x4", "Close-ups: the share of the light", "slit-skin1 > 2mm (truth",
-                 "Close-ups: each visible mesh's energy", "`truth_tail_5mm_g_sigma`"):  # fmt: skip
+                 "Close-ups: each visible mesh's energy", "Close-ups: the tails per channel",
+                 "slit-skin1 > 10mm (truth ", "`truth_tail_5mm_g_sigma`"):  # fmt: skip
         assert says in md, says
+    # the luminance's tails, then each channel's: a cell R/G/B +- the largest standard error
+    assert md.index("Close-ups: the share of the light") < md.index("Close-ups: the tails per channel")
+    per_channel = md.split("Close-ups: the tails per channel", 1)[1].split("\n\n", 2)[1].splitlines()
+    assert per_channel[0].count("slit-skin1 > ") == 3 and "slabs" not in per_channel[0]
+    assert re.search(r"\| [+-]\d+\.\d\d/[+-]\d+\.\d\d/[+-]\d+\.\d\d \+- \d+\.\d\d \|", per_channel[2])
     assert "Close-ups: the deep shadow's level" not in md  # no scene here declares it
     page = (tmp_path / "out" / "ledger.html").read_text()
     sections = {s.split("</h2>", 1)[0]: s for s in page.split("<h2>")[1:]}
@@ -138,6 +145,8 @@ def test_closeups_in_the_ledger_at_their_own_truth_size(ctx, tmp_path, monkeypat
     slabs = next(v for k, v in sections.items() if k.startswith("slabs-gap-backlit-skin1"))
     assert "Close-ups: the share of the light" in slit and "slit-skin1 &gt; 2mm (truth" in slit
     assert "each visible mesh&#x27;s energy" in slabs and "Close-ups: the share of the light" not in slabs
+    assert "Close-ups: the tails per channel" in slit and "tails per channel" not in slabs
+    assert re.search(r"<td>[+-]\d+\.\d\d/[+-]\d+\.\d\d/[+-]\d+\.\d\d \u00b1 \d+\.\d\d</td>", slit)
     assert "the deep shadow&#x27;s level" not in page
 
 
