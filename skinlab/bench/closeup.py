@@ -3,7 +3,8 @@ docs/ledger.md "Close-ups in the ledger"), shared by the accuracy ledger (skinla
 and tools/closeup_table.py. A scene says which apply in its ``[measure]`` table:
 
 * ``profile = "line"`` (a slit): the tails, the share of the light in view farther than 2, 5 and 10 mm
-  from the line (``TAIL_MM``);
+  from the line (``TAIL_MM``), of luminance and of each channel alone (``CHANNELS``: skin's red diffuses
+  about 5 times as far as its blue, which a luminance tail hides);
 * ``deep_shadow = true``: the deep shadow's level: the mean luminance of camera-visible points the first
   light does not reach, more than ``DEEP_SHADOW_MM`` from a lit one (found by ray casting with Embree,
   independent of the shadow maps), as a share of the lit surface's (farther than that from the shadow);
@@ -20,6 +21,7 @@ import math
 import numpy as np
 
 TAIL_MM = (2.0, 5.0, 10.0)
+CHANNELS = "rgb"  # the per-channel tails' column suffixes (tail_key)
 DEEP_SHADOW_MM = 2.0  # deep shadow: more than this from any lit point (the red diffusion length is 2.3 mm)
 EDGE_MM = 3.0  # edge region: within this of the shadow's edge, both sides
 LUMINANCE = np.array([0.2126, 0.7152, 0.0722])  # Rec. 709
@@ -220,11 +222,14 @@ class CloseupRegions:
         return self.across is not None or self.deep is not None or bool(self.meshes)
 
     def values(self, img: np.ndarray) -> dict[str, float]:
-        """The image's own close-up measures (fractions): tail shares of luminance, the deep shadow level."""
+        """The image's own close-up measures (fractions): tail shares of luminance and of each channel (its
+        own light's share: 0 for a channel without light), the deep shadow level."""
         out: dict[str, float] = {}
         if self.across is not None:
             shares = tail_shares(luminance(img), self.across, self.mask)
             out.update({tail_key(d): float(v) for d, v in zip(TAIL_MM, shares)})
+            each = tail_shares(img[..., :3], self.across, self.mask)  # (len(TAIL_MM), 3)
+            out.update({tail_key(d, c): float(v) for d, row in zip(TAIL_MM, each) for c, v in zip(CHANNELS, row)})
         if self.deep is not None:
             out["truth_deep_shadow"] = region_level(img, self.deep, self.lit)
         return out
@@ -248,9 +253,13 @@ class CloseupRegions:
         return "; ".join(f"{n} " + "/".join(f"{100 * x:+.1f}" for x in v) + " %" for n, v in e.items())
 
 
-def tail_key(mm: float) -> str:
-    return f"truth_tail_{mm:g}mm"
+def tail_key(mm: float, channel: str = "") -> str:
+    """The ledger's column of the tail beyond `mm`: of luminance ("truth_tail_2mm"), or of one of CHANNELS
+    alone ("truth_tail_2mm_r")."""
+    assert channel in ("", *CHANNELS), channel
+    return f"truth_tail_{mm:g}mm" + (f"_{channel}" if channel else "")
 
 
 TAIL_KEYS = tuple(tail_key(d) for d in TAIL_MM)
-CLOSEUP_KEYS = (*TAIL_KEYS, "truth_deep_shadow", "truth_mesh_energy")
+TAIL_CHANNEL_KEYS = tuple(tail_key(d, c) for d in TAIL_MM for c in CHANNELS)
+CLOSEUP_KEYS = (*TAIL_KEYS, *TAIL_CHANNEL_KEYS, "truth_deep_shadow", "truth_mesh_energy")

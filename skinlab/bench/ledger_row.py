@@ -107,6 +107,26 @@ class LedgerRow:
     truth_tail_5mm_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
     truth_tail_10mm: float = column(NAN, "float", "fraction", "the same beyond 10 mm")
     truth_tail_10mm_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_2mm_r: float = column(NAN, "float", "fraction", "share of the red channel's own light in view "
+                                     "farther than 2 mm from the declared line, frame minus truth (a line "
+                                     "profile; skin's red diffuses farthest)")  # fmt: skip
+    truth_tail_2mm_r_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_2mm_g: float = column(NAN, "float", "fraction", "the same of the green channel beyond 2 mm")
+    truth_tail_2mm_g_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_2mm_b: float = column(NAN, "float", "fraction", "the same of the blue channel beyond 2 mm")
+    truth_tail_2mm_b_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_5mm_r: float = column(NAN, "float", "fraction", "the same of the red channel beyond 5 mm")
+    truth_tail_5mm_r_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_5mm_g: float = column(NAN, "float", "fraction", "the same of the green channel beyond 5 mm")
+    truth_tail_5mm_g_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_5mm_b: float = column(NAN, "float", "fraction", "the same of the blue channel beyond 5 mm")
+    truth_tail_5mm_b_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_10mm_r: float = column(NAN, "float", "fraction", "the same of the red channel beyond 10 mm")
+    truth_tail_10mm_r_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_10mm_g: float = column(NAN, "float", "fraction", "the same of the green channel beyond 10 mm")
+    truth_tail_10mm_g_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
+    truth_tail_10mm_b: float = column(NAN, "float", "fraction", "the same of the blue channel beyond 10 mm")
+    truth_tail_10mm_b_sigma: float = column(NAN, "float", "fraction", "its standard error (jackknife)")
     truth_deep_shadow: float = column(NAN, "float", "fraction", "the deep shadow's mean luminance as a share of "
                                       "the lit surface's (ray-cast regions), frame minus truth "
                                       "(deep_shadow = true)")  # fmt: skip

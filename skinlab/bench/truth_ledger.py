@@ -21,7 +21,8 @@ truth size and samples, or the scene's own where its ``[measure]`` declares them
   (Mitsuba's box pixel filter), a frame without antialiasing samples each pixel's centre, which
   differs on the object's outline by far more than the scattering errors the ledger is for;
 * the close-up measures a scene declares (skinlab/bench/closeup.py): ``truth_tail_2mm`` ... for a line
-  profile, ``truth_deep_shadow``, ``truth_mesh_energy`` (frame minus truth, with their standard errors);
+  profile (of luminance, and ``truth_tail_2mm_r`` ... of each channel alone), ``truth_deep_shadow``,
+  ``truth_mesh_energy`` (frame minus truth, with their standard errors);
 * a signed relative-difference image per setting (red: brighter than the truth, blue: darker, one
   scale for all), and a contact sheet of them.
 """
@@ -45,7 +46,7 @@ from skinlab.truth.compare import (
     judged_blocks,
 )
 
-from .closeup import CLOSEUP_KEYS, TAIL_MM, CloseupRegions, tail_key
+from .closeup import CHANNELS, CLOSEUP_KEYS, TAIL_KEYS, TAIL_MM, CloseupRegions, tail_key
 from .ledger_row import LedgerRow, finite
 
 REFERENCE_SCENES = scenes_root() / "reference"
@@ -450,11 +451,40 @@ def _error_table(rows: list[LedgerRow], scenes: list[str], key: str, what: str, 
 
 
 CLOSEUP_TABLES = (  # ledger.md's close-up tables (skinlab/bench/closeup.py): the columns, what they measure
-    (tuple(tail_key(d) for d in TAIL_MM), "the share of the light (luminance) in view beyond "
+    (TAIL_KEYS, "the share of the light (luminance) in view beyond "
      + ", ".join(f"{d:g}" for d in TAIL_MM) + " mm from the line"),
     (("truth_deep_shadow",), "the deep shadow's level: its mean luminance as a share of the lit surface's "
      "(regions found by ray casting)"),
 )  # fmt: skip
+
+
+def _measure_table(rows: list[LedgerRow], cols: list[tuple[str, str]], keys: tuple[str, ...], what: str,
+                   per_scene: dict, pm: str) -> tuple:  # fmt: skip
+    """closeup_tables' table of one measure over `cols` (scene, column)."""
+    title = (f"Close-ups: {what}", f" (the frame's; in brackets frame minus truth {pm} its standard error from "
+             "the truth's passes, in percentage points; the truth's in the header)")  # fmt: skip
+    head = []
+    for s, k in cols:
+        tv = ((per_scene.get(s) or {}).get("closeup") or {}).get(k)
+        name = s if len(keys) == 1 else f"{s} > {k.removeprefix('truth_tail_')}"
+        head.append(name + (f" (truth {100 * tv[0]:.2f} {pm} {100 * tv[1]:.2f} %)" if tv and finite(tv[0]) else ""))
+    body = []
+    for labl, per in _by_label(rows).items():
+        cells = []
+        for s, k in cols:
+            r = per.get(s)
+            tv = ((per_scene.get(s) or {}).get("closeup") or {}).get(k)
+            if r is None or not finite(r[k]) or not tv:
+                cells.append("")
+                continue
+            sig = r.get(f"{k}_sigma")
+            cells.append(
+                f"{100 * (tv[0] + r[k]):.2f} % ({100 * r[k]:+.2f}"
+                + (f" {pm} {100 * sig:.2f}" if finite(sig) else "")
+                + ")"
+            )
+        body.append([labl, *cells])
+    return title, ["setting", *head], body
 
 
 def closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict, pm: str = "+-") -> list[tuple]:
@@ -465,32 +495,10 @@ def closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict, pm
     out: list[tuple] = []
     for keys, what in CLOSEUP_TABLES:
         cols = [(s, k) for s in scenes for k in keys if any(finite(r[k]) for r in rows if r.scene == s)]
-        if not cols:
-            continue
-        title = (f"Close-ups: {what}", f" (the frame's; in brackets frame minus truth {pm} its standard error from "
-                 "the truth's passes, in percentage points; the truth's in the header)")  # fmt: skip
-        head = []
-        for s, k in cols:
-            tv = ((per_scene.get(s) or {}).get("closeup") or {}).get(k)
-            name = s if len(keys) == 1 else f"{s} > {k.removeprefix('truth_tail_')}"
-            head.append(name + (f" (truth {100 * tv[0]:.2f} {pm} {100 * tv[1]:.2f} %)" if tv and finite(tv[0]) else ""))
-        body = []
-        for labl, per in _by_label(rows).items():
-            cells = []
-            for s, k in cols:
-                r = per.get(s)
-                tv = ((per_scene.get(s) or {}).get("closeup") or {}).get(k)
-                if r is None or not finite(r[k]) or not tv:
-                    cells.append("")
-                    continue
-                sig = r.get(f"{k}_sigma")
-                cells.append(
-                    f"{100 * (tv[0] + r[k]):.2f} % ({100 * r[k]:+.2f}"
-                    + (f" {pm} {100 * sig:.2f}" if finite(sig) else "")
-                    + ")"
-                )
-            body.append([labl, *cells])
-        out.append((title, ["setting", *head], body))
+        if cols:
+            out.append(_measure_table(rows, cols, keys, what, per_scene, pm))
+        if keys == TAIL_KEYS:  # the tails per channel after the luminance's
+            out += channel_tail_table(rows, scenes, per_scene, pm)
     have = [s for s in scenes if any(finite(r.truth_mesh_energy) for r in rows if r.scene == s)]
     if have:
         title = ("Close-ups: each visible mesh's energy", " (relative difference of its R/G/B sums against the "
@@ -505,6 +513,47 @@ def closeup_tables(rows: list[LedgerRow], scenes: list[str], per_scene: dict, pm
             body.append([labl, *cells])
         out.append((title, ["setting", *have], body))
     return out
+
+
+def channel_tail_table(rows: list[LedgerRow], scenes: list[str], per_scene: dict, pm: str = "+-") -> list[tuple]:
+    """The tails per channel (closeup_tables' form, one table or none): settings x (scene, distance), each
+    cell the R/G/B frame minus truth of each channel's own share beyond the distance, in percentage points,
+    `pm` the largest of the three standard errors; the truth's R/G/B in the header. Only the scenes whose
+    rows have them (a line profile; an older ledger.csv has none)."""
+
+    def keys(d: float) -> list[str]:
+        return [tail_key(d, c) for c in CHANNELS]
+
+    def have(r: LedgerRow, d: float) -> bool:
+        return all(finite(r[k]) for k in keys(d))
+
+    cols = [(s, d) for s in scenes for d in TAIL_MM if any(have(r, d) for r in rows if r.scene == s)]
+    if not cols:
+        return []
+    title = ("Close-ups: the tails per channel", " (each channel's own share of its light in view beyond "
+             + ", ".join(f"{d:g}" for d in TAIL_MM) + f" mm from the line: frame minus truth, R/G/B, in percentage "
+             f"points, {pm} the largest of the three standard errors from the truth's passes; the truth's R/G/B in "
+             "the header)")  # fmt: skip
+    head = []
+    for s, d in cols:
+        closeup = (per_scene.get(s) or {}).get("closeup") or {}
+        tv = [closeup.get(k) for k in keys(d)]
+        known = all(t and finite(t[0]) for t in tv)
+        head.append(f"{s} > {d:g}mm" + (f" (truth {'/'.join(f'{100 * t[0]:.2f}' for t in tv)} %)" if known else ""))
+    body = []
+    for labl, per in _by_label(rows).items():
+        cells = []
+        for s, d in cols:
+            r = per.get(s)
+            if r is None or not have(r, d):
+                cells.append("")
+                continue
+            sig = [r[f"{k}_sigma"] for k in keys(d) if finite(r[f"{k}_sigma"])]
+            cells.append(
+                "/".join(f"{100 * r[k]:+.2f}" for k in keys(d)) + (f" {pm} {100 * max(sig):.2f}" if sig else "")
+            )
+        body.append([labl, *cells])
+    return [(title, ["setting", *head], body)]
 
 
 def closeup_notes(per_scene: dict) -> dict[str, list[str]]:

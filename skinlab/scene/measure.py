@@ -22,7 +22,7 @@ mesh_energy = true            # the ledger measures each visible mesh's energy a
 ```
 
 A ``profile = "line"`` scene also gets the ledger's tails: the share of the light in view farther than
-2, 5 and 10 mm from the line (skinlab/bench/closeup.py).
+2, 5 and 10 mm from the line, of luminance and of each channel alone (skinlab/bench/closeup.py).
 
 With no profile the edge region comes from the plain frame's light: pixels within ``edge_mm`` of
 where its luminance changes by more than a factor of 2 between neighbouring pixels (shadow and light

@@ -4,6 +4,7 @@ the tails of a line profile, the deep shadow, each mesh's energy), on tiny copie
 against tiny truths path-traced here (a few seconds), and the measures on arrays."""
 
 import math
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -32,6 +33,50 @@ def test_tail_shares_on_a_profile_and_per_pixel_agree():
     assert np.isfinite(closeup.tail_shares(img, dist)).all()
     assert closeup.largest([0.1, -0.3, math.nan]) == -0.3 and math.isnan(closeup.largest([math.nan]))
     assert math.isnan(closeup.region_level(img, np.zeros((4, 10), bool), np.ones((4, 10), bool)))
+
+
+def _slit_regions(w: int = 41, h: int = 4, mask=None):
+    """CloseupRegions of a slit down the middle of a w x h image, columns 1 mm apart (no scene needed)."""
+    from skinlab.scene.measure import MeasureSpec
+
+    spec = MeasureSpec(profile="line", profile_origin=(0.0, 0.0, 0.0), profile_axis=(1.0, 0.0, 0.0))
+    across = np.repeat((np.arange(w) - w // 2.0)[None], h, axis=0)
+    return closeup.CloseupRegions(None, spec, (w, h), across, np.ones((h, w), bool) if mask is None else mask)
+
+
+def test_each_channel_tail_is_its_own():
+    """Red wide, blue narrow (skin's): red's tail beyond each distance is larger than blue's, luminance's
+    between them; a one-channel image's other channels, an empty mask and a black image stay finite."""
+    import warnings
+
+    cu = _slit_regions()
+    x = np.abs(np.arange(41) - 20.0)
+    img = np.zeros((4, 41, 4))  # an alpha channel too: not a colour
+    img[..., 0] = np.exp(-x / 4.0)  # red: 4 mm
+    img[..., 1] = np.exp(-x / 2.0)
+    img[..., 2] = np.exp(-x / 0.8)  # blue: 0.8 mm
+    img[..., 3] = 1.0
+    v = cu.values(img)
+    assert set(v) == {*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS}
+    assert closeup.tail_key(2.0) == "truth_tail_2mm" and closeup.tail_key(10.0, "b") == "truth_tail_10mm_b"
+    for d in closeup.TAIL_MM:
+        r, g, b = (v[closeup.tail_key(d, c)] for c in closeup.CHANNELS)
+        assert r > g > b >= 0
+        assert b < v[closeup.tail_key(d)] < r
+        assert r == pytest.approx(float((img[..., 0] * (x > d)).sum() / img[..., 0].sum()))  # red's own share
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        red = img.copy()
+        red[..., 1:3] = 0.0  # light in red alone: the others have no tail (0, not NaN)
+        v = cu.values(red)
+        assert all(v[closeup.tail_key(d, c)] == 0.0 for d in closeup.TAIL_MM for c in "gb")
+        assert v[closeup.tail_key(2.0, "r")] > 0  # and luminance's is red's
+        assert all(v[closeup.tail_key(d, "r")] == pytest.approx(v[closeup.tail_key(d)]) for d in closeup.TAIL_MM)
+        for got in (cu.values(np.zeros_like(img)), _slit_regions(mask=np.zeros((4, 41), bool)).values(img)):
+            assert set(got) == {*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS}
+            assert all(math.isfinite(x) for x in got.values())
+        diff = {k: fn(img) for k, fn in cu.measures(img * 2.0).items()}  # twice as bright: the same shares
+        assert diff.keys() == v.keys() and max(map(abs, diff.values())) < 1e-12
 
 
 def test_a_scene_without_truth_settings_keeps_the_sweeps():
@@ -69,21 +114,30 @@ def test_closeups_in_the_ledger_at_their_own_truth_size(ctx, tmp_path, monkeypat
     for (scene, _), r in rows.items():
         assert r["status"] == "ok", r["error"]
         assert math.isfinite(r["truth_rel_l1_block"])
-        tails = [r[k] for k in closeup.TAIL_KEYS]
+        tails = [r[k] for k in (*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS)]
         assert all(map(math.isfinite, tails)) == (scene == "slit-skin1")
+        assert any(map(math.isfinite, tails)) == (scene == "slit-skin1")
         assert math.isnan(r["truth_deep_shadow"])
         assert math.isfinite(r["truth_mesh_energy"]) == (scene == "slabs-gap-backlit-skin1")
         if scene == "slit-skin1":
-            assert all(math.isfinite(r[f"{k}_sigma"]) for k in closeup.TAIL_KEYS)
+            assert all(math.isfinite(r[f"{k}_sigma"]) for k in (*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS))
             assert len(r["jackknife"]["truth_tail_2mm"]) == 2  # a 2-pass truth: two groups
+            assert len(r["jackknife"]["truth_tail_2mm_r"]) == 2
     slabs = next(r for (s, _), r in rows.items() if s == "slabs-gap-backlit-skin1")
     assert slabs["truth_mesh_energy"] >= 0 and math.isfinite(slabs["truth_mesh_energy_sigma"])
     assert slabs["truth_mesh_energy_each"].startswith("front ") and "; back " in slabs["truth_mesh_energy_each"]
-    assert set(truths["slit-skin1"]["closeup"]) == set(closeup.TAIL_KEYS)
+    assert set(truths["slit-skin1"]["closeup"]) == {*closeup.TAIL_KEYS, *closeup.TAIL_CHANNEL_KEYS}
+    assert "truth_tail_2mm_r" in (tmp_path / "out" / "ledger.csv").read_text().splitlines()[0].split(",")
     md = (tmp_path / "out" / "ledger.md").read_text()
     for says in ("| slit-skin1 |", "32x4", "Close-ups: the share of the light", "slit-skin1 > 2mm (truth",
-                 "Close-ups: each visible mesh's energy"):  # fmt: skip
+                 "Close-ups: each visible mesh's energy", "Close-ups: the tails per channel",
+                 "slit-skin1 > 10mm (truth ", "`truth_tail_5mm_g_sigma`"):  # fmt: skip
         assert says in md, says
+    # the luminance's tails, then each channel's: a cell R/G/B +- the largest standard error
+    assert md.index("Close-ups: the share of the light") < md.index("Close-ups: the tails per channel")
+    per_channel = md.split("Close-ups: the tails per channel", 1)[1].split("\n\n", 2)[1].splitlines()
+    assert per_channel[0].count("slit-skin1 > ") == 3 and "slabs" not in per_channel[0]
+    assert re.search(r"\| [+-]\d+\.\d\d/[+-]\d+\.\d\d/[+-]\d+\.\d\d \+- \d+\.\d\d \|", per_channel[2])
     assert "Close-ups: the deep shadow's level" not in md  # no scene here declares it
     page = (tmp_path / "out" / "ledger.html").read_text()
     sections = {s.split("</h2>", 1)[0]: s for s in page.split("<h2>")[1:]}
@@ -91,6 +145,8 @@ def test_closeups_in_the_ledger_at_their_own_truth_size(ctx, tmp_path, monkeypat
     slabs = next(v for k, v in sections.items() if k.startswith("slabs-gap-backlit-skin1"))
     assert "Close-ups: the share of the light" in slit and "slit-skin1 &gt; 2mm (truth" in slit
     assert "each visible mesh&#x27;s energy" in slabs and "Close-ups: the share of the light" not in slabs
+    assert "Close-ups: the tails per channel" in slit and "tails per channel" not in slabs
+    assert re.search(r"<td>[+-]\d+\.\d\d/[+-]\d+\.\d\d/[+-]\d+\.\d\d \u00b1 \d+\.\d\d</td>", slit)
     assert "the deep shadow&#x27;s level" not in page
 
 
