@@ -150,7 +150,9 @@ def main(argv: list[str] | None = None) -> int:
         noise = truth.noise
         exposure = scene.environment.exposure
         head = (
-            f"{s:24s} truth {spec.size[0]}x{spec.size[1]} {spec.spp} spp: noise 4x4 "
+            # the truth's own spp and passes: a cache holding more passes than asked for gives them all
+            f"{s:24s} truth {spec.size[0]}x{spec.size[1]} {truth.meta.get('spp', spec.spp)} spp "
+            f"({truth.meta.get('passes', '?')} passes): noise 4x4 "
             f"{100 * noise['rel_l1_block']:.2f} %, px {100 * noise['rel_l1']:.2f} %, "
             f"FLIP {flip_mean(ha, hb, exposure=exposure):.4f}"
         )

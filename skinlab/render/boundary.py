@@ -12,7 +12,7 @@ from skinlab.gl.uniforms import set_array, set_uniforms
 from skinlab.scene.optics.boundary import ANGULAR_NODES, MS_REST_NODES, BoundaryTables, boundary_tables, ms_rest_table
 from skinlab.scene.optics.fresnel import fdr
 from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
-from skinlab.scene.optics.similarity import real_albedo
+from skinlab.scene.optics.similarity import real_albedo, real_mfp
 from skinlab.scene.optics.slab import LN_FLOOR, SLAB_MU_NODES, SLAB_TAU_NODES, slab_decay, slab_exit_tables, slab_table
 
 _ZERO_TABLE = np.zeros((ANGULAR_NODES, 3))
@@ -89,6 +89,16 @@ def single_scattering_factor(material, tables: BoundaryTables) -> np.ndarray:
     return tables.single * ratio
 
 
+def real_extinction(material) -> np.ndarray:
+    """u_sss_sigma_t: the medium's real extinction 1 / l per channel, per mm (the reduced medium's
+    mean free path turned into the real one by similarity, skinlab/scene/optics/similarity.py; 0 where
+    there is no scattering). The near light's single scattering needs it (lib/sss_near_single.glsl)."""
+    g = float(material.values.get("subsurface_scatter_anisotropy", 0.0))
+    medium = material_medium(material.values)
+    mfp = real_mfp(medium.mfp_arr, medium.alpha_arr, g)
+    return np.where(mfp > 0, 1.0 / np.where(mfp > 0, mfp, 1.0), 0.0)
+
+
 def boundary_ggx_alpha(material) -> float:
     """GGX alpha of the material's boundary, roughness^2 (as the truth exporter's rough dielectric)."""
     return float(material["roughness"]) ** 2
@@ -117,7 +127,7 @@ def bind_boundary(prog, material) -> None:
         set_array(prog, "u_sss_slab_norm", _DARK_NORM, SLAB_TAU_NODES)
         set_array(prog, "u_sss_slab_h", _ZERO_H, _SLAB_ROWS)
         set_array(prog, "u_sss_slab_ab", _UNIT_AB, 2 * SLAB_TAU_NODES)
-        set_uniforms(prog, {"u_sss_mfp": zero, "u_sss_slab_decay": zero, "u_sss_slab_out": 1.0})
+        set_uniforms(prog, {"u_sss_mfp": zero, "u_sss_sigma_t": zero, "u_sss_slab_decay": zero, "u_sss_slab_out": 1.0})
         return
     set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
     set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
@@ -140,5 +150,10 @@ def bind_boundary(prog, material) -> None:
     out = 1.0 - float(fdr(medium.eta)) if medium.eta > 1.0 else 1.0
     set_uniforms(
         prog,
-        {"u_sss_mfp": medium.mfp_arr, "u_sss_slab_decay": slab_decay(medium.alpha_arr), "u_sss_slab_out": out},
+        {
+            "u_sss_mfp": medium.mfp_arr,
+            "u_sss_sigma_t": real_extinction(material),
+            "u_sss_slab_decay": slab_decay(medium.alpha_arr),
+            "u_sss_slab_out": out,
+        },
     )

@@ -216,3 +216,20 @@ SH_C4 = 0.5462742152960396  # sqrt(15 / (16 pi))
 SH_A = (PI, 2.0 * PI / 3.0, PI / 4.0)
 GLSL_CONSTANTS.update({"SH_C0": SH_C0, "SH_C1": SH_C1, "SH_C2": SH_C2, "SH_C3": SH_C3, "SH_C4": SH_C4})
 GLSL_CONSTANTS.update({f"SH_A{band}": a for band, a in enumerate(SH_A)})
+
+# ---------------------------------------------------------------------------------------------
+# Single scattering under a near (point or spot) light (issue 21; skinlab/scene/optics/near_single.py,
+# skinlab/shaders/lib/sss_near_single.glsl): Gauss-Laguerre nodes and weights (weight e^{-t} on
+# [0, inf); numpy.polynomial.laguerre.laggauss(4), checked in tests/scene/optics/test_near_single.py).
+NEAR_SINGLE_T = (0.3225476896193924, 1.7457611011583465, 4.536620296921128, 9.395070912301133)
+NEAR_SINGLE_W = (0.6031541043416337, 0.35741869243779956, 0.038887908515005405, 0.0005392947055613296)
+# The gain is at most this (a light nearer than its height allows: the ratio of inverse squares grows
+# as 1 / mu_i^2 at the light's foot, where the far term it multiplies falls as mu_i).
+NEAR_SINGLE_MAX_GAIN = 8.0
+# sigma_t x the light's distance is taken as at least this (no extinction: the points that scatter lie
+# farther than the light is from the surface, the gain is about 0; finite in fp32).
+NEAR_SINGLE_MIN_OPTICAL = 1.0e-3
+GLSL_CONSTANTS.update({f"NEAR_SINGLE_T{i}": t for i, t in enumerate(NEAR_SINGLE_T)})
+GLSL_CONSTANTS.update({f"NEAR_SINGLE_W{i}": w for i, w in enumerate(NEAR_SINGLE_W)})
+GLSL_CONSTANTS.update({"NEAR_SINGLE_MAX_GAIN": NEAR_SINGLE_MAX_GAIN})
+GLSL_CONSTANTS.update({"NEAR_SINGLE_MIN_OPTICAL": NEAR_SINGLE_MIN_OPTICAL})

@@ -18,6 +18,7 @@ uniform vec3 u_sss_entry_diffuse;  // A_ms_d / A_colour: uniform (ambient) light
 uniform vec3 u_sss_single;         // alpha / A_colour (0: no single-scattering term)
 uniform float u_sss_eta;           // relative index of the boundary (1: index-matched)
 uniform float u_sss_g;             // Henyey-Greenstein g of the medium (material subsurface_scatter_anisotropy)
+uniform vec3 u_sss_sigma_t;        // the real extinction 1 / l per channel, per mm (single scattering of near lights)
 
 vec3 sss_entry(float mu) {
     float x = clamp(mu, 0.0, 1.0) * float(SSS_ANGULAR_NODES - 1);

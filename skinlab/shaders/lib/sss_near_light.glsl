@@ -5,6 +5,7 @@
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
+#include "lib/sss_near_single.glsl"
 
 // Per channel, the factor on e NoL sss_entry(NoL) at a point d_mm (millimetres) from the light:
 // sss_near_entry's g x entry(mu_s) / entry(mu_x), mu the cosines to the geometric normal ng, at most
@@ -25,4 +26,11 @@ vec3 sss_near_entry_gain(vec3 d_mm, vec3 ng, vec3 z0_mm) {
 vec3 sss_light_near_gain(int i, vec3 world, vec3 ng, vec3 z0_mm) {
     if (u_light_vec[i].w == 0.0 || u_light_axis[i].w > 1.5) return vec3(1.0);
     return sss_near_entry_gain((u_light_vec[i].xyz - world) * u_mm_per_unit, ng, z0_mm);
+}
+
+// The single-scattering term's factor for light i at world (v to the eye, sigma_t the real extinction
+// per mm x the radius map; lib/sss_near_single.glsl): 1 for directional and area lights.
+vec3 sss_light_near_single(int i, vec3 world, vec3 ng, vec3 v, vec3 sigma_t) {
+    if (u_light_vec[i].w == 0.0 || u_light_axis[i].w > 1.5) return vec3(1.0);
+    return sss_near_single_gain((u_light_vec[i].xyz - world) * u_mm_per_unit, ng, v, sigma_t, u_sss_eta, u_sss_g);
 }

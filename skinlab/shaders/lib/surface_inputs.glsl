@@ -58,3 +58,13 @@ float sss_entry_visibility(Surface s, int i, vec3 l) {
 vec3 sss_near_gain(Surface s, int i) {
     return sss_light_near_gain(i, s.position, s.ng, u_sss_mfp * s.sss_radius_scale);
 }
+
+// Light i's single scattering at s relative to a far light's (a point or spot light is seen from
+// other directions and distances by the points below s, lib/sss_near_single.glsl); 1 for
+// directional and area lights. The radius map scales the mean free path, so divides the extinction.
+vec3 sss_near_single(Surface s, int i) {
+#ifdef MEASURE_FAR_SINGLE  // a measurement variant (tests/render/test_near_single_frame.py): the far light's term
+    return vec3(1.0);
+#endif
+    return sss_light_near_single(i, s.position, s.ng, s.v, u_sss_sigma_t / max(s.sss_radius_scale, 1e-6));
+}

@@ -93,10 +93,11 @@ void main() {
         vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
         color += e * vis * (diffuse + spec) * NoL;
 #endif
-        // single scattering where the light lands, and there too, for a hook of the separable boundary
-        // that does not spread it with its diffusion (SSS_MS_REST_LANDS: tsd, exact, preintegrated), the
-        // multiple scattering's non-separable rest (lib/sss_boundary.glsl sss_ms_rest)
-        if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v);
+        // single scattering where the light lands (a near light's seen from below, lib/surface_inputs.glsl
+        // sss_near_single), and there too, for a hook of the separable boundary that does not spread it
+        // with its diffusion (SSS_MS_REST_LANDS: tsd, exact, preintegrated), the multiple scattering's
+        // non-separable rest (lib/sss_boundary.glsl sss_ms_rest)
+        if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v) * sss_near_single(s, i);
 #ifdef SSS_MS_REST_LANDS
         if (u_sss_ms_rest_on > 0.0) color += e * (vis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
 #endif
