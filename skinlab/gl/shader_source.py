@@ -3,7 +3,9 @@
 A pass file such as ``skinlab/shaders/passes/forward.frag`` starts with ``#version`` and may say
 ``#include "lib/brdf.glsl"``. :class:`ShaderLibrary` expands includes (each file once, like
 ``#pragma once``), inserts ``#define`` lines for the variant, and emits ``#line LINE FILE``
-directives so that drivers that honour source-string numbers report the right file.
+directives so that drivers that honour source-string numbers report the right file. An
+``#extension`` line of any file moves up to just after ``#version`` (GLSL allows it only before
+the first code; ``lib/shadow.glsl``'s textureGather with a compare), each distinct one once.
 
 Mesa reports every error as source string 0, so the ``#line`` numbers alone cannot tell which
 file an error is in. Each expansion therefore also keeps a table from the *flat* text (the same
@@ -26,6 +28,7 @@ SHADER_ROOT = shader_root()
 
 _INCLUDE = re.compile(r'^\s*#\s*include\s+[<"]([^">]+)[">]\s*(//.*)?$')
 _VERSION = re.compile(r"^\s*#\s*version\b")
+_EXTENSION = re.compile(r"^\s*#\s*extension\b")
 _INCLUDE_WORD = re.compile(r"#\s*include\b")
 # Mesa: "0:12(5): error: ..."; NVIDIA: "0(12) : error C0000: ..."; AMD/Intel Windows: "ERROR: 0:12: ..."
 _ERROR_LOC = [
@@ -157,11 +160,23 @@ class ShaderLibrary:
         flat: list[str] = []
         line_map: list[tuple[int, int]] = []
         seen: set[str] = set()
+        hoisted: list[str] = []  # the #extension lines, in the order met
+        head = [0, 0]  # where they go in out and in flat: after the top file's #version
 
         def emit(code: str, file_idx: int, line: int) -> None:
             flat.append(code)
             line_map.append((file_idx, line))
             out.append(code)
+
+        def hoist(code: str, file_idx: int, line: int) -> None:
+            directive = " ".join(code.split())
+            if directive not in hoisted:
+                k = len(hoisted)
+                hoisted.append(directive)
+                out.insert(head[0] + k, code)
+                flat.insert(head[1] + k, code)
+                line_map.insert(head[1] + k, (file_idx, line))
+            emit("", file_idx, line)  # the line keeps its place (the line numbers after it stay)
 
         def visit(fname: str, including: Path | None, include_site: tuple[int, int] | None) -> None:
             if fname in aliases:
@@ -181,6 +196,7 @@ class ShaderLibrary:
                 if lines and _VERSION.match(lines[0]):
                     emit(lines[0], idx, 1)
                     first = 1
+                head[:] = [len(out), len(flat)]
                 for k, v in defines.items():
                     emit(f"#define {k} {'' if v is True else v}".rstrip(), idx, 0)
             out.append(f"#line {first + 1} {idx}")
@@ -207,6 +223,9 @@ class ShaderLibrary:
                         f"{shown}:{i + 1}: #version is only allowed on the first line of a pass file",
                         [(shown, i + 1)],
                     )
+                if _EXTENSION.match(code):
+                    hoist(code.strip(), idx, i + 1)
+                    continue
                 # moderngl scans the whole source for #include "..." again, comments too: defuse it there
                 emit(_INCLUDE_WORD.sub("# include", lines[i]), idx, i + 1)
 

@@ -47,6 +47,23 @@ def test_expand_inserts_line_directives_and_includes_once(root):
     assert twice.text.count("float util_value()") == 1
 
 
+def test_extension_directives_move_up_to_the_version(ctx, root):
+    """An #extension in an included file (GLSL allows it only before the first code) goes just after
+    #version, once however many files say it; the error locations after it stay right."""
+    ext = "#extension GL_ARB_gpu_shader5 : enable"
+    (root / "lib" / "util.glsl").write_text(f"// util\n{ext}  // gather\n" + UTIL.split("\n", 1)[1])
+    (root / "p.frag").write_text(FS.replace('#include "lib/util.glsl"', f'#include "lib/util.glsl"\n{ext}'))
+    src = ShaderLibrary(root=root).expand("p.frag", {"HAS_MAP": "1"})
+    lines = src.text.splitlines()
+    assert lines[:3] == ["#version 330 core", ext, "#define HAS_MAP 1"] and src.text.count("#extension") == 1
+    assert src.locate(2) == (f"{root.name}/lib/util.glsl", 2)
+    ProgramCache(ctx, ShaderLibrary(root=root)).get("p.vert", "p.frag")  # compiles (Mesa refuses it mid-shader)
+    (root / "lib" / "util.glsl").write_text(f"// util\n{ext}\n" + UTIL.split("\n", 1)[1].replace("1.0;", "bogus;"))
+    with pytest.raises(ShaderError) as info:
+        ProgramCache(ctx, ShaderLibrary(root=root)).get("p.vert", "p.frag")
+    assert f"{root.name}/lib/util.glsl:5:" in str(info.value), str(info.value)
+
+
 def test_missing_include_names_the_including_file(root):
     (root / "lib" / "util.glsl").write_text('#include "lib/nope.glsl"\n')
     with pytest.raises(ShaderError, match=r"lib/nope.glsl' not found \(included from .*lib/util.glsl\)"):

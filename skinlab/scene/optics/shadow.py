@@ -1,7 +1,12 @@
 """NumPy twins of skinlab/shaders/lib/shadow.glsl (and lib/shadow_soft.glsl, below) for a depth-compare
-sampler with NEAREST filtering, clamp-to-edge addressing and compare function '<=' (the result of each
-tap is exactly 0 or 1, so the twin is exact). The renderer samples with LINEAR compare filtering, whose bilinear weights
-are implementation precision (llvmpipe uses 8-bit weights); those are not part of the twin.
+sampler with clamp-to-edge addressing and compare function '<='. shadow_pcf is the renderer's 3x3 PCF
+of bilinear (LINEAR) compare taps, which lib/shadow.glsl computes with four textureGather calls (each
+2 x 2 compares, exactly 0 or 1) and its own weights in fp32: the twin to fp32 rounding, whatever the
+texture's filter mode (a gather ignores it). The other lookups' taps are twinned with NEAREST
+filtering (each tap exactly 0 or 1, so the twin is exact); the renderer samples them with LINEAR
+compare filtering, whose bilinear weights are implementation precision (llvmpipe's, for a depth
+texture, are float: its 9-tap PCF of before was within 1.1e-6 of the exact bilinear one); those are
+not part of the twin.
 
 The depth bias is sized to the map's texel at the receiver (constants.py SHADOW_BIAS_TEXELS,
 SHADOW_SLOPE_TEXELS, SHADOW_SLOPE_MAX): a texel and a bounded slope term, so that a lit surface
@@ -51,30 +56,51 @@ def shadow_bias(NoL, shadow_matrix, world, size) -> np.ndarray:
     return texel * depth * (SHADOW_BIAS_TEXELS + SHADOW_SLOPE_TEXELS * slope)
 
 
-def shadow_pcf(depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarray, NoL) -> np.ndarray:
-    """depth_map: (H, W) with row 0 at texture v = 0 (GL order). world: (N, 3)."""
+def shadow_pcf(
+    depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarray, NoL, nearest: bool = False
+) -> np.ndarray:
+    """The 3x3 PCF at each point. depth_map: (H, W) with row 0 at texture v = 0 (GL order). world: (N, 3).
+    The nine taps at offsets -1, 0, +1 texel, each bilinear: with t = uv x size - 1/2, b = floor(t) and
+    f = t - b, the 4 x 4 texels from b - 1 to b + 2 weighted 1 - f, 1, 1, f per axis, / 9 (GLSL
+    shadow_pcf's textureGather path). `nearest`: the nine taps with NEAREST filtering instead (GLSL's
+    fallback without textureGather, on a NEAREST texture)."""
     m, p = _light_space(shadow_matrix, world)
     c = p[:, :3] / p[:, 3:4]
     outside = (c < 0).any(1) | (c > 1).any(1)
     h, w = depth_map.shape
     ref = c[:, 2] - shadow_bias(NoL, m, world, (w, h))
     total = np.zeros(len(c))
-    for dy in (-1, 0, 1):
-        for dx in (-1, 0, 1):
-            u = c[:, 0] + dx / w
-            v = c[:, 1] + dy / h
-            i = np.clip(np.floor(u * w).astype(np.int64), 0, w - 1)
-            j = np.clip(np.floor(v * h).astype(np.int64), 0, h - 1)
-            total += (ref <= depth_map[j, i]).astype(np.float64)
+    if nearest:
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                u = c[:, 0] + dx / w
+                v = c[:, 1] + dy / h
+                i = np.clip(np.floor(u * w).astype(np.int64), 0, w - 1)
+                j = np.clip(np.floor(v * h).astype(np.int64), 0, h - 1)
+                total += (ref <= depth_map[j, i]).astype(np.float64)
+    else:  # the outer weights as lerps, as GLSL's: a wholly lit (shadowed) footprint reads exactly 1 (0)
+        tu, tv = c[:, 0] * w - 0.5, c[:, 1] * h - 0.5
+        bu, bv = np.floor(tu), np.floor(tv)
+        fu, fv = tu - bu, tv - bv
+        i = [np.clip(bu.astype(np.int64) + k - 1, 0, w - 1) for k in range(4)]
+        rows = []
+        for k in range(4):
+            j = np.clip(bv.astype(np.int64) + k - 1, 0, h - 1)
+            s0, s1, s2, s3 = ((ref <= depth_map[j, ik]).astype(np.float64) for ik in i)
+            rows.append((s1 + s2) + (s0 + fu * (s3 - s0)))
+        total = (rows[1] + rows[2]) + (rows[0] + fv * (rows[3] - rows[0]))
     return np.where(outside, 1.0, total / 9.0)
 
 
-def shadow_pcf_area(depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarray, NoL, du, dv) -> np.ndarray:
+def shadow_pcf_area(
+    depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarray, NoL, du, dv, nearest: bool = False
+) -> np.ndarray:
     """The visibility averaged over each receiver's footprint, the parallelogram spanned by the world
     vectors du and dv (N, 3) centred on world (N, 3) (a texture-space texel's; GLSL shadow_pcf_area):
-    shadow_pcf where the footprint spans at most SHADOW_AREA_MIN_TEXELS of the map's texels along both
-    sides, else ceil(e) taps along a side spanning e texels (at most SHADOW_AREA_TAPS), each a compare
-    at its own depth on the footprint's plane with shadow_pcf's bias at the centre."""
+    shadow_pcf (with `nearest`) where the footprint spans at most SHADOW_AREA_MIN_TEXELS of the map's
+    texels along both sides, else ceil(e) taps along a side spanning e texels (at most
+    SHADOW_AREA_TAPS), each a NEAREST compare at its own depth on the footprint's plane with
+    shadow_pcf's bias at the centre."""
     m, p = _light_space(shadow_matrix, world)
     world = np.atleast_2d(np.asarray(world, np.float64))
     c = p[:, :3] / p[:, 3:4]
@@ -100,7 +126,7 @@ def shadow_pcf_area(depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.
             total += np.where(on, lit, 0.0)
     area = total / (na * nb)
     small = np.maximum(ea, eb) <= SHADOW_AREA_MIN_TEXELS
-    return np.where(outside, 1.0, np.where(small, shadow_pcf(depth_map, m, world, NoL), area))
+    return np.where(outside, 1.0, np.where(small, shadow_pcf(depth_map, m, world, NoL, nearest), area))
 
 
 SOFT_SEARCH_TAPS = 8  # blocker search taps (lib/shadow_soft.glsl)

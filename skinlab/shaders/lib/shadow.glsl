@@ -1,11 +1,20 @@
-// Shadow-map lookups: 3x3 PCF on a depth-compare sampler (compare '<='), with a depth bias sized to
+// Shadow-map lookups: 3x3 PCF of bilinear taps on a depth-compare sampler (compare '<='; four
+// textureGather calls where GLSL 4.00 or ARB_gpu_shader5 has them, 16 texel compares instead of the
+// nine taps' 36; the same filter), with a depth bias sized to
 // the map's texel at the receiver (skinlab/scene/optics/constants.py SHADOW_BIAS_TEXELS, ...): a
 // constant in normalised depth was far too large at close range and grazing light (light through
 // the nose's shadow on the cheek) and too small on a scene many times larger.
 // shadow_pcf_area: the same lookup averaged over a receiver's footprint wider than the 3x3 PCF (a
 // texture-space texel's: techniques/tsd/irradiance.frag).
-// NumPy twin: skinlab/scene/optics/shadow.py (exact for NEAREST compare filtering).
+// NumPy twin: skinlab/scene/optics/shadow.py (the gathered 3x3 PCF to fp32 rounding, whatever the
+// texture's filter mode; the other taps exact for NEAREST compare filtering).
 #include "skinlab/constants.glsl"
+
+// (skinlab/gl/shader_source.py moves the #extension up to the #version: GLSL wants it before any code)
+#extension GL_ARB_gpu_shader5 : enable  // textureGather with a compare (core in GLSL 4.00)
+#if defined(GL_ARB_gpu_shader5) || __VERSION__ >= 400
+#define SHADOW_GATHER 1
+#endif
 
 // At p = shadow_matrix * (world, 1): x, the side of the map's texel there in world units (the larger
 // of its two sides); y, texture depth per world unit along the light. From the matrix's rows: exact
@@ -38,6 +47,28 @@ float shadow_pcf(sampler2DShadow map, mat4 shadow_matrix, vec3 world, float NoL)
     float bias = shadow_bias(shadow_matrix, p, size, NoL);
 #ifdef MEASURE_PCF_1TAP  // a measurement variant (tools/irradiance_cost.py): one compare, no filter
     return texture(map, vec3(c.xy, c.z - bias));
+#elif defined(SHADOW_GATHER)
+    // The nine bilinear taps at offsets -1, 0, +1 texel read the 4 x 4 texels from b - 1 to b + 2
+    // (b the texel below the point after the half-texel shift to texel centres, f its fraction),
+    // weighted per axis 1 - f, 1, 1, f (the taps' bilinear weights summed): four gathers of 2 x 2
+    // compares, each at the corner its four texels share (the map's own addressing at its edges).
+    // A gather's components: x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0), i0 the lower column.
+    // The outer weights as lerps (a + f (b - a)), so that a wholly lit or shadowed footprint reads
+    // exactly 1 or 0, as the hardware's bilinear taps do.
+    vec2 t = c.xy * size - 0.5;
+    vec2 b = floor(t);
+    vec2 f = t - b;
+    float z = c.z - bias;
+    vec4 s00 = textureGather(map, b / size, z);                     // columns b-1, b; rows b-1, b
+    vec4 s10 = textureGather(map, (b + vec2(2.0, 0.0)) / size, z);  // columns b+1, b+2
+    vec4 s01 = textureGather(map, (b + vec2(0.0, 2.0)) / size, z);  // rows b+1, b+2
+    vec4 s11 = textureGather(map, (b + 2.0) / size, z);
+    vec4 c0 = vec4(s00.w, s00.x, s01.w, s01.x);  // column b-1, rows b-1 .. b+2
+    vec4 c1 = vec4(s00.z, s00.y, s01.z, s01.y);
+    vec4 c2 = vec4(s10.w, s10.x, s11.w, s11.x);
+    vec4 c3 = vec4(s10.z, s10.y, s11.z, s11.y);
+    vec4 rows = (c1 + c2) + (c0 + f.x * (c3 - c0));  // each row's 1 - f, 1, 1, f
+    return ((rows.y + rows.z) + (rows.x + f.y * (rows.w - rows.x))) / 9.0;
 #else
     vec2 texel = 1.0 / size;
     float sum = 0.0;

@@ -24,14 +24,21 @@ _VIEW[2, 3] = -4.0  # the light at z = 4, looking down -z
 PERSPECTIVE = CLIP_TO_TEXTURE @ tf.perspective(math.radians(40), 1.0, 2.0, 6.0) @ _VIEW
 
 
-def nearest_depth_map(ctx, rng, h: int, w: int):
-    """A random depth map (0.2-0.9) and its depth-compare texture ('<=', NEAREST: the twins' filtering)."""
+def nearest_depth_map(ctx, rng, h: int, w: int, filter: int = moderngl.NEAREST):
+    """A random depth map (0.2-0.9) and its depth-compare texture ('<=', NEAREST by default: the twins'
+    filtering of single taps; the renderer's maps are LINEAR)."""
     depth = rng.uniform(0.2, 0.9, (h, w)).astype(np.float32)
     tex = ctx.depth_texture((w, h), data=depth.tobytes())
     tex.compare_func = "<="
-    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+    tex.filter = (filter, filter)
     tex.repeat_x = tex.repeat_y = False
     return depth, tex
+
+
+def has_gather(ctx) -> bool:
+    """Whether lib/shadow.glsl's shadow_pcf takes its textureGather path (GLSL 4.00 or ARB_gpu_shader5):
+    then it is the bilinear 3x3 PCF whatever the texture's filter mode (a gather ignores it)."""
+    return ctx.version_code >= 400 or "GL_ARB_gpu_shader5" in ctx.extensions
 
 
 def world_at(m: np.ndarray, uv: np.ndarray, z: np.ndarray, perspective: bool) -> np.ndarray:
@@ -41,15 +48,21 @@ def world_at(m: np.ndarray, uv: np.ndarray, z: np.ndarray, perspective: bool) ->
     return world[:, :3] / world[:, 3:]
 
 
+@pytest.mark.parametrize("filter", ["linear", "nearest"])
 @pytest.mark.parametrize("matrix", ["orthographic", "perspective"])
-def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
+def test_shadow_pcf_matches_numpy(ctx, glsl, matrix, filter):
+    """The 3x3 PCF against its twin: the bilinear one (four gathers, the weights in fp32) on the
+    renderer's LINEAR map, and on a NEAREST one too where the gather path runs (it ignores the filter;
+    the fallback's nine taps are then NEAREST taps); points anywhere on the map, its edge texels (clamped
+    to the edge) included."""
     rng = np.random.default_rng(7)
     h, w = 16, 24
-    depth, tex = nearest_depth_map(ctx, rng, h, w)
+    depth, tex = nearest_depth_map(ctx, rng, h, w, moderngl.LINEAR if filter == "linear" else moderngl.NEAREST)
     m = ORTHO if matrix == "orthographic" else PERSPECTIVE
     n = 2000
-    # texel centres jittered away from texel borders, so NEAREST picks the same texel on both sides
-    uv = (rng.integers(0, [w, h], (n, 2)) + rng.uniform(0.2, 0.8, (n, 2))) / [w, h]
+    uv = rng.uniform(0.0, 1.0, (n, 2))
+    if filter == "nearest" and not has_gather(ctx):  # NEAREST taps: away from texel borders
+        uv = (rng.integers(0, [w, h], (n, 2)) + rng.uniform(0.2, 0.8, (n, 2))) / [w, h]
     z = rng.uniform(0.0, 1.0, n)
     world = world_at(m, uv, z, matrix == "perspective")
     world[:50, 0] = 50.0  # outside the map: lit
@@ -62,7 +75,7 @@ def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
         uniforms={"u_m": ("mat4", m)},
         samplers={"u_map": ("sampler2DShadow", tex)},
     )[:, 0]
-    ref = shadow.shadow_pcf(depth, m, world, nol)
+    ref = shadow.shadow_pcf(depth, m, world, nol, nearest=filter == "nearest" and not has_gather(ctx))
     p = np.c_[world, np.ones(n)] @ m.T
     zt = p[:, 2] / p[:, 3]
     # a tap whose reference depth lies within fp32 rounding of the stored depth may flip
@@ -71,6 +84,8 @@ def test_shadow_pcf_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
     assert margin.mean() > 0.95
     assert_close_fp32(gpu[margin], ref[margin], what="shadow_pcf")
     assert (ref[:50] == 1).all() and 0 < ref[50:].mean() < 1
+    partial = (ref > 0) & (ref < 1)
+    assert partial.mean() > 0.1  # the weights are tested, not only whole footprints (14-26 %)
     # the bias term alone, GPU against NumPy (the texel scale from the matrix's rows)
     gpu_bias = glsl.evaluate(
         "lib/shadow.glsl",
@@ -159,9 +174,9 @@ def test_no_light_through_a_close_occluder_at_grazing_light(degrees):
 @pytest.mark.parametrize("matrix", ["orthographic", "perspective"])
 def test_shadow_pcf_area_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
     """The footprint's average (a texture-space texel's) against its twin: footprints from half a
-    texel (the 3x3 PCF) to 40 texels (more than SHADOW_AREA_TAPS taps a side), at any angle to the
-    map's axes, across the light (the depth constant over them, so that the compare margin of the
-    plain PCF's test holds for every tap)."""
+    texel (the 3x3 PCF, bilinear where it gathers) to 40 texels (more than SHADOW_AREA_TAPS taps a
+    side; NEAREST taps), at any angle to the map's axes, across the light (the depth constant over
+    them, so that the compare margin of the plain PCF's test holds for every tap)."""
     rng = np.random.default_rng(11)
     h, w = 32, 48
     depth, tex = nearest_depth_map(ctx, rng, h, w)
@@ -184,7 +199,7 @@ def test_shadow_pcf_area_matches_numpy_with_nearest_compare(ctx, glsl, matrix):
         uniforms={"u_m": ("mat4", m)},
         samplers={"u_map": ("sampler2DShadow", tex)},
     )[:, 0]
-    ref = shadow.shadow_pcf_area(depth, m, world, nol, du, dv)
+    ref = shadow.shadow_pcf_area(depth, m, world, nol, du, dv, nearest=not has_gather(ctx))
     p = np.c_[world, np.ones(n)] @ m.T
     zt = p[:, 2] / p[:, 3]
     bias = shadow.shadow_bias(nol, m, world, (w, h))
