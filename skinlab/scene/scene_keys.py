@@ -193,6 +193,16 @@ SCENE_FILE_KEYS: dict[str, tuple[Field, ...]] = {
             False,
             doc="make an xatlas UV atlas where the file has none (cached by mesh content in ~/.cache/skinlab)",
         ),
+        _key(
+            "subdivide",
+            "int",
+            0,
+            (0, 3),
+            type_text="integer in [0, 3]",
+            doc="Loop subdivision levels (each splits a triangle in four and smooths the surface), for the frame "
+            "and the path-traced truth alike: an index-matched truth has no shading normals, so a coarse mesh's "
+            "facets show in its light (skinlab/scene/mesh_subdivide.py)",
+        ),
     ),
     "[meshes.nodes.NAME]": (
         _key("material", "string", shown="the mesh's material", doc="name of a [materials.NAME] table"),

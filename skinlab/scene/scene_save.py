@@ -130,6 +130,8 @@ def scene_toml(scene: Scene) -> str:
         for flag in ("flip_v", "generate_uvs"):
             if info.get(flag):
                 entry[flag] = True
+        if info.get("subdivide"):
+            entry["subdivide"] = int(info["subdivide"])
         lines += _table("[[meshes]]", entry)
         for sub in top.walk():
             if sub is top:

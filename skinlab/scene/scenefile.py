@@ -422,6 +422,10 @@ def _read(where: str, table: dict, section: str, name: str) -> Any:
         return value
     if f.kind == "float":
         return _num(w, value, None if lo == -math.inf else lo, None if hi == math.inf else hi, f.lo_open)
+    if f.kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+            raise SceneFileError(f"{w}: expected an integer in [{lo:g}, {hi:g}], got {_show(value)}")
+        return int(value)
     if f.kind in _VECTOR_KEYS:
         return _vec(w, value, _VECTOR_KEYS[f.kind], lo=None if lo == -math.inf else lo)
     if f.kind == "table":
@@ -501,7 +505,8 @@ def _mesh_entry(where: str, entry: dict, scene: Scene, materials: SceneMaterials
     flip, atlas = _read(where, entry, sec, "flip_v"), _read(where, entry, sec, "generate_uvs")
     top = Node(_read(where, entry, sec, "name") if "name" in entry else mpath.stem, **_trs(where, entry))
     top.visible = _read(where, entry, sec, "visible")
-    top.file_info = {"file": mpath, "flip_v": flip, "generate_uvs": atlas}
+    levels = _read(where, entry, sec, "subdivide")
+    top.file_info = {"file": mpath, "flip_v": flip, "generate_uvs": atlas, "subdivide": levels}
     scene.add(top)
     node_cfg = _table(f"{where}.nodes", entry.get("nodes", {}))
     try:
@@ -519,6 +524,10 @@ def _mesh_entry(where: str, entry: dict, scene: Scene, materials: SceneMaterials
         loaded = [replace(ln, mesh=flip_v(ln.mesh)) for ln in loaded]
     if atlas:  # an xatlas atlas where none
         loaded = [replace(ln, mesh=ln.mesh and with_atlas(ln.mesh)) for ln in loaded]
+    if levels:  # the same smoothed surface for the frame and the truth
+        from .mesh_subdivide import loop_subdivide
+
+        loaded = [replace(ln, mesh=ln.mesh and loop_subdivide(ln.mesh, levels)) for ln in loaded]
     _file_nodes(where, entry, top, loaded, node_cfg, mpath, materials)
     _check_world_transforms(where, top)
     return top

@@ -93,6 +93,7 @@ def _tiny_copy(tmp_path, name: str, size: str) -> str:
     """The close-up's scene file with a tiny truth of its own (4 spp; its meshes' paths made absolute)."""
     text = (REFERENCE_SCENES / f"{name}.toml").read_text(encoding="utf-8")
     text = text.replace("../../meshes", str(MESHES)).replace("../../lee-perry-smith", str(HEADS))
+    text = text.replace("\nsubdivide = 2\n", "\n")  # the scan as it is: these measure the plumbing, not the facets
     head, measure = text.split("[measure]\n")
     keep = [ln for ln in measure.splitlines() if not ln.startswith(("truth_size", "truth_spp", "truth_rr_depth"))]
     p = tmp_path / f"{name}.toml"
