@@ -89,12 +89,11 @@ def single_scattering_factor(material, tables: BoundaryTables) -> np.ndarray:
     return tables.single * ratio
 
 
-def real_extinction(material) -> np.ndarray:
-    """u_sss_sigma_t: the medium's real extinction 1 / l per channel, per mm (the reduced medium's
-    mean free path turned into the real one by similarity, skinlab/scene/optics/similarity.py; 0 where
-    there is no scattering). The near light's single scattering needs it (lib/sss_near_single.glsl)."""
-    g = float(material.values.get("subsurface_scatter_anisotropy", 0.0))
-    medium = material_medium(material.values)
+def real_extinction(medium, g: float) -> np.ndarray:
+    """u_sss_sigma_t: the real extinction 1 / l per channel, per mm, of the reduced `medium`
+    (skinlab/scene/optics/material_medium.py) of anisotropy g (its mean free path turned into the real
+    one by similarity, skinlab/scene/optics/similarity.py; 0 where there is no scattering). The near
+    light's single scattering needs it (lib/sss_near_single.glsl)."""
     mfp = real_mfp(medium.mfp_arr, medium.alpha_arr, g)
     return np.where(mfp > 0, 1.0 / np.where(mfp > 0, mfp, 1.0), 0.0)
 
@@ -152,7 +151,7 @@ def bind_boundary(prog, material) -> None:
         prog,
         {
             "u_sss_mfp": medium.mfp_arr,
-            "u_sss_sigma_t": real_extinction(material),
+            "u_sss_sigma_t": real_extinction(medium, g),
             "u_sss_slab_decay": slab_decay(medium.alpha_arr),
             "u_sss_slab_out": out,
         },

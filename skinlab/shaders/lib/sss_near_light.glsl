@@ -23,14 +23,18 @@ vec3 sss_near_entry_gain(vec3 d_mm, vec3 ng, vec3 z0_mm) {
 // That factor for light i at world (z0_mm the mean free path x the radius map): 1 for directional
 // and area lights (a directional light's irradiance does not change along the surface: its entry
 // is a shift, which only the shadow lookup needs, lib/sss_oblique.glsl sss_entry_point).
+// Whether light i is at a finite distance from a point (a point or a spot light; not a directional
+// or an area light).
+bool sss_light_is_near(int i) { return u_light_vec[i].w != 0.0 && u_light_axis[i].w <= 1.5; }
+
 vec3 sss_light_near_gain(int i, vec3 world, vec3 ng, vec3 z0_mm) {
-    if (u_light_vec[i].w == 0.0 || u_light_axis[i].w > 1.5) return vec3(1.0);
+    if (!sss_light_is_near(i)) return vec3(1.0);
     return sss_near_entry_gain((u_light_vec[i].xyz - world) * u_mm_per_unit, ng, z0_mm);
 }
 
 // The single-scattering term's factor for light i at world (v to the eye, sigma_t the real extinction
 // per mm x the radius map; lib/sss_near_single.glsl): 1 for directional and area lights.
 vec3 sss_light_near_single(int i, vec3 world, vec3 ng, vec3 v, vec3 sigma_t) {
-    if (u_light_vec[i].w == 0.0 || u_light_axis[i].w > 1.5) return vec3(1.0);
+    if (!sss_light_is_near(i)) return vec3(1.0);
     return sss_near_single_gain((u_light_vec[i].xyz - world) * u_mm_per_unit, ng, v, sigma_t, u_sss_eta, u_sss_g);
 }
