@@ -42,6 +42,10 @@ SHADOW_SLOPE_MAX = 5.0
 # PCF), with a tap per texel along each side, at most SHADOW_AREA_TAPS (wider: taps further apart).
 SHADOW_AREA_MIN_TEXELS = 3.0
 SHADOW_AREA_TAPS = 16
+# A map fitted to what the camera sees (skinlab/render/shadow_fit.py) answers a lookup whose texels lie
+# SHADOW_FIT_REACH of its texels inside its edge (the 3x3 PCF's bilinear taps read 2 texels each way:
+# a half-texel shift, one tap and its bilinear neighbour); beyond, the full map does.
+SHADOW_FIT_REACH = 2.5
 
 GLSL_CONSTANTS: dict[str, float] = {
     "PI": PI,
@@ -56,6 +60,7 @@ GLSL_CONSTANTS: dict[str, float] = {
     "SHADOW_SLOPE_MAX": SHADOW_SLOPE_MAX,
     "SHADOW_AREA_MIN_TEXELS": SHADOW_AREA_MIN_TEXELS,
     "SHADOW_AREA_TAPS": float(SHADOW_AREA_TAPS),
+    "SHADOW_FIT_REACH": SHADOW_FIT_REACH,
     "MIN_LIGHT_DISTANCE_M": MIN_LIGHT_DISTANCE_M,
 }
 

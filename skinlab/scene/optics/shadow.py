@@ -21,6 +21,7 @@ from .constants import (
     SHADOW_AREA_MIN_TEXELS,
     SHADOW_AREA_TAPS,
     SHADOW_BIAS_TEXELS,
+    SHADOW_FIT_REACH,
     SHADOW_SLOPE_MAX,
     SHADOW_SLOPE_TEXELS,
 )
@@ -127,6 +128,44 @@ def shadow_pcf_area(
     area = total / (na * nb)
     small = np.maximum(ea, eb) <= SHADOW_AREA_MIN_TEXELS
     return np.where(outside, 1.0, np.where(small, shadow_pcf(depth_map, m, world, NoL, nearest), area))
+
+
+def in_window(fine_matrix, world, size, reach) -> np.ndarray:
+    """Whether each point's lookup in a map fitted to the view (skinlab/render/shadow_fit.py; GLSL
+    shadow_in_window) lies within it: its texel position at least `reach` (N,) or a scalar texels from
+    every edge of the map `size` (w, h) texels, in front of it (w > 0)."""
+    _, p = _light_space(fine_matrix, world)
+    w = p[:, 3]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = p[:, :2] / np.where(w > 0, w, 1.0)[:, None] * np.asarray(size, np.float64)
+    r = np.asarray(reach, np.float64).reshape(-1, 1)
+    return (w > 0) & (c >= r).all(1) & (c <= np.asarray(size, np.float64) - r).all(1)
+
+
+def shadow_pcf_fitted(fine_map, fine_matrix, depth_map, shadow_matrix, world, NoL, nearest: bool = False):
+    """The fitted map's 3x3 PCF where in_window (SHADOW_FIT_REACH), else the full map's (GLSL
+    shadow_pcf_fitted)."""
+    h, w = fine_map.shape
+    inside = in_window(fine_matrix, world, (w, h), SHADOW_FIT_REACH)
+    fine = shadow_pcf(fine_map, fine_matrix, world, NoL, nearest)
+    full = shadow_pcf(depth_map, shadow_matrix, world, NoL, nearest)
+    return np.where(inside, fine, full)
+
+
+def shadow_pcf_area_fitted(fine_map, fine_matrix, depth_map, shadow_matrix, world, NoL, du, dv, nearest=False):
+    """shadow_pcf_area on the fitted map where the footprint's lookup lies within it (SHADOW_FIT_REACH
+    and the footprint's half-extent in its texels), else on the full map (GLSL shadow_pcf_area_fitted)."""
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    h, w = fine_map.shape
+    _, p = _light_space(fine_matrix, world)
+    _, pa = _light_space(fine_matrix, world + np.atleast_2d(np.asarray(du, np.float64)))
+    _, pb = _light_space(fine_matrix, world + np.atleast_2d(np.asarray(dv, np.float64)))
+    c = p[:, :2] / p[:, 3:4]
+    half = 0.5 * (np.abs(pa[:, :2] / pa[:, 3:4] - c) + np.abs(pb[:, :2] / pb[:, 3:4] - c)) * [w, h]
+    inside = in_window(fine_matrix, world, (w, h), SHADOW_FIT_REACH + half.max(1))
+    fine = shadow_pcf_area(fine_map, fine_matrix, world, NoL, du, dv, nearest)
+    full = shadow_pcf_area(depth_map, shadow_matrix, world, NoL, du, dv, nearest)
+    return np.where(inside, fine, full)
 
 
 SOFT_SEARCH_TAPS = 8  # blocker search taps (lib/shadow_soft.glsl)

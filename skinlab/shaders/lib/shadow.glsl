@@ -117,3 +117,33 @@ float shadow_pcf_area(sampler2DShadow map, mat4 m, vec3 world, float NoL, vec3 d
     }
     return sum / float(na * nb);
 }
+
+// A map fitted to what the camera sees (skinlab/render/shadow_fit.py): the fine map m_f where the
+// lookup's texels lie within it, the full map m elsewhere. `reach`: how far from p the lookup reads,
+// in the fine map's texels (the 3x3 PCF's 1.5, and a footprint's half-extent); NumPy twin
+// skinlab/scene/optics/shadow.py in_window.
+bool shadow_in_window(mat4 m_f, vec3 world, vec2 size, float reach) {
+    vec4 p = m_f * vec4(world, 1.0);
+    if (p.w <= 0.0) return false;
+    vec2 c = p.xy / p.w * size;
+    return all(greaterThanEqual(c, vec2(reach))) && all(lessThanEqual(c, size - reach));
+}
+
+float shadow_pcf_fitted(sampler2DShadow fine, mat4 m_f, sampler2DShadow map, mat4 m, vec3 world, float NoL) {
+    if (shadow_in_window(m_f, world, vec2(textureSize(fine, 0)), SHADOW_FIT_REACH))
+        return shadow_pcf(fine, m_f, world, NoL);
+    return shadow_pcf(map, m, world, NoL);
+}
+
+float shadow_pcf_area_fitted(sampler2DShadow fine, mat4 m_f, sampler2DShadow map, mat4 m, vec3 world, float NoL,
+                             vec3 du, vec3 dv) {
+    vec2 size = vec2(textureSize(fine, 0));
+    vec4 p = m_f * vec4(world, 1.0);
+    vec4 pa = m_f * vec4(world + du, 1.0);
+    vec4 pb = m_f * vec4(world + dv, 1.0);
+    // the footprint's half-extent in the fine map's texels (the parallelogram's corners about p)
+    vec2 half_extent = 0.5 * (abs(pa.xy / pa.w - p.xy / p.w) + abs(pb.xy / pb.w - p.xy / p.w)) * size;
+    if (shadow_in_window(m_f, world, size, SHADOW_FIT_REACH + max(half_extent.x, half_extent.y)))
+        return shadow_pcf_area(fine, m_f, world, NoL, du, dv);
+    return shadow_pcf_area(map, m, world, NoL, du, dv);
+}

@@ -265,3 +265,74 @@ def test_a_lit_plane_stays_lit_under_a_wide_footprint(ctx, glsl, degrees):
         samplers={"u_map": ("sampler2DShadow", tex)},
     )[:, 0]
     assert np.all(gpu == 1.0)
+
+
+def _fitted_maps(ctx, rng):
+    """A full map and a fitted one over a window of it (the crop of skinlab/render/shadow_fit.py): their
+    depth arrays, textures and texture matrices (orthographic, world [-1, 1]^3 -> the full map)."""
+    from skinlab.render.shadow_fit import ShadowWindow
+
+    full, full_tex = nearest_depth_map(ctx, rng, 16, 24)
+    fine, fine_tex = nearest_depth_map(ctx, rng, 40, 28)  # w 28, h 40: not square
+    win = ShadowWindow(-0.3, -0.5, 0.25, 0.4, 28, 40, 2.0)
+    m_full = ORTHO
+    m_fine = CLIP_TO_TEXTURE @ win.crop() @ np.linalg.inv(CLIP_TO_TEXTURE) @ ORTHO
+    return full, full_tex, fine, fine_tex, m_full, m_fine
+
+
+def test_shadow_fitted_lookups_match_numpy(ctx, glsl):
+    """The fitted map's lookups (lib/shadow.glsl shadow_in_window, shadow_pcf_fitted,
+    shadow_pcf_area_fitted) against their twins: points inside the window read the fitted map, points
+    outside it or too near its edge for the lookup's reach read the full map."""
+    rng = np.random.default_rng(5)
+    full, full_tex, fine, fine_tex, m_full, m_fine = _fitted_maps(ctx, rng)
+    n = 1500
+    world = np.c_[rng.uniform(-0.6, 0.6, (n, 2)), rng.uniform(-1.0, 1.0, n)].astype(np.float32).astype(np.float64)
+    nol = rng.uniform(0.1, 1.0, n).astype(np.float32).astype(np.float64)
+    reach = 2.5
+    inside = shadow.in_window(m_fine, world, (28, 40), reach)
+    assert 0.2 < inside.mean() < 0.8
+    gpu_in = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_in_window(u_mf, world, vec2(28.0, 40.0), 2.5) ? 1.0 : 0.0",
+        {"world": world},
+        uniforms={"u_mf": ("mat4", m_fine)},
+    )[:, 0]
+    # a point within fp32 rounding of the reach may go either way
+    p = np.c_[world, np.ones(n)] @ m_fine.T
+    c = p[:, :2] / p[:, 3:] * [28, 40]
+    edge = np.minimum(np.abs(c - reach), np.abs(c - ([28, 40] - np.array(reach)))).min(1) < 1e-3
+    assert np.array_equal(gpu_in[~edge] > 0.5, inside[~edge])
+    samplers = {"u_fine": ("sampler2DShadow", fine_tex), "u_full": ("sampler2DShadow", full_tex)}
+    uniforms = {"u_mf": ("mat4", m_fine), "u_m": ("mat4", m_full)}
+    gpu = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_pcf_fitted(u_fine, u_mf, u_full, u_m, world, nol)",
+        {"world": world, "nol": nol},
+        uniforms=uniforms,
+        samplers=samplers,
+    )[:, 0]
+    ref = shadow.shadow_pcf_fitted(fine, m_fine, full, m_full, world, nol, nearest=not has_gather(ctx))
+    on_fine = shadow.shadow_pcf(fine, m_fine, world, nol, nearest=not has_gather(ctx))
+    on_full = shadow.shadow_pcf(full, m_full, world, nol, nearest=not has_gather(ctx))
+    assert np.array_equal(ref, np.where(inside, on_fine, on_full))
+    assert np.mean(on_fine[inside] != on_full[inside]) > 0.3  # the two maps do differ there
+    ok = ~edge
+    diff = np.abs(gpu[ok] - ref[ok])
+    assert np.mean(diff < 1e-4) > 0.97, diff.max()
+    # the footprint's average: wider footprints need to lie further inside
+    du = np.tile([0.04, 0.0, 0.0], (n, 1))
+    dv = np.tile([0.0, 0.05, 0.0], (n, 1))
+    gpu_a = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_pcf_area_fitted(u_fine, u_mf, u_full, u_m, world, nol, du, dv)",
+        {"world": world, "nol": nol, "du": du, "dv": dv},
+        uniforms=uniforms,
+        samplers=samplers,
+    )[:, 0]
+    ref_a = shadow.shadow_pcf_area_fitted(fine, m_fine, full, m_full, world, nol, du, dv, nearest=not has_gather(ctx))
+    diff_a = np.abs(gpu_a[ok] - ref_a[ok])
+    assert np.mean(diff_a < 1e-4) > 0.95, diff_a.max()
+    half = 0.5 * (np.abs((du @ m_fine[:3, :3].T)[:, :2]) + np.abs((dv @ m_fine[:3, :3].T)[:, :2])) * [28, 40]
+    inside_a = shadow.in_window(m_fine, world, (28, 40), reach + half.max(1))
+    assert inside_a.sum() < inside.sum() and (inside_a <= inside).all()
