@@ -45,7 +45,8 @@ def fitted_window(scene: Scene, settings: RenderSettings, light: LightNode, geom
     except ValueError:  # a point light inside the scene: the shadow pass says so
         return None
     size = settings.shadow_size
-    return shadow_window(scene, clip, settings.width / settings.height, size, min(FIT_MAX_TEXELS, 8 * size), geometry)
+    samples = settings.render_size
+    return shadow_window(scene, clip, samples, size, min(FIT_MAX_TEXELS, 8 * size), geometry)
 
 
 def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Device | None = None) -> FramePlan:

@@ -15,7 +15,10 @@ translucency's distance maps, which keep the full map).
 The window: camera rays on a FIT_RAYS x FIT_RAYS grid over the view (Embree through trimesh, the
 intersector kept per geometry), their first hits projected by the light's matrix, their bounds grown by
 FIT_PAD of the window each side and by FIT_GUARD_TEXELS of the fine map's texels (what lies between two
-rays, the PCF's reach), and snapped outward to a grid (FIT_SNAP) so that a camera moving a little
+rays, the PCF's reach); its texels square and no smaller than a FIT_SAMPLE_TEXELS-th of a screen
+sample's footprint there (the median over the grid: finer adds lookups, not detail, and a screen
+pass averages each lookup over its sample's footprint, lib/lights.glsl, so that a sharp shadow is
+box-filtered as the truth's pixels filter it, not aliased); and snapped outward to a grid (FIT_SNAP) so that a camera moving a little
 keeps the same window, and the texture-space irradiance that reads it is kept too (its own pass,
 `shadow_fit[LIGHT]`; the interreflection reads only the full map). Only depth is cropped: the window
 keeps the full map's near and far planes, so every occluder along the light's rays through it is in
@@ -35,6 +38,7 @@ from skinlab.cache import Memo
 FIT_RAYS = 17  # camera rays per side of the view that find what it sees
 FIT_PAD = 0.03  # the window grows by this fraction of its size each side (what lies between the rays)
 FIT_GUARD_TEXELS = 4.0  # and by this many fine-map texels (the 3x3 PCF's reach, with room)
+FIT_SAMPLE_TEXELS = 4.0  # the fine texel no smaller than this share of a screen sample's footprint
 FIT_SNAP = 8.0  # the window's corners snap to a grid this many times finer than its longer side
 FIT_MIN_GAIN = 2.0  # a fine map only where its texels are at least this much smaller (per side)
 FIT_MIN_TEXELS = 16  # the fine map's shortest side
@@ -103,29 +107,54 @@ def _intersector(nodes):
     return RayMeshIntersector(trimesh.Trimesh(np.concatenate(pos), np.concatenate(faces), process=False))
 
 
-def visible_points(scene, aspect: float, key, n: int = FIT_RAYS) -> np.ndarray:
-    """(M, 3) the first surfaces the camera's grid of rays meets (`key`: the scene's geometry, under
-    which the intersector is kept)."""
+def camera_hits(scene, aspect: float, key, n: int = FIT_RAYS) -> np.ndarray:
+    """(n, n, 3) the first surface each of the camera's grid of rays meets (NaN: none; `key`: the scene's
+    geometry, under which the intersector is kept)."""
+    out = np.full((n * n, 3), np.nan)
     nodes = list(scene.mesh_nodes())
-    if not nodes:
-        return np.zeros((0, 3))
-    ray = _INTERSECTORS.get(key, lambda: _intersector(nodes))
-    o, d = camera_rays(scene.camera, aspect, n)
-    _, _, loc = ray.intersects_id(np.broadcast_to(o, d.shape).copy(), d, multiple_hits=False, return_locations=True)
-    return np.asarray(loc, np.float64).reshape(-1, 3)
+    if nodes:
+        ray = _INTERSECTORS.get(key, lambda: _intersector(nodes))
+        o, d = camera_rays(scene.camera, aspect, n)
+        _, idx, loc = ray.intersects_id(
+            np.broadcast_to(o, d.shape).copy(), d, multiple_hits=False, return_locations=True
+        )
+        out[idx] = loc
+    return out.reshape(n, n, 3)
 
 
-def fit_window(light_clip: np.ndarray, points: np.ndarray, size: int, max_size: int) -> ShadowWindow | None:
-    """The fine map of `size` x `size` texels' worth (the full map's count, shaped as the window, each
-    side at most `max_size`) over the points as the light's clip matrix `light_clip` (full map: x, y in
-    [-1, 1]) projects them; None where it would gain less than FIT_MIN_GAIN or no point is in the map."""
-    if len(points) == 0:
+def _light_xy(light_clip: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(..., 2) the points' x, y in the light's clip coordinates after the division by w (NaN behind it)."""
+    q = np.concatenate([points, np.ones((*points.shape[:-1], 1))], -1) @ np.asarray(light_clip, np.float64).T
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(q[..., 3:4] > 0.0, q[..., :2] / q[..., 3:4], np.nan)
+
+
+def sample_footprint(light_clip: np.ndarray, hits: np.ndarray, samples: tuple[float, float]) -> float | None:
+    """The median side, in the light's clip units, of one screen sample's footprint where the camera's
+    grid of rays `hits` (n, n, 3) meets the scene: the light-space distance between neighbouring hits
+    over the samples between their rays, `samples` (along x, along y). None without two neighbours."""
+    xy = _light_xy(light_clip, hits)
+    steps = []
+    for axis, per in ((1, samples[0]), (0, samples[1])):
+        d = np.diff(xy, axis=axis)
+        steps.append(np.hypot(d[..., 0], d[..., 1]).ravel() / per)
+    f = np.concatenate(steps)
+    f = f[np.isfinite(f) & (f > 0.0)]
+    return float(np.median(f)) if len(f) else None
+
+
+def fit_window(
+    light_clip: np.ndarray, points: np.ndarray, size: int, max_size: int, footprint: float | None = None
+) -> ShadowWindow | None:
+    """The fine map over the points (M, 3) as the light's clip matrix `light_clip` (full map: x, y in
+    [-1, 1]) projects them: square texels, at most the full map's `size` x `size` of them shaped as the
+    window (each side at most `max_size`), and no smaller than a FIT_SAMPLE_TEXELS-th of a screen
+    sample's `footprint` (sample_footprint; finer would add lookups, not detail); None where it would
+    gain less than FIT_MIN_GAIN or no point is in the map."""
+    xy = _light_xy(light_clip, np.asarray(points, np.float64).reshape(-1, 3))
+    xy = xy[np.isfinite(xy).all(1)]
+    if len(xy) == 0:
         return None
-    q = np.c_[points, np.ones(len(points))] @ np.asarray(light_clip, np.float64).T
-    q = q[q[:, 3] > 0.0]
-    if len(q) == 0:
-        return None
-    xy = q[:, :2] / q[:, 3:4]
     x0, y0 = np.maximum(xy.min(0), -1.0)
     x1, y1 = np.minimum(xy.max(0), 1.0)
     w, h = max(x1 - x0, 1e-3), max(y1 - y0, 1e-3)  # a line or a point still gets an area
@@ -139,18 +168,32 @@ def fit_window(light_clip: np.ndarray, points: np.ndarray, size: int, max_size: 
     x1, y1 = (math.ceil(v / step) * step for v in (x1 + gx, y1 + gy))
     x0, y0, x1, y1 = max(x0, -1.0), max(y0, -1.0), min(x1, 1.0), min(y1, 1.0)
     w, h = x1 - x0, y1 - y0
-    nx = int(min(max(round(size * math.sqrt(w / h)), FIT_MIN_TEXELS), max_size))
-    ny = int(min(max(round(size * math.sqrt(h / w)), FIT_MIN_TEXELS), max_size))
+    # the texel: the full map's count over the window, or the sample's share if larger, rounded up to a
+    # power of sqrt 2 (a moving camera keeps it too)
+    texel = math.sqrt(w * h) / size
+    if footprint is not None and footprint > 0.0:
+        texel = max(texel, footprint / FIT_SAMPLE_TEXELS)
+    texel = 2.0 ** (math.ceil(2.0 * math.log2(texel)) / 2.0)
+    nx = int(min(max(math.ceil(w / texel), FIT_MIN_TEXELS), max_size))
+    ny = int(min(max(math.ceil(h / texel), FIT_MIN_TEXELS), max_size))
     gain = min(nx / w, ny / h) / (size / 2.0)
     if gain < FIT_MIN_GAIN:
         return None
     return ShadowWindow(float(x0), float(y0), float(x1), float(y1), nx, ny, float(gain))
 
 
-def shadow_window(scene, light_clip: np.ndarray, aspect: float, size: int, max_size: int, key) -> ShadowWindow | None:
-    """The fine map for one light (its full map's clip matrix `light_clip`) under the scene's camera,
-    or None: where the camera sees the whole scene, or the fit gains too little."""
+def shadow_window(
+    scene, light_clip: np.ndarray, samples: tuple[int, int], size: int, max_size: int, key
+) -> ShadowWindow | None:
+    """The fine map for one light (its full map's clip matrix `light_clip`) under the scene's camera
+    rendering `samples` (width, height: the screen passes' samples), or None: where the camera sees the
+    whole scene, or the fit gains too little."""
     lo, hi = scene.world_bounds()
+    aspect = samples[0] / samples[1]
     if sees_everything(scene.camera, aspect, lo, hi):
         return None
-    return fit_window(light_clip, visible_points(scene, aspect, key), size, max_size)
+    hits = camera_hits(scene, aspect, key)
+    n = hits.shape[0]
+    per = (samples[0] / (n - 1), samples[1] / (n - 1))  # samples between neighbouring rays
+    footprint = sample_footprint(light_clip, hits, per)
+    return fit_window(light_clip, hits.reshape(-1, 3), size, max_size, footprint)
