@@ -20,8 +20,8 @@ sample's footprint there (the median over the grid: finer adds lookups, not deta
 pass averages each lookup over its sample's footprint, lib/lights.glsl, so that a sharp shadow is
 box-filtered as the truth's pixels filter it, not aliased); and snapped outward to a grid (FIT_SNAP)
 so that a camera moving a little keeps the same window, and the texture-space irradiance that reads
-it is kept too (its own pass, `shadow_fit[LIGHT]`; the interreflection reads only the full map). Only depth is cropped: the window
-keeps the full map's near and far planes, so every occluder along the light's rays through it is in
+it is kept too (its own pass, `shadow_fit[LIGHT]`; the interreflection reads only the full map).
+Only depth is cropped: the window keeps the full map's near and far planes, so every occluder along the light's rays through it is in
 the fine map. Where the camera sees the whole scene (every corner of its bounding box projects into
 the view) or the fit gains less than FIT_MIN_GAIN, there is no fine map and the frame is as it was.
 """
