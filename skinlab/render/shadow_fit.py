@@ -16,14 +16,15 @@ The window: camera rays on a FIT_RAYS x FIT_RAYS grid over the view (Embree thro
 intersector kept per geometry), their first hits projected by the light's matrix, their bounds grown by
 FIT_PAD of the window each side and by FIT_GUARD_TEXELS of the fine map's texels (what lies between two
 rays, the PCF's reach); its texels square and no smaller than a FIT_SAMPLE_TEXELS-th of a screen
-sample's footprint there (the median over the grid: finer adds lookups, not detail, and a screen
-pass averages each lookup over its sample's footprint, lib/lights.glsl, so that a sharp shadow is
-box-filtered as the truth's pixels filter it, not aliased); and snapped outward to a grid (FIT_SNAP)
-so that a camera moving a little keeps the same window, and the texture-space irradiance that reads
-it is kept too (its own pass, `shadow_fit[LIGHT]`; the interreflection reads only the full map).
-Only depth is cropped: the window keeps the full map's near and far planes, so every occluder along the light's rays through it is in
-the fine map. Where the camera sees the whole scene (every corner of its bounding box projects into
-the view) or the fit gains less than FIT_MIN_GAIN, there is no fine map and the frame is as it was.
+sample's footprint there (the median over the grid: finer adds lookups, not detail, and a screen pass
+averages each lookup over its sample's footprint, lib/lights.glsl, so that a sharp shadow is box-
+filtered as the truth's pixels filter it, not aliased); and snapped outward to a grid (FIT_SNAP) so that
+a camera moving a little keeps the same window, and the texture-space irradiance that reads it is kept
+too (its own pass, `shadow_fit[LIGHT]`; the interreflection reads only the full map). Only depth is
+cropped: the window keeps the full map's near and far planes, so every occluder along the light's rays
+through it is in the fine map. Where the camera sees the whole scene (every corner of its bounding box
+projects into the view) or the fit gains less than FIT_MIN_GAIN, there is no fine map and the frame is
+as it was.
 """
 
 from __future__ import annotations
