@@ -39,7 +39,10 @@ from skinlab.cache import Memo
 FIT_RAYS = 17  # camera rays per side of the view that find what it sees
 FIT_PAD = 0.03  # the window grows by this fraction of its size each side (what lies between the rays)
 FIT_GUARD_TEXELS = 4.0  # and by this many fine-map texels (the 3x3 PCF's reach, with room)
-FIT_SAMPLE_TEXELS = 4.0  # the fine texel no smaller than this share of a screen sample's footprint
+FIT_SAMPLE_TEXELS = 8.0  # the fine texel no smaller than this share of a screen sample's footprint
+# (its bounding box's longer side in the map, the median over the view): finer than the samples, for
+# where an occluder's edge falls (a 2 mm slit within 1 % wants texels of 0.02 mm), not so fine that
+# the screen passes' box (lib/shadow.glsl shadow_box: nine gathers) samples too few of its texels
 FIT_SNAP = 8.0  # the window's corners snap to a grid this many times finer than its longer side
 FIT_MIN_GAIN = 2.0  # a fine map only where its texels are at least this much smaller (per side)
 FIT_MIN_TEXELS = 16  # the fine map's shortest side
@@ -131,17 +134,16 @@ def _light_xy(light_clip: np.ndarray, points: np.ndarray) -> np.ndarray:
 
 
 def sample_footprint(light_clip: np.ndarray, hits: np.ndarray, samples: tuple[float, float]) -> float | None:
-    """The median side, in the light's clip units, of one screen sample's footprint where the camera's
-    grid of rays `hits` (n, n, 3) meets the scene: the light-space distance between neighbouring hits
-    over the samples between their rays, `samples` (along x, along y). None without two neighbours."""
+    """The median of the longer side of one screen sample's footprint, as the light's map sees it (the
+    bounding box, in its clip units, of the parallelogram spanned by one sample along x and along y),
+    over the cells of the camera's grid of rays `hits` (n, n, 3) whose corners all meet the scene;
+    `samples`: the samples between neighbouring rays (along x, along y). None without such a cell."""
     xy = _light_xy(light_clip, hits)
-    steps = []
-    for axis, per in ((1, samples[0]), (0, samples[1])):
-        d = np.diff(xy, axis=axis)
-        steps.append(np.hypot(d[..., 0], d[..., 1]).ravel() / per)
-    f = np.concatenate(steps)
-    f = f[np.isfinite(f) & (f > 0.0)]
-    return float(np.median(f)) if len(f) else None
+    a = (xy[:-1, 1:] - xy[:-1, :-1]) / samples[0]  # one sample along the view's x
+    b = (xy[1:, :-1] - xy[:-1, :-1]) / samples[1]  # and along its y
+    side = (np.abs(a) + np.abs(b)).max(-1).ravel()
+    side = side[np.isfinite(side) & (side > 0.0)]
+    return float(np.median(side)) if len(side) else None
 
 
 def fit_window(

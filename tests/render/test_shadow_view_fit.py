@@ -12,7 +12,7 @@ import pytest
 from skinlab.bench.truth_ledger import REFERENCE_SCENES
 from skinlab.render.passes.shadow import CLIP_TO_TEXTURE, light_view_proj
 from skinlab.render.settings import RenderSettings
-from skinlab.render.shadow_fit import FIT_MIN_GAIN, ShadowWindow, fit_window, sees_everything
+from skinlab.render.shadow_fit import FIT_MIN_GAIN, FIT_SAMPLE_TEXELS, ShadowWindow, fit_window, sees_everything
 from skinlab.scene import transform as tf
 from skinlab.scene.scenefile import load_scene
 
@@ -49,11 +49,11 @@ def test_fit_window_holds_the_points_at_the_full_maps_texel_count():
     assert abs(tx / ty - 1) < 0.05  # square texels
     assert win.gain == pytest.approx(min(win.nx / (win.x1 - win.x0), win.ny / (win.y1 - win.y0)) / 512)
     assert win.gain > 10
-    # a screen sample wider than 4 of those texels: the texel grows to a quarter of it
-    coarse = fit_window(np.eye(4), pts, 1024, 16384, footprint=0.002)
+    # a screen sample wider than FIT_SAMPLE_TEXELS of those texels: the texel grows to that share of it
+    coarse = fit_window(np.eye(4), pts, 1024, 16384, footprint=0.0005 * FIT_SAMPLE_TEXELS)
     assert coarse is not None and 0.0005 <= (coarse.x1 - coarse.x0) / coarse.nx < 0.0005 * 1.42
     assert coarse.nx < win.nx and coarse.gain < win.gain
-    assert fit_window(np.eye(4), pts, 1024, 16384, footprint=0.05) is None  # gains too little
+    assert fit_window(np.eye(4), pts, 1024, 16384, footprint=0.01 * FIT_SAMPLE_TEXELS) is None  # too little gain
     wide = np.c_[rng.uniform(-0.9, 0.9, 500), rng.uniform(-0.9, 0.9, 500), np.zeros(500)]
     assert fit_window(np.eye(4), wide, 1024, 16384) is None
     assert fit_window(np.eye(4), np.zeros((0, 3)), 1024, 16384) is None

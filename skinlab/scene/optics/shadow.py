@@ -21,6 +21,8 @@ from .constants import (
     SHADOW_AREA_MIN_TEXELS,
     SHADOW_AREA_TAPS,
     SHADOW_BIAS_TEXELS,
+    SHADOW_BOX_CELLS,
+    SHADOW_BOX_TEXELS,
     SHADOW_FIT_REACH,
     SHADOW_SLOPE_MAX,
     SHADOW_SLOPE_TEXELS,
@@ -166,6 +168,68 @@ def shadow_pcf_area_fitted(fine_map, fine_matrix, depth_map, shadow_matrix, worl
     fine = shadow_pcf_area(fine_map, fine_matrix, world, NoL, du, dv, nearest)
     full = shadow_pcf_area(depth_map, shadow_matrix, world, NoL, du, dv, nearest)
     return np.where(inside, fine, full)
+
+
+def shadow_box(depth_map, shadow_matrix, world, NoL, w) -> np.ndarray:
+    """The compares averaged over a box `w` (N, 2) texels wide centred where each point falls (clamp to
+    edge; GLSL shadow_box, whose gathers are NEAREST compares: the twin to fp32 rounding): up to
+    SHADOW_BOX_TEXELS wide, each texel weighted by its share of the box; wider, the mean over the box's
+    SHADOW_BOX_CELLS^2 cells of the 2 x 2 texels around the texel corner nearest each cell's centre."""
+    m, p = _light_space(shadow_matrix, world)
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    c = p[:, :3] / p[:, 3:4]
+    outside = (c < 0).any(1) | (c > 1).any(1)
+    h, wd = depth_map.shape
+    z = c[:, 2] - shadow_bias(NoL, m, world, (wd, h))
+    w = np.atleast_2d(np.asarray(w, np.float64))
+    lo = c[:, :2] * [wd, h] - 0.5 * w
+    hi = lo + w
+
+    def lit(jx, jy):
+        cols = np.clip(jx.astype(np.int64), 0, wd - 1)
+        rows = np.clip(jy.astype(np.int64), 0, h - 1)
+        return (z <= depth_map[rows, cols]).astype(np.float64)
+
+    exact = np.zeros(len(c))
+    j0 = np.floor(lo)
+    for ky in range(6):
+        jy = j0[:, 1] + ky
+        oy = np.maximum(0.0, np.minimum(hi[:, 1], jy + 1) - np.maximum(lo[:, 1], jy))
+        for kx in range(6):
+            jx = j0[:, 0] + kx
+            ox = np.maximum(0.0, np.minimum(hi[:, 0], jx + 1) - np.maximum(lo[:, 0], jx))
+            exact += ox * oy * lit(jx, jy)
+    exact /= w[:, 0] * w[:, 1]
+    sampled = np.zeros(len(c))
+    n = SHADOW_BOX_CELLS
+    for gy in range(n):
+        for gx in range(n):
+            k = np.floor(lo + (np.array([gx, gy]) + 0.5) * w / n + 0.5)
+            for dx in (-1, 0):
+                for dy in (-1, 0):
+                    sampled += 0.25 * lit(k[:, 0] + dx, k[:, 1] + dy)
+    sampled /= n * n
+    return np.where(outside, 1.0, np.where(w.max(1) > SHADOW_BOX_TEXELS, sampled, exact))
+
+
+def _footprint_texels(m, world, du, dv, size) -> np.ndarray:
+    _, p = _light_space(m, world)
+    _, pa = _light_space(m, world + np.atleast_2d(np.asarray(du, np.float64)))
+    _, pb = _light_space(m, world + np.atleast_2d(np.asarray(dv, np.float64)))
+    c = p[:, :2] / p[:, 3:4]
+    return (np.abs(pa[:, :2] / pa[:, 3:4] - c) + np.abs(pb[:, :2] / pb[:, 3:4] - c)) * np.asarray(size, np.float64)
+
+
+def shadow_box_fitted(fine_map, fine_matrix, depth_map, shadow_matrix, world, NoL, du, dv) -> np.ndarray:
+    """A screen sample's shadow (GLSL shadow_box_fitted, its gather path): shadow_box over the bounding box
+    of the footprint du, dv (N, 3) in the fitted map's texels (at least 1) where the lookup lies within
+    it; the full map's 3x3 PCF outside."""
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    h, wd = fine_map.shape
+    w = np.maximum(_footprint_texels(fine_matrix, world, du, dv, (wd, h)), 1.0)
+    inside = in_window(fine_matrix, world, (wd, h), SHADOW_FIT_REACH + 0.5 * w.max(1))
+    box = shadow_box(fine_map, fine_matrix, world, NoL, w)
+    return np.where(inside, box, shadow_pcf(depth_map, shadow_matrix, world, NoL))
 
 
 SOFT_SEARCH_TAPS = 8  # blocker search taps (lib/shadow_soft.glsl)

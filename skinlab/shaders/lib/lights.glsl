@@ -48,7 +48,7 @@ vec3 g_shadow_dv = vec3(0.0);
 
 float shadow_fitted(sampler2DShadow fine, mat4 mf, sampler2DShadow map, mat4 m, vec3 world, float NoL) {
     if (g_shadow_du == vec3(0.0) && g_shadow_dv == vec3(0.0)) return shadow_pcf_fitted(fine, mf, map, m, world, NoL);
-    return shadow_pcf_area_fitted(fine, mf, map, m, world, NoL, g_shadow_du, g_shadow_dv);
+    return shadow_box_fitted(fine, mf, map, m, world, NoL, g_shadow_du, g_shadow_dv);
 }
 #endif
 uniform float u_mm_per_unit;

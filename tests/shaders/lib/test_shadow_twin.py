@@ -336,3 +336,52 @@ def test_shadow_fitted_lookups_match_numpy(ctx, glsl):
     half = 0.5 * (np.abs((du @ m_fine[:3, :3].T)[:, :2]) + np.abs((dv @ m_fine[:3, :3].T)[:, :2])) * [28, 40]
     inside_a = shadow.in_window(m_fine, world, (28, 40), reach + half.max(1))
     assert inside_a.sum() < inside.sum() and (inside_a <= inside).all()
+
+
+def test_shadow_box_matches_numpy_and_is_the_lit_share(ctx, glsl):
+    """A screen sample's lookup in a fitted map (lib/shadow.glsl shadow_box, shadow_box_fitted) against
+    its twins, boxes from under a texel (read as one: bilinear) to past SHADOW_BOX_TEXELS (the area
+    taps); and on a map lit left of a column edge, the box reads the share of it left of the edge."""
+    if not has_gather(ctx):
+        pytest.skip("shadow_box needs textureGather (GLSL 4.00 or ARB_gpu_shader5)")
+    rng = np.random.default_rng(9)
+    full, full_tex, fine, fine_tex, m_full, m_fine = _fitted_maps(ctx, rng)
+    n = 1500
+    world = np.c_[rng.uniform(-0.3, 0.25, n), rng.uniform(-0.5, 0.4, n), rng.uniform(-1, 1, n)]
+    scale = 10 ** rng.uniform(-1.5, -0.3, (n, 2))  # world units: 0.1 to 8 fitted texels
+    du = np.c_[scale[:, 0], np.zeros(n), np.zeros(n)]
+    dv = np.c_[np.zeros(n), scale[:, 1], np.zeros(n)]
+    nol = rng.uniform(0.2, 1.0, n)
+    world, du, dv, nol = (a.astype(np.float32).astype(np.float64) for a in (world, du, dv, nol))
+    gpu = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_box_fitted(u_fine, u_mf, u_full, u_m, world, nol, du, dv)",
+        {"world": world, "nol": nol, "du": du, "dv": dv},
+        uniforms={"u_mf": ("mat4", m_fine), "u_m": ("mat4", m_full)},
+        samplers={"u_fine": ("sampler2DShadow", fine_tex), "u_full": ("sampler2DShadow", full_tex)},
+    )[:, 0]
+    ref = shadow.shadow_box_fitted(fine, m_fine, full, m_full, world, nol, du, dv)
+    diff = np.abs(gpu - ref)
+    assert np.mean(diff < 1e-4) > 0.95 and np.median(diff) < 1e-5, diff.max()
+    # a step: texels left of column 10 lit (depth 1), the rest in shadow (depth 0); a receiver at z 0.5
+    h, w = 12, 24
+    step = np.where(np.arange(w)[None, :] < 10, 1.0, 0.0).repeat(h, 0).astype(np.float32)
+    tex = ctx.depth_texture((w, h), data=step.tobytes())
+    tex.compare_func = "<="
+    tex.repeat_x = tex.repeat_y = False
+    k = 200
+    x = rng.uniform(7.0, 13.0, k)  # texel units across the edge at 10
+    bw = rng.uniform(1.0, 5.0, k)
+    uv = np.c_[x / w, np.full(k, 6.0 / h)]
+    pts = world_at(ORTHO, uv, np.full(k, 0.5), False)
+    wbox = np.c_[bw, np.full(k, 2.0)]
+    lit = np.clip((10.0 - (x - bw / 2)) / bw, 0.0, 1.0)
+    got = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_box(u_map, u_m, world, 1.0, wbox)",
+        {"world": pts.astype(np.float32).astype(np.float64), "wbox": wbox},
+        uniforms={"u_m": ("mat4", ORTHO)},
+        samplers={"u_map": ("sampler2DShadow", tex)},
+    )[:, 0]
+    assert np.allclose(got, lit, atol=2e-4), np.abs(got - lit).max()
+    assert np.allclose(shadow.shadow_box(step, ORTHO, pts, np.ones(k), wbox), lit, atol=1e-9)
