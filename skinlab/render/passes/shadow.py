@@ -245,12 +245,12 @@ class ShadowPass(RenderPass):
         # toward an occluder's silhouette in the light's view; the lookup's bias is sized to the
         # texel instead (skinlab/shaders/lib/shadow.glsl)
         with gl_state(ctx, moderngl.DEPTH_TEST):
-            self._draw(frame, {"SHADOW_DISTANCE": 1} if distance else {}, {"u_light_eye": light_eye(light)}, vp)
+            self.draw_casters(frame, {"SHADOW_DISTANCE": 1} if distance else {}, {"u_light_eye": light_eye(light)}, vp)
             if prm.layers:
                 self._draw_layers(frame, slot, light, vp)
         self.publish(frame, p)
 
-    def _draw(
+    def draw_casters(
         self, frame, defines: dict, uniforms: dict, vp, textures: dict | None = None, facing: str | None = None
     ) -> None:
         """Every mesh that casts a shadow, each with its program (a masked material's cut-away pixels
@@ -305,10 +305,10 @@ class ShadowPass(RenderPass):
         eye = light_eye(light)
         exit_fbo.clear(1e30, 0.0, 0.0, 0.0, depth=1.0)
         exit_fbo.use()
-        self._draw(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp, facing=AWAY)
+        self.draw_casters(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp, facing=AWAY)
         entry_fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
         entry_fbo.use()
-        self._draw(
+        self.draw_casters(
             frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 2}, {"u_light_eye": eye, "u_part_gap": part_gap(frame)},
             vp, {"u_exit": exit_tex}, facing=TOWARD,
         )  # fmt: skip
@@ -367,7 +367,9 @@ class FittedShadowPass(RenderPass):
             t.fbo.clear(depth=1.0)
             t.fbo.use()
             with gl_state(self.r.ctx, moderngl.DEPTH_TEST):
-                self.r.passes["shadow"]._draw(frame, {}, {"u_light_eye": light_eye(prm.light)}, vp)  # type: ignore[attr-defined]
+                full = self.r.passes["shadow"]
+                assert isinstance(full, ShadowPass)
+                full.draw_casters(frame, {}, {"u_light_eye": light_eye(prm.light)}, vp)  # the full map's casters
         self.publish(frame, p)
 
 
