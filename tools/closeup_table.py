@@ -117,6 +117,7 @@ def parser() -> argparse.ArgumentParser:
     ap.add_argument("--sss-model", default=None, help="override every material's sss_model")
     ap.add_argument("--no-translucency", action="store_true", help="every technique's translucency off")
     ap.add_argument("--size", type=_size, default=None, help="WxH of the truths instead of CLOSEUPS'")
+    ap.add_argument("--shadow-size", type=int, default=None, help="shadow map texels per side instead of 2048")
     ap.add_argument("--spp", type=int, default=None, help="samples per pixel of the truths instead of CLOSEUPS'")
     return ap
 
@@ -134,7 +135,9 @@ def main(argv: list[str] | None = None) -> int:
     if unknown:
         raise SystemExit(f"closeup_table: no close-up {', '.join(unknown)}; expected some of {', '.join(CLOSEUPS)}")
     techs = args.techniques.split(",") if args.techniques else TECHNIQUES
-    extra = {} if args.bounces is None else {"bounces": args.bounces}
+    extra: dict[str, Any] = {} if args.bounces is None else {"bounces": args.bounces}
+    if args.shadow_size:
+        extra["shadow_size"] = args.shadow_size
     model = args.sss_model
     r = Renderer(create_headless_context())
     saved: dict[str, Any] = {}  # name -> array (np.savez's keyword arguments)

@@ -279,7 +279,11 @@ class BouncePass(RenderPass):
         nmax = frame.settings.max_lights
         for node in prm.nodes:
             mat = node.material
-            defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **environment_defines(frame, node)}
+            defines = {
+                **mat.defines(),
+                **light_defines(prm.shadow_lights, nmax),
+                **environment_defines(frame, node),
+            }
             prog = self.r.programs.get("passes/fullscreen.vert", "passes/bounce_exitance.frag", defines)
             units = TextureUnits(ctx)
             bind_shadow_maps(self.r, frame, prog, units)

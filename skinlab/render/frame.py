@@ -21,6 +21,7 @@ class Frame:
     camera_pos: np.ndarray
     targets: dict[str, moderngl.Texture] = field(default_factory=dict)
     shadow_matrices: dict[int, np.ndarray] = field(default_factory=dict)
+    shadow_fine_matrices: dict[int, np.ndarray] = field(default_factory=dict)  # slot -> its fitted map's
     shadow_eyes: dict[int, np.ndarray] = field(default_factory=dict)  # slot -> light pos (w=1) / dir (w=0)
     data: dict[str, dict] = field(default_factory=dict)  # a technique's per-frame data, by its state key
 

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from skinlab.scene.graph import LightNode
 
+    from .shadow_fit import ShadowWindow
     from .vertex_streams import VertexStream
 
 
@@ -37,12 +38,18 @@ def shadow_pass_name(light: LightNode) -> str:
     return f"shadow[{light.name}]"
 
 
+def shadow_fit_pass_name(light: LightNode) -> str:
+    """The name of the pass that renders `light`'s map fitted to the view (skinlab/render/shadow_fit.py)."""
+    return f"shadow_fit[{light.name}]"
+
+
 @dataclass
 class ShadowParams:
     light: LightNode
     slot: int  # shadow map slot 0 or 1
     distance: bool  # also a light-space distance map of the first surface (translucency, soft shadows)
     layers: bool = False  # and the part layers, the first part's exit and the next entry (translucency)
+    fine: ShadowWindow | None = None  # a second map fitted to what the camera sees (shadow_fit.py)
 
 
 @dataclass

@@ -17,6 +17,9 @@ def bind_shadow_maps(renderer, frame, prog, units) -> None:
     for slot in range(SHADOW_SLOTS):
         tex = frame.targets.get(f"shadow_map{slot}")
         units.bind(prog, f"u_shadow{slot}", tex if tex is not None else renderer.dummy_shadow_map())
+        fine = frame.targets.get(f"shadow_fine{slot}")
+        if fine is not None and f"u_shadow_fine{slot}" in prog:  # a map fitted to the view (SHADOW_FINE<slot>)
+            units.bind(prog, f"u_shadow_fine{slot}", fine)
     if soft and ("u_shadow_distance0" in prog or "u_shadow_distance1" in prog):
         for slot in range(SHADOW_SLOTS):
             dist = frame.targets.get(f"shadow_distance{slot}") if slot in soft else None
@@ -31,12 +34,16 @@ def soft_shadow(light) -> bool:
     return getattr(light, "size", 0.0) > 0.0
 
 
-def light_defines(shadow_lights, nmax: int) -> dict:
+def light_defines(shadow_lights, nmax: int, frame=None) -> dict:
     """The variant defines of a program that lights surfaces (skinlab/shaders/lib/lights.glsl): MAX_LIGHTS,
     and SHADOW_SLOTS, the shadow-map slots this frame fills (the others' lookups are compiled out);
-    SHADOW_SOFT<slot> for a slot whose light has a size (soft shadows, lib/shadow_soft.glsl)."""
+    SHADOW_SOFT<slot> for a slot whose light has a size (soft shadows, lib/shadow_soft.glsl);
+    SHADOW_FINE<slot> for a slot the frame gave a map fitted to the view (skinlab/render/shadow_fit.py)."""
     soft = {f"SHADOW_SOFT{k}": 1 for k, l in enumerate(shadow_lights[:SHADOW_SLOTS]) if soft_shadow(l)}
-    return {"MAX_LIGHTS": nmax, "SHADOW_SLOTS": min(len(shadow_lights), SHADOW_SLOTS), **soft}
+    fine = {}
+    if frame is not None:
+        fine = {f"SHADOW_FINE{k}": 1 for k in range(SHADOW_SLOTS) if f"shadow_fine{k}" in frame.targets}
+    return {"MAX_LIGHTS": nmax, "SHADOW_SLOTS": min(len(shadow_lights), SHADOW_SLOTS), **soft, **fine}
 
 
 def area_defines(lights) -> dict:
@@ -87,6 +94,10 @@ def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
         ids = np.full(nmax, -1, np.int32)
         ids[: len(lights)] = [slots.get(id(l), -1) for l in lights]
         prog["u_light_shadow"].write(ids[: max(prog["u_light_shadow"].array_length, 1)].tobytes())
-    if "u_shadow_matrix" in prog:
-        mats = np.stack([frame.shadow_matrices.get(s, np.eye(4)).T for s in (0, 1)]).astype(np.float32)
-        prog["u_shadow_matrix"].write(mats[: max(prog["u_shadow_matrix"].array_length, 1)].tobytes())
+    for name, held in (
+        ("u_shadow_matrix", frame.shadow_matrices),
+        ("u_shadow_fine_matrix", frame.shadow_fine_matrices),
+    ):
+        if name in prog:
+            mats = np.stack([held.get(s, np.eye(4)).T for s in (0, 1)]).astype(np.float32)
+            prog[name].write(mats[: max(prog[name].array_length, 1)].tobytes())

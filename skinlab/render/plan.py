@@ -9,7 +9,7 @@ from .bounce import plan_bounce, prefetch_bounce
 from .boundary import prefetch_boundaries
 from .compute import Device, choose_path
 from .environment import plan_environment, plan_sky, prefetch_sky
-from .frame_plan import FramePlan, PlannedPass, ShadowParams, TonemapParams, shadow_pass_name
+from .frame_plan import FramePlan, PlannedPass, ShadowParams, TonemapParams, shadow_fit_pass_name, shadow_pass_name
 from .lights import soft_shadow
 from .registry import get_technique
 from .reuse import light_placement, scene_geometry
@@ -32,6 +32,21 @@ def soft_size(light: LightNode) -> str:
     if light.kind == "directional":
         return f"angular radius {math.degrees(light.angular_radius):.2g} deg"
     return f"radius {light.size:.3g} scene units"
+
+
+def fitted_window(scene: Scene, settings: RenderSettings, light: LightNode, geometry: tuple):
+    """The light's second shadow map fitted to what the camera sees (skinlab/render/shadow_fit.py), or None."""
+    from .passes.shadow import light_view_proj
+    from .shadow_fit import FIT_MAX_TEXELS, shadow_window
+
+    lo, hi = scene.world_bounds()
+    try:
+        clip = light_view_proj(light, lo, hi)
+    except ValueError:  # a point light inside the scene: the shadow pass says so
+        return None
+    size = settings.shadow_size
+    samples = settings.render_size
+    return shadow_window(scene, clip, samples, size, min(FIT_MAX_TEXELS, 8 * size), geometry)
 
 
 def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Device | None = None) -> FramePlan:
@@ -75,10 +90,12 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
     layer_size = part_layer_size(settings.shadow_size)
     geometry = scene_geometry(scene) if shadow_lights else ()
     plan.passes += environment
+    fitted: list[str] = []
     for slot, l in enumerate(shadow_lights[:2]):
         soft = soft_shadow(l)  # a light with a size: soft shadows from the distance map too
         dist = distance or soft
         why = [w for w, on in (("translucency", distance), ("soft shadows", soft)) if on]
+        fine = fitted_window(scene, settings, l, geometry) if settings.shadow_fit and not soft else None
         plan.passes.append(
             PlannedPass(
                 shadow_pass_name(l),
@@ -93,6 +110,25 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
                 inputs=(slot, dist, distance, light_placement(l), geometry),
             )
         )
+        if fine is not None:
+            plan.passes.append(
+                PlannedPass(
+                    shadow_fit_pass_name(l),
+                    "shadow_fit",
+                    f"shadow_fine{slot}",
+                    (fine.nx, fine.ny),
+                    f"the camera sees {100 * (fine.x1 - fine.x0) * (fine.y1 - fine.y0) / 4:.2g} % of light "
+                    f"'{l.name}''s map: a second map over that window, {fine.gain:.1f}x finer texels",
+                    ShadowParams(l, slot, False, False, fine),
+                    inputs=(slot, light_placement(l), geometry, fine),
+                )
+            )
+            fitted.append(shadow_fit_pass_name(l))
+    # what lights surfaces from the shadow maps kept across frames reads the fitted ones too (the
+    # interreflection does not: its senders are mostly out of view, and it is kept while the camera moves)
+    for p in tp.before_forward:
+        if fitted and p.reads_light and any(a.startswith("shadow[") for a in p.after):
+            p.after = (*p.after, *fitted)
     for l in shadow_lights[2:]:
         plan.skipped.append((f"shadow[{l.name}]", "at most 2 shadow-casting lights"))
     bounce = plan_bounce(scene, settings, meshes, lights, shadow_lights[:2], plan)

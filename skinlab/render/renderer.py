@@ -21,7 +21,7 @@ from .frame import Frame
 from .frame_plan import FramePlan
 from .gpu_resources import GpuResources
 from .passes.forward import ForwardPass
-from .passes.shadow import ShadowPass
+from .passes.shadow import FittedShadowPass, ShadowPass
 from .passes.tonemap import TonemapPass
 from .plan import plan_frame
 from .registry import get_technique, pass_class
@@ -52,6 +52,7 @@ class Renderer:
         # the core's passes; a technique's are made on first use (pass_for)
         self.passes: dict[str, RenderPass] = {
             "shadow": ShadowPass(self),
+            "shadow_fit": FittedShadowPass(self),
             "bounce": BouncePass(self),
             "environment": EnvironmentPass(self),
             "sky_occlusion": SkyOcclusionPass(self),

@@ -36,6 +36,13 @@ class RenderSettings:
         unit="texels",
         panel=False,  # a slider over 1-16384 texels helps no one; the command line sets it
     )
+    shadow_fit: bool = option(
+        True,
+        "a second shadow map per light fitted to what the camera sees, where that makes its texels at "
+        "least twice as fine (close-ups: skinlab/render/shadow_fit.py); off: one map over the whole scene",
+        "bool",
+        panel=False,
+    )
     background: tuple[float, float, float] = option(
         (0.045, 0.045, 0.05),
         "the colour behind the meshes where no environment map is drawn",

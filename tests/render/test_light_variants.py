@@ -46,7 +46,7 @@ def test_forward_compiles_only_filled_slots_and_renders_the_same(ctx, monkeypatc
         # the same frame with both slots compiled in (what every frame compiled before)
         import skinlab.render.passes.forward as forward
 
-        monkeypatch.setattr(forward, "light_defines", lambda sl, n: {"MAX_LIGHTS": n, "SHADOW_SLOTS": 2})
+        monkeypatch.setattr(forward, "light_defines", lambda sl, n, frame=None: {"MAX_LIGHTS": n, "SHADOW_SLOTS": 2})
         full = r.render(scene, st).hdr
         assert "2" in _frame_programs(r, "passes/forward.frag")
     finally:

@@ -169,7 +169,7 @@ class ForwardPass(RenderPass):
         sh = hook.shading(node, frame) or NodeShading(node.material)
         defines = {
             **sh.material.defines(),
-            **light_defines(prm.shadow_lights, nmax),
+            **light_defines(prm.shadow_lights, nmax, frame),
             **area_defines(prm.lights),
             **ambient_defines(frame, node),
             **sh.defines,

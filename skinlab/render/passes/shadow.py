@@ -17,6 +17,7 @@ from skinlab.render.frame_plan import ShadowParams
 from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import SOFT_KEY, soft_shadow
 from skinlab.render.shadow_facing import AWAY, TOWARD, layer_triangles
+from skinlab.render.shadow_fit import ShadowWindow
 from skinlab.render.technique import RenderPass
 from skinlab.render.texture_units import TextureUnits
 from skinlab.render.translucency import part_gap, part_layer_size
@@ -244,12 +245,12 @@ class ShadowPass(RenderPass):
         # toward an occluder's silhouette in the light's view; the lookup's bias is sized to the
         # texel instead (skinlab/shaders/lib/shadow.glsl)
         with gl_state(ctx, moderngl.DEPTH_TEST):
-            self._draw(frame, {"SHADOW_DISTANCE": 1} if distance else {}, {"u_light_eye": light_eye(light)}, vp)
+            self.draw_casters(frame, {"SHADOW_DISTANCE": 1} if distance else {}, {"u_light_eye": light_eye(light)}, vp)
             if prm.layers:
                 self._draw_layers(frame, slot, light, vp)
         self.publish(frame, p)
 
-    def _draw(
+    def draw_casters(
         self, frame, defines: dict, uniforms: dict, vp, textures: dict | None = None, facing: str | None = None
     ) -> None:
         """Every mesh that casts a shadow, each with its program (a masked material's cut-away pixels
@@ -304,13 +305,72 @@ class ShadowPass(RenderPass):
         eye = light_eye(light)
         exit_fbo.clear(1e30, 0.0, 0.0, 0.0, depth=1.0)
         exit_fbo.use()
-        self._draw(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp, facing=AWAY)
+        self.draw_casters(frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 1}, {"u_light_eye": eye}, vp, facing=AWAY)
         entry_fbo.clear(1e30, 1e30, 1e30, 1e30, depth=1.0)
         entry_fbo.use()
-        self._draw(
+        self.draw_casters(
             frame, {"SHADOW_DISTANCE": 1, "SHADOW_LAYER": 2}, {"u_light_eye": eye, "u_part_gap": part_gap(frame)},
             vp, {"u_exit": exit_tex}, facing=TOWARD,
         )  # fmt: skip
+
+
+class FittedShadowPass(RenderPass):
+    """A light's second depth map, fitted to what the camera sees (skinlab/render/shadow_fit.py): the
+    same casters as its full map (ShadowPass), drawn through the window's crop. Its own pass, so
+    that what reads only the full map (the interreflection) is kept while the camera moves."""
+
+    def __init__(self, renderer):
+        super().__init__(renderer)
+        self.fine: dict[int, ShadowMap] = {}  # per slot
+
+    def target(self, slot: int, window: ShadowWindow | None) -> ShadowMap | None:
+        """A slot's fitted map (depth only) at the window's size, made or remade; None (and any held
+        one released) without a window."""
+        t = self.fine.get(slot)
+        if t is not None and (window is None or t.depth.size != (window.nx, window.ny)):
+            t.release()
+            del self.fine[slot]
+            t = None
+        if window is None or t is not None:
+            return t
+        tex = self.r.ctx.depth_texture((window.nx, window.ny))
+        tex.compare_func = "<="
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        tex.repeat_x = tex.repeat_y = False
+        t = self.fine[slot] = ShadowMap(tex, self.r.ctx.framebuffer([], depth_attachment=tex), None)
+        return t
+
+    def release(self) -> None:
+        for m in self.fine.values():
+            m.release()
+        self.fine.clear()
+
+    def outputs(self, frame, p) -> tuple:
+        t = self.target(p.params.slot, p.params.fine)
+        return () if t is None else (t.depth,)
+
+    def publish(self, frame, p) -> None:
+        prm: ShadowParams = p.params
+        t = self.target(prm.slot, prm.fine)
+        if t is None or prm.fine is None:
+            return
+        lo, hi = frame.scene.world_bounds()
+        frame.targets[f"shadow_fine{prm.slot}"] = t.depth
+        frame.shadow_fine_matrices[prm.slot] = CLIP_TO_TEXTURE @ prm.fine.crop() @ light_view_proj(prm.light, lo, hi)
+
+    def run(self, frame, p) -> None:
+        prm: ShadowParams = p.params
+        t = self.target(prm.slot, prm.fine)
+        if t is not None and prm.fine is not None:
+            lo, hi = frame.scene.world_bounds()
+            vp = prm.fine.crop() @ light_view_proj(prm.light, lo, hi)
+            t.fbo.clear(depth=1.0)
+            t.fbo.use()
+            with gl_state(self.r.ctx, moderngl.DEPTH_TEST):
+                full = self.r.passes["shadow"]
+                assert isinstance(full, ShadowPass)
+                full.draw_casters(frame, {}, {"u_light_eye": light_eye(prm.light)}, vp)  # the full map's casters
+        self.publish(frame, p)
 
 
 def _float_texture(ctx, size: int, components: int) -> moderngl.Texture:

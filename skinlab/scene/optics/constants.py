@@ -42,6 +42,15 @@ SHADOW_SLOPE_MAX = 5.0
 # PCF), with a tap per texel along each side, at most SHADOW_AREA_TAPS (wider: taps further apart).
 SHADOW_AREA_MIN_TEXELS = 3.0
 SHADOW_AREA_TAPS = 16
+# A map fitted to what the camera sees (skinlab/render/shadow_fit.py) answers a lookup whose texels lie
+# SHADOW_FIT_REACH of its texels inside its edge (the 3x3 PCF's bilinear taps read 2 texels each way:
+# a half-texel shift, one tap and its bilinear neighbour); beyond, the full map does.
+SHADOW_FIT_REACH = 2.5
+# A screen pass's lookup in a fitted map averages it over the sample's footprint (its bounding box in the
+# map, at least a texel): nine gathers of 2 x 2 compares cover a box up to SHADOW_BOX_TEXELS wide
+# (lib/shadow.glsl shadow_box); wider, shadow_pcf_area's taps.
+SHADOW_BOX_TEXELS = 5.0
+SHADOW_BOX_CELLS = 3  # a wider box: sampled by a gather in each of these many cells per side
 
 GLSL_CONSTANTS: dict[str, float] = {
     "PI": PI,
@@ -56,6 +65,9 @@ GLSL_CONSTANTS: dict[str, float] = {
     "SHADOW_SLOPE_MAX": SHADOW_SLOPE_MAX,
     "SHADOW_AREA_MIN_TEXELS": SHADOW_AREA_MIN_TEXELS,
     "SHADOW_AREA_TAPS": float(SHADOW_AREA_TAPS),
+    "SHADOW_FIT_REACH": SHADOW_FIT_REACH,
+    "SHADOW_BOX_TEXELS": SHADOW_BOX_TEXELS,
+    "SHADOW_BOX_CELLS": float(SHADOW_BOX_CELLS),
     "MIN_LIGHT_DISTANCE_M": MIN_LIGHT_DISTANCE_M,
 }
 

@@ -21,6 +21,9 @@ from .constants import (
     SHADOW_AREA_MIN_TEXELS,
     SHADOW_AREA_TAPS,
     SHADOW_BIAS_TEXELS,
+    SHADOW_BOX_CELLS,
+    SHADOW_BOX_TEXELS,
+    SHADOW_FIT_REACH,
     SHADOW_SLOPE_MAX,
     SHADOW_SLOPE_TEXELS,
 )
@@ -127,6 +130,106 @@ def shadow_pcf_area(
     area = total / (na * nb)
     small = np.maximum(ea, eb) <= SHADOW_AREA_MIN_TEXELS
     return np.where(outside, 1.0, np.where(small, shadow_pcf(depth_map, m, world, NoL, nearest), area))
+
+
+def in_window(fine_matrix, world, size, reach) -> np.ndarray:
+    """Whether each point's lookup in a map fitted to the view (skinlab/render/shadow_fit.py; GLSL
+    shadow_in_window) lies within it: its texel position at least `reach` (N,) or a scalar texels from
+    every edge of the map `size` (w, h) texels, in front of it (w > 0)."""
+    _, p = _light_space(fine_matrix, world)
+    w = p[:, 3]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = p[:, :2] / np.where(w > 0, w, 1.0)[:, None] * np.asarray(size, np.float64)
+    r = np.asarray(reach, np.float64).reshape(-1, 1)
+    return (w > 0) & (c >= r).all(1) & (c <= np.asarray(size, np.float64) - r).all(1)
+
+
+def shadow_pcf_fitted(fine_map, fine_matrix, depth_map, shadow_matrix, world, NoL, nearest: bool = False):
+    """The fitted map's 3x3 PCF where in_window (SHADOW_FIT_REACH), else the full map's (GLSL
+    shadow_pcf_fitted)."""
+    h, w = fine_map.shape
+    inside = in_window(fine_matrix, world, (w, h), SHADOW_FIT_REACH)
+    fine = shadow_pcf(fine_map, fine_matrix, world, NoL, nearest)
+    full = shadow_pcf(depth_map, shadow_matrix, world, NoL, nearest)
+    return np.where(inside, fine, full)
+
+
+def shadow_pcf_area_fitted(fine_map, fine_matrix, depth_map, shadow_matrix, world, NoL, du, dv, nearest=False):
+    """shadow_pcf_area on the fitted map where the footprint's lookup lies within it (SHADOW_FIT_REACH
+    and the footprint's half-extent in its texels), else on the full map (GLSL shadow_pcf_area_fitted)."""
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    h, w = fine_map.shape
+    _, p = _light_space(fine_matrix, world)
+    _, pa = _light_space(fine_matrix, world + np.atleast_2d(np.asarray(du, np.float64)))
+    _, pb = _light_space(fine_matrix, world + np.atleast_2d(np.asarray(dv, np.float64)))
+    c = p[:, :2] / p[:, 3:4]
+    half = 0.5 * (np.abs(pa[:, :2] / pa[:, 3:4] - c) + np.abs(pb[:, :2] / pb[:, 3:4] - c)) * [w, h]
+    inside = in_window(fine_matrix, world, (w, h), SHADOW_FIT_REACH + half.max(1))
+    fine = shadow_pcf_area(fine_map, fine_matrix, world, NoL, du, dv, nearest)
+    full = shadow_pcf_area(depth_map, shadow_matrix, world, NoL, du, dv, nearest)
+    return np.where(inside, fine, full)
+
+
+def shadow_box(depth_map, shadow_matrix, world, NoL, w) -> np.ndarray:
+    """The compares averaged over a box `w` (N, 2) texels wide centred where each point falls (clamp to
+    edge; GLSL shadow_box, whose gathers are NEAREST compares: the twin to fp32 rounding): up to
+    SHADOW_BOX_TEXELS wide, each texel weighted by its share of the box; wider, the mean over the box's
+    SHADOW_BOX_CELLS^2 cells of the 2 x 2 texels around the texel corner nearest each cell's centre."""
+    m, p = _light_space(shadow_matrix, world)
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    c = p[:, :3] / p[:, 3:4]
+    outside = (c < 0).any(1) | (c > 1).any(1)
+    h, wd = depth_map.shape
+    z = c[:, 2] - shadow_bias(NoL, m, world, (wd, h))
+    w = np.atleast_2d(np.asarray(w, np.float64))
+    lo = c[:, :2] * [wd, h] - 0.5 * w
+    hi = lo + w
+
+    def lit(jx, jy):
+        cols = np.clip(jx.astype(np.int64), 0, wd - 1)
+        rows = np.clip(jy.astype(np.int64), 0, h - 1)
+        return (z <= depth_map[rows, cols]).astype(np.float64)
+
+    exact = np.zeros(len(c))
+    j0 = np.floor(lo)
+    for ky in range(6):
+        jy = j0[:, 1] + ky
+        oy = np.maximum(0.0, np.minimum(hi[:, 1], jy + 1) - np.maximum(lo[:, 1], jy))
+        for kx in range(6):
+            jx = j0[:, 0] + kx
+            ox = np.maximum(0.0, np.minimum(hi[:, 0], jx + 1) - np.maximum(lo[:, 0], jx))
+            exact += ox * oy * lit(jx, jy)
+    exact /= w[:, 0] * w[:, 1]
+    sampled = np.zeros(len(c))
+    n = SHADOW_BOX_CELLS
+    for gy in range(n):
+        for gx in range(n):
+            k = np.floor(lo + (np.array([gx, gy]) + 0.5) * w / n + 0.5)
+            for dx in (-1, 0):
+                for dy in (-1, 0):
+                    sampled += 0.25 * lit(k[:, 0] + dx, k[:, 1] + dy)
+    sampled /= n * n
+    return np.where(outside, 1.0, np.where(w.max(1) > SHADOW_BOX_TEXELS, sampled, exact))
+
+
+def _footprint_texels(m, world, du, dv, size) -> np.ndarray:
+    _, p = _light_space(m, world)
+    _, pa = _light_space(m, world + np.atleast_2d(np.asarray(du, np.float64)))
+    _, pb = _light_space(m, world + np.atleast_2d(np.asarray(dv, np.float64)))
+    c = p[:, :2] / p[:, 3:4]
+    return (np.abs(pa[:, :2] / pa[:, 3:4] - c) + np.abs(pb[:, :2] / pb[:, 3:4] - c)) * np.asarray(size, np.float64)
+
+
+def shadow_box_fitted(fine_map, fine_matrix, depth_map, shadow_matrix, world, NoL, du, dv) -> np.ndarray:
+    """A screen sample's shadow (GLSL shadow_box_fitted, its gather path): shadow_box over the bounding box
+    of the footprint du, dv (N, 3) in the fitted map's texels (at least 1) where the lookup lies within
+    it; the full map's 3x3 PCF outside."""
+    world = np.atleast_2d(np.asarray(world, np.float64))
+    h, wd = fine_map.shape
+    w = np.maximum(_footprint_texels(fine_matrix, world, du, dv, (wd, h)), 1.0)
+    inside = in_window(fine_matrix, world, (wd, h), SHADOW_FIT_REACH + 0.5 * w.max(1))
+    box = shadow_box(fine_map, fine_matrix, world, NoL, w)
+    return np.where(inside, box, shadow_pcf(depth_map, shadow_matrix, world, NoL))
 
 
 SOFT_SEARCH_TAPS = 8  # blocker search taps (lib/shadow_soft.glsl)

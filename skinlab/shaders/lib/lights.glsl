@@ -31,6 +31,26 @@ uniform int u_light_shadow[MAX_LIGHTS];      // shadow slot, or -1
 uniform sampler2DShadow u_shadow0;
 uniform sampler2DShadow u_shadow1;
 uniform mat4 u_shadow_matrix[2];
+#ifdef SHADOW_FINE0  // a slot's map fitted to what the camera sees (skinlab/render/shadow_fit.py)
+uniform sampler2DShadow u_shadow_fine0;
+#endif
+#ifdef SHADOW_FINE1
+uniform sampler2DShadow u_shadow_fine1;
+#endif
+#if defined(SHADOW_FINE0) || defined(SHADOW_FINE1)
+uniform mat4 u_shadow_fine_matrix[2];
+// A screen pass's sample footprint on the surface (world vectors across one sample along x and y; the
+// pass sets them from its position's derivatives where control flow is uniform, passes/forward.frag):
+// the fitted map's lookups average over it, the pixel's box filter of a sharp shadow (the truth's
+// pixel filter); zero (a texture-space pass): the 3x3 PCF.
+vec3 g_shadow_du = vec3(0.0);
+vec3 g_shadow_dv = vec3(0.0);
+
+float shadow_fitted(sampler2DShadow fine, mat4 mf, sampler2DShadow map, mat4 m, vec3 world, float NoL) {
+    if (g_shadow_du == vec3(0.0) && g_shadow_dv == vec3(0.0)) return shadow_pcf_fitted(fine, mf, map, m, world, NoL);
+    return shadow_box_fitted(fine, mf, map, m, world, NoL, g_shadow_du, g_shadow_dv);
+}
+#endif
 uniform float u_mm_per_unit;
 
 // Direction to light i (l) and the irradiance it brings to a surface facing it (e) at world.
@@ -76,12 +96,16 @@ float light_visibility(int i, vec3 world, float NoL_geom) {
     int slot = u_light_shadow[i];
 #ifdef SHADOW_SOFT0  // a light with a size: soft shadows (lib/shadow_soft.glsl)
     if (slot == 0) return shadow_soft(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom);
+#elif defined(SHADOW_FINE0)
+    if (slot == 0) return shadow_fitted(u_shadow_fine0, u_shadow_fine_matrix[0], u_shadow0, u_shadow_matrix[0], world, NoL_geom);
 #else
     if (slot == 0) return shadow_pcf(u_shadow0, u_shadow_matrix[0], world, NoL_geom);
 #endif
 #if SHADOW_SLOTS > 1
 #ifdef SHADOW_SOFT1
     if (slot == 1) return shadow_soft(u_shadow1, u_shadow_distance1, u_shadow_matrix[1], u_shadow_soft[1], u_shadow_eye[1], world, NoL_geom);
+#elif defined(SHADOW_FINE1)
+    if (slot == 1) return shadow_fitted(u_shadow_fine1, u_shadow_fine_matrix[1], u_shadow1, u_shadow_matrix[1], world, NoL_geom);
 #else
     if (slot == 1) return shadow_pcf(u_shadow1, u_shadow_matrix[1], world, NoL_geom);
 #endif
@@ -98,12 +122,16 @@ float light_visibility_area(int i, vec3 world, float NoL_geom, vec3 du, vec3 dv)
     int slot = u_light_shadow[i];
 #ifdef SHADOW_SOFT0
     if (slot == 0) return shadow_soft_area(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom, du, dv);
+#elif defined(SHADOW_FINE0)
+    if (slot == 0) return shadow_pcf_area_fitted(u_shadow_fine0, u_shadow_fine_matrix[0], u_shadow0, u_shadow_matrix[0], world, NoL_geom, du, dv);
 #else
     if (slot == 0) return shadow_pcf_area(u_shadow0, u_shadow_matrix[0], world, NoL_geom, du, dv);
 #endif
 #if SHADOW_SLOTS > 1
 #ifdef SHADOW_SOFT1
     if (slot == 1) return shadow_soft_area(u_shadow1, u_shadow_distance1, u_shadow_matrix[1], u_shadow_soft[1], u_shadow_eye[1], world, NoL_geom, du, dv);
+#elif defined(SHADOW_FINE1)
+    if (slot == 1) return shadow_pcf_area_fitted(u_shadow_fine1, u_shadow_fine_matrix[1], u_shadow1, u_shadow_matrix[1], world, NoL_geom, du, dv);
 #else
     if (slot == 1) return shadow_pcf_area(u_shadow1, u_shadow_matrix[1], world, NoL_geom, du, dv);
 #endif

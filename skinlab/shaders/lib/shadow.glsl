@@ -117,3 +117,101 @@ float shadow_pcf_area(sampler2DShadow map, mat4 m, vec3 world, float NoL, vec3 d
     }
     return sum / float(na * nb);
 }
+
+// A map fitted to what the camera sees (skinlab/render/shadow_fit.py): the fine map m_f where the
+// lookup's texels lie within it, the full map m elsewhere. `reach`: how far from p the lookup reads,
+// in the fine map's texels (the 3x3 PCF's 1.5, and a footprint's half-extent); NumPy twin
+// skinlab/scene/optics/shadow.py in_window.
+bool shadow_in_window(mat4 m_f, vec3 world, vec2 size, float reach) {
+    vec4 p = m_f * vec4(world, 1.0);
+    if (p.w <= 0.0) return false;
+    vec2 c = p.xy / p.w * size;
+    return all(greaterThanEqual(c, vec2(reach))) && all(lessThanEqual(c, size - reach));
+}
+
+float shadow_pcf_fitted(sampler2DShadow fine, mat4 m_f, sampler2DShadow map, mat4 m, vec3 world, float NoL) {
+    if (shadow_in_window(m_f, world, vec2(textureSize(fine, 0)), SHADOW_FIT_REACH))
+        return shadow_pcf(fine, m_f, world, NoL);
+    return shadow_pcf(map, m, world, NoL);
+}
+
+float shadow_pcf_area_fitted(sampler2DShadow fine, mat4 m_f, sampler2DShadow map, mat4 m, vec3 world, float NoL,
+                             vec3 du, vec3 dv) {
+    vec2 size = vec2(textureSize(fine, 0));
+    vec4 p = m_f * vec4(world, 1.0);
+    vec4 pa = m_f * vec4(world + du, 1.0);
+    vec4 pb = m_f * vec4(world + dv, 1.0);
+    // the footprint's half-extent in the fine map's texels (the parallelogram's corners about p)
+    vec2 half_extent = 0.5 * (abs(pa.xy / pa.w - p.xy / p.w) + abs(pb.xy / pb.w - p.xy / p.w)) * size;
+    if (shadow_in_window(m_f, world, size, SHADOW_FIT_REACH + max(half_extent.x, half_extent.y)))
+        return shadow_pcf_area(fine, m_f, world, NoL, du, dv);
+    return shadow_pcf_area(map, m, world, NoL, du, dv);
+}
+
+#ifdef SHADOW_GATHER
+// The share of texel j's [j, j + 1] within [lo, hi] (texel units).
+float shadow_overlap(float lo, float hi, float j) { return max(0.0, min(hi, j + 1.0) - max(lo, j)); }
+
+// The depth compares averaged over a box `w` texels wide (at least 1 per axis) centred where world
+// falls. Up to SHADOW_BOX_TEXELS wide: each texel's compare weighted by its share of the box, the
+// exact box filter of the map's texels (a 1-texel box: bilinear filtering), from nine gathers of
+// 2 x 2 compares over the 6 x 6 texels such a box can touch. Wider: the box in SHADOW_BOX_CELLS x SHADOW_BOX_CELLS cells, each
+// the mean of the 2 x 2 texels around the texel corner nearest its centre (a gather each: a sampled
+// box, not every texel). The bias as shadow_pcf's. NumPy twin: skinlab/scene/optics/shadow.py shadow_box.
+const int BOX_CELLS = int(SHADOW_BOX_CELLS);
+float shadow_box(sampler2DShadow map, mat4 m, vec3 world, float NoL, vec2 w) {
+    vec4 p = m * vec4(world, 1.0);
+    vec3 c = p.xyz / p.w;
+    if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0)))) return 1.0;
+    vec2 size = vec2(textureSize(map, 0));
+    float z = c.z - shadow_bias(m, p, size, NoL);
+    vec2 lo = c.xy * size - 0.5 * w;
+    vec2 hi = lo + w;
+    float sum = 0.0;
+    if (max(w.x, w.y) > SHADOW_BOX_TEXELS) {
+        for (int gy = 0; gy < BOX_CELLS; ++gy)
+            for (int gx = 0; gx < BOX_CELLS; ++gx) {
+                vec2 k = floor(lo + (vec2(float(gx), float(gy)) + 0.5) * w / float(BOX_CELLS) + 0.5);
+                sum += dot(textureGather(map, k / size, z), vec4(0.25));
+            }
+        return sum / float(BOX_CELLS * BOX_CELLS);
+    }
+    vec2 j0 = floor(lo);
+    for (int gy = 0; gy < 3; ++gy) {
+        for (int gx = 0; gx < 3; ++gx) {
+            // a gather at the corner k returns texels k - 1 (i0, j0) and k (i1, j1) along each axis;
+            // components x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0)
+            vec2 k = j0 + vec2(float(2 * gx + 1), float(2 * gy + 1));
+            vec4 s = textureGather(map, k / size, z);
+            float x0 = shadow_overlap(lo.x, hi.x, k.x - 1.0), x1 = shadow_overlap(lo.x, hi.x, k.x);
+            float y0 = shadow_overlap(lo.y, hi.y, k.y - 1.0), y1 = shadow_overlap(lo.y, hi.y, k.y);
+            sum += (s.w * x0 + s.z * x1) * y0 + (s.x * x0 + s.y * x1) * y1;
+        }
+    }
+    return sum / (w.x * w.y);
+}
+#endif
+
+// A screen sample's shadow in a fitted map: shadow_box over the bounding box of its footprint (the world
+// vectors du, dv across one sample) in the fitted map's texels where the lookup lies within it; the full
+// map's 3x3 PCF elsewhere, as without one. Without gathers, shadow_pcf_area in the fitted map.
+vec2 shadow_footprint_texels(mat4 m, vec3 world, vec3 du, vec3 dv, vec2 size) {
+    vec4 p = m * vec4(world, 1.0);
+    vec4 pa = m * vec4(world + du, 1.0);
+    vec4 pb = m * vec4(world + dv, 1.0);
+    vec2 c = p.xy / p.w;
+    return (abs(pa.xy / pa.w - c) + abs(pb.xy / pb.w - c)) * size;
+}
+
+float shadow_box_fitted(sampler2DShadow fine, mat4 m_f, sampler2DShadow map, mat4 m, vec3 world, float NoL,
+                        vec3 du, vec3 dv) {
+    vec2 size = vec2(textureSize(fine, 0));
+    vec2 w = max(shadow_footprint_texels(m_f, world, du, dv, size), vec2(1.0));
+    if (!shadow_in_window(m_f, world, size, SHADOW_FIT_REACH + 0.5 * max(w.x, w.y)))
+        return shadow_pcf(map, m, world, NoL);
+#ifdef SHADOW_GATHER
+    return shadow_box(fine, m_f, world, NoL, w);
+#else
+    return shadow_pcf_area(fine, m_f, world, NoL, du, dv);
+#endif
+}

@@ -44,6 +44,11 @@ void main() {
     f_color = vec4(v_world + v_normal + v_tangent.xyz + vec3(v_uv, 0.0), 1.0);
     return;
 #endif
+#if defined(SHADOW_FINE0) || defined(SHADOW_FINE1)
+    // the sample's footprint for the fitted shadow maps' lookups (lib/lights.glsl), before any branch
+    g_shadow_du = dFdx(v_world);
+    g_shadow_dv = dFdy(v_world);
+#endif
     // the surface inputs, once: normals, view direction, the material's maps, the subsurface weight
     Surface s = surface_inputs(v_world, v_normal, v_uv, v_tangent, v_color, u_camera_pos, gl_FrontFacing);
 #ifdef ALPHA_MASK

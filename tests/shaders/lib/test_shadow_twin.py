@@ -265,3 +265,123 @@ def test_a_lit_plane_stays_lit_under_a_wide_footprint(ctx, glsl, degrees):
         samplers={"u_map": ("sampler2DShadow", tex)},
     )[:, 0]
     assert np.all(gpu == 1.0)
+
+
+def _fitted_maps(ctx, rng):
+    """A full map and a fitted one over a window of it (the crop of skinlab/render/shadow_fit.py): their
+    depth arrays, textures and texture matrices (orthographic, world [-1, 1]^3 -> the full map)."""
+    from skinlab.render.shadow_fit import ShadowWindow
+
+    full, full_tex = nearest_depth_map(ctx, rng, 16, 24)
+    fine, fine_tex = nearest_depth_map(ctx, rng, 40, 28)  # w 28, h 40: not square
+    win = ShadowWindow(-0.3, -0.5, 0.25, 0.4, 28, 40, 2.0)
+    m_full = ORTHO
+    m_fine = CLIP_TO_TEXTURE @ win.crop() @ np.linalg.inv(CLIP_TO_TEXTURE) @ ORTHO
+    return full, full_tex, fine, fine_tex, m_full, m_fine
+
+
+def test_shadow_fitted_lookups_match_numpy(ctx, glsl):
+    """The fitted map's lookups (lib/shadow.glsl shadow_in_window, shadow_pcf_fitted,
+    shadow_pcf_area_fitted) against their twins: points inside the window read the fitted map, points
+    outside it or too near its edge for the lookup's reach read the full map."""
+    rng = np.random.default_rng(5)
+    full, full_tex, fine, fine_tex, m_full, m_fine = _fitted_maps(ctx, rng)
+    n = 1500
+    world = np.c_[rng.uniform(-0.6, 0.6, (n, 2)), rng.uniform(-1.0, 1.0, n)].astype(np.float32).astype(np.float64)
+    nol = rng.uniform(0.1, 1.0, n).astype(np.float32).astype(np.float64)
+    reach = 2.5
+    inside = shadow.in_window(m_fine, world, (28, 40), reach)
+    assert 0.2 < inside.mean() < 0.8
+    gpu_in = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_in_window(u_mf, world, vec2(28.0, 40.0), 2.5) ? 1.0 : 0.0",
+        {"world": world},
+        uniforms={"u_mf": ("mat4", m_fine)},
+    )[:, 0]
+    # a point within fp32 rounding of the reach may go either way
+    p = np.c_[world, np.ones(n)] @ m_fine.T
+    c = p[:, :2] / p[:, 3:] * [28, 40]
+    edge = np.minimum(np.abs(c - reach), np.abs(c - ([28, 40] - np.array(reach)))).min(1) < 1e-3
+    assert np.array_equal(gpu_in[~edge] > 0.5, inside[~edge])
+    samplers = {"u_fine": ("sampler2DShadow", fine_tex), "u_full": ("sampler2DShadow", full_tex)}
+    uniforms = {"u_mf": ("mat4", m_fine), "u_m": ("mat4", m_full)}
+    gpu = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_pcf_fitted(u_fine, u_mf, u_full, u_m, world, nol)",
+        {"world": world, "nol": nol},
+        uniforms=uniforms,
+        samplers=samplers,
+    )[:, 0]
+    ref = shadow.shadow_pcf_fitted(fine, m_fine, full, m_full, world, nol, nearest=not has_gather(ctx))
+    on_fine = shadow.shadow_pcf(fine, m_fine, world, nol, nearest=not has_gather(ctx))
+    on_full = shadow.shadow_pcf(full, m_full, world, nol, nearest=not has_gather(ctx))
+    assert np.array_equal(ref, np.where(inside, on_fine, on_full))
+    assert np.mean(on_fine[inside] != on_full[inside]) > 0.3  # the two maps do differ there
+    ok = ~edge
+    diff = np.abs(gpu[ok] - ref[ok])
+    assert np.mean(diff < 1e-4) > 0.97, diff.max()
+    # the footprint's average: wider footprints need to lie further inside
+    du = np.tile([0.04, 0.0, 0.0], (n, 1))
+    dv = np.tile([0.0, 0.05, 0.0], (n, 1))
+    gpu_a = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_pcf_area_fitted(u_fine, u_mf, u_full, u_m, world, nol, du, dv)",
+        {"world": world, "nol": nol, "du": du, "dv": dv},
+        uniforms=uniforms,
+        samplers=samplers,
+    )[:, 0]
+    ref_a = shadow.shadow_pcf_area_fitted(fine, m_fine, full, m_full, world, nol, du, dv, nearest=not has_gather(ctx))
+    diff_a = np.abs(gpu_a[ok] - ref_a[ok])
+    assert np.mean(diff_a < 1e-4) > 0.95, diff_a.max()
+    half = 0.5 * (np.abs((du @ m_fine[:3, :3].T)[:, :2]) + np.abs((dv @ m_fine[:3, :3].T)[:, :2])) * [28, 40]
+    inside_a = shadow.in_window(m_fine, world, (28, 40), reach + half.max(1))
+    assert inside_a.sum() < inside.sum() and (inside_a <= inside).all()
+
+
+def test_shadow_box_matches_numpy_and_is_the_lit_share(ctx, glsl):
+    """A screen sample's lookup in a fitted map (lib/shadow.glsl shadow_box, shadow_box_fitted) against
+    its twins, boxes from under a texel (read as one: bilinear) to past SHADOW_BOX_TEXELS (the area
+    taps); and on a map lit left of a column edge, the box reads the share of it left of the edge."""
+    if not has_gather(ctx):
+        pytest.skip("shadow_box needs textureGather (GLSL 4.00 or ARB_gpu_shader5)")
+    rng = np.random.default_rng(9)
+    full, full_tex, fine, fine_tex, m_full, m_fine = _fitted_maps(ctx, rng)
+    n = 1500
+    world = np.c_[rng.uniform(-0.3, 0.25, n), rng.uniform(-0.5, 0.4, n), rng.uniform(-1, 1, n)]
+    scale = 10 ** rng.uniform(-1.5, -0.3, (n, 2))  # world units: 0.1 to 8 fitted texels
+    du = np.c_[scale[:, 0], np.zeros(n), np.zeros(n)]
+    dv = np.c_[np.zeros(n), scale[:, 1], np.zeros(n)]
+    nol = rng.uniform(0.2, 1.0, n)
+    world, du, dv, nol = (a.astype(np.float32).astype(np.float64) for a in (world, du, dv, nol))
+    gpu = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_box_fitted(u_fine, u_mf, u_full, u_m, world, nol, du, dv)",
+        {"world": world, "nol": nol, "du": du, "dv": dv},
+        uniforms={"u_mf": ("mat4", m_fine), "u_m": ("mat4", m_full)},
+        samplers={"u_fine": ("sampler2DShadow", fine_tex), "u_full": ("sampler2DShadow", full_tex)},
+    )[:, 0]
+    ref = shadow.shadow_box_fitted(fine, m_fine, full, m_full, world, nol, du, dv)
+    diff = np.abs(gpu - ref)
+    assert np.mean(diff < 1e-4) > 0.95 and np.median(diff) < 1e-5, diff.max()
+    # a step: texels left of column 10 lit (depth 1), the rest in shadow (depth 0); a receiver at z 0.5
+    h, w = 12, 24
+    step = np.where(np.arange(w)[None, :] < 10, 1.0, 0.0).repeat(h, 0).astype(np.float32)
+    tex = ctx.depth_texture((w, h), data=step.tobytes())
+    tex.compare_func = "<="
+    tex.repeat_x = tex.repeat_y = False
+    k = 200
+    x = rng.uniform(7.0, 13.0, k)  # texel units across the edge at 10
+    bw = rng.uniform(1.0, 5.0, k)
+    uv = np.c_[x / w, np.full(k, 6.0 / h)]
+    pts = world_at(ORTHO, uv, np.full(k, 0.5), False)
+    wbox = np.c_[bw, np.full(k, 2.0)]
+    lit = np.clip((10.0 - (x - bw / 2)) / bw, 0.0, 1.0)
+    got = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_box(u_map, u_m, world, 1.0, wbox)",
+        {"world": pts.astype(np.float32).astype(np.float64), "wbox": wbox},
+        uniforms={"u_m": ("mat4", ORTHO)},
+        samplers={"u_map": ("sampler2DShadow", tex)},
+    )[:, 0]
+    assert np.allclose(got, lit, atol=2e-4), np.abs(got - lit).max()
+    assert np.allclose(shadow.shadow_box(step, ORTHO, pts, np.ones(k), wbox), lit, atol=1e-9)

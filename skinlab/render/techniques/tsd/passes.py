@@ -432,7 +432,7 @@ class TsdIrradiancePass(TsdPass):
         fbo = t.fbo(ctx, t.raw, *(record if slots > 1 else record[0::2]))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
-        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **ambient}
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax, frame), **ambient}
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         if prm.deferred:
