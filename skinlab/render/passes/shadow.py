@@ -367,7 +367,7 @@ class FittedShadowPass(RenderPass):
             t.fbo.clear(depth=1.0)
             t.fbo.use()
             with gl_state(self.r.ctx, moderngl.DEPTH_TEST):
-                full = self.r.passes["shadow"]
+                full = self.r.passes["shadow"]  # type: ignore[attr-defined]  # the renderer's (PassHost does not name it)
                 assert isinstance(full, ShadowPass)
                 full.draw_casters(frame, {}, {"u_light_eye": light_eye(prm.light)}, vp)  # the full map's casters
         self.publish(frame, p)
