@@ -21,11 +21,11 @@ from skinlab.gl.state import gl_state
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.alpha import bind_mask, blended, draw_order, mask_defines
 from skinlab.render.ambient import ambient_defines, bind_ambient
-from skinlab.render.boundary import bind_boundary
+from skinlab.render.boundary import bind_boundary, boundary_defines
 from skinlab.render.environment import DATA_KEY as ENV_DATA
 from skinlab.render.environment import bind_env_bands, env_uniforms
 from skinlab.render.gpu_resources import node_uniforms
-from skinlab.render.lights import area_defines, bind_shadow_maps, light_defines, set_light_uniforms
+from skinlab.render.lights import area_defines, bind_shadow_maps, light_defines, near_defines, set_light_uniforms
 from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK, ForwardParams, NodeShading, RenderPass
 from skinlab.render.texture_units import TextureUnits
 
@@ -167,10 +167,13 @@ class ForwardPass(RenderPass):
     def shade_node(self, frame, prm: ForwardParams, per_frame, node) -> None:
         ctx, hook, nmax = self.r.ctx, prm.hook, frame.settings.max_lights
         sh = hook.shading(node, frame) or NodeShading(node.material)
+        scatters = sh.hook != PLAIN_HOOK and sh.subsurface
         defines = {
             **sh.material.defines(),
             **light_defines(prm.shadow_lights, nmax),
             **area_defines(prm.lights),
+            **near_defines(prm.lights),
+            **boundary_defines(sh.material if scatters else None),
             **ambient_defines(frame, node),
             **sh.defines,
         }
@@ -184,7 +187,6 @@ class ForwardPass(RenderPass):
         set_uniforms(prog, node_uniforms(node))
         bind_ambient(frame, node, prog, units)
         self.r.resources.bind_material(prog, sh.material, units)
-        scatters = sh.hook != PLAIN_HOOK and sh.subsurface
         bind_boundary(prog, sh.material if scatters else None)
         bind_env_bands(prog, sh.material if scatters else None)
         if sh.bind is not None:

@@ -32,7 +32,7 @@ from skinlab.render.boundary import bind_boundary
 from skinlab.render.compute import bind_images, dispatch, pass_program
 from skinlab.render.environment import bind_env_bands
 from skinlab.render.gpu_resources import node_uniforms
-from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
+from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, near_defines, set_light_uniforms
 from skinlab.render.technique import RenderPass, TechniqueState
 from skinlab.render.texture_units import TextureUnits
 from skinlab.render.translucency import bind_translucency
@@ -432,7 +432,7 @@ class TsdIrradiancePass(TsdPass):
         fbo = t.fbo(ctx, t.raw, *(record if slots > 1 else record[0::2]))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
-        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **ambient}
+        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax), **near_defines(prm.lights), **ambient}
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         if prm.deferred:

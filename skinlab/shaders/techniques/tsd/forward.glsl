@@ -54,6 +54,9 @@ vec3 unpremultiply(vec4 t) { return t.a > COVERAGE_EPS ? t.rgb / t.a : vec3(0.0)
 
 // Diffused irradiance (still x albedo^mix) at uv: I E + sum_k W_k level_k.
 vec3 tsd_diffused(vec2 uv) {
+#ifdef MEASURE_NO_GATHER  // a measurement variant (tools/orbit_cost.py): no irradiance or level fetched
+    return vec3(uv, 0.5);
+#endif
     vec3 d = u_tsd_identity * unpremultiply(texture(u_tsd_irradiance, uv));
 #if TSD_LEVELS > 0
     d += u_tsd_w[0] * unpremultiply(texture(u_tsd_level0, uv));
@@ -88,8 +91,11 @@ vec3 sss_radiance(Surface s) {
     // medium (lib/sss_boundary.glsl; the irradiance pass applied the entry factor)
     vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
     vec3 exit_ = sss_exit(abs(NoV));
+#ifdef MEASURE_NO_EXIT  // a measurement variant (tools/orbit_cost.py): the exit table not read
+    exit_ = vec3(NoV);
+#endif
     vec3 leaving = post * tsd_diffused(uv) * exit_;
-#ifdef TSD_THROUGH
+#if defined(TSD_THROUGH) && !defined(MEASURE_NO_THROUGH)  // MEASURE_NO_THROUGH: tools/orbit_cost.py
     vec2 backs = texture(u_tsd_through_cos, uv).rg;
     vec3 diff = tsd_through_exit(texture(u_tsd_through0, uv), backs.r, abs(NoV), exit_);
 #if TSD_THROUGH > 1
