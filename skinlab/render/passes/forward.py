@@ -165,7 +165,7 @@ class ForwardPass(RenderPass):
                 self.shade_node(frame, prm, per_frame, node)
 
     def shade_node(self, frame, prm: ForwardParams, per_frame, node) -> None:
-        ctx, hook, nmax = self.r.ctx, prm.hook, frame.settings.max_lights
+        hook, nmax = prm.hook, frame.settings.max_lights
         sh = hook.shading(node, frame) or NodeShading(node.material)
         scatters = sh.hook != PLAIN_HOOK and sh.subsurface
         defines = {
@@ -177,6 +177,16 @@ class ForwardPass(RenderPass):
             **ambient_defines(frame, node),
             **sh.defines,
         }
+        # the hook's parts of the triangles, each with its own variant (an opaque mesh's), or all at once
+        parts = [q for q in sh.parts if q.count > 0] if sh.parts and not blended(node.material) else [None]
+        for part in parts:
+            variant = defines if part is None else {**defines, **part.defines}
+            self.draw_node(frame, prm, per_frame, node, sh, variant, part)
+
+    def draw_node(self, frame, prm: ForwardParams, per_frame, node, sh: NodeShading, defines, part) -> None:
+        """Bind and draw `node`'s triangles (those of DrawPart `part`, or all: None) with variant `defines`."""
+        ctx, nmax = self.r.ctx, frame.settings.max_lights
+        scatters = sh.hook != PLAIN_HOOK and sh.subsurface
         prog = self.r.programs.get(
             "passes/forward.vert", "passes/forward.frag", defines, includes={HOOK_INCLUDE: sh.hook}
         )
@@ -191,4 +201,8 @@ class ForwardPass(RenderPass):
         bind_env_bands(prog, sh.material if scatters else None)
         if sh.bind is not None:
             sh.bind(prog, units)
-        self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        mesh = self.r.resources.mesh(node.mesh)
+        if part is None:
+            mesh.vao(prog).render(moderngl.TRIANGLES)
+        else:
+            mesh.vao(prog, part.indices).render(moderngl.TRIANGLES, part.count, part.first)

@@ -40,6 +40,7 @@ from skinlab.scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
 from .seams import SeamMap, node_border_strips
+from .through_split import lit_texels, split_indices, through_triangles
 
 STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
@@ -85,6 +86,9 @@ class TsdNodeTargets:
     strips: tuple = ()  # (source array, depth renderbuffer): where the record's fill runs (strip_mask)
     surface: list = field(default_factory=list)  # the surface G-buffer (surface_buffer), RGBA32F, nearest
     masks: dict = field(default_factory=dict)  # coverage masks by what was rasterised (coverage_mask)
+    # (index buffer, n, total): the mesh's triangles that can read light from the record first (n
+    # indices), the others after them (record_split); () where it was not made
+    through_faces: tuple = ()
 
     def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture, depth=None) -> moderngl.Framebuffer:
         key = (id(tex), *(id(m) for m in more), id(depth))
@@ -203,6 +207,8 @@ class TsdNodeTargets:
             self.seam.release()
         if self.strips:
             self.strips[1].release()
+        if self.through_faces:
+            self.through_faces[0].release()
 
 
 @dataclass
@@ -466,6 +472,7 @@ class TsdIrradiancePass(TsdPass):
         self.r.resources.unbind_samplers()
         if prm.translucency:  # the record's gutter by the chart borders: across the seams, else dilated
             through_fill(self.r, t, prm.seams is not None, node_border_strips(node.mesh, size), slots)
+            record_split(ctx, t, node.mesh, slots)
         self.publish(frame, p)
 
 
@@ -509,6 +516,27 @@ def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | 
     # with the mask only the strips (0.5 <= their depth 0.5; 0 elsewhere): an early depth test
     with gl_state(ctx, enable=moderngl.DEPTH_TEST if mask is not None else 0, depth_func="<="):
         renderer.fullscreen(prog)
+
+
+# the share of the triangles that must read no light through for the mesh to be drawn in two parts
+MIN_SPLIT_SHARE = 0.1
+
+
+def record_split(ctx, t: TsdNodeTargets, mesh, slots: int) -> None:
+    """t.through_faces from the filled record of the `slots` the gather reads (at most 2): the mesh's
+    triangles that can read a texel holding light through first, then the others (through_split.py;
+    the forward pass draws the others without the exit factor of that light, the same image)."""
+    if t.through_faces:
+        t.through_faces[0].release()
+        t.through_faces = ()
+    if mesh.uvs is None or slots < 1:
+        return
+    lit = np.zeros((t.size, t.size), bool)
+    for tex in t.through_record(ctx)[: min(slots, SHADOW_SLOTS)]:
+        lit |= lit_texels(tex.read(), t.size)
+    flat, first = split_indices(mesh.indices, through_triangles(mesh.uvs, mesh.indices, lit))
+    if flat.size - first >= MIN_SPLIT_SHARE * flat.size:  # else a second variant's draw is not worth it
+        t.through_faces = (ctx.buffer(flat.tobytes()), first, int(flat.size))
 
 
 class TsdDilatePass(TsdPass):
