@@ -92,8 +92,8 @@ def main(argv=None) -> int:
     probe.release()
     if not variants:
         raise SystemExit("no texture-space forward program in the frame")
-    # the mesh's part that reads the light through thin parts, where it is drawn in two (TSD_THROUGH 0: the other)
-    hook, hook_defines = max(variants, key=lambda v: int(dict(v[1]).get("TSD_THROUGH", 0)))
+    # the group of triangles that reads every slot's light through thin parts, where the mesh is drawn in groups
+    hook, hook_defines = min(variants, key=lambda v: int("TSD_THROUGH_READ" in dict(v[1])))
     runs = {}
 
     def add(name, settings, measure=None, library=None):

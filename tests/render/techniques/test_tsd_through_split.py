@@ -20,6 +20,7 @@ from skinlab.render.techniques.tsd.through_split import (
     BLOCK_TEXELS,
     MARGIN_TEXELS,
     lit_texels,
+    slot_masks,
     split_indices,
     through_triangles,
 )
@@ -77,13 +78,21 @@ def test_marking_is_conservative_against_sampled_reads():
     assert not through_triangles(uvs, idx, np.zeros((n, n), bool)).any()
 
 
-def test_split_indices_keeps_every_triangle_once():
-    idx = np.arange(30, dtype=np.uint32).reshape(-1, 3)
-    reads = np.array([False, True, False, True, True, False, False, False, True, False])
-    flat, first = split_indices(idx, reads)
-    assert first == 4 * 3
-    assert flat[:first].reshape(-1, 3).tolist() == idx[reads].tolist()
-    assert flat[first:].reshape(-1, 3).tolist() == idx[~reads].tolist()
+def test_split_indices_groups_every_triangle_once_by_its_slots():
+    n = 32
+    lits = [np.zeros((n, n), bool), np.zeros((n, n), bool)]
+    lits[0][:, : n // 4] = True  # slot 0 lights the left quarter, slot 1 the right one
+    lits[1][:, -n // 4 :] = True
+    centres = np.array([[0.1, 0.5], [0.9, 0.5], [0.5, 0.5], [0.1, 0.2], [0.5, 0.9]], np.float32)
+    uvs = np.concatenate([centres, centres + [0.01, 0], centres + [0, 0.01]]).astype(np.float32)
+    uvs = np.concatenate([uvs, [[0.05, 0.5], [0.95, 0.5], [0.5, 0.52]]]).astype(np.float32)  # one across both
+    idx = np.concatenate([np.stack([np.arange(5), 5 + np.arange(5), 10 + np.arange(5)], 1), [[15, 16, 17]]])
+    mask = slot_masks(uvs, idx.astype(np.uint32), lits)
+    assert mask.tolist() == [1, 2, 0, 1, 0, 3]
+    flat, groups = split_indices(idx, mask)
+    assert groups == [(0, 0, 6), (1, 6, 6), (2, 12, 3), (3, 15, 3)]
+    for m, first, count in groups:
+        assert flat[first : first + count].reshape(-1, 3).tolist() == idx[mask == m].tolist()
 
 
 def test_lit_texels_tests_the_bits():
@@ -101,30 +110,41 @@ def head():
 
 
 def _forward_variants(renderer) -> list:
-    return [dict(d).get("TSD_THROUGH") for (_, fs, d, _) in renderer.programs.entries if fs == FWD]
+    """The forward programs' TSD_THROUGH_READ (None: every slot's record read)."""
+    return [dict(d).get("TSD_THROUGH_READ") for (_, fs, d, _) in renderer.programs.entries if fs == FWD]
 
 
-def test_the_head_drawn_in_two_parts_is_the_same_image(ctx, head, monkeypatch):
+@pytest.mark.parametrize("scene_name", ["head", "bunny-skimmilk"])
+def test_the_mesh_drawn_in_groups_is_the_same_image(ctx, scene_name, monkeypatch):
+    """The head (one shadow slot: those that read its light through and the others) and the skim-milk
+    bunny (two slots: every combination), against the mesh drawn whole with every slot's exit factor."""
+    scene = load_scene(scene_name)
     st = RenderSettings.for_technique("tsd", 64, 64, shadow_size=512, size=128)
     r = Renderer(ctx)
     r.reuse = True
     try:
-        split = r.render(head, st).hdr
+        split = r.render(scene, st).hdr
         t = next(iter(frame_nodes(r.last_frame).values()))
-        ibo, n, total = t.targets.through_faces
-        assert 0 < n < total and total == head.mesh_nodes()[0].mesh.indices.size
-        assert sorted(_forward_variants(r)) == ["0", "1"]
-        res = r.render(head, st)  # orbiting: the irradiance pass reused, its split kept
+        ibo, groups = t.targets.through_faces
+        total = scene.mesh_nodes()[0].mesh.indices.size
+        assert sum(c for _, _, c in groups) == total and len(groups) > 1
+        every = (1 << t.through_slots) - 1
+        assert t.through_slots == (2 if "bunny" in scene_name else 1)
+        assert {m for m, _, _ in groups} <= set(range(every + 1))
+        assert sorted(_forward_variants(r), key=str) == sorted(
+            [None if m == every else str(m) for m, _, _ in groups], key=str
+        )
+        res = r.render(scene, st)  # orbiting: the irradiance pass reused, its groups kept
         assert next(p for p in res.plan.passes if p.kind == "tsd_irradiance").reused_since is not None
         orbit = res.hdr
-        # every triangle drawn as the part without the exit factor: another image (a wrong split shows)
-        t.targets.through_faces = (ibo, 0, total)
-        none = r.render(head, st).hdr
-        monkeypatch.setattr(tsd_passes, "MIN_SPLIT_SHARE", 2.0)  # never split: the whole mesh with the exit factor
+        # every triangle drawn as reading no slot's light through: another image (a wrong split shows)
+        t.targets.through_faces = (ibo, [(0, 0, total)])
+        none = r.render(scene, st).hdr
+        monkeypatch.setattr(tsd_passes, "MIN_SPLIT_SHARE", 2.0)  # never grouped: the whole mesh, every slot
         whole = Renderer(ctx)
-        full = whole.render(head, st).hdr
+        full = whole.render(scene, st).hdr
         assert not next(iter(frame_nodes(whole.last_frame).values())).targets.through_faces
-        assert _forward_variants(whole) == ["1"]
+        assert _forward_variants(whole) == [None]
         whole.release()
     finally:
         r.release()

@@ -2,9 +2,9 @@
 levels (skinlab/shaders/techniques/tsd/forward.glsl) for every mesh whose irradiance pass ran this frame, and
 local scattering (skinlab/shaders/techniques/tsd/local.glsl: entry, exit and single scattering without a
 blur) for a scattering mesh whose profile is narrower than a texel. Where the irradiance pass recorded light
-through thin parts, the mesh is drawn in two parts (NodeShading.parts, through_split.py): the triangles
-that can read a texel of the record holding light, with the exit factor of that light, and the others
-without it (TSD_THROUGH 0: it adds exactly 0 there), the same image."""
+through thin parts, the mesh is drawn in groups (NodeShading.parts, through_split.py): each group of
+triangles with the exit factor of the light through of only the shadow slots whose record it can read
+holding light (TSD_THROUGH_READ, a mask; the others add exactly 0 there), the same image."""
 
 from __future__ import annotations
 
@@ -44,9 +44,13 @@ class TsdForward(ForwardHook):
         parts: tuple[DrawPart, ...] = ()
         if t.translucency and t.through_slots > 0:
             defines["TSD_THROUGH"] = t.through_slots
-            if t.targets.through_faces:  # the triangles that can read light through first, the others without it
-                ibo, n, total = t.targets.through_faces
-                parts = (DrawPart(ibo, 0, n), DrawPart(ibo, n, total - n, {"TSD_THROUGH": 0}))
+            if t.targets.through_faces:  # each group of triangles with the slots whose light through it can read
+                ibo, groups = t.targets.through_faces
+                every = (1 << t.through_slots) - 1
+                parts = tuple(
+                    DrawPart(ibo, first, count, {} if m == every else {"TSD_THROUGH_READ": m})
+                    for m, first, count in groups
+                )
 
         def bind(prog, units):
             bind_gather(prog, t, units)

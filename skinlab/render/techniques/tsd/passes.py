@@ -40,7 +40,7 @@ from skinlab.scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
 from .seams import SeamMap, node_border_strips
-from .through_split import lit_texels, split_indices, through_triangles
+from .through_split import lit_texels, slot_masks, split_indices
 
 STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
@@ -86,8 +86,8 @@ class TsdNodeTargets:
     strips: tuple = ()  # (source array, depth renderbuffer): where the record's fill runs (strip_mask)
     surface: list = field(default_factory=list)  # the surface G-buffer (surface_buffer), RGBA32F, nearest
     masks: dict = field(default_factory=dict)  # coverage masks by what was rasterised (coverage_mask)
-    # (index buffer, n, total): the mesh's triangles that can read light from the record first (n
-    # indices), the others after them (record_split); () where it was not made
+    # (index buffer, [(slot mask, first, count), ...]): the mesh's triangles grouped by the slots of the
+    # record whose light they can read (record_split); () where it was not made
     through_faces: tuple = ()
 
     def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture, depth=None) -> moderngl.Framebuffer:
@@ -518,25 +518,27 @@ def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | 
         renderer.fullscreen(prog)
 
 
-# the share of the triangles that must read no light through for the mesh to be drawn in two parts
+# the share of the slot records' reads by triangles that grouping must save for the mesh to be drawn in groups
 MIN_SPLIT_SHARE = 0.1
 
 
 def record_split(ctx, t: TsdNodeTargets, mesh, slots: int) -> None:
-    """t.through_faces from the filled record of the `slots` the gather reads (at most 2): the mesh's
-    triangles that can read a texel holding light through first, then the others (through_split.py;
-    the forward pass draws the others without the exit factor of that light, the same image)."""
+    """t.through_faces from the filled records of the `slots` the gather reads (at most 2): the mesh's
+    triangles grouped by the slots whose light through they can read (through_split.py; the forward pass
+    draws each group without the exit factor of the other slots' light, the same image); none where
+    that saves less than MIN_SPLIT_SHARE of the reads (a draw per group is not worth it)."""
     if t.through_faces:
         t.through_faces[0].release()
         t.through_faces = ()
-    if mesh.uvs is None or slots < 1:
+    n = min(slots, SHADOW_SLOTS)
+    if mesh.uvs is None or n < 1:
         return
-    lit = np.zeros((t.size, t.size), bool)
-    for tex in t.through_record(ctx)[: min(slots, SHADOW_SLOTS)]:
-        lit |= lit_texels(tex.read(), t.size)
-    flat, first = split_indices(mesh.indices, through_triangles(mesh.uvs, mesh.indices, lit))
-    if flat.size - first >= MIN_SPLIT_SHARE * flat.size:  # else a second variant's draw is not worth it
-        t.through_faces = (ctx.buffer(flat.tobytes()), first, int(flat.size))
+    lits = [lit_texels(tex.read(), t.size) for tex in t.through_record(ctx)[:n]]
+    mask = slot_masks(mesh.uvs, mesh.indices, lits)
+    reads = sum(int(np.count_nonzero(mask & (1 << k))) for k in range(n))
+    if reads <= (1.0 - MIN_SPLIT_SHARE) * n * len(mask):
+        flat, groups = split_indices(mesh.indices, mask)
+        t.through_faces = (ctx.buffer(flat.tobytes()), groups)
 
 
 class TsdDilatePass(TsdPass):

@@ -1,17 +1,18 @@
 """Which of a mesh's triangles can read light through thin parts from the irradiance pass's record
-(skinlab/render/techniques/tsd/passes.py TsdNodeTargets.through_record), so that the forward pass
-draws only those with the gather's exit factor of that light (skinlab/shaders/techniques/tsd/forward.glsl,
-TSD_THROUGH) and the others without it (TSD_THROUGH 0).
+(skinlab/render/techniques/tsd/passes.py TsdNodeTargets.through_record), per shadow slot, so that the
+forward pass draws each triangle with the gather's exit factor of that light for the slots it can read
+only (skinlab/shaders/techniques/tsd/forward.glsl, TSD_THROUGH_READ: a mask of the slots; 0 none).
 
 The gather reads the record at the fragment's interpolated uv with nearest filtering and clamp to edge:
 the texel floor(uv x size), clamped to the texture. A fragment inside a triangle has its uv inside the
 triangle's UV bounding box, so it reads a texel of the box's texels; `MARGIN_TEXELS` more on every
 side keep a fragment whose uv the interpolation put a rounding past the box's edge. A triangle none
-of whose box's texels holds light reads only records of zero light, for which the exit factor's
-difference adds exactly 0 (its factor is finite: skinlab/shaders/lib/sss_boundary.glsl sss_slab_exit
-divides by at least 1e-30), so drawing it without the exit factor gives the same image. On
-llvmpipe a branch's arithmetic runs even where no fragment of a group takes it (docs/tsd.md, "Fifth
-round"): only a variant without the code saves it. A triangle with a UV that is not finite is kept."""
+of whose box's texels holds a slot's light reads only records of zero light from it, for which the
+exit factor's difference adds exactly 0 (its factor is finite: skinlab/shaders/lib/sss_boundary.glsl
+sss_slab_exit divides by at least 1e-30), so drawing it without that slot's exit factor gives the same
+image. On llvmpipe a branch's arithmetic runs even where no fragment of a group takes it (docs/tsd.md,
+"Fifth round"): only a variant without the code saves it. A triangle with a UV that is not finite
+reads every slot."""
 
 from __future__ import annotations
 
@@ -54,9 +55,21 @@ def lit_texels(record: bytes, size: int) -> np.ndarray:
     return (bits[..., 0] | bits[..., 1] | bits[..., 2]) != 0
 
 
-def split_indices(indices: np.ndarray, reads: np.ndarray) -> tuple[np.ndarray, int]:
-    """The triangles `reads` marks first, then the others (each in its order): (flat uint32 indices,
-    how many of them belong to the first part)."""
+def slot_masks(uvs: np.ndarray, indices: np.ndarray, lits: list[np.ndarray]) -> np.ndarray:
+    """Per triangle the mask of the slots (bit k: lits[k], each (H, W) bool) whose lit texels it can read."""
+    mask = np.zeros(len(np.asarray(indices).reshape(-1, 3)), np.int64)
+    for k, lit in enumerate(lits):
+        mask |= through_triangles(uvs, indices, lit).astype(np.int64) << k
+    return mask
+
+
+def split_indices(indices: np.ndarray, mask: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int, int]]]:
+    """The triangles grouped by `mask` (per triangle: an int, e.g. slot_masks'), each group in its
+    order: (flat uint32 indices, [(mask value, first index, index count), ...] in increasing value)."""
     tris = np.asarray(indices, np.uint32).reshape(-1, 3)
-    order = np.concatenate([np.flatnonzero(reads), np.flatnonzero(~reads)])
-    return np.ascontiguousarray(tris[order].reshape(-1)), int(np.count_nonzero(reads)) * 3
+    mask = np.asarray(mask)
+    order = np.argsort(mask, kind="stable")
+    values, counts = np.unique(mask, return_counts=True)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    groups = [(int(v), int(a) * 3, int(c) * 3) for v, a, c in zip(values, starts, counts)]
+    return np.ascontiguousarray(tris[order].reshape(-1)), groups

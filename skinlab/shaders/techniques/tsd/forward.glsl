@@ -9,9 +9,9 @@
 // record (per shadow slot: the light through, its thickness and cosine; TSD_THROUGH = slots):
 // exact where that light varies slowly across the profile (a flat part), linear in the lights; at a
 // sharp edge of the light through (a rim where the thickness drops) it can take a little more than
-// the blur brought there (at least 0). TSD_THROUGH 0: triangles that read no texel of the record
-// holding light (skinlab/render/techniques/tsd/through_split.py), for which that difference is exactly 0:
-// the record is not read. Contract: skinlab/render/technique.py.
+// the blur brought there (at least 0). TSD_THROUGH_READ (a mask of the slots, default all): triangles
+// that read no texel of the other slots' records holding light (skinlab/render/techniques/tsd/through_split.py),
+// for which their difference is exactly 0: those records are not read. Contract: skinlab/render/technique.py.
 // The separable boundary's non-separable rest is added by the forward pass where the light lands
 // (passes/forward.frag): this hook does not spread it with its diffusion.
 #define SSS_MS_REST_LANDS
@@ -23,7 +23,10 @@ uniform float u_tsd_mix;
 uniform vec3 u_tsd_identity;         // weight of the unblurred irradiance per channel
 uniform vec3 u_tsd_w[6];             // weight of each blurred level per channel
 uniform sampler2D u_tsd_irradiance;  // premultiplied by coverage: rgb / a
-#if defined(TSD_THROUGH) && TSD_THROUGH > 0
+#ifdef TSD_THROUGH
+#ifndef TSD_THROUGH_READ
+#define TSD_THROUGH_READ 3
+#endif
 uniform sampler2D u_tsd_through0;     // slot 0's light through (rgb), its thickness in mm (a); nearest
 uniform sampler2D u_tsd_through1;     // slot 1's
 uniform sampler2D u_tsd_through_cos;  // their cosines on the far face (r, g)
@@ -97,15 +100,18 @@ vec3 sss_radiance(Surface s) {
     exit_ = vec3(NoV);
 #endif
     vec3 leaving = post * tsd_diffused(uv) * exit_;
-#if defined(TSD_THROUGH) && TSD_THROUGH > 0 && !defined(MEASURE_NO_THROUGH)  // MEASURE_NO_THROUGH: tools/orbit_cost.py
+#if defined(TSD_THROUGH) && !defined(MEASURE_NO_THROUGH)  // MEASURE_NO_THROUGH: tools/orbit_cost.py
+    vec3 diff = vec3(0.0);
+#if TSD_THROUGH_READ != 0
     vec2 backs = texture(u_tsd_through_cos, uv).rg;
-    vec3 diff = tsd_through_exit(texture(u_tsd_through0, uv), backs.r, abs(NoV), exit_);
-#if TSD_THROUGH > 1
+#endif
+#if TSD_THROUGH_READ == 1 || TSD_THROUGH_READ == 3
+    diff = tsd_through_exit(texture(u_tsd_through0, uv), backs.r, abs(NoV), exit_);
+#endif
+#if TSD_THROUGH > 1 && TSD_THROUGH_READ >= 2
     diff += tsd_through_exit(texture(u_tsd_through1, uv), backs.g, abs(NoV), exit_);
 #endif
     leaving = max(leaving + max(base, vec3(0.0)) * diff, vec3(0.0));
-#elif defined(TSD_THROUGH)
-    leaving = max(leaving, vec3(0.0));  // TSD_THROUGH 0: the record holds no light here (diff is 0)
 #endif
     return (1.0 - u_metallic) * s.sss_weight * INV_PI * leaving;
 }
