@@ -49,6 +49,17 @@ def material_ms_rest(material) -> np.ndarray:
     return ms_rest_table(medium.alpha_arr, subsurface_albedo(material.values), medium.eta, boundary_ggx_alpha(material))
 
 
+def boundary_defines(material) -> dict:
+    """The forward pass's variant for `material`'s boundary (None: a mesh shaded without its medium):
+    SSS_MS_REST where its multiple scattering's non-separable rest is not all zero
+    (lib/sss_boundary.glsl sss_ms_rest; zero at eta > 1); without it the rest is compiled out, as it
+    adds 0 (a software rasteriser runs a branch's arithmetic even where no fragment takes it,
+    docs/tsd.md "Fifth round")."""
+    if material_boundary(material) is None:
+        return {}
+    return {"SSS_MS_REST": 1} if np.any(material_ms_rest(material) != 0) else {}
+
+
 def boundary_data(material) -> None:
     """Make (or read) everything :func:`bind_boundary` binds for `material`: its boundary tables and
     its slab tables (both memoised: a later bind finds them)."""

@@ -57,12 +57,17 @@ class GpuMesh:
         extra = [(self.streams[s], s.format, s.attribute) for s in self.active]
         return [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRS), *extra]
 
-    def vao(self, program: moderngl.Program) -> moderngl.VertexArray:
-        key = (id(program), self.active)
+    def vao(self, program: moderngl.Program, indices: moderngl.Buffer | None = None) -> moderngl.VertexArray:
+        """The vertex array of `program` over this mesh's vertices, indexed by its own triangles or
+        by `indices` (a uint32 index buffer into its vertices, e.g. its triangles reordered)."""
+        ibo = self.ibo if indices is None else indices
+        key = (id(program), self.active, id(ibo))
         vao = self._vaos.get(key)
-        if vao is None or vao.program is not program:
+        if vao is None or vao.program is not program or vao.index_buffer is not ibo:
+            if vao is not None:
+                vao.release()
             vao = self.ctx.vertex_array(
-                program, self.content(), index_buffer=self.ibo, index_element_size=4, skip_errors=True
+                program, self.content(), index_buffer=ibo, index_element_size=4, skip_errors=True
             )
             self._vaos[key] = vao
         return vao

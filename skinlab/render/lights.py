@@ -52,6 +52,15 @@ def area_defines(lights) -> dict:
     return {"AREA_LIGHTS": 1} if any(getattr(l, "is_area", False) for l in lights) else {}
 
 
+def near_defines(lights) -> dict:
+    """NEAR_LIGHTS: 1 when `lights` (those a pass uploads, set_light_uniforms) hold a point or spot light
+    (lib/sss_near_light.glsl sss_light_is_near), else 0: the subsurface factors of a light at a finite
+    distance are then compiled out (each is 1 for the other kinds)."""
+    return {"NEAR_LIGHTS": int(any(l.kind in NEAR_KINDS for l in lights))}
+
+
+NEAR_KINDS = ("point", "spot")  # lights at a finite distance (lib/sss_near_light.glsl sss_light_is_near)
+
 LIGHT_KIND_CODE = {"directional": 0.0, "point": 0.0, "spot": 1.0, "rect": 2.0, "sphere": 3.0}
 
 

@@ -119,6 +119,18 @@ class TechniqueState:
 
 
 @dataclass
+class DrawPart:
+    """Some of a mesh's triangles drawn with a variant of their own: `count` indices from `first` of
+    `indices` (a uint32 index buffer into the mesh's vertices), with the NodeShading's defines updated
+    by `defines`."""
+
+    indices: moderngl.Buffer
+    first: int
+    count: int
+    defines: dict[str, object] = field(default_factory=dict)
+
+
+@dataclass
 class NodeShading:
     """How the forward pass shades one mesh: the material to bind, the hook file, the variant's
     defines and a function binding the hook's uniforms and textures."""
@@ -130,6 +142,11 @@ class NodeShading:
     # the mesh scatters below its surface: the forward pass binds its medium's entry/exit factors
     # and single scattering (skinlab/render/boundary.py); False for a hook that shades it without
     subsurface: bool = True
+    # the mesh's triangles in parts, each drawn with its own variant (texture-space diffusion: those
+    # that can read light through thin parts, and the others without that code); () draws the mesh's
+    # own triangles at once. The parts together must be every triangle once; an opaque mesh's alone
+    # (a blended one is drawn whole)
+    parts: tuple[DrawPart, ...] = ()
 
 
 class ForwardHook:

@@ -88,3 +88,19 @@ def test_forward_cost_times_a_technique_s_translucency_by_its_parts(ctx, capsys)
         forward_cost.main(["--translucency", "tsd", "--size", "16", "--rounds", "1"])  # its irradiance pass does
     with pytest.raises(SystemExit, match="'tint' has no translucency setting"):
         forward_cost.main(["--translucency", "tint", "--size", "16", "--rounds", "1"])
+
+
+def test_orbit_cost_runs_tiny_and_reads_its_defines(capsys):
+    from pathlib import Path
+
+    import skinlab
+    from tools import orbit_cost
+
+    here = Path(skinlab.__file__).resolve().parents[1]  # a checkout holding skinlab/shaders: these shaders again
+    assert orbit_cost.main(["--size", "16", "--rounds", "1", "--against", str(here)]) == 0
+    out = capsys.readouterr().out
+    for name in ("base", "plain", "no_bounce", *orbit_cost.MEASURES, "against0"):
+        assert f"  {name:<16}" in out
+    assert "HDR relative difference max 0," in out  # the same shaders: the same image
+    with pytest.raises(SystemExit, match="--against: no shaders under"):
+        orbit_cost.main(["--size", "16", "--rounds", "1", "--only", "plain", "--against", str(here / "tests")])

@@ -13,7 +13,9 @@ import tools
 from skinlab.resources import asset_path
 
 TOOLS = Path(tools.__file__).parent
-TESTED_ELSEWHERE = {"truth_table", "closeup_table", "forward_cost", "irradiance_cost", "cost_variants", "gpu_reference"}
+TESTED_ELSEWHERE = {
+    "truth_table", "closeup_table", "forward_cost", "irradiance_cost", "orbit_cost", "cost_variants", "gpu_reference",
+}  # fmt: skip
 HERE = {
     "accuracy_table", "boundary_slab", "branch_cost", "env_sphere", "frame_times", "full_over_plain",
     "make_face_parts", "make_reference_meshes", "near_light_check", "repair_bunny", "seam_report",
@@ -62,8 +64,17 @@ def test_branch_cost(capsys):
 
     assert branch_cost.main(["--size", "64", "--rounds", "1", "--stripe", "4"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0].endswith("64x64") and [line.split()[0] for line in out[1:]] == ["not", "taken", "stripes"]
+    assert out[0].endswith("64x64 (looped branch)") and [line.split()[0] for line in out[1:]] == [
+        "not",
+        "taken",
+        "stripes",
+    ]
     assert all(float(line.split()[-2]) >= 0.0 for line in out[1:])
+    from tools.branch_cost import FRAGMENT, STRAIGHT
+
+    assert "for (" in FRAGMENT and "for (" not in STRAIGHT and STRAIGHT.count("texelFetch") == 65  # written out
+    assert branch_cost.main(["--size", "64", "--rounds", "1", "--straight"]) == 0
+    assert capsys.readouterr().out.splitlines()[0].endswith("(straight-line branch)")
 
 
 def test_env_sphere(tmp_path, capsys):

@@ -21,11 +21,11 @@ from skinlab.gl.state import gl_state
 from skinlab.gl.uniforms import set_uniforms
 from skinlab.render.alpha import bind_mask, blended, draw_order, mask_defines
 from skinlab.render.ambient import ambient_defines, bind_ambient
-from skinlab.render.boundary import bind_boundary
+from skinlab.render.boundary import bind_boundary, boundary_defines
 from skinlab.render.environment import DATA_KEY as ENV_DATA
 from skinlab.render.environment import bind_env_bands, env_uniforms
 from skinlab.render.gpu_resources import node_uniforms
-from skinlab.render.lights import area_defines, bind_shadow_maps, light_defines, set_light_uniforms
+from skinlab.render.lights import area_defines, bind_shadow_maps, light_defines, near_defines, set_light_uniforms
 from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK, ForwardParams, NodeShading, RenderPass
 from skinlab.render.texture_units import TextureUnits
 
@@ -165,15 +165,28 @@ class ForwardPass(RenderPass):
                 self.shade_node(frame, prm, per_frame, node)
 
     def shade_node(self, frame, prm: ForwardParams, per_frame, node) -> None:
-        ctx, hook, nmax = self.r.ctx, prm.hook, frame.settings.max_lights
+        hook, nmax = prm.hook, frame.settings.max_lights
         sh = hook.shading(node, frame) or NodeShading(node.material)
+        scatters = sh.hook != PLAIN_HOOK and sh.subsurface
         defines = {
             **sh.material.defines(),
             **light_defines(prm.shadow_lights, nmax, frame),
             **area_defines(prm.lights),
+            **near_defines(prm.lights),
+            **boundary_defines(sh.material if scatters else None),
             **ambient_defines(frame, node),
             **sh.defines,
         }
+        # the hook's parts of the triangles, each with its own variant (an opaque mesh's), or all at once
+        parts = [q for q in sh.parts if q.count > 0] if sh.parts and not blended(node.material) else [None]
+        for part in parts:
+            variant = defines if part is None else {**defines, **part.defines}
+            self.draw_node(frame, prm, per_frame, node, sh, variant, part)
+
+    def draw_node(self, frame, prm: ForwardParams, per_frame, node, sh: NodeShading, defines, part) -> None:
+        """Bind and draw `node`'s triangles (those of DrawPart `part`, or all: None) with variant `defines`."""
+        ctx, nmax = self.r.ctx, frame.settings.max_lights
+        scatters = sh.hook != PLAIN_HOOK and sh.subsurface
         prog = self.r.programs.get(
             "passes/forward.vert", "passes/forward.frag", defines, includes={HOOK_INCLUDE: sh.hook}
         )
@@ -184,9 +197,12 @@ class ForwardPass(RenderPass):
         set_uniforms(prog, node_uniforms(node))
         bind_ambient(frame, node, prog, units)
         self.r.resources.bind_material(prog, sh.material, units)
-        scatters = sh.hook != PLAIN_HOOK and sh.subsurface
         bind_boundary(prog, sh.material if scatters else None)
         bind_env_bands(prog, sh.material if scatters else None)
         if sh.bind is not None:
             sh.bind(prog, units)
-        self.r.resources.mesh(node.mesh).vao(prog).render(moderngl.TRIANGLES)
+        mesh = self.r.resources.mesh(node.mesh)
+        if part is None:
+            mesh.vao(prog).render(moderngl.TRIANGLES)
+        else:
+            mesh.vao(prog, part.indices).render(moderngl.TRIANGLES, part.count, part.first)

@@ -82,9 +82,9 @@ void light_incidence(int i, vec3 world, vec3 n, out vec3 l, out vec3 e) {
 
 // SHADOW_SLOTS: how many shadow-map slots the frame fills (0, 1 or 2; skinlab/render/lights.py
 // light_defines). A slot the frame leaves empty is compiled out: a software rasteriser (llvmpipe)
-// runs a branch with the lanes masked wherever a group of fragments disagrees or any takes it
-// (docs/tsd.md "Third round": one no fragment takes is skipped); compiled out, an unused slot costs
-// nothing for certain (measured when this was written: the plain frame without shadows took 1.9x as
+// runs a branch's arithmetic with the lanes masked even where no fragment of a group takes it (a
+// loop in it stops after one masked turn: docs/tsd.md "Third round", corrected in the "Fifth
+// round"); compiled out, an unused slot costs nothing for certain (measured when this was written: the plain frame without shadows took 1.9x as
 // long with them in).
 #ifndef SHADOW_SLOTS
 #define SHADOW_SLOTS 2

@@ -9,17 +9,38 @@ float refract_cos(float cos_i, float eta) {
     return sqrt(max((eta - 1.0) * (eta + 1.0) + c * c, 0.0)) / eta;
 }
 
-vec3 single_scatter_brdf(vec3 n, vec3 wi, vec3 wo, vec3 alpha, float eta, float g) {
+// The view's half of single_scatter_brdf, the same for every light (a pass with several lights makes it
+// once): the view's cosine co, its refracted cosine cto and direction to inside, and the Fresnel
+// transmission out t_out. single_scatter_brdf_view with it is single_scatter_brdf, operation for
+// operation.
+struct SingleView {
+    float co;
+    float cto;
+    vec3 to;
+    float t_out;
+};
+
+SingleView single_scatter_view(vec3 n, vec3 wo, float eta) {
+    SingleView sv;
+    sv.co = dot(n, wo);
+    sv.cto = refract_cos(sv.co, eta);
+    sv.to = -wo / eta + (sv.co / eta - sv.cto) * n;
+    sv.t_out = 1.0 - fresnel_from_cosines(sv.co, sv.cto, 1.0, eta);
+    return sv;
+}
+
+vec3 single_scatter_brdf_view(vec3 n, vec3 wi, SingleView sv, vec3 alpha, float eta, float g) {
     float ci = dot(n, wi);
-    float co = dot(n, wo);
-    if (ci <= 0.0 || co <= 0.0) return vec3(0.0);
+    if (ci <= 0.0 || sv.co <= 0.0) return vec3(0.0);
     float cti = refract_cos(ci, eta);
-    float cto = refract_cos(co, eta);
     vec3 ti = -wi / eta + (ci / eta - cti) * n;
-    vec3 to = -wo / eta + (co / eta - cto) * n;
-    float cos_s = clamp(-dot(ti, to), -1.0, 1.0);
-    float ft = (1.0 - fresnel_from_cosines(ci, cti, 1.0, eta)) * (1.0 - fresnel_from_cosines(co, cto, 1.0, eta));
-    return alpha * (ft * hg_phase(cos_s, g) / (max(cti + cto, 1e-4) * eta * eta));  // 1/eta^2: solid angle
+    float cos_s = clamp(-dot(ti, sv.to), -1.0, 1.0);
+    float ft = (1.0 - fresnel_from_cosines(ci, cti, 1.0, eta)) * sv.t_out;
+    return alpha * (ft * hg_phase(cos_s, g) / (max(cti + sv.cto, 1e-4) * eta * eta));  // 1/eta^2: solid angle
+}
+
+vec3 single_scatter_brdf(vec3 n, vec3 wi, vec3 wo, vec3 alpha, float eta, float g) {
+    return single_scatter_brdf_view(n, wi, single_scatter_view(n, wo, eta), alpha, eta, g);
 }
 
 vec3 single_scatter_profile(float r, vec3 alpha, vec3 mfp, float eta, float g) {

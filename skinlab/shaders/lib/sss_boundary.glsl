@@ -69,6 +69,13 @@ vec3 sss_single_brdf(vec3 n, vec3 l, vec3 v) {
     return single_scatter_brdf(n, l, v, u_sss_single, max(u_sss_eta, 1.0), u_sss_g);
 }
 
+// The same in two halves: the view's (sss_single_view, once per fragment) and each light's.
+SingleView sss_single_view(vec3 n, vec3 v) { return single_scatter_view(n, v, max(u_sss_eta, 1.0)); }
+
+vec3 sss_single_brdf_view(vec3 n, vec3 l, SingleView sv) {
+    return single_scatter_brdf_view(n, l, sv, u_sss_single, max(u_sss_eta, 1.0), u_sss_g);
+}
+
 // Light through thin parts (NumPy twin: skinlab/scene/optics/slab.py slab_through): of the irradiance (normal
 // to the light) arriving at cosine `back` on the far face of a part d_mm thick, what leaves the near
 // face after scattering inside, per unit base colour: the exact diffuse transmittance of the
@@ -137,6 +144,9 @@ uniform vec3 u_sss_slab_ab[2 * SSS_SLAB_TAU];           // A per thickness node,
 vec2 sss_slab_uh(float x, int j, float ft, float lnn, int c) {
     float xm = x * float(SSS_SLAB_MU - 1);
     int i = min(int(floor(xm)), SSS_SLAB_MU - 2);
+#ifdef MEASURE_SLAB_CONST_INDEX
+    i = 3;
+#endif
     float fm = xm - float(i);
     int r0 = i * SSS_SLAB_TAU + j;
     int r1 = r0 + SSS_SLAB_TAU;
@@ -165,14 +175,27 @@ vec3 sss_slab_exit(float mu, float mu0, float d_mm) {
         if (l <= 0.0) continue;
         float tc = clamp(d / l, tmin, tmax);
         int j = max(min(int(floor((log2(tc) - SSS_SLAB_LOG2_TAU_MIN) * 2.0)), SSS_SLAB_TAU - 2), 0);
+#ifdef MEASURE_SLAB_CONST_INDEX  // a measurement variant (tools/orbit_cost.py): the tables read at fixed rows
+        j = 5;
+#endif
         float t0 = exp2(SSS_SLAB_LOG2_TAU_MIN + 0.5 * float(j));
+#ifdef MEASURE_SLAB_NO_LOG  // a measurement variant (tools/orbit_cost.py): no log2 or exp2 for the node
+        j = 5;
+        t0 = 0.4;
+#endif
         float ft = clamp((tc - t0) / (t0 * (sqrt(2.0) - 1.0)), 0.0, 1.0);
         float lnn = mix(u_sss_slab_norm[j][c], u_sss_slab_norm[j + 1][c], ft);
         float a = mix(u_sss_slab_ab[j][c], u_sss_slab_ab[j + 1][c], ft);
         float b = mix(u_sss_slab_ab[SSS_SLAB_TAU + j][c], u_sss_slab_ab[SSS_SLAB_TAU + j + 1][c], ft);
         vec2 uh = sss_slab_uh(m, j, ft, lnn, c);
+#ifdef MEASURE_SLAB_VIEW_ONLY  // a measurement variant (tools/orbit_cost.py): only the view's half computed
+        float q = m0 * d;
+        a = 1.0 + q;
+        b = q;
+#else
         vec2 uh0 = sss_slab_uh(m0, j, ft, lnn, c);
         float q = clamp(uh0.y / max(uh0.x, 1e-30), -SSS_EXIT_Q_MAX, SSS_EXIT_Q_MAX);
+#endif
         out_[c] = t_out * max(uh.x - uh.y * q, 0.0) / max(max(a - b * q, 0.5 * a), 1e-30);
     }
     return out_;

@@ -23,7 +23,9 @@ vec3 sss_rest = vec3(0.0);  // sum of e NoL rest(mu, mu0) over the lights (radia
 
 void sss_add_light(Surface s, vec3 e, float vis, float NoL) {
     sss_in += e * (vis * NoL) * sss_entry(NoL);
+#ifdef SSS_MS_REST  // the material's rest is not all zero (skinlab/render/boundary.py boundary_defines)
     if (u_sss_ms_rest_on > 0.0) sss_rest += e * (vis * NoL) * sss_ms_rest(abs(s.NoV), NoL);
+#endif
 }
 
 // The radiance leaving the medium toward the viewer at s for subsurface weight sss_w (ambient

@@ -25,7 +25,18 @@ vec3 sss_near_entry_gain(vec3 d_mm, vec3 ng, vec3 z0_mm) {
 // is a shift, which only the shadow lookup needs, lib/sss_oblique.glsl sss_entry_point).
 // Whether light i is at a finite distance from a point (a point or a spot light; not a directional
 // or an area light).
+// NEAR_LIGHTS 0 (skinlab/render/lights.py near_defines: the pass's lights hold no point or spot light)
+// compiles the near-light factors out, each then its far value 1: a software rasteriser pays for code
+// behind a branch no fragment takes (docs/tsd.md, "Fifth round"). Without the define, as with 1, they
+// are decided per light.
+#ifndef NEAR_LIGHTS
+#define NEAR_LIGHTS 1
+#endif
+#if NEAR_LIGHTS
 bool sss_light_is_near(int i) { return u_light_vec[i].w != 0.0 && u_light_axis[i].w <= 1.5; }
+#else
+bool sss_light_is_near(int i) { return false; }
+#endif
 
 vec3 sss_light_near_gain(int i, vec3 world, vec3 ng, vec3 z0_mm) {
     if (!sss_light_is_near(i)) return vec3(1.0);

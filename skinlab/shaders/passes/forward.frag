@@ -14,7 +14,10 @@
 // technique blurs it. Ambient light is the sky and, with variant BOUNCE, the light the scene's
 // surfaces throw onto this one (interreflection, lib/ambient.glsl); with variant ENV_MAP the
 // environment map's diffuse light (lib/ambient.glsl, every hook's entering light too) and its
-// specular light by the split sum (lib/sky_occlusion.glsl env_specular).
+// specular light by the split sum (lib/sky_occlusion.glsl env_specular). Variant SSS_MS_REST
+// (skinlab/render/boundary.py boundary_defines): the material's non-separable rest is not all zero;
+// NEAR_LIGHTS 0 (skinlab/render/lights.py near_defines): no point or spot light, the near-light
+// factors compiled out (lib/sss_near_light.glsl).
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
@@ -64,7 +67,12 @@ void main() {
     float NoV = s.NoV;
     vec3 color = vec3(0.0);
     bool single = any(greaterThan(u_sss_single, vec3(0.0)));
+#ifdef MEASURE_NO_SINGLE  // a measurement variant (tools/orbit_cost.py): no single scattering
+    single = false;
+#endif
     vec3 single_w = s.m.sss_albedo * ((1.0 - metal) * s.sss_weight);  // x the weight map
+    SingleView single_view;  // single scattering's half that no light changes, made once
+    if (single) single_view = sss_single_view(n, v);
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, e;
@@ -83,6 +91,9 @@ void main() {
         vec3 h = half_vector(n, v, l);
         float LoH = dot(l, h);
         vec3 diffuse = base * ((1.0 - metal) * plain * burley_diffuse(NoL, NoV, LoH, rough));
+#ifdef MEASURE_NO_PLAIN_DIFFUSE  // a measurement variant (tools/orbit_cost.py): no Burley diffuse per light
+        diffuse = vec3(0.0);
+#endif
 #ifdef DIFFUSE_TRANSMISSION
         diffuse *= 1.0 - u_diffuse_transmission;  // what is not sent through
 #endif
@@ -102,13 +113,15 @@ void main() {
         // sss_near_single), and there too, for a hook of the separable boundary that does not spread it
         // with its diffusion (SSS_MS_REST_LANDS: tsd, exact, preintegrated), the multiple scattering's
         // non-separable rest (lib/sss_boundary.glsl sss_ms_rest)
-        if (single) color += e * (vis * NoL) * single_w * sss_single_brdf(n, l, v) * sss_near_single(s, i);
-#ifdef SSS_MS_REST_LANDS
+        if (single) color += e * (vis * NoL) * single_w * sss_single_brdf_view(n, l, single_view) * sss_near_single(s, i);
+#if defined(SSS_MS_REST_LANDS) && defined(SSS_MS_REST) && !defined(MEASURE_NO_MS_REST)  // MEASURE_NO_MS_REST: tools/orbit_cost.py
         if (u_sss_ms_rest_on > 0.0) color += e * (vis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
 #endif
         // the technique's diffusion: shadowed where it entered (oblique entry, lib/surface_inputs.glsl)
         // and fed by the irradiance where it entered (a point or spot light's, lib/surface_inputs.glsl)
+#ifndef MEASURE_NO_ADD_LIGHT  // a measurement variant (tools/orbit_cost.py): the hook told of no light
         sss_add_light(s, e * sss_near_gain(s, i), sss_entry_visibility(s, i, l), NoL);
+#endif
     }
     vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
     float kept = 1.0;
@@ -125,7 +138,9 @@ void main() {
     color += ambient * (base * ((1.0 - metal) * plain * kept) + f0);
     if (single) color += ambient * single_w * sss_single_ambient(NoV);  // its single scattering
 #endif
+#ifndef MEASURE_NO_SSS_RADIANCE  // a measurement variant (tools/orbit_cost.py): the hook's radiance left out
     color += sss_radiance(s);
+#endif
     vec3 emission = u_emissive;
 #ifdef HAS_EMISSIVE_MAP
     emission *= texture(u_emissive_map, s.m.uv).rgb;

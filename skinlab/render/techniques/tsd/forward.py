@@ -1,12 +1,15 @@
 """The forward pass's part of texture-space diffusion: the gather of the irradiance and its blurred
 levels (skinlab/shaders/techniques/tsd/forward.glsl) for every mesh whose irradiance pass ran this frame, and
 local scattering (skinlab/shaders/techniques/tsd/local.glsl: entry, exit and single scattering without a
-blur) for a scattering mesh whose profile is narrower than a texel."""
+blur) for a scattering mesh whose profile is narrower than a texel. Where the irradiance pass recorded light
+through thin parts, the mesh is drawn in groups (NodeShading.parts, through_split.py): each group of
+triangles with the exit factor of the light through of only the shadow slots whose record it can read
+holding light (TSD_THROUGH_READ, a mask; the others add exactly 0 there), the same image."""
 
 from __future__ import annotations
 
 from skinlab.gl.uniforms import set_array, set_uniforms
-from skinlab.render.technique import ForwardHook, NodeShading
+from skinlab.render.technique import DrawPart, ForwardHook, NodeShading
 
 from .passes import frame_nodes
 
@@ -38,13 +41,21 @@ class TsdForward(ForwardHook):
             mat = self.local.get(node.uid)
             return None if mat is None else NodeShading(mat, LOCAL_HOOK)
         defines = {"TSD_LEVELS": t.kernel.levels}
+        parts: tuple[DrawPart, ...] = ()
         if t.translucency and t.through_slots > 0:
             defines["TSD_THROUGH"] = t.through_slots
+            if t.targets.through_faces:  # each group of triangles with the slots whose light through it can read
+                ibo, groups = t.targets.through_faces
+                every = (1 << t.through_slots) - 1
+                parts = tuple(
+                    DrawPart(ibo, first, count, {} if m == every else {"TSD_THROUGH_READ": m})
+                    for m, first, count in groups
+                )
 
         def bind(prog, units):
             bind_gather(prog, t, units)
 
-        return NodeShading(t.material, HOOK, defines, bind)
+        return NodeShading(t.material, HOOK, defines, bind, parts=parts)
 
 
 def bind_gather(prog, t, units) -> None:

@@ -32,7 +32,7 @@ from skinlab.render.boundary import bind_boundary
 from skinlab.render.compute import bind_images, dispatch, pass_program
 from skinlab.render.environment import bind_env_bands
 from skinlab.render.gpu_resources import node_uniforms
-from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, set_light_uniforms
+from skinlab.render.lights import SHADOW_SLOTS, bind_shadow_maps, light_defines, near_defines, set_light_uniforms
 from skinlab.render.technique import RenderPass, TechniqueState
 from skinlab.render.texture_units import TextureUnits
 from skinlab.render.translucency import bind_translucency
@@ -40,6 +40,7 @@ from skinlab.scene.optics.tsd import DiffusionKernel, blur_taps
 
 from .plan import TsdBlurParams, TsdIrradianceParams, TsdNodeParams
 from .seams import SeamMap, node_border_strips
+from .through_split import lit_texels, slot_masks, split_indices
 
 STATE_KEY = "tsd"  # the renderer-side store (shared with technique "exact") and frame.data key
 
@@ -85,6 +86,9 @@ class TsdNodeTargets:
     strips: tuple = ()  # (source array, depth renderbuffer): where the record's fill runs (strip_mask)
     surface: list = field(default_factory=list)  # the surface G-buffer (surface_buffer), RGBA32F, nearest
     masks: dict = field(default_factory=dict)  # coverage masks by what was rasterised (coverage_mask)
+    # (index buffer, [(slot mask, first, count), ...]): the mesh's triangles grouped by the slots of the
+    # record whose light they can read (record_split); () where it was not made
+    through_faces: tuple = ()
 
     def fbo(self, ctx, tex: moderngl.Texture, *more: moderngl.Texture, depth=None) -> moderngl.Framebuffer:
         key = (id(tex), *(id(m) for m in more), id(depth))
@@ -203,6 +207,8 @@ class TsdNodeTargets:
             self.seam.release()
         if self.strips:
             self.strips[1].release()
+        if self.through_faces:
+            self.through_faces[0].release()
 
 
 @dataclass
@@ -432,7 +438,12 @@ class TsdIrradiancePass(TsdPass):
         fbo = t.fbo(ctx, t.raw, *(record if slots > 1 else record[0::2]))
         _uv_raster_setup(ctx, fbo, size)
         fbo.clear(0.0, 0.0, 0.0, 0.0)
-        defines = {**mat.defines(), **light_defines(prm.shadow_lights, nmax, frame), **ambient}
+        defines = {
+            **mat.defines(),
+            **light_defines(prm.shadow_lights, nmax, frame),
+            **near_defines(prm.lights),
+            **ambient,
+        }
         if prm.translucency:
             defines["TSD_TRANSLUCENCY"] = 1
         if prm.deferred:
@@ -466,6 +477,7 @@ class TsdIrradiancePass(TsdPass):
         self.r.resources.unbind_samplers()
         if prm.translucency:  # the record's gutter by the chart borders: across the seams, else dilated
             through_fill(self.r, t, prm.seams is not None, node_border_strips(node.mesh, size), slots)
+            record_split(ctx, t, node.mesh, slots)
         self.publish(frame, p)
 
 
@@ -509,6 +521,29 @@ def through_fill(renderer, t: TsdNodeTargets, seams: bool, strips: np.ndarray | 
     # with the mask only the strips (0.5 <= their depth 0.5; 0 elsewhere): an early depth test
     with gl_state(ctx, enable=moderngl.DEPTH_TEST if mask is not None else 0, depth_func="<="):
         renderer.fullscreen(prog)
+
+
+# the share of the slot records' reads by triangles that grouping must save for the mesh to be drawn in groups
+MIN_SPLIT_SHARE = 0.1
+
+
+def record_split(ctx, t: TsdNodeTargets, mesh, slots: int) -> None:
+    """t.through_faces from the filled records of the `slots` the gather reads (at most 2): the mesh's
+    triangles grouped by the slots whose light through they can read (through_split.py; the forward pass
+    draws each group without the exit factor of the other slots' light, the same image); none where
+    that saves less than MIN_SPLIT_SHARE of the reads (a draw per group is not worth it)."""
+    if t.through_faces:
+        t.through_faces[0].release()
+        t.through_faces = ()
+    n = min(slots, SHADOW_SLOTS)
+    if mesh.uvs is None or n < 1:
+        return
+    lits = [lit_texels(tex.read(), t.size) for tex in t.through_record(ctx)[:n]]
+    mask = slot_masks(mesh.uvs, mesh.indices, lits)
+    reads = sum(int(np.count_nonzero(mask & (1 << k))) for k in range(n))
+    if reads <= (1.0 - MIN_SPLIT_SHARE) * n * len(mask):
+        flat, groups = split_indices(mesh.indices, mask)
+        t.through_faces = (ctx.buffer(flat.tobytes()), groups)
 
 
 class TsdDilatePass(TsdPass):

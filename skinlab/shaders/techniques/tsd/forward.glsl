@@ -9,7 +9,9 @@
 // record (per shadow slot: the light through, its thickness and cosine; TSD_THROUGH = slots):
 // exact where that light varies slowly across the profile (a flat part), linear in the lights; at a
 // sharp edge of the light through (a rim where the thickness drops) it can take a little more than
-// the blur brought there (at least 0). Contract: skinlab/render/technique.py.
+// the blur brought there (at least 0). TSD_THROUGH_READ (a mask of the slots, default all): triangles
+// that read no texel of the other slots' records holding light (skinlab/render/techniques/tsd/through_split.py),
+// for which their difference is exactly 0: those records are not read. Contract: skinlab/render/technique.py.
 // The separable boundary's non-separable rest is added by the forward pass where the light lands
 // (passes/forward.frag): this hook does not spread it with its diffusion.
 #define SSS_MS_REST_LANDS
@@ -22,6 +24,9 @@ uniform vec3 u_tsd_identity;         // weight of the unblurred irradiance per c
 uniform vec3 u_tsd_w[6];             // weight of each blurred level per channel
 uniform sampler2D u_tsd_irradiance;  // premultiplied by coverage: rgb / a
 #ifdef TSD_THROUGH
+#ifndef TSD_THROUGH_READ
+#define TSD_THROUGH_READ 3
+#endif
 uniform sampler2D u_tsd_through0;     // slot 0's light through (rgb), its thickness in mm (a); nearest
 uniform sampler2D u_tsd_through1;     // slot 1's
 uniform sampler2D u_tsd_through_cos;  // their cosines on the far face (r, g)
@@ -54,6 +59,9 @@ vec3 unpremultiply(vec4 t) { return t.a > COVERAGE_EPS ? t.rgb / t.a : vec3(0.0)
 
 // Diffused irradiance (still x albedo^mix) at uv: I E + sum_k W_k level_k.
 vec3 tsd_diffused(vec2 uv) {
+#ifdef MEASURE_NO_GATHER  // a measurement variant (tools/orbit_cost.py): no irradiance or level fetched
+    return vec3(uv, 0.5);
+#endif
     vec3 d = u_tsd_identity * unpremultiply(texture(u_tsd_irradiance, uv));
 #if TSD_LEVELS > 0
     d += u_tsd_w[0] * unpremultiply(texture(u_tsd_level0, uv));
@@ -88,11 +96,19 @@ vec3 sss_radiance(Surface s) {
     // medium (lib/sss_boundary.glsl; the irradiance pass applied the entry factor)
     vec3 post = pow(max(base, vec3(0.0)), vec3(1.0 - u_tsd_mix));
     vec3 exit_ = sss_exit(abs(NoV));
+#ifdef MEASURE_NO_EXIT  // a measurement variant (tools/orbit_cost.py): the exit table not read
+    exit_ = vec3(NoV);
+#endif
     vec3 leaving = post * tsd_diffused(uv) * exit_;
-#ifdef TSD_THROUGH
+#if defined(TSD_THROUGH) && !defined(MEASURE_NO_THROUGH)  // MEASURE_NO_THROUGH: tools/orbit_cost.py
+    vec3 diff = vec3(0.0);
+#if TSD_THROUGH_READ != 0
     vec2 backs = texture(u_tsd_through_cos, uv).rg;
-    vec3 diff = tsd_through_exit(texture(u_tsd_through0, uv), backs.r, abs(NoV), exit_);
-#if TSD_THROUGH > 1
+#endif
+#if TSD_THROUGH_READ == 1 || TSD_THROUGH_READ == 3
+    diff = tsd_through_exit(texture(u_tsd_through0, uv), backs.r, abs(NoV), exit_);
+#endif
+#if TSD_THROUGH > 1 && TSD_THROUGH_READ >= 2
     diff += tsd_through_exit(texture(u_tsd_through1, uv), backs.g, abs(NoV), exit_);
 #endif
     leaving = max(leaving + max(base, vec3(0.0)) * diff, vec3(0.0));
