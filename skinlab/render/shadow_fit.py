@@ -96,6 +96,7 @@ def sees_everything(camera, aspect: float, lo: np.ndarray, hi: np.ndarray) -> bo
 
 
 _INTERSECTORS = Memo(2)  # scene geometry -> Embree intersector over every visible mesh
+_HITS = Memo(8)  # (geometry, camera, aspect, rays) -> camera_hits: a camera that holds still casts no rays
 
 
 def _intersector(nodes):
@@ -114,16 +115,22 @@ def _intersector(nodes):
 def camera_hits(scene, aspect: float, key, n: int = FIT_RAYS) -> np.ndarray:
     """(n, n, 3) the first surface each of the camera's grid of rays meets (NaN: none; `key`: the scene's
     geometry, under which the intersector is kept)."""
-    out = np.full((n * n, 3), np.nan)
-    nodes = list(scene.mesh_nodes())
-    if nodes:
-        ray = _INTERSECTORS.get(key, lambda: _intersector(nodes))
-        o, d = camera_rays(scene.camera, aspect, n)
-        _, idx, loc = ray.intersects_id(
-            np.broadcast_to(o, d.shape).copy(), d, multiple_hits=False, return_locations=True
-        )
-        out[idx] = loc
-    return out.reshape(n, n, 3)
+    cam = scene.camera
+
+    def cast() -> np.ndarray:
+        out = np.full((n * n, 3), np.nan)
+        nodes = list(scene.mesh_nodes())
+        if nodes:
+            ray = _INTERSECTORS.get(key, lambda: _intersector(nodes))
+            o, d = camera_rays(cam, aspect, n)
+            _, idx, loc = ray.intersects_id(
+                np.broadcast_to(o, d.shape).copy(), d, multiple_hits=False, return_locations=True
+            )
+            out[idx] = loc
+        return out.reshape(n, n, 3)
+
+    view = (key, np.asarray(cam.world_matrix, np.float64).tobytes(), float(cam.yfov), float(aspect), n)
+    return _HITS.get(view, cast)
 
 
 def _light_xy(light_clip: np.ndarray, points: np.ndarray) -> np.ndarray:
