@@ -24,7 +24,8 @@ too (its own pass, `shadow_fit[LIGHT]`; the interreflection reads only the full 
 cropped: the window keeps the full map's near and far planes, so every occluder along the light's rays
 through it is in the fine map. Where the camera sees the whole scene (every corner of its bounding box
 projects into the view) or the fit gains less than FIT_MIN_GAIN, there is no fine map and the frame is
-as it was.
+as it was. A light with a size (soft shadows from its distance map, lib/shadow_soft.glsl) keeps its one
+map.
 """
 
 from __future__ import annotations
