@@ -170,12 +170,11 @@ def slab_through(back, d_mm, table, mfp_mm, alpha, eta) -> np.ndarray:
     """Light through a part d mm thick per unit irradiance (normal to the light) arriving at cosine
     `back` on its far face, per unit base colour, leaving the near face (3,): the exact table at eta 1
     (`slab_table`: ln T), ln T - ln(tau / (1 + tau)) linear in the optical thickness tau = d / l between
-    its nodes (`_knee`) and linear in the cosine; below 1/16 mean free path linear in tau to 0, beyond 64 mean free paths decaying as
-    e^{-k (tau - 64)} 64 / tau. At eta > 1: Fresnel
-    transmission in at `back`, the table at the refracted cosine, and 1 - F_dr(eta) out (the
-    interface's internal reflections between the faces are left out). GLSL twin sss_slab_through.
-    `back` and `d_mm` may be arrays (broadcast together): the result is then (..., 3), each entry
-    what the scalar call gives."""
+    its nodes (`_knee`) and linear in the cosine; below 1/16 mean free path linear in tau to 0, beyond
+    64 mean free paths decaying as e^{-k (tau - 64)} 64 / tau. At eta > 1: Fresnel transmission in at
+    `back`, the table at the refracted cosine, and 1 - F_dr(eta) out (the interface's internal
+    reflections between the faces are left out). GLSL twin sss_slab_through. `back` and `d_mm` may be
+    arrays (broadcast together): the result is then (..., 3), each entry what the scalar call gives."""
     eta = float(clamp_eta(eta))
     b, d = np.broadcast_arrays(np.clip(np.asarray(back, np.float64), 0.0, 1.0), np.asarray(d_mm, np.float64))
     d = np.maximum(d, 0.0)
@@ -336,11 +335,11 @@ def slab_exit(mu, mu0, d_mm, table, exit_tables, mfp_mm, eta) -> np.ndarray:
     """(3,) the exit factor of light that came through a part d mm thick, arriving on its far face
     at cosine mu0 and leaving at cosine mu (cosine-weighted hemispherical mean 1 over mu, like
     boundary.py's exit): (1 - F(mu)) [u(mu_t) - h(mu_t) q] / (A - B q), q = h(mu0_t) / u(mu0_t), from
-    `table` (slab_table) and `exit_tables` (slab_exit_tables): ln T linear in tau between the nodes (the knee
-    slab_through takes out would cancel in u = T / T_d), u and h linear in the cosine, h, A and B linear in tau) with tau = d / l
-    clamped to the table (beyond it the frame's extrapolations of T cancel in u); q clamped to
-    +-EXIT_Q_MAX, A - B q at least A / 2, the result at least 0; 1 for a channel without scattering
-    (l = 0). GLSL sss_slab_exit."""
+    `table` (slab_table) and `exit_tables` (slab_exit_tables): ln T linear in tau between the nodes
+    (the knee slab_through takes out would cancel in u = T / T_d), u and h linear in the cosine, h, A
+    and B linear in tau, with tau = d / l clamped to the table (beyond it the frame's extrapolations of
+    T cancel in u); q clamped to +-EXIT_Q_MAX, A - B q at least A / 2, the result at least 0; 1 for a
+    channel without scattering (l = 0). GLSL sss_slab_exit."""
     eta = float(clamp_eta(eta))
     norm, h, ab = (np.asarray(x, np.float64) for x in exit_tables)
     tab = np.asarray(table, np.float64).reshape(SLAB_MU_NODES, SLAB_TAU_NODES, 3)
