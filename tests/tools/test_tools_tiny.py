@@ -19,7 +19,7 @@ TESTED_ELSEWHERE = {
 HERE = {
     "accuracy_table", "boundary_slab", "branch_cost", "env_sphere", "frame_times", "full_over_plain",
     "make_face_parts", "make_reference_meshes", "near_light_check", "repair_bunny", "seam_report",
-    "supersample_cost", "translucency_check",
+    "slab_gap", "supersample_cost", "translucency_check",
 }  # fmt: skip
 
 
@@ -113,6 +113,27 @@ def test_full_over_plain(capsys):
     assert d["size"] == 16 and set(d["head"]["cpu_ms"]) == {"full", "plain", "orbit"}
     assert d["head"]["full_over_plain_cpu"] == pytest.approx(d["head"]["cpu_ms"]["full"] / d["head"]["cpu_ms"]["plain"])
     assert "tsd_irradiance[LeePerrySmith]" in d["head"]["passes_cpu_ms"]["full"]
+
+
+def test_slab_gap(capsys):
+    """The gap's round trips: all kept reads the summed slab, fewer kept pass less, red (the highest
+    albedo, the most reflected) loses most; the view factor's closed form; the Monte Carlo near the
+    slab model (a tiny photon count, a loose bound). The frame against the truth needs a cached truth."""
+    from tools import slab_gap
+
+    assert slab_gap.main(["--gap"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("two 3 mm slabs") and lines[1].startswith("  F = 1.00: 1.000 / 1.000 / 1.000")
+    kept = [[float(x) for x in line.split(":")[1].split("(")[0].split("/")] for line in lines[1:]]
+    assert all(a > b for a, b in zip(kept[1][0:1] + kept[2][0:1], kept[2][0:1] + kept[3][0:1]))
+    assert all(row[0] < row[1] < row[2] <= 1.0 for row in kept[1:])
+    assert slab_gap.parallel_squares_view_factor(1.0, 1.0) == pytest.approx(0.1998, abs=1e-4)
+    assert 0.7 < slab_gap.parallel_squares_view_factor(60.0, 10.0) < 0.75
+    flux, _ = slab_gap.monte_carlo(0.9, 1.0, 2.0, 1.0, 20_000, seed=1)
+    from skinlab.scene.optics.slab import slab_table, slab_through
+
+    model = slab_through(1.0, 2.0, slab_table([0.9] * 3, [1.0] * 3), [1.0] * 3, [0.9] * 3, 1.0)[0]
+    assert flux == pytest.approx(model, rel=0.05)
 
 
 def test_supersample_cost(capsys):

@@ -80,8 +80,8 @@ vec3 sss_single_brdf_view(vec3 n, vec3 l, SingleView sv) {
 // to the light) arriving at cosine `back` on the far face of a part d_mm thick, what leaves the near
 // face after scattering inside, per unit base colour: the exact diffuse transmittance of the
 // index-matched slab (doubling method, all orders) from a table in the cosine (i / 8) and the optical
-// thickness tau = d / l (half octaves from 1/16 to 64 mean free paths; ln T linear in tau, T linear in
-// the cosine); thinner: linear in tau to 0, thicker: e^{-k (tau - 64)} 64 / tau. At eta > 1 Fresnel
+// thickness tau = d / l (half octaves from 1/16 to 64 mean free paths; ln T - ln(tau / (1 + tau))
+// linear in tau and in the cosine); thinner: linear in tau to 0, thicker: e^{-k (tau - 64)} 64 / tau. At eta > 1 Fresnel
 // transmission in, the table at the refracted cosine, and u_sss_slab_out = 1 - F_dr out.
 #define SSS_SLAB_MU 9
 #define SSS_SLAB_TAU 21
@@ -101,9 +101,11 @@ float sss_slab_channel(int i, float fm, float tau, int c, float k) {
     float ft = clamp((tc - t0) / (t0 * (sqrt(2.0) - 1.0)), 0.0, 1.0);
     int r0 = i * SSS_SLAB_TAU + j;
     int r1 = r0 + SSS_SLAB_TAU;
-    float v0 = exp(mix(u_sss_slab[r0][c], u_sss_slab[r0 + 1][c], ft));
-    float v1 = exp(mix(u_sss_slab[r1][c], u_sss_slab[r1 + 1][c], ft));
-    float v = mix(v0, v1, fm);
+    // ln T - ln(tau / (1 + tau)) linear in tau between the nodes (slab.py _knee: the knee taken out)
+    float k0 = log(t0 / (1.0 + t0)), t1 = t0 * sqrt(2.0), k1 = log(t1 / (1.0 + t1)), kc = log(tc / (1.0 + tc));
+    float v0 = mix(u_sss_slab[r0][c] - k0, u_sss_slab[r0 + 1][c] - k1, ft) + kc;
+    float v1 = mix(u_sss_slab[r1][c] - k0, u_sss_slab[r1 + 1][c] - k1, ft) + kc;
+    float v = exp(mix(v0, v1, fm));  // ln T linear in the cosine too
     if (tau < tmin) v *= tau / tmin;
     else if (tau > tmax) v *= exp(-k * (tau - tmax)) * tmax / tau;
     return v;

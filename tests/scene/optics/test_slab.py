@@ -87,6 +87,25 @@ def test_slab_against_the_flat_medium_monte_carlo():
     assert _exact(a, tau, 1.0)[0] == pytest.approx(mc, abs=4 * se + 2e-3)
 
 
+def test_table_lookup_is_within_a_percent_between_the_nodes():
+    """The lookup's interpolation (ln T less the knee ln(tau / (1 + tau)), linear in tau and in the
+    cosine) against the exact doubling at points between the nodes (cosines 0.3-0.95, albedos 0.3-0.99,
+    1/13 to 52 mean free paths, where T > 1e-4): median within 0.35 %, 90th percentile within 1 %, all
+    within 2 %. ln T alone linear in tau and T linear in the cosine read 0.72 / 1.42 / 2.27 % here, dark
+    throughout at a few mean free paths (3 mm of skin1 1.1-1.3 % dark)."""
+    errs = []
+    mus = np.array([0.3, 0.5, 0.7, 0.866, 0.95])
+    for a in (0.3, 0.5, 0.7, 0.9, 0.99):
+        table = s.slab_table([a] * 3, [1.0] * 3)
+        for lt in np.linspace(-3.7, 5.7, 17):
+            for mu, want in zip(mus, _exact(a, 2.0**lt, mus)):
+                if want > 1e-4:
+                    errs.append(s.slab_through(mu, 2.0**lt, table, [1.0] * 3, [a] * 3, 1.0)[0] / want - 1.0)
+    e = np.abs(np.array(errs))
+    assert len(e) > 300
+    assert np.median(e) < 0.0035 and np.quantile(e, 0.9) < 0.01 and e.max() < 0.02, (np.median(e), e.max())
+
+
 def test_table_lookup_follows_the_exact_slab():
     """Between the nodes (where T > 1e-4): within 5 % for cosines >= 0.3 and 8 % at 0.1, every albedo; limits."""
     for a in (0.2, 0.687, 0.99, 1.0):
