@@ -17,7 +17,7 @@ from skinlab.scene.optics.exact_profile import exact_profile_convolution
 from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.single_scattering import single_scatter_brdf
 from skinlab.scene.optics.slab import slab_table, slab_through
-from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, quad_mesh, skin, slab_scene
+from tests.tsd_scenes import entered, exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 
 def tsd_node(renderer, scene, name="slab"):
@@ -106,14 +106,16 @@ def _edge_row(renderer, model: str, place: float, angular_radius: float = 0.0):
     row = res.hdr[n // 2, :, :3].astype(np.float64)
     lit = row[-8:].mean(axis=0)
     texel_mm = 2 * scene.mm_per_unit / n
-    x_mm = (pixel_x(n, 1.0) - h * tilt) * scene.mm_per_unit - entry_shift_mm(
-        scene, texel_mm, averaged=True
-    )  # where the light entered
+    x_mm = (pixel_x(n, 1.0) - h * tilt) * scene.mm_per_unit
     profile = exact_profile(model, material_medium(t.material.values))
-    edge = edge_response(-x_mm, profile, "profile")
+
+    def response(x):  # x from where the light entered, spread as the frame spreads it (entered)
+        return entered(lambda e: edge_response(-e, profile, "profile"), x, scene, texel_mm, averaged=True)
+
+    edge = response(x_mm)
     moved = (row / lit - edge).sum(axis=0)  # pixels (= texels) of light too much
     within = (np.arange(16) + 0.5) / 16 - 0.5  # across a texel (midpoint rule)
-    held = np.mean([edge_response(-(x_mm + w * texel_mm), profile, "profile") for w in within], axis=0)
+    held = np.mean([response(x_mm + w * texel_mm) for w in within], axis=0)
     return row / lit, moved, np.abs(row / lit - held)
 
 

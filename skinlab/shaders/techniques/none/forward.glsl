@@ -4,6 +4,6 @@
 
 float sss_plain_weight(Surface s) { return 1.0; }
 
-void sss_add_light(Surface s, vec3 e, float vis, float NoL) {}
+void sss_add_light(Surface s, vec3 e, vec3 vis, float NoL) {}
 
 vec3 sss_radiance(Surface s) { return vec3(0.0); }
