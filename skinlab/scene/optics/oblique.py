@@ -196,6 +196,18 @@ def _inside(c, eta):
     return np.sqrt(np.maximum(1.0 - (1.0 - c * c) / (eta * eta), 0.0))
 
 
+def single_pair_rate(z0_mm) -> np.ndarray:
+    """(3,) per channel 0.5 log2(e) z0_luma / z0_c (at most 1e4): single scattering's pair weight is
+    w0 = 1 - 2^(-k rate) = entry_pair_weights(entry_ramp_means(z0, k))[..., 0], one exp2 per fragment;
+    the ratio does not change with the radius map (it scales z0_c and z0_luma alike), so the frame binds
+    it per material (u_sss_single_ramp, skinlab/render/boundary.py). GLSL sss_single_pair."""
+    z0 = np.maximum(np.asarray(z0_mm, np.float64).reshape(3), 0.0)
+    zl = float(z0 @ LUMA)
+    with np.errstate(divide="ignore"):
+        r = np.where(z0 > 0, 0.5 * np.log2(np.e) * zl / np.where(z0 > 0, z0, 1.0), 1e4)
+    return np.minimum(r, 1e4)
+
+
 def single_entry_k(mu_l, mu_v, eta) -> np.ndarray:
     """1 + mu_l / mu_v at the refracted cosines (eta clamped at 1; mu_v at least SINGLE_K_MIN_COS):
     single scattering's entry lies upstream by the offset over this. GLSL sss_single_k."""

@@ -65,6 +65,13 @@ vec3 sss_pair_mix(vec3 m, float v0, float vb) {
     return w0 * v0 + (1.0 - w0) * vb;
 }
 
+// sss_pair_mix for single scattering from its k and the material's rate (oblique.py single_pair_rate,
+// bound as u_sss_single_ramp): the same weights, one exp2.
+vec3 sss_single_pair(float k, vec3 rate, float v0, float vb) {
+    vec3 w0 = 1.0 - exp2(-k * rate);
+    return w0 * v0 + (1.0 - w0) * vb;
+}
+
 vec3 sss_entry_point(vec3 world, vec3 ng, vec3 l, vec3 z0_mm, float eta, float mm_per_unit) {
     vec3 off = sss_entry_offset(ng, l, z0_mm, eta, mm_per_unit);
     return world + off + l * length(off);

@@ -57,7 +57,11 @@ float sss_entry_visibility(Surface s, int i, vec3 l) {
 // exponential distance upstream, per channel, lib/sss_oblique.glsl): three lookups along the
 // luminance offset; decay per channel sqrt(3 (1 - a')) (lib/sss_boundary.glsl u_sss_slab_decay); 1
 // for a light without a shadow map.
+// Without SSS_ENTRY_SPREAD (RenderSettings.entry_spread off): the shadow at the mean entry point.
 vec3 sss_entry_ramp(Surface s, int i, vec3 l, vec3 decay) {
+#ifndef SSS_ENTRY_SPREAD
+    return vec3(sss_entry_visibility(s, i, l));
+#endif
     if (u_light_shadow[i] < 0) return vec3(1.0);
     vec3 z0 = u_sss_mfp * s.sss_radius_scale;
     vec3 off = sss_entry_offset(s.ng, l, z0, u_sss_eta, u_mm_per_unit);
@@ -72,11 +76,17 @@ vec3 sss_entry_ramp(Surface s, int i, vec3 l, vec3 decay) {
 
 // Light i's shadow per channel for single scattering at s (lib/sss_oblique.glsl sss_pair_mix): its light
 // entered upstream by the diffusion's offset over k = 1 + mu_l / mu_v, read from the point's own shadow
-// vis and the one at the whole offset, evis (sss_entry_visibility); vis where the light has no map.
-vec3 sss_single_visibility(Surface s, int i, float NoL, float vis, float evis) {
+// vis and one bilinear tap at the whole offset (lights.glsl light_visibility_tap: the pair's weights
+// smooth it); vis where the light has no map.
+uniform vec3 u_sss_single_ramp;  // skinlab/scene/optics/oblique.py single_pair_rate (skinlab/render/boundary.py)
+vec3 sss_single_visibility(Surface s, int i, vec3 l, float NoL, float vis) {
+#ifndef SSS_ENTRY_SPREAD  // RenderSettings.entry_spread off: the point's own shadow
+    return vec3(vis);
+#endif
     if (u_light_shadow[i] < 0) return vec3(vis);
-    float k = sss_single_k(NoL, s.NoV, u_sss_eta);
-    return sss_pair_mix(sss_ramp_means(u_sss_mfp * s.sss_radius_scale, vec3(k)), vis, evis);
+    vec3 at = sss_entry_point(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, u_sss_eta, u_mm_per_unit);
+    return sss_single_pair(sss_single_k(NoL, s.NoV, u_sss_eta), u_sss_single_ramp, vis,
+                           light_visibility_tap(i, at, dot(s.ng, l)));
 }
 
 // Light i's irradiance feeding the diffusion at s relative to its own (a point or spot light's

@@ -20,6 +20,7 @@ from skinlab.scene.optics.oblique import (
     near_entry,
     near_entry_gain,
     single_entry_k,
+    single_pair_rate,
 )
 
 
@@ -198,6 +199,7 @@ def test_near_entry_keeps_the_flux_and_moves_it_away():
 RAMP_OUTS = """
 vec3 ramp_mix(vec3 m, vec3 v) { return sss_ramp_mix(m, v.x, v.y, v.z); }
 vec3 pair_mix(vec3 m, vec3 v) { return sss_pair_mix(m, v.x, v.y); }
+vec3 single_pair(float k, vec3 rate, vec3 v) { return sss_single_pair(k, rate, v.x, v.y); }
 vec3 means_single(vec3 z0, float mu_l, float mu_v, float eta) {
     return sss_ramp_means(z0, vec3(sss_single_k(mu_l, mu_v, eta)));
 }
@@ -238,6 +240,16 @@ def test_entry_ramp_twins(glsl):
     ):
         gpu = glsl.evaluate("lib/sss_oblique.glsl", expr, ins, out_components=3, prelude=RAMP_OUTS)
         assert_close_fp32(gpu, ref, rtol=2e-4, atol=2e-5, what=expr)
+    # single scattering's pair from the material's rate (the frame's one exp2) is the pair of its means
+    k = single_entry_k(f32(mu_l), f32(mu_v), f32(eta))
+    rate = np.array([single_pair_rate(z) for z in f32(z0)])
+    want = np.einsum("ncs,ns->nc", entry_pair_weights(entry_ramp_means(f32(z0), k)), f32(v)[:, :2])
+    scat = (f32(z0) > 0).all(axis=1)  # a channel without scattering: the rate's cap, all at the point
+    ins = {"k": k, "rate": rate, "v": v}
+    for expr, ref in (("single_pair(k, rate, v)", want),):
+        gpu = glsl.evaluate("lib/sss_oblique.glsl", expr, ins, out_components=3, prelude=RAMP_OUTS)
+        assert_close_fp32(gpu[scat], ref[scat], rtol=2e-4, atol=2e-5, what=expr)
+        assert np.isfinite(gpu).all()
 
 
 def test_entry_ramp_spreads_each_channel_as_an_exponential():

@@ -2,6 +2,7 @@
 // term, the surface's own Burley diffuse carries all of the diffuse light. The hook's contract is in
 // skinlab/render/technique.py.
 
+#define SSS_HOOK_PLAIN  // passes/forward.frag: no single scattering to shade
 float sss_plain_weight(Surface s) { return 1.0; }
 
 void sss_add_light(Surface s, vec3 e, vec3 vis, float NoL) {}
