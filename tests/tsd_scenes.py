@@ -89,23 +89,38 @@ def exact_profile(model, medium):
     return lambda r: get_profile(MODEL_PROFILES[model]).evaluate(np.asarray(r, np.float64), medium)
 
 
-def entry_shift_mm(scene: Scene, grid_mm: float, node: str = "slab", averaged: bool = False) -> float:
-    """How far (mm, along +x) slab_scene's shadow edge moves for the light feeding the diffusion:
-    the light travels along (1, 0, -1), so the diffusion is centred sin(theta_t) z0 further along +x
-    than where the light entered (oblique entry, skinlab/scene/optics/oblique.py; the frame looks the shadow
-    up at the entry point). Edge responses of the multiply scattered light are centred there. The
-    light is sampled at the centres of a grid of grid_mm (irradiance texels, or pixels for the
-    screen-space techniques) whose boundaries fall on x = 0: the sampled edge moves by the shift
-    rounded to whole cells. averaged: the light is averaged over each cell instead (the texture-space
-    irradiance's texels, lib/shadow.glsl shadow_pcf_area): the edge moves by the shift itself."""
+def entry_ramp_mm(scene: Scene, grid_mm: float, node: str = "slab", averaged: bool = False):
+    """Where the light feeding the diffusion of slab_scene entered, spread as the frame spreads it
+    (skinlab/scene/optics/oblique.py entry_ramp_weights; lib/surface_inputs.glsl sss_entry_ramp): the
+    three lookups' shifts along +x (mm, (3,); rounded to whole cells of grid_mm unless averaged: the
+    light sampled at the cells' centres, whose boundaries fall on x = 0, moves the sampled edge by whole
+    cells; averaged over each cell, the texture-space irradiance's texels, by the shift itself) and their
+    weights per channel (3 channels, 3 lookups)."""
     from skinlab.scene.optics.material_medium import material_medium
-    from skinlab.scene.optics.oblique import entry_offset
+    from skinlab.scene.optics.oblique import (
+        entry_diffusion_k,
+        entry_offset,
+        entry_ramp_means,
+        entry_ramp_nodes,
+        entry_ramp_weights,
+    )
 
     medium = material_medium(scene.find(node).material.values)
-    z0 = np.asarray(medium.mfp_arr)  # 1 / mu_t' (isotropic phase): the shaders' u_sss_mfp
+    z0 = np.asarray(medium.mfp_arr)
     to_light = -scene.lights()[0].direction
-    off = entry_offset(np.array([[0.0, 0.0, 1.0]]), to_light[None], z0, medium.eta, 1.0)[0]
-    return float(-off[0]) if averaged else float(np.round(-off[0] / grid_mm) * grid_mm)
+    b = float(-entry_offset(np.array([[0.0, 0.0, 1.0]]), to_light[None], z0, medium.eta, 1.0)[0][0])
+    m = entry_ramp_means(z0, entry_diffusion_k(medium.alpha_arr, float(to_light[2]), medium.eta))
+    shifts = entry_ramp_nodes(m) * b
+    if not averaged:
+        shifts = np.round(shifts / grid_mm) * grid_mm
+    return shifts, entry_ramp_weights(m)
+
+
+def entered(response, x_mm, scene: Scene, grid_mm: float, node: str = "slab", averaged: bool = False):
+    """An edge response of the light that left at x_mm (pixel positions, mm; response(x) -> (N, 3) with
+    x measured from where the light entered), summed over entry_ramp_mm's lookups with their weights."""
+    shifts, w = entry_ramp_mm(scene, grid_mm, node, averaged)
+    return sum(w[None, :, k] * response(np.asarray(x_mm) - shifts[k]) for k in range(3))
 
 
 def sky_slab(color, mfp=(1.0, 1.0, 1.0)) -> Scene:

@@ -10,6 +10,8 @@ measure, each with the truth's own noise (the same measure between the halves of
 * the nose's shadow: the mean radiance of the deep shadow (camera-visible points the light does not
   reach, more than 2 mm from any lit one: a ray cast with Embree, independent of the shadow maps)
   relative to the lit cheek's, and the relative L1 within 3 mm of the shadow's edges (edge region);
+  with --edge-bins also each channel's energy and the relative L1 in bands by the signed distance from
+  the shadow's edge (EDGE_BINS_MM, + on the lit side);
 * the two back-lit slabs: the front slab's and the back slab's energy apart (the light through
   both slabs and through one).
 
@@ -18,7 +20,7 @@ docs/ground-truth.md). Frames are supersampled like the truth's pixels (TRUTH_SU
 measures are skinlab/bench/closeup.py's, the accuracy ledger's (docs/ledger.md "Close-ups in the ledger").
 
     python -m tools.closeup_table [SCENES] [TECHNIQUES] [--profiles OUT.npz] [--bounces N]
-        [--sss-model MODEL] [--no-translucency] [--size WxH --spp N]
+        [--sss-model MODEL] [--no-translucency] [--size WxH --spp N] [--edge-bins]
 
 SCENES and TECHNIQUES are comma-separated ("" or left out: all). --bounces and --sss-model as in
 tools/truth_table.py; --no-translucency renders with every technique's translucency off; --size and
@@ -51,6 +53,37 @@ from skinlab.truth.compare import image_error
 from skinlab.truth.metrics import flip_mean
 
 TECHNIQUES = ["none", "tint", "tsd", "exact", "ssss", "disk", "preintegrated"]
+EDGE_BINS_MM = (-3.0, -2.0, -1.0, -0.5, 0.0, 0.5, 1.0, 2.0, 3.0, 6.0)  # --edge-bins' bands (and beyond 6 mm)
+
+
+def signed_edge_mm(scene, size) -> np.ndarray:
+    """Per pixel of a shadow scene at `size`: the distance (mm) from the shadow's edge, + where the
+    light reaches the point, - where it does not; NaN where no mesh is seen."""
+    from scipy.ndimage import distance_transform_edt
+
+    from skinlab.bench.closeup import mm_per_pixel
+
+    node, lit = ray_geometry(scene, *size)
+    mm = np.nanmedian(mm_per_pixel(scene, *size))
+    seen = node >= 0
+    sd = np.where(lit, distance_transform_edt(lit | ~seen) * mm, -distance_transform_edt(~lit) * mm)
+    return np.where(seen, sd, np.nan)
+
+
+def edge_bins(img, truth, sd) -> list[str]:
+    """One line per band of signed_edge_mm: its pixels, each channel's energy against the truth's and
+    the relative L1 there."""
+    lines = []
+    edges = list(EDGE_BINS_MM) + [np.inf]
+    for lo, hi in zip(edges[:-1], edges[1:]):
+        m = (sd >= lo) & (sd < hi)
+        if not m.any():
+            continue
+        f, t = img[m][:, :3].astype(np.float64), truth[m][:, :3].astype(np.float64)
+        energy = "/".join(f"{100 * (a / b - 1):+.1f}" for a, b in zip(f.sum(0), t.sum(0)))
+        l1 = np.abs(f - t).sum() / t.sum()
+        lines.append(f"    {lo:+5.1f} to {hi:+5.1f} mm ({m.sum():4d} px): energy {energy} %, L1 {100 * l1:5.2f} %")
+    return lines
 
 
 @dataclass(frozen=True)
@@ -119,6 +152,9 @@ def parser() -> argparse.ArgumentParser:
     ap.add_argument("--size", type=_size, default=None, help="WxH of the truths instead of CLOSEUPS'")
     ap.add_argument("--shadow-size", type=int, default=None, help="shadow map texels per side instead of 2048")
     ap.add_argument("--spp", type=int, default=None, help="samples per pixel of the truths instead of CLOSEUPS'")
+    ap.add_argument(
+        "--edge-bins", action="store_true", help="shadow scenes: energy and L1 by the distance from the shadow's edge"
+    )
     return ap
 
 
@@ -179,6 +215,7 @@ def main(argv: list[str] | None = None) -> int:
         elif spec.kind == "shadow":
             masks = shadow_regions(scene, spec.size)
             deep, lit, edge = masks
+            sd = signed_edge_mm(scene, spec.size) if args.edge_bins else None
             lv = region_level(t_img, deep, lit)
             lva, lvb = region_level(ha, deep, lit), region_level(hb, deep, lit)
             head += (
@@ -231,6 +268,8 @@ def main(argv: list[str] | None = None) -> int:
                     + " %"
                 )
             print(line, flush=True)
+            if spec.kind == "shadow" and args.edge_bins:
+                print("\n".join(edge_bins(img, t_img, sd)), flush=True)
     print("load average at end: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
     r.release()
     if out:

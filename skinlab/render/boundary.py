@@ -12,6 +12,7 @@ from skinlab.gl.uniforms import set_array, set_uniforms
 from skinlab.scene.optics.boundary import ANGULAR_NODES, MS_REST_NODES, BoundaryTables, boundary_tables, ms_rest_table
 from skinlab.scene.optics.fresnel import fdr
 from skinlab.scene.optics.material_medium import material_medium, subsurface_albedo
+from skinlab.scene.optics.oblique import single_pair_rate
 from skinlab.scene.optics.similarity import real_albedo, real_mfp
 from skinlab.scene.optics.slab import LN_FLOOR, SLAB_MU_NODES, SLAB_TAU_NODES, slab_decay, slab_exit_tables, slab_table
 
@@ -137,7 +138,16 @@ def bind_boundary(prog, material) -> None:
         set_array(prog, "u_sss_slab_norm", _DARK_NORM, SLAB_TAU_NODES)
         set_array(prog, "u_sss_slab_h", _ZERO_H, _SLAB_ROWS)
         set_array(prog, "u_sss_slab_ab", _UNIT_AB, 2 * SLAB_TAU_NODES)
-        set_uniforms(prog, {"u_sss_mfp": zero, "u_sss_sigma_t": zero, "u_sss_slab_decay": zero, "u_sss_slab_out": 1.0})
+        set_uniforms(
+            prog,
+            {
+                "u_sss_mfp": zero,
+                "u_sss_sigma_t": zero,
+                "u_sss_slab_decay": zero,
+                "u_sss_slab_out": 1.0,
+                "u_sss_single_ramp": zero,
+            },
+        )
         return
     set_array(prog, "u_sss_entry", t.entry, ANGULAR_NODES)
     set_array(prog, "u_sss_exit", t.exit, ANGULAR_NODES)
@@ -164,6 +174,7 @@ def bind_boundary(prog, material) -> None:
             "u_sss_mfp": medium.mfp_arr,
             "u_sss_sigma_t": real_extinction(medium, g),
             "u_sss_slab_decay": slab_decay(medium.alpha_arr),
+            "u_sss_single_ramp": single_pair_rate(medium.mfp_arr),
             "u_sss_slab_out": out,
         },
     )

@@ -38,11 +38,15 @@ def light_defines(shadow_lights, nmax: int, frame=None) -> dict:
     """The variant defines of a program that lights surfaces (skinlab/shaders/lib/lights.glsl): MAX_LIGHTS,
     and SHADOW_SLOTS, the shadow-map slots this frame fills (the others' lookups are compiled out);
     SHADOW_SOFT<slot> for a slot whose light has a size (soft shadows, lib/shadow_soft.glsl);
-    SHADOW_FINE<slot> for a slot the frame gave a map fitted to the view (skinlab/render/shadow_fit.py)."""
+    SHADOW_FINE<slot> for a slot the frame gave a map fitted to the view (skinlab/render/shadow_fit.py);
+    SSS_ENTRY_SPREAD where the frame's settings spread the oblique entry's shadow (RenderSettings.entry_spread,
+    lib/surface_inputs.glsl sss_entry_ramp)."""
     soft = {f"SHADOW_SOFT{k}": 1 for k, l in enumerate(shadow_lights[:SHADOW_SLOTS]) if soft_shadow(l)}
-    fine = {}
+    fine: dict = {}
     if frame is not None:
         fine = {f"SHADOW_FINE{k}": 1 for k in range(SHADOW_SLOTS) if f"shadow_fine{k}" in frame.targets}
+        if frame.settings.entry_spread:
+            fine["SSS_ENTRY_SPREAD"] = 1
     return {"MAX_LIGHTS": nmax, "SHADOW_SLOTS": min(len(shadow_lights), SHADOW_SLOTS), **soft, **fine}
 
 

@@ -43,6 +43,15 @@ class RenderSettings:
         "bool",
         panel=False,
     )
+    entry_spread: bool = option(
+        True,
+        "light entering a scattering medium at an angle entered upstream by an exponential distance per "
+        "channel: its shadow spread over three lookups (the texture-space irradiance, the forward hooks "
+        "that gather their light) and single scattering's over two (one more per light in the forward "
+        "pass; skinlab/scene/optics/oblique.py); off: one lookup at the mean entry point",
+        "bool",
+        panel=False,
+    )
     background: tuple[float, float, float] = option(
         (0.045, 0.045, 0.05),
         "the colour behind the meshes where no environment map is drawn",

@@ -22,9 +22,14 @@ position, normals, tangent frame, view, uv, the material sample ``m``, the subsu
 ``sss_weight``), and hands it to each function of the hook:
 
     float sss_plain_weight(Surface s);                  // weight of the surface's own Burley diffuse
-    void  sss_add_light(Surface s, vec3 e, float vis, float NoL);  // per light: irradiance, shadow, cosine
+    void  sss_add_light(Surface s, vec3 e, vec3 vis, float NoL);  // per light: irradiance, shadow
+                                                        // per channel, cosine
     vec3  sss_radiance(Surface s);                      // after the lights: the subsurface radiance
                                                         // added toward the viewer
+
+A hook that defines ``SSS_HOOK_GATHERS_LIGHT`` (lib/sss_local.glsl) is given the shadow spread as the
+oblique entry is (three lookups per light, lib/surface_inputs.glsl sss_entry_ramp); the others the
+shadow at the mean entry point (sss_entry_visibility).
 
 ``s.m.sss_albedo`` is the subsurface albedo at the fragment: subsurface_color x the colour map x the
 vertex colour (the colour rule, docs/scenes.md), not the plain part's base colour (``s.m.base``).

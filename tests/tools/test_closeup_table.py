@@ -31,13 +31,15 @@ def test_every_kind_of_closeup_against_a_tiny_truth(tmp_path, capsys):
         scene = load_scene(REFERENCE_SCENES / f"{name}.toml")
         render_reference(scene, ReferenceRequest(16, 8, spp=4, rr_depth=spec.rr_depth), progress=False)
     out = tmp_path / "profiles.npz"
-    argv = [",".join(SCENES), "none,tsd", "--size", "16x8", "--spp", "4", "--profiles", str(out)]
+    argv = [",".join(SCENES), "none,tsd", "--size", "16x8", "--spp", "4", "--profiles", str(out), "--edge-bins"]
     assert closeup_table.main(argv) == 0
     text = capsys.readouterr().out
     assert "no cached reference" not in text
     for name in SCENES:
         assert f"{name:24s} truth 16x8 4 spp" in text
-    rows = [line.split()[0] for line in text.splitlines() if line.startswith("  ")]
+    bins = [line for line in text.splitlines() if line.startswith("    ") and " mm (" in line]
+    assert bins and all("energy" in b and "L1" in b for b in bins)  # the shadow scene's bands, per technique
+    rows = [line.split()[0] for line in text.splitlines() if line.startswith("  ") and not line.startswith("    ")]
     assert rows == ["none", "tsd"] * 3
     assert "deep shadow" in text and "front slab" in text and "beyond 2 mm" in text
     with np.load(out) as z:

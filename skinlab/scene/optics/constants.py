@@ -216,6 +216,25 @@ GLSL_CONSTANTS.update(
 LUMA_R, LUMA_G, LUMA_B = 0.2126, 0.7152, 0.0722
 GLSL_CONSTANTS.update({"LUMA_R": LUMA_R, "LUMA_G": LUMA_G, "LUMA_B": LUMA_B})
 
+# The spread of where obliquely entering light entered (issue 21; skinlab/scene/optics/oblique.py
+# entry_ramp_weights): the first scattering lies an exponentially distributed path along the refracted
+# beam, so the entry point lies upstream by an exponential distance. Three shadow lookups stand for it,
+# at the conditional means of the terciles of Exp(1) (in units of the luminance offset), each weighted by
+# its channel's probability of the tercile's span: bounds ln 3/2 and ln 3.
+ENTRY_RAMP_B1, ENTRY_RAMP_B2 = math.log(1.5), math.log(3.0)
+ENTRY_RAMP_N1 = 1.0 - ENTRY_RAMP_B1 * 2.0  # E[x | x < ln 3/2] = (1 - (1 + b) e^-b) / (1 - e^-b), e^-b = 2/3
+ENTRY_RAMP_N2 = (ENTRY_RAMP_B1 * 2.0 / 3.0 - ENTRY_RAMP_B2 / 3.0 + 1.0 / 3.0) * 3.0
+ENTRY_RAMP_N3 = 1.0 + ENTRY_RAMP_B2  # memorylessness: E[x | x > b] = b + 1
+GLSL_CONSTANTS.update(
+    {
+        "ENTRY_RAMP_B1": ENTRY_RAMP_B1,
+        "ENTRY_RAMP_B2": ENTRY_RAMP_B2,
+        "ENTRY_RAMP_N1": ENTRY_RAMP_N1,
+        "ENTRY_RAMP_N2": ENTRY_RAMP_N2,
+        "ENTRY_RAMP_N3": ENTRY_RAMP_N3,
+    }
+)
+
 # ---------------------------------------------------------------------------------------------
 # Environment lighting (issue 22; skinlab/scene/optics/sh.py, skinlab/scene/envmap.py,
 # skinlab/shaders/lib/environment.glsl). Real spherical harmonics to order 2 (Sloan 2008, appendix

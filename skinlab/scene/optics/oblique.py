@@ -17,13 +17,40 @@ feeding the subsurface term is made at x + offset, offset = (l - n (n.l)) z0 / m
 One offset for the three channels: z0 weighted by luminance (one shadow lookup, not three).
 GLSL twin: skinlab/shaders/lib/sss_oblique.glsl sss_entry_offset. Measured against the path-traced truth on
 the slab's shadow edge in docs/ground-truth.md.
+
+The offset is a mean: the first scattering lies an exponentially distributed path s (mean 1 / mu_t')
+along the refracted beam, so the point where that light entered lies s sin(theta_t) upstream. Not every
+source counts alike: one at depth z = s mu_t (mu_t the refracted cosine) returns to the surface in
+proportion to e^{-mu_tr z} (the diffusion's decay, mu_tr / mu_t' = sqrt(3 (1 - a')), the dipole's total
+reflectance of a buried source), so the light the surface re-emits entered upstream by an exponential
+distance of mean
+
+    m = sin(theta_t) / (mu_t' + mu_tr mu_t) = offset / (1 + sqrt(3 (1 - a')) mu_t)    per channel.
+
+A shadow edge the light crosses is therefore not moved but spread (issue 21: at a grazing key light on
+the nose, one shift for every channel left the lit side of the edge 25-30 % too bright and the shadow
+side too dark). The frame looks the shadow up at three points along the luminance offset, at
+ENTRY_RAMP_N1..N3 times the luminance mean of m (the conditional means of an exponential's terciles),
+each weighted per channel by the probability that the channel's exponential falls in its tercile's span
+(entry_ramp_weights). Single scattering, which leaves from a depth of 1 / (mu_t (1 / mu_l + 1 / mu_v))
+along the beam, entered upstream by a mean of the offset / (1 + mu_l / mu_v) (refracted cosines), read
+from the surface point's own shadow and the one at the whole offset (entry_pair_weights: one lookup).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from .constants import LUMA_B, LUMA_G, LUMA_R
+from .constants import (
+    ENTRY_RAMP_B1,
+    ENTRY_RAMP_B2,
+    ENTRY_RAMP_N1,
+    ENTRY_RAMP_N2,
+    ENTRY_RAMP_N3,
+    LUMA_B,
+    LUMA_G,
+    LUMA_R,
+)
 
 LUMA = np.array([LUMA_R, LUMA_G, LUMA_B])
 
@@ -109,3 +136,82 @@ def near_entry_gain(d_mm, ng, z0_mm, eta, entry_table) -> np.ndarray:
     at_x = table_lookup(table, mu_x)
     gain = np.minimum(g * at_s / np.maximum(at_x, 1e-6), NEAR_MAX_GAIN)
     return np.where((mu_x > NEAR_MIN_COS)[:, None], gain, 1.0)
+
+
+def entry_ramp_means(z0_mm, k=1.0) -> np.ndarray:
+    """(..., 3) each channel's mean upstream distance of the entry in units of the luminance offset b
+    (the length of entry_offset): z0_c / z0_luma over k, k per channel or one (the diffusion:
+    entry_diffusion_k; single scattering: single_entry_k, at least 1); 1 / k where z0_luma is 0. GLSL
+    twin sss_ramp_means."""
+    z0 = np.maximum(np.asarray(z0_mm, np.float64), 0.0)
+    zl = z0 @ LUMA
+    k = np.asarray(k, np.float64)
+    if k.ndim < z0.ndim:
+        k = k[..., None]
+    m = np.where((zl > 0)[..., None], z0 / np.where(zl > 0, zl, 1.0)[..., None], 1.0)
+    return m / np.maximum(k, 1.0)
+
+
+def entry_diffusion_k(alpha, mu_l, eta) -> np.ndarray:
+    """(..., 3) 1 + sqrt(3 (1 - a')) mu_t per channel (a' the reduced albedo, mu_t the refracted cosine
+    of the light, eta clamped at 1): the diffusion's entry lies upstream by the offset over this. GLSL:
+    the shaders pass sqrt(3 (1 - a')) as u_sss_slab_decay (skinlab/scene/optics/slab.py slab_decay)."""
+    a = np.clip(np.asarray(alpha, np.float64), 0.0, 1.0)
+    mu = _inside(mu_l, eta)
+    return 1.0 + np.sqrt(3.0 * (1.0 - a)) * np.asarray(mu)[..., None]
+
+
+def entry_ramp_nodes(m) -> np.ndarray:
+    """(..., 3) the three lookups' fractions of the luminance offset: ENTRY_RAMP_N1..N3 x the luminance
+    mean of m (entry_ramp_means). GLSL twin sss_ramp_nodes."""
+    mbar = np.maximum(np.asarray(m, np.float64), 1e-9) @ LUMA
+    return np.asarray(mbar)[..., None] * np.array([ENTRY_RAMP_N1, ENTRY_RAMP_N2, ENTRY_RAMP_N3])
+
+
+def entry_ramp_weights(m) -> np.ndarray:
+    """(..., 3 channels, 3 nodes) the weights of the shadow lookups at ENTRY_RAMP_N1..N3 x the
+    luminance mean of m (in units of b) for channels whose entry lies upstream by an exponential
+    distance of mean m b (entry_ramp_means): the probabilities of [0, B1 mbar b), [B1 mbar b, B2 mbar b)
+    and beyond, mbar = m . LUMA. Sum 1; a third each for a channel at mbar; all on the first as m -> 0.
+    GLSL twin sss_ramp_mix."""
+    m = np.maximum(np.asarray(m, np.float64), 1e-9)
+    mbar = (m @ LUMA)[..., None]
+    c1, c2 = np.exp(-ENTRY_RAMP_B1 * mbar / m), np.exp(-ENTRY_RAMP_B2 * mbar / m)
+    return np.stack([1.0 - c1, c1 - c2, c2], -1)
+
+
+def entry_pair_weights(m) -> np.ndarray:
+    """(..., 3 channels, 2) the weights of the surface point's own shadow and the one at b for
+    channels whose entry lies upstream by an exponential distance of mean m b: the probabilities of
+    [0, b / 2) and beyond (each point takes the half nearer it). GLSL twin sss_pair_mix."""
+    m = np.maximum(np.asarray(m, np.float64), 1e-9)
+    w0 = 1.0 - np.exp(-0.5 / m)
+    return np.stack([w0, 1.0 - w0], -1)
+
+
+def _inside(c, eta):
+    """The refracted cosine of a direction at cosine c outside (eta clamped at 1)."""
+    eta = np.maximum(np.asarray(eta, np.float64), 1.0)
+    c = np.clip(np.abs(np.asarray(c, np.float64)), 0.0, 1.0)
+    return np.sqrt(np.maximum(1.0 - (1.0 - c * c) / (eta * eta), 0.0))
+
+
+def single_pair_rate(z0_mm) -> np.ndarray:
+    """(3,) per channel 0.5 log2(e) z0_luma / z0_c (at most 1e4): single scattering's pair weight is
+    w0 = 1 - 2^(-k rate) = entry_pair_weights(entry_ramp_means(z0, k))[..., 0], one exp2 per fragment;
+    the ratio does not change with the radius map (it scales z0_c and z0_luma alike), so the frame binds
+    it per material (u_sss_single_ramp, skinlab/render/boundary.py). GLSL sss_single_pair."""
+    z0 = np.maximum(np.asarray(z0_mm, np.float64).reshape(3), 0.0)
+    zl = float(z0 @ LUMA)
+    with np.errstate(divide="ignore"):
+        r = np.where(z0 > 0, 0.5 * np.log2(np.e) * zl / np.where(z0 > 0, z0, 1.0), 1e4)
+    return np.minimum(r, 1e4)
+
+
+def single_entry_k(mu_l, mu_v, eta) -> np.ndarray:
+    """1 + mu_l / mu_v at the refracted cosines (eta clamped at 1; mu_v at least SINGLE_K_MIN_COS):
+    single scattering's entry lies upstream by the offset over this. GLSL sss_single_k."""
+    return 1.0 + _inside(mu_l, eta) / np.maximum(_inside(mu_v, eta), SINGLE_K_MIN_COS)
+
+
+SINGLE_K_MIN_COS = 0.05  # GLSL SSS_SINGLE_K_MIN_COS: a viewer at grazing does not make k unbounded

@@ -114,6 +114,27 @@ float light_visibility(int i, vec3 world, float NoL_geom) {
     return 1.0;
 }
 
+// light_visibility from one bilinear tap of the light's full map (lib/shadow.glsl shadow_tap); a light
+// with a size as light_visibility (its penumbra's filter).
+float light_visibility_tap(int i, vec3 world, float NoL_geom) {
+#if SHADOW_SLOTS > 0
+    int slot = u_light_shadow[i];
+#ifdef SHADOW_SOFT0
+    if (slot == 0) return shadow_soft(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom);
+#else
+    if (slot == 0) return shadow_tap(u_shadow0, u_shadow_matrix[0], world, NoL_geom);
+#endif
+#if SHADOW_SLOTS > 1
+#ifdef SHADOW_SOFT1
+    if (slot == 1) return shadow_soft(u_shadow1, u_shadow_distance1, u_shadow_matrix[1], u_shadow_soft[1], u_shadow_eye[1], world, NoL_geom);
+#else
+    if (slot == 1) return shadow_tap(u_shadow1, u_shadow_matrix[1], world, NoL_geom);
+#endif
+#endif
+#endif
+    return 1.0;
+}
+
 // light_visibility averaged over a receiver's footprint (world vectors du, dv: one texture-space
 // texel along u and v; lib/shadow.glsl shadow_pcf_area, a soft slot's lib/shadow_soft.glsl
 // shadow_soft_area).

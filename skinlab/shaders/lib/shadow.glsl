@@ -79,6 +79,16 @@ float shadow_pcf(sampler2DShadow map, mat4 shadow_matrix, vec3 world, float NoL)
 #endif
 }
 
+// One bilinear compare tap, the bias as shadow_pcf's: a point's visibility at a quarter of the 3x3
+// PCF's fetches, for lookups that a wider weighting smooths anyway (single scattering's shadow where its
+// light entered, lib/surface_inputs.glsl sss_single_visibility).
+float shadow_tap(sampler2DShadow map, mat4 shadow_matrix, vec3 world, float NoL) {
+    vec4 p = shadow_matrix * vec4(world, 1.0);
+    vec3 c = p.xyz / p.w;
+    if (any(lessThan(c, vec3(0.0))) || any(greaterThan(c, vec3(1.0)))) return 1.0;
+    return texture(map, vec3(c.xy, c.z - shadow_bias(shadow_matrix, p, vec2(textureSize(map, 0)), NoL)));
+}
+
 // The visibility averaged over a receiver's footprint: the parallelogram spanned by the world vectors
 // du and dv centred on world (a texture-space texel's, one texel along u and along v). A texel's
 // irradiance is then its square's mean, as the gather's bilinear reading of it needs for the light in

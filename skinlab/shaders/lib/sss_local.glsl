@@ -14,6 +14,9 @@
 #include "lib/sss_translucency.glsl"
 #endif
 
+// This hook takes each light's entering light in the forward pass: that pass gives it the shadow per
+// channel, spread as the entry is (passes/forward.frag, lib/surface_inputs.glsl sss_entry_ramp).
+#define SSS_HOOK_GATHERS_LIGHT
 vec3 sss_in = vec3(0.0);  // irradiance entering the medium (this fragment)
 // The multiple scattering's non-separable rest (lib/sss_boundary.glsl sss_ms_rest) goes with the light
 // into the technique's diffusion (for a screen-space blur: spread with it); a hook of the separable
@@ -21,7 +24,7 @@ vec3 sss_in = vec3(0.0);  // irradiance entering the medium (this fragment)
 // (SSS_MS_REST_LANDS, passes/forward.frag).
 vec3 sss_rest = vec3(0.0);  // sum of e NoL rest(mu, mu0) over the lights (radiance x pi per base colour)
 
-void sss_add_light(Surface s, vec3 e, float vis, float NoL) {
+void sss_add_light(Surface s, vec3 e, vec3 vis, float NoL) {
     sss_in += e * (vis * NoL) * sss_entry(NoL);
 #ifdef SSS_MS_REST  // the material's rest is not all zero (skinlab/render/boundary.py boundary_defines)
     if (u_sss_ms_rest_on > 0.0) sss_rest += e * (vis * NoL) * sss_ms_rest(abs(s.NoV), NoL);

@@ -16,6 +16,62 @@ vec3 sss_entry_offset(vec3 ng, vec3 l, vec3 z0_mm, float eta, float mm_per_unit)
     return lt * (z0 / (max(eta, max(length(lt), 1e-6)) * max(mm_per_unit, 1e-30)));
 }
 
+// The spread of the entry (skinlab/scene/optics/oblique.py, issue 21): the light re-emitted at a point
+// entered upstream by an exponential distance, per channel of mean m b (b the luminance offset's
+// length). sss_ramp_point: the lookup point at fraction f of the offset (moved toward the light as
+// sss_entry_point is); sss_ramp_means: m per channel, z0_c / z0_luma over k (per channel);
+// sss_diffusion_k: the diffusion's k, 1 + sqrt(3 (1 - a')) mu_t (decay = sqrt(3 (1 - a')),
+// lib/sss_boundary.glsl's u_sss_slab_decay); sss_single_k: single scattering's, 1 + mu_l / mu_v (refracted
+// cosines); sss_ramp_nodes: the three lookups' fractions of b, ENTRY_RAMP_N1..N3 x m's luminance mean;
+// sss_ramp_mix: the three lookups weighted per channel by its exponential's spans; sss_pair_mix: the
+// surface point's own shadow and the one at b, each the half nearer it.
+#define SSS_SINGLE_K_MIN_COS 0.05
+vec3 sss_ramp_point(vec3 world, vec3 off, vec3 l, float f) {
+    return world + off * f + l * (length(off) * f);
+}
+
+float sss_inside_cos(float c, float eta) {
+    float e = max(eta, 1.0), cc = clamp(abs(c), 0.0, 1.0);
+    return sqrt(max(1.0 - (1.0 - cc * cc) / (e * e), 0.0));
+}
+
+vec3 sss_ramp_means(vec3 z0_mm, vec3 k) {
+    vec3 z0 = max(z0_mm, vec3(0.0));
+    float zl = dot(z0, vec3(LUMA_R, LUMA_G, LUMA_B));
+    return (zl > 0.0 ? z0 / zl : vec3(1.0)) / max(k, vec3(1.0));
+}
+
+vec3 sss_diffusion_k(vec3 decay, float mu_l, float eta) {
+    return 1.0 + decay * sss_inside_cos(mu_l, eta);
+}
+
+float sss_single_k(float mu_l, float mu_v, float eta) {
+    return 1.0 + sss_inside_cos(mu_l, eta) / max(sss_inside_cos(mu_v, eta), SSS_SINGLE_K_MIN_COS);
+}
+
+vec3 sss_ramp_nodes(vec3 m) {
+    return vec3(ENTRY_RAMP_N1, ENTRY_RAMP_N2, ENTRY_RAMP_N3) * dot(max(m, vec3(1e-9)), vec3(LUMA_R, LUMA_G, LUMA_B));
+}
+
+vec3 sss_ramp_mix(vec3 m, float v1, float v2, float v3) {
+    vec3 mm = max(m, vec3(1e-9));
+    float mbar = dot(mm, vec3(LUMA_R, LUMA_G, LUMA_B));
+    vec3 c1 = exp(-ENTRY_RAMP_B1 * mbar / mm), c2 = exp(-ENTRY_RAMP_B2 * mbar / mm);
+    return (1.0 - c1) * v1 + (c1 - c2) * v2 + c2 * v3;
+}
+
+vec3 sss_pair_mix(vec3 m, float v0, float vb) {
+    vec3 w0 = 1.0 - exp(-0.5 / max(m, vec3(1e-9)));
+    return w0 * v0 + (1.0 - w0) * vb;
+}
+
+// sss_pair_mix for single scattering from its k and the material's rate (oblique.py single_pair_rate,
+// bound as u_sss_single_ramp): the same weights, one exp2.
+vec3 sss_single_pair(float k, vec3 rate, float v0, float vb) {
+    vec3 w0 = 1.0 - exp2(-k * rate);
+    return w0 * v0 + (1.0 - w0) * vb;
+}
+
 vec3 sss_entry_point(vec3 world, vec3 ng, vec3 l, vec3 z0_mm, float eta, float mm_per_unit) {
     vec3 off = sss_entry_offset(ng, l, z0_mm, eta, mm_per_unit);
     return world + off + l * length(off);

@@ -44,12 +44,49 @@ Surface surface_inputs(vec3 world, vec3 normal, vec2 uv, vec4 tangent, vec4 colo
     return s;
 }
 
-// Light i's shadow where the diffusion leaving at s entered (oblique entry, lib/sss_oblique.glsl: the
-// mean free path x the radius map toward the light l); 1 for a light without a shadow map.
+// Light i's shadow where the diffusion leaving at s entered on average (oblique entry,
+// lib/sss_oblique.glsl: the mean free path x the radius map toward the light l); 1 for a light without
+// a shadow map.
 float sss_entry_visibility(Surface s, int i, vec3 l) {
     if (u_light_shadow[i] < 0) return 1.0;
     vec3 entry = sss_entry_point(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, u_sss_eta, u_mm_per_unit);
     return light_visibility(i, entry, dot(s.ng, l));
+}
+
+// Light i's shadow per channel where the diffusion leaving at s entered, spread as the entry is (an
+// exponential distance upstream, per channel, lib/sss_oblique.glsl): three lookups along the
+// luminance offset; decay per channel sqrt(3 (1 - a')) (lib/sss_boundary.glsl u_sss_slab_decay); 1
+// for a light without a shadow map.
+// Without SSS_ENTRY_SPREAD (RenderSettings.entry_spread off): the shadow at the mean entry point.
+vec3 sss_entry_ramp(Surface s, int i, vec3 l, vec3 decay) {
+#ifndef SSS_ENTRY_SPREAD
+    return vec3(sss_entry_visibility(s, i, l));
+#endif
+    if (u_light_shadow[i] < 0) return vec3(1.0);
+    vec3 z0 = u_sss_mfp * s.sss_radius_scale;
+    vec3 off = sss_entry_offset(s.ng, l, z0, u_sss_eta, u_mm_per_unit);
+    float c = dot(s.ng, l);
+    vec3 m = sss_ramp_means(z0, sss_diffusion_k(decay, c, u_sss_eta));
+    vec3 f = sss_ramp_nodes(m);
+    float v1 = light_visibility(i, sss_ramp_point(s.position, off, l, f.x), c);
+    float v2 = light_visibility(i, sss_ramp_point(s.position, off, l, f.y), c);
+    float v3 = light_visibility(i, sss_ramp_point(s.position, off, l, f.z), c);
+    return sss_ramp_mix(m, v1, v2, v3);
+}
+
+// Light i's shadow per channel for single scattering at s (lib/sss_oblique.glsl sss_pair_mix): its light
+// entered upstream by the diffusion's offset over k = 1 + mu_l / mu_v, read from the point's own shadow
+// vis and one bilinear tap at the whole offset (lights.glsl light_visibility_tap: the pair's weights
+// smooth it); vis where the light has no map.
+uniform vec3 u_sss_single_ramp;  // skinlab/scene/optics/oblique.py single_pair_rate (skinlab/render/boundary.py)
+vec3 sss_single_visibility(Surface s, int i, vec3 l, float NoL, float vis) {
+#ifndef SSS_ENTRY_SPREAD  // RenderSettings.entry_spread off: the point's own shadow
+    return vec3(vis);
+#endif
+    if (u_light_shadow[i] < 0) return vec3(vis);
+    vec3 at = sss_entry_point(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, u_sss_eta, u_mm_per_unit);
+    return sss_single_pair(sss_single_k(NoL, s.NoV, u_sss_eta), u_sss_single_ramp, vis,
+                           light_visibility_tap(i, at, dot(s.ng, l)));
 }
 
 // Light i's irradiance feeding the diffusion at s relative to its own (a point or spot light's

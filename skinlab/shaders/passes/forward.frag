@@ -113,14 +113,26 @@ void main() {
         // sss_near_single), and there too, for a hook of the separable boundary that does not spread it
         // with its diffusion (SSS_MS_REST_LANDS: tsd, exact, preintegrated), the multiple scattering's
         // non-separable rest (lib/sss_boundary.glsl sss_ms_rest)
-        if (single) color += e * (vis * NoL) * single_w * sss_single_brdf_view(n, l, single_view) * sss_near_single(s, i);
-#if defined(SSS_MS_REST_LANDS) && defined(SSS_MS_REST) && !defined(MEASURE_NO_MS_REST)  // MEASURE_NO_MS_REST: tools/orbit_cost.py
-        if (u_sss_ms_rest_on > 0.0) color += e * (vis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
+        // (shadowed where their light entered, spread upstream: lib/surface_inputs.glsl
+        // sss_single_visibility, one bilinear tap more per light)
+        vec3 svis = vec3(vis);
+#ifndef SSS_HOOK_PLAIN  // a mesh that does not scatter (techniques/none/forward.glsl) has no single scattering
+        svis = sss_single_visibility(s, i, l, NoL, vis);
 #endif
-        // the technique's diffusion: shadowed where it entered (oblique entry, lib/surface_inputs.glsl)
-        // and fed by the irradiance where it entered (a point or spot light's, lib/surface_inputs.glsl)
+        if (single) color += e * (svis * NoL) * single_w * sss_single_brdf_view(n, l, single_view) * sss_near_single(s, i);
+#if defined(SSS_MS_REST_LANDS) && defined(SSS_MS_REST) && !defined(MEASURE_NO_MS_REST)  // MEASURE_NO_MS_REST: tools/orbit_cost.py
+        if (u_sss_ms_rest_on > 0.0) color += e * (svis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
+#endif
+        // the technique's diffusion: shadowed where it entered (oblique entry, spread upstream per
+        // channel, for a hook that gathers its light here: SSS_HOOK_GATHERS_LIGHT, lib/sss_local.glsl;
+        // lib/surface_inputs.glsl sss_entry_ramp) and fed by the irradiance where it entered (a point
+        // or spot light's, lib/surface_inputs.glsl)
 #ifndef MEASURE_NO_ADD_LIGHT  // a measurement variant (tools/orbit_cost.py): the hook told of no light
-        sss_add_light(s, e * sss_near_gain(s, i), sss_entry_visibility(s, i, l), NoL);
+#ifdef SSS_HOOK_GATHERS_LIGHT
+        sss_add_light(s, e * sss_near_gain(s, i), sss_entry_ramp(s, i, l, u_sss_slab_decay), NoL);
+#else
+        sss_add_light(s, e * sss_near_gain(s, i), vec3(sss_entry_visibility(s, i, l)), NoL);
+#endif
 #endif
     }
     vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)

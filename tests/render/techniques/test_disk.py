@@ -12,7 +12,7 @@ from skinlab.scene.graph import MeshNode
 from skinlab.scene.optics import burley, disk
 from skinlab.scene.optics.edges import edge_response
 from skinlab.scene.optics.material_medium import material_medium
-from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, quad_mesh, skin, slab_scene
+from tests.tsd_scenes import entered, exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 
 def medium(radius=(8.0, 4.0, 2.0), color=(0.8, 0.6, 0.5)):
@@ -85,9 +85,7 @@ def test_rendered_edge_follows_the_kernel_and_keeps_energy(renderer, multiple_on
     renormalised)."""
     n = 160
     scene = slab_scene(occluder=True, material=skin("burley"))
-    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
-        scene, 2 * scene.mm_per_unit / n
-    )  # where the light entered
+    x_mm, px_mm = pixel_x(n, 1.0) * scene.mm_per_unit, 2 * scene.mm_per_unit / n  # from where the light entered
     for samples in (16, 64):
         res = renderer.render(scene, RenderSettings(n, n, shadow_size=4096, technique=DiskSettings(samples=samples)))
         assert [p.kind for p in res.plan.passes] == ["shadow", "forward", "disk_sss", "tonemap"]
@@ -96,7 +94,7 @@ def test_rendered_edge_follows_the_kernel_and_keeps_energy(renderer, multiple_on
         assert len(k.radii_mm) == samples
         rows = res.hdr[8:-8, :, :3].astype(np.float64).mean(axis=0)
         lit = rows[-8:].mean(axis=0)
-        own = disk.disk_edge_response(-x_mm, k)
+        own = entered(lambda e, k=k: disk.disk_edge_response(-e, k), x_mm, scene, px_mm)
         err = np.abs(rows / lit - own)
         assert err.max() < 0.02 + 0.5 / samples, (samples, err.max(axis=0))  # pixel-scale sampling
         # energy: the filtered subsurface light against the unfiltered one, far from the edge

@@ -13,7 +13,7 @@ from skinlab.scene.optics import ssss
 from skinlab.scene.optics.edges import edge_response
 from skinlab.scene.optics.exact_profile import exact_profile_convolution
 from skinlab.scene.optics.material_medium import material_medium
-from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, skin, slab_scene
+from tests.tsd_scenes import entered, exact_profile, pixel_x, skin, slab_scene
 
 
 def edge_row(res, n):
@@ -32,14 +32,13 @@ def test_exact_reference_follows_the_profile_edge_and_numpy_brute_force(renderer
     medium = material_medium(t.material.values)
     row, lit = edge_row(res, n)
     texel_mm = 2 * scene.mm_per_unit / n
-    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
-        scene, texel_mm, averaged=True
-    )  # where the light entered
+    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit
     # the edge response averaged over an irradiance texel: each texel holds the light over its square
-    # (lib/shadow.glsl shadow_pcf_area)
+    # (lib/shadow.glsl shadow_pcf_area), from where the light entered (entered: spread as the frame does)
     within = (np.arange(16) + 0.5) / 16 - 0.5
     profile = exact_profile(model, medium)
-    edge = np.mean([edge_response(-(x_mm + w * texel_mm), profile, "profile") for w in within], axis=0)
+    er = lambda e: edge_response(-e, profile, "profile")  # noqa: E731
+    edge = np.mean([entered(er, x_mm + w * texel_mm, scene, texel_mm, averaged=True) for w in within], axis=0)
     err = np.abs(row / lit - edge)
     assert err.max() < 0.03, (err.max(axis=0), int(err.argmax()) // 3)
     # texture level against the NumPy brute-force convolution of the same irradiance
@@ -67,14 +66,14 @@ def test_screen_space_sss_follows_its_separable_kernel(renderer, multiple_only):
         kernel = plan.kernels[0]  # the frame's one scattering material
         assert plan.taps == len(kernel.offsets_mm) == taps
         row, lit = edge_row(res, n)
-        x_mm = pixel_x(n, 1.0) * scene.mm_per_unit - entry_shift_mm(
-            scene, 2 * scene.mm_per_unit / n
-        )  # where the light entered
-        own = ssss.separable_edge_response(-x_mm, kernel.offsets_mm, kernel.weights)
+        x_mm, px_mm = pixel_x(n, 1.0) * scene.mm_per_unit, 2 * scene.mm_per_unit / n  # from where the light entered:
+        own = entered(lambda e, k=kernel: ssss.separable_edge_response(-e, k.offsets_mm, k.weights), x_mm, scene, px_mm)
         err = np.abs(row / lit - own)
         assert err.max() < 0.02 + 1.0 / taps, (taps, err.max(axis=0))
         medium = material_medium(kernel.material.values)
-        exact = edge_response(-x_mm, exact_profile("burley", medium), "profile")
+        exact = entered(
+            lambda e, m=medium: edge_response(-e, exact_profile("burley", m), "profile"), x_mm, scene, px_mm
+        )
         assert np.abs(row / lit - exact).max() < 0.06 + 1.0 / taps
     # the kernel itself: weights sum to 1 per channel, symmetric offsets
     np.testing.assert_allclose(kernel.weights.sum(axis=0), 1.0)

@@ -17,7 +17,7 @@ from skinlab.scene.optics.exact_profile import exact_profile_convolution
 from skinlab.scene.optics.material_medium import material_medium
 from skinlab.scene.optics.single_scattering import single_scatter_brdf
 from skinlab.scene.optics.slab import slab_table, slab_through
-from tests.tsd_scenes import entry_shift_mm, exact_profile, pixel_x, quad_mesh, skin, slab_scene
+from tests.tsd_scenes import entered, exact_profile, pixel_x, quad_mesh, skin, slab_scene
 
 
 def tsd_node(renderer, scene, name="slab"):
@@ -106,14 +106,16 @@ def _edge_row(renderer, model: str, place: float, angular_radius: float = 0.0):
     row = res.hdr[n // 2, :, :3].astype(np.float64)
     lit = row[-8:].mean(axis=0)
     texel_mm = 2 * scene.mm_per_unit / n
-    x_mm = (pixel_x(n, 1.0) - h * tilt) * scene.mm_per_unit - entry_shift_mm(
-        scene, texel_mm, averaged=True
-    )  # where the light entered
+    x_mm = (pixel_x(n, 1.0) - h * tilt) * scene.mm_per_unit
     profile = exact_profile(model, material_medium(t.material.values))
-    edge = edge_response(-x_mm, profile, "profile")
+
+    def response(x):  # x from where the light entered, spread as the frame spreads it (entered)
+        return entered(lambda e: edge_response(-e, profile, "profile"), x, scene, texel_mm, averaged=True)
+
+    edge = response(x_mm)
     moved = (row / lit - edge).sum(axis=0)  # pixels (= texels) of light too much
     within = (np.arange(16) + 0.5) / 16 - 0.5  # across a texel (midpoint rule)
-    held = np.mean([edge_response(-(x_mm + w * texel_mm), profile, "profile") for w in within], axis=0)
+    held = np.mean([response(x_mm + w * texel_mm) for w in within], axis=0)
     return row / lit, moved, np.abs(row / lit - held)
 
 
@@ -311,3 +313,32 @@ def test_a_lit_slab_reflects_chandrasekhars_brdf(renderer, technique, cos_light)
     assert np.all(np.abs(sep / want - 1) > 0.015)  # what the rest takes back
     got = img[22:26, 22:26, :3].reshape(-1, 3).mean(0)
     np.testing.assert_allclose(got, want, rtol=0.01)
+
+
+def test_entry_spread_off_takes_the_shadow_at_the_mean_entry_point(renderer, multiple_only):
+    """RenderSettings.entry_spread: on, the shadow where the light entered is spread over three lookups
+    per channel (skinlab/scene/optics/oblique.py); off, one lookup at the mean entry point. The two frames
+    are the same far from the shadow's edge and differ across it; off, the light summed across the edge
+    is the hard shift's (each channel's edge response shifted by the luminance offset) within a tenth
+    of a texel, as before the spread."""
+    from skinlab.scene.optics.oblique import entry_offset
+
+    n = 192
+    scene = slab_scene(occluder=True, material=skin("burley"))
+    rows = {}
+    for spread in (True, False):
+        res = renderer.render(
+            scene, RenderSettings(n, n, shadow_size=4096, entry_spread=spread, technique=TsdSettings(size=n))
+        )
+        row = res.hdr[n // 2, :, :3].astype(np.float64)
+        rows[spread] = row / row[-8:].mean(axis=0)
+    far = np.r_[0:16, n - 16 : n]
+    np.testing.assert_allclose(rows[True][far], rows[False][far], atol=2e-3)
+    assert np.abs(rows[True] - rows[False]).max() > 0.01
+    t = tsd_node(renderer, scene)
+    medium = material_medium(t.material.values)
+    off = entry_offset(np.array([[0.0, 0.0, 1.0]]), -scene.lights()[0].direction[None], medium.mfp_arr, medium.eta, 1.0)
+    x_mm = pixel_x(n, 1.0) * scene.mm_per_unit + off[0][0]  # from the mean entry point
+    edge = edge_response(-x_mm, exact_profile("burley", medium), "profile")
+    moved = (rows[False] - edge).sum(axis=0)
+    assert np.all(np.abs(moved) < 0.1), moved

@@ -1,13 +1,27 @@
 """Oblique entry (skinlab/shaders/lib/sss_oblique.glsl vs skinlab/scene/optics/oblique.py): the diffusion of light
 arriving at an angle is centred sin(theta_t) z0 along the surface from where it entered (Wang &
-Jacques 1995), and the shadow lookup point built from it. Twins within 1e-4, hard cases finite."""
+Jacques 1995), and the shadow lookup point built from it; the entry's spread (three lookups weighted per
+channel, single scattering's pair). Twins within 1e-4, hard cases finite."""
 
 import numpy as np
 import pytest
 
 from skinlab.gl.glsl_eval import assert_close_fp32
-from skinlab.scene.optics.constants import LUMA_B, LUMA_G, LUMA_R
-from skinlab.scene.optics.oblique import LUMA, entry_offset, entry_point, near_entry, near_entry_gain
+from skinlab.scene.optics.constants import ENTRY_RAMP_N1, ENTRY_RAMP_N2, ENTRY_RAMP_N3, LUMA_B, LUMA_G, LUMA_R
+from skinlab.scene.optics.oblique import (
+    LUMA,
+    entry_diffusion_k,
+    entry_offset,
+    entry_pair_weights,
+    entry_point,
+    entry_ramp_means,
+    entry_ramp_nodes,
+    entry_ramp_weights,
+    near_entry,
+    near_entry_gain,
+    single_entry_k,
+    single_pair_rate,
+)
 
 
 def _unit(v):
@@ -180,3 +194,85 @@ def test_near_entry_keeps_the_flux_and_moves_it_away():
     # a light far away (directional-like within a small patch): no change
     far = near_entry(np.array([[0.3, 0.0, 1e6]]), ng[:1], k, 1.0)[0]
     assert far == pytest.approx(np.ones((1, 3)), abs=1e-5)
+
+
+RAMP_OUTS = """
+vec3 ramp_mix(vec3 m, vec3 v) { return sss_ramp_mix(m, v.x, v.y, v.z); }
+vec3 pair_mix(vec3 m, vec3 v) { return sss_pair_mix(m, v.x, v.y); }
+vec3 single_pair(float k, vec3 rate, vec3 v) { return sss_single_pair(k, rate, v.x, v.y); }
+vec3 means_single(vec3 z0, float mu_l, float mu_v, float eta) {
+    return sss_ramp_means(z0, vec3(sss_single_k(mu_l, mu_v, eta)));
+}
+vec3 means_diffusion(vec3 z0, vec3 decay, float mu_l, float eta) {
+    return sss_ramp_means(z0, sss_diffusion_k(decay, mu_l, eta));
+}
+"""
+
+
+def _ramp_cases(n=400, seed=11):
+    rng = np.random.default_rng(seed)
+    z0 = rng.uniform(0.0, 3.0, (n, 3))
+    z0[:10] = 0.0  # no scattering
+    z0[10:20, 1:] = 0.0  # red alone
+    alpha = rng.uniform(0.0, 1.0, (n, 3))
+    alpha[20:30] = 1.0  # no absorption: the diffusion's k is 1
+    mu_l, mu_v = rng.uniform(0.0, 1.0, n), rng.uniform(-1.0, 1.0, n)
+    mu_l[30:40], mu_v[40:50] = 0.0, 0.0  # grazing light, grazing view
+    eta = rng.uniform(0.8, 1.6, n)
+    v = rng.uniform(0.0, 1.0, (n, 3))
+    return z0, alpha, mu_l, mu_v, eta, v
+
+
+def test_entry_ramp_twins(glsl):
+    z0, alpha, mu_l, mu_v, eta, v = _ramp_cases()
+    f32 = lambda x: np.asarray(x, np.float32).astype(np.float64)
+    decay = np.sqrt(3.0 * (1.0 - f32(alpha)))
+    m_d = entry_ramp_means(f32(z0), entry_diffusion_k(f32(alpha), f32(mu_l), f32(eta)))
+    m_s = entry_ramp_means(f32(z0), single_entry_k(f32(mu_l), f32(mu_v), f32(eta)))
+    assert np.isfinite(m_d).all() and np.isfinite(m_s).all() and (m_d >= 0).all() and (m_d[:10] <= 1.0).all()
+    ins = {"z0": z0, "decay": decay, "mu_l": mu_l, "mu_v": mu_v, "eta": eta, "m": m_d, "v": v}
+    for expr, ref in (
+        ("means_diffusion(z0, decay, mu_l, eta)", m_d),
+        ("means_single(z0, mu_l, mu_v, eta)", m_s),
+        ("sss_ramp_nodes(m)", entry_ramp_nodes(f32(m_d))),
+        ("ramp_mix(m, v)", np.einsum("ncs,ns->nc", entry_ramp_weights(f32(m_d)), f32(v))),
+        ("pair_mix(m, v)", np.einsum("ncs,ns->nc", entry_pair_weights(f32(m_d)), f32(v)[:, :2])),
+    ):
+        gpu = glsl.evaluate("lib/sss_oblique.glsl", expr, ins, out_components=3, prelude=RAMP_OUTS)
+        assert_close_fp32(gpu, ref, rtol=2e-4, atol=2e-5, what=expr)
+    # single scattering's pair from the material's rate (the frame's one exp2) is the pair of its means
+    k = single_entry_k(f32(mu_l), f32(mu_v), f32(eta))
+    rate = np.array([single_pair_rate(z) for z in f32(z0)])
+    want = np.einsum("ncs,ns->nc", entry_pair_weights(entry_ramp_means(f32(z0), k)), f32(v)[:, :2])
+    scat = (f32(z0) > 0).all(axis=1)  # a channel without scattering: the rate's cap, all at the point
+    ins = {"k": k, "rate": rate, "v": v}
+    for expr, ref in (("single_pair(k, rate, v)", want),):
+        gpu = glsl.evaluate("lib/sss_oblique.glsl", expr, ins, out_components=3, prelude=RAMP_OUTS)
+        assert_close_fp32(gpu[scat], ref[scat], rtol=2e-4, atol=2e-5, what=expr)
+        assert np.isfinite(gpu).all()
+
+
+def test_entry_ramp_spreads_each_channel_as_an_exponential():
+    """The three lookups stand for an exponential distance of mean m: their weights sum to 1, are a third
+    each for a channel at the luminance mean, and the lookups' mean for each channel is its own m within
+    25 % over a 4x range of m (the coarse three-point rule); single scattering's pair keeps its mean
+    within a factor (its nodes are 0 and the whole offset). The diffusion's k is 1 without absorption and
+    grows with it and with the light's cosine; single scattering's is 2 at normal incidence and view."""
+    m = np.array([[1.3, 1.0, 0.7], [0.5, 0.5, 0.5], [2.0, 1.0, 0.5]])
+    w = entry_ramp_weights(m)
+    assert w.sum(-1) == pytest.approx(np.ones((3, 3)))
+    assert w[1] == pytest.approx(np.full((3, 3), 1.0 / 3.0))
+    nodes = entry_ramp_nodes(m)
+    mean = np.einsum("ncs,ns->nc", w, nodes)
+    assert mean == pytest.approx(m, rel=0.25)
+    assert np.einsum("s,s->", np.full(3, 1.0 / 3.0), [ENTRY_RAMP_N1, ENTRY_RAMP_N2, ENTRY_RAMP_N3]) == pytest.approx(
+        1.0
+    )
+    assert entry_ramp_weights(np.array([[1e-12, 1.0, 1.0]]))[0, 0] == pytest.approx([1.0, 0.0, 0.0])
+    pw = entry_pair_weights(np.array([0.25, 1.0, 4.0]))
+    assert pw.sum(-1) == pytest.approx(np.ones(3)) and np.all(np.diff(pw[:, 1]) > 0)  # longer: more from b
+    assert entry_diffusion_k(np.array([1.0, 1.0, 1.0]), 0.7, 1.0) == pytest.approx(np.ones(3))
+    k = entry_diffusion_k(np.array([0.9, 0.7, 0.5]), np.array([0.2, 0.9]), 1.0)
+    assert np.all(np.diff(k, axis=-1) > 0) and np.all(k[1] > k[0])
+    assert single_entry_k(1.0, 1.0, 1.4) == pytest.approx(2.0) and single_entry_k(0.3, 0.0, 1.0) == pytest.approx(7.0)
+    assert entry_ramp_means(np.zeros(3)) == pytest.approx(np.ones(3))  # no scattering: finite, unused

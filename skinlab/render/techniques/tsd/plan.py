@@ -381,7 +381,8 @@ def stretch_inputs(node, scene) -> tuple:
 def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tuple:
     """What the texture-space irradiance depends on besides the shadow maps it reads: the node's
     geometry and transform, its material, the lights, the ambient light, the scene scale (the
-    translucency's thickness in mm), the albedo mix and the translucency's Gaussians. Not the camera."""
+    translucency's thickness in mm), the albedo mix and the translucency's Gaussians, whether the oblique
+    entry's shadow is spread (RenderSettings.entry_spread). Not the camera."""
     k = t.kernel
     trans = (
         (tuple(s.variance_mm2 for s in k.steps), np.asarray(k.weights(), np.float64).tobytes())
@@ -398,6 +399,7 @@ def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tu
         float(mix),
         trans,
         ctx.settings.max_lights,
+        ctx.settings.entry_spread,
     )
 
 

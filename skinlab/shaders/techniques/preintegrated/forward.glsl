@@ -31,7 +31,7 @@ uniform vec3 u_pis_soften;       // per channel: 0 the normal-mapped normal, 1 t
 
 float sss_plain_weight(Surface s) { return 1.0 - s.sss_weight; }
 
-void sss_add_light(Surface s, vec3 e, float vis, float NoL) {}  // the hook runs its own light loop (below)
+void sss_add_light(Surface s, vec3 e, vec3 vis, float NoL) {}  // the hook runs its own light loop (below)
 
 // Its own light loop: each light is looked up past the terminator too (the forward pass's loop skips
 // lights behind the shading normal) and by the geometric normal (the table is over it), with the
@@ -52,8 +52,9 @@ vec3 sss_radiance(Surface s) {
         light_incidence(i, s.position, ng, l, e);
         float nlg = dot(ng, l);
         // shadow maps only where the light faces the surface; past the terminator the ring's light
-        // comes from the lit side (looked up where the light entered, lib/surface_inputs.glsl)
-        float vis = nlg > 0.0 ? sss_entry_visibility(s, i, l) : 1.0;
+        // comes from the lit side (looked up where the light entered, spread per channel as the
+        // entry is: lib/surface_inputs.glsl sss_entry_ramp)
+        vec3 vis = nlg > 0.0 ? sss_entry_ramp(s, i, l, u_sss_slab_decay) : vec3(1.0);
 #ifdef HAS_NORMAL_MAP
         vec3 D = vec3(pis_lookup(u_pis_lut, u_pis_lut_size, dot(nr, l), t).r,
                       pis_lookup(u_pis_lut, u_pis_lut_size, dot(nG, l), t).g,

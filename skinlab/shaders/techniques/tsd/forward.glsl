@@ -86,7 +86,7 @@ vec3 tsd_diffused(vec2 uv) {
 
 float sss_plain_weight(Surface s) { return 1.0 - s.sss_weight; }
 
-void sss_add_light(Surface s, vec3 e, float vis, float NoL) {}  // the irradiance pass gathered the light
+void sss_add_light(Surface s, vec3 e, vec3 vis, float NoL) {}  // the irradiance pass gathered the light
 
 vec3 sss_radiance(Surface s) {
     vec3 base = s.m.sss_albedo;
