@@ -183,7 +183,7 @@ def entry_ramp_weights(m) -> np.ndarray:
 def entry_pair_weights(m) -> np.ndarray:
     """(..., 3 channels, 2) the weights of the surface point's own shadow and the one at b for
     channels whose entry lies upstream by an exponential distance of mean m b: the probabilities of
-    [0, b / 2) and beyond (each point takes the half nearer it). GLSL twin sss_pair_mix."""
+    [0, b / 2) and beyond (each point takes the half nearer it). GLSL: sss_single_pair (from single_pair_rate)."""
     m = np.maximum(np.asarray(m, np.float64), 1e-9)
     w0 = 1.0 - np.exp(-0.5 / m)
     return np.stack([w0, 1.0 - w0], -1)

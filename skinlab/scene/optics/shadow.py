@@ -95,6 +95,26 @@ def shadow_pcf(
     return np.where(outside, 1.0, total / 9.0)
 
 
+def shadow_tap(depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarray, NoL) -> np.ndarray:
+    """One bilinear compare tap at each point (a LINEAR depth-compare texture): the four texels around
+    uv x size - 1/2 compared with the biased depth (shadow_bias), weighted bilinearly, clamped to the
+    map's edge; 1 outside the map. GLSL shadow_tap."""
+    m, p = _light_space(shadow_matrix, world)
+    c = p[:, :3] / p[:, 3:4]
+    outside = (c < 0).any(1) | (c > 1).any(1)
+    h, w = depth_map.shape
+    ref = c[:, 2] - shadow_bias(NoL, m, world, (w, h))
+    tu, tv = c[:, 0] * w - 0.5, c[:, 1] * h - 0.5
+    bu, bv = np.floor(tu), np.floor(tv)
+    fu, fv = tu - bu, tv - bv
+    i0, i1 = (np.clip(bu.astype(np.int64) + k, 0, w - 1) for k in (0, 1))
+    j0, j1 = (np.clip(bv.astype(np.int64) + k, 0, h - 1) for k in (0, 1))
+    lit = lambda j, i: (ref <= depth_map[j, i]).astype(np.float64)  # noqa: E731
+    row0 = lit(j0, i0) * (1.0 - fu) + lit(j0, i1) * fu
+    row1 = lit(j1, i0) * (1.0 - fu) + lit(j1, i1) * fu
+    return np.where(outside, 1.0, row0 * (1.0 - fv) + row1 * fv)
+
+
 def shadow_pcf_area(
     depth_map: np.ndarray, shadow_matrix: np.ndarray, world: np.ndarray, NoL, du, dv, nearest: bool = False
 ) -> np.ndarray:

@@ -23,7 +23,7 @@ vec3 sss_entry_offset(vec3 ng, vec3 l, vec3 z0_mm, float eta, float mm_per_unit)
 // sss_diffusion_k: the diffusion's k, 1 + sqrt(3 (1 - a')) mu_t (decay = sqrt(3 (1 - a')),
 // lib/sss_boundary.glsl's u_sss_slab_decay); sss_single_k: single scattering's, 1 + mu_l / mu_v (refracted
 // cosines); sss_ramp_nodes: the three lookups' fractions of b, ENTRY_RAMP_N1..N3 x m's luminance mean;
-// sss_ramp_mix: the three lookups weighted per channel by its exponential's spans; sss_pair_mix: the
+// sss_ramp_mix: the three lookups weighted per channel by its exponential's spans; sss_single_pair: the
 // surface point's own shadow and the one at b, each the half nearer it.
 #define SSS_SINGLE_K_MIN_COS 0.05
 vec3 sss_ramp_point(vec3 world, vec3 off, vec3 l, float f) {
@@ -60,13 +60,8 @@ vec3 sss_ramp_mix(vec3 m, float v1, float v2, float v3) {
     return (1.0 - c1) * v1 + (c1 - c2) * v2 + c2 * v3;
 }
 
-vec3 sss_pair_mix(vec3 m, float v0, float vb) {
-    vec3 w0 = 1.0 - exp(-0.5 / max(m, vec3(1e-9)));
-    return w0 * v0 + (1.0 - w0) * vb;
-}
-
-// sss_pair_mix for single scattering from its k and the material's rate (oblique.py single_pair_rate,
-// bound as u_sss_single_ramp): the same weights, one exp2.
+// single scattering's pair from its k and the material's rate (oblique.py single_pair_rate, bound as
+// u_sss_single_ramp): the weights of oblique.py entry_pair_weights, one exp2.
 vec3 sss_single_pair(float k, vec3 rate, float v0, float vb) {
     vec3 w0 = 1.0 - exp2(-k * rate);
     return w0 * v0 + (1.0 - w0) * vb;

@@ -74,7 +74,7 @@ vec3 sss_entry_ramp(Surface s, int i, vec3 l, vec3 decay) {
     return sss_ramp_mix(m, v1, v2, v3);
 }
 
-// Light i's shadow per channel for single scattering at s (lib/sss_oblique.glsl sss_pair_mix): its light
+// Light i's shadow per channel for single scattering at s (lib/sss_oblique.glsl sss_single_pair): its light
 // entered upstream by the diffusion's offset over k = 1 + mu_l / mu_v, read from the point's own shadow
 // vis and one bilinear tap at the whole offset (lights.glsl light_visibility_tap: the pair's weights
 // smooth it); vis where the light has no map.

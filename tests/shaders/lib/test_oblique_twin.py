@@ -198,7 +198,6 @@ def test_near_entry_keeps_the_flux_and_moves_it_away():
 
 RAMP_OUTS = """
 vec3 ramp_mix(vec3 m, vec3 v) { return sss_ramp_mix(m, v.x, v.y, v.z); }
-vec3 pair_mix(vec3 m, vec3 v) { return sss_pair_mix(m, v.x, v.y); }
 vec3 single_pair(float k, vec3 rate, vec3 v) { return sss_single_pair(k, rate, v.x, v.y); }
 vec3 means_single(vec3 z0, float mu_l, float mu_v, float eta) {
     return sss_ramp_means(z0, vec3(sss_single_k(mu_l, mu_v, eta)));
@@ -236,7 +235,6 @@ def test_entry_ramp_twins(glsl):
         ("means_single(z0, mu_l, mu_v, eta)", m_s),
         ("sss_ramp_nodes(m)", entry_ramp_nodes(f32(m_d))),
         ("ramp_mix(m, v)", np.einsum("ncs,ns->nc", entry_ramp_weights(f32(m_d)), f32(v))),
-        ("pair_mix(m, v)", np.einsum("ncs,ns->nc", entry_pair_weights(f32(m_d)), f32(v)[:, :2])),
     ):
         gpu = glsl.evaluate("lib/sss_oblique.glsl", expr, ins, out_components=3, prelude=RAMP_OUTS)
         assert_close_fp32(gpu, ref, rtol=2e-4, atol=2e-5, what=expr)

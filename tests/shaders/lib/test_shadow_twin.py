@@ -96,6 +96,36 @@ def test_shadow_pcf_matches_numpy(ctx, glsl, matrix, filter):
     assert_close_fp32(gpu_bias, bias[50:], rtol=1e-4, what="shadow_bias")
 
 
+@pytest.mark.parametrize("matrix", ["orthographic", "perspective"])
+def test_shadow_tap_matches_numpy(ctx, glsl, matrix):
+    """One bilinear compare tap (single scattering's upstream shadow) against its twin on the renderer's
+    LINEAR map: points anywhere, the map's edges and outside it included (llvmpipe's bilinear weights
+    are float: within about 1e-6)."""
+    rng = np.random.default_rng(11)
+    h, w = 16, 24
+    depth, tex = nearest_depth_map(ctx, rng, h, w, moderngl.LINEAR)
+    m = ORTHO if matrix == "orthographic" else PERSPECTIVE
+    n = 2000
+    world = world_at(m, rng.uniform(0.0, 1.0, (n, 2)), rng.uniform(0.0, 1.0, n), matrix == "perspective")
+    world[:50, 0] = 50.0  # outside the map: lit
+    nol = rng.uniform(-0.2, 1.0, n)
+    world, nol = world.astype(np.float32).astype(np.float64), nol.astype(np.float32).astype(np.float64)
+    gpu = glsl.evaluate(
+        "lib/shadow.glsl",
+        "shadow_tap(u_map, u_m, world, nol)",
+        {"world": world, "nol": nol},
+        uniforms={"u_m": ("mat4", m)},
+        samplers={"u_map": ("sampler2DShadow", tex)},
+    )[:, 0]
+    ref = shadow.shadow_tap(depth, m, world, nol)
+    p = np.c_[world, np.ones(n)] @ m.T
+    bias = shadow.shadow_bias(nol, m, world, (w, h))
+    margin = np.abs(depth.reshape(-1)[None, :] - (p[:, 2:3] / p[:, 3:4] - bias[:, None])).min(1) > 1e-5
+    assert margin.mean() > 0.95
+    assert_close_fp32(gpu[margin], ref[margin], atol=4e-6, what="shadow_tap")
+    assert (ref[:50] == 1).all() and ((ref > 0) & (ref < 1)).mean() > 0.1
+
+
 def test_bias_is_sized_to_the_texel_and_bounded():
     """The bias is a texel plus the slope over the PCF's reach in texels, clamped: scaling the scene
     scales it in world units (a constant in normalised depth did not), a larger map shrinks it, and at
