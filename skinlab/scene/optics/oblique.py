@@ -168,6 +168,20 @@ def entry_ramp_nodes(m) -> np.ndarray:
     return np.asarray(mbar)[..., None] * np.array([ENTRY_RAMP_N1, ENTRY_RAMP_N2, ENTRY_RAMP_N3])
 
 
+def entry_ramp_points(world, ng, l, z0_mm, alpha, eta, mm_per_unit) -> tuple[np.ndarray, np.ndarray]:
+    """The diffusion's spread entry at each point (N, 3): the per-channel means m (N, 3; entry_ramp_means
+    with entry_diffusion_k at the light's cosine) and the three shadow lookup points (N, 3 lookups, 3):
+    the luminance offset (entry_offset) at the fractions entry_ramp_nodes(m), each moved toward the light
+    by its length (as entry_point). GLSL twin sss_ramp_setup."""
+    world, ng, l = (np.atleast_2d(np.asarray(x, np.float64)) for x in (world, ng, l))
+    off = entry_offset(ng, l, z0_mm, eta, mm_per_unit)
+    mu_l = np.sum(ng * l, -1)
+    m = entry_ramp_means(np.broadcast_to(np.asarray(z0_mm, np.float64), ng.shape), entry_diffusion_k(alpha, mu_l, eta))
+    f = entry_ramp_nodes(m)[..., None]  # (N, 3 lookups, 1)
+    size = np.linalg.norm(off, axis=-1)[:, None, None]
+    return m, world[:, None, :] + off[:, None, :] * f + l[:, None, :] * (size * f)
+
+
 def entry_ramp_weights(m) -> np.ndarray:
     """(..., 3 channels, 3 nodes) the weights of the shadow lookups at ENTRY_RAMP_N1..N3 x the
     luminance mean of m (in units of b) for channels whose entry lies upstream by an exponential

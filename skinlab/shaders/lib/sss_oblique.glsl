@@ -60,6 +60,22 @@ vec3 sss_ramp_mix(vec3 m, float v1, float v2, float v3) {
     return (1.0 - c1) * v1 + (c1 - c2) * v2 + c2 * v3;
 }
 
+// The three lookup points of the diffusion's spread entry and its per-channel means m (returned): the
+// luminance offset (sss_entry_offset) at the fractions sss_ramp_nodes, each moved toward the light by
+// its length (sss_ramp_point); decay per channel sqrt(3 (1 - a')). Shared by the texture-space
+// irradiance and lib/surface_inputs.glsl sss_entry_ramp, which look each point up in their own way.
+// NumPy twin: oblique.py entry_ramp_points.
+vec3 sss_ramp_setup(vec3 world, vec3 ng, vec3 l, vec3 z0_mm, vec3 decay, float eta, float mm_per_unit,
+                    out vec3 p1, out vec3 p2, out vec3 p3) {
+    vec3 off = sss_entry_offset(ng, l, z0_mm, eta, mm_per_unit);
+    vec3 m = sss_ramp_means(z0_mm, sss_diffusion_k(decay, dot(ng, l), eta));
+    vec3 f = sss_ramp_nodes(m);
+    p1 = sss_ramp_point(world, off, l, f.x);
+    p2 = sss_ramp_point(world, off, l, f.y);
+    p3 = sss_ramp_point(world, off, l, f.z);
+    return m;
+}
+
 // single scattering's pair from its k and the material's rate (oblique.py single_pair_rate, bound as
 // u_sss_single_ramp): the weights of oblique.py entry_pair_weights, one exp2.
 vec3 sss_single_pair(float k, vec3 rate, float v0, float vb) {

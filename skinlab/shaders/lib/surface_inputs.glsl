@@ -63,15 +63,11 @@ vec3 sss_entry_ramp(Surface s, int i, vec3 l, vec3 decay) {
     return vec3(sss_entry_visibility(s, i, l));
 #endif
     if (u_light_shadow[i] < 0) return vec3(1.0);
-    vec3 z0 = u_sss_mfp * s.sss_radius_scale;
-    vec3 off = sss_entry_offset(s.ng, l, z0, u_sss_eta, u_mm_per_unit);
+    vec3 p1, p2, p3;
+    vec3 m = sss_ramp_setup(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, decay, u_sss_eta, u_mm_per_unit,
+                            p1, p2, p3);
     float c = dot(s.ng, l);
-    vec3 m = sss_ramp_means(z0, sss_diffusion_k(decay, c, u_sss_eta));
-    vec3 f = sss_ramp_nodes(m);
-    float v1 = light_visibility(i, sss_ramp_point(s.position, off, l, f.x), c);
-    float v2 = light_visibility(i, sss_ramp_point(s.position, off, l, f.y), c);
-    float v3 = light_visibility(i, sss_ramp_point(s.position, off, l, f.z), c);
-    return sss_ramp_mix(m, v1, v2, v3);
+    return sss_ramp_mix(m, light_visibility(i, p1, c), light_visibility(i, p2, c), light_visibility(i, p3, c));
 }
 
 // Light i's shadow per channel for single scattering at s (lib/sss_oblique.glsl sss_single_pair): its light

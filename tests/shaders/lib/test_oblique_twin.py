@@ -16,6 +16,7 @@ from skinlab.scene.optics.oblique import (
     entry_point,
     entry_ramp_means,
     entry_ramp_nodes,
+    entry_ramp_points,
     entry_ramp_weights,
     near_entry,
     near_entry_gain,
@@ -199,6 +200,15 @@ def test_near_entry_keeps_the_flux_and_moves_it_away():
 RAMP_OUTS = """
 vec3 ramp_mix(vec3 m, vec3 v) { return sss_ramp_mix(m, v.x, v.y, v.z); }
 vec3 single_pair(float k, vec3 rate, vec3 v) { return sss_single_pair(k, rate, v.x, v.y); }
+vec3 ramp_means_at(vec3 w, vec3 ng, vec3 l, vec3 z0, vec3 decay, float eta) {
+    vec3 p1, p2, p3;
+    return sss_ramp_setup(w, ng, l, z0, decay, eta, 1.0, p1, p2, p3);
+}
+vec3 ramp_point_at(vec3 w, vec3 ng, vec3 l, vec3 z0, vec3 decay, float eta, float k) {
+    vec3 p[3];
+    sss_ramp_setup(w, ng, l, z0, decay, eta, 1.0, p[0], p[1], p[2]);
+    return k < 0.5 ? p[0] : (k < 1.5 ? p[1] : p[2]);
+}
 vec3 means_single(vec3 z0, float mu_l, float mu_v, float eta) {
     return sss_ramp_means(z0, vec3(sss_single_k(mu_l, mu_v, eta)));
 }
@@ -274,3 +284,32 @@ def test_entry_ramp_spreads_each_channel_as_an_exponential():
     assert np.all(np.diff(k, axis=-1) > 0) and np.all(k[1] > k[0])
     assert single_entry_k(1.0, 1.0, 1.4) == pytest.approx(2.0) and single_entry_k(0.3, 0.0, 1.0) == pytest.approx(7.0)
     assert entry_ramp_means(np.zeros(3)) == pytest.approx(np.ones(3))  # no scattering: finite, unused
+
+
+def test_entry_ramp_setup_twin(glsl):
+    """sss_ramp_setup (the diffusion's three lookup points and its means) against entry_ramp_points, the
+    entry offset's hard cases included (normal incidence: every point at the surface point, grazing,
+    light from below, no scattering, eta 1 and < 1)."""
+    ng, l, z0, eta, _ = _cases(seed=12)
+    rng = np.random.default_rng(13)
+    world = rng.uniform(-5, 5, ng.shape)
+    alpha = rng.uniform(0.0, 1.0, ng.shape)
+    f32 = lambda x: np.asarray(x, np.float32).astype(np.float64)  # noqa: E731
+    m, pts = entry_ramp_points(f32(world), f32(ng), f32(l), f32(z0), f32(alpha), f32(eta), 1.0)
+    assert np.isfinite(m).all() and np.isfinite(pts).all()
+    assert pts[:10] == pytest.approx(np.repeat(f32(world)[:10, None, :], 3, 1), abs=1e-6)  # normal incidence
+    decay = np.sqrt(3.0 * (1.0 - f32(alpha)))
+    ins = {"w": world, "ng": ng, "l": l, "z0": z0, "decay": decay, "eta": eta}
+    gpu = glsl.evaluate(
+        "lib/sss_oblique.glsl", "ramp_means_at(w, ng, l, z0, decay, eta)", ins, out_components=3, prelude=RAMP_OUTS
+    )
+    assert_close_fp32(gpu, m, rtol=2e-4, atol=2e-5, what="sss_ramp_setup means")
+    for k in range(3):
+        gpu = glsl.evaluate(
+            "lib/sss_oblique.glsl",
+            "ramp_point_at(w, ng, l, z0, decay, eta, kk)",
+            {**ins, "kk": np.full(len(ng), float(k))},
+            out_components=3,
+            prelude=RAMP_OUTS,
+        )
+        assert_close_fp32(gpu, pts[:, k], rtol=1e-4, atol=3e-5, what=f"sss_ramp_setup point {k}")

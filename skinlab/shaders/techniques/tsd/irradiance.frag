@@ -89,15 +89,13 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
 #ifdef SSS_ENTRY_SPREAD  // RenderSettings.entry_spread
         // spread as the entry is: three lookups along the luminance offset, weighted per channel by
         // its exponential's terciles (lib/sss_oblique.glsl sss_ramp_mix; skinlab/scene/optics/oblique.py)
-        vec3 off = sss_entry_offset(ng, l, z0, u_sss_eta, u_mm_per_unit);
         // each averaged over the texel's footprint (lib/shadow.glsl shadow_pcf_area): the texel holds
         // its square's mean, not its centre's, so a shadow edge along the layout's grid does not alias
+        vec3 p1, p2, p3;
+        vec3 m = sss_ramp_setup(v_world, ng, l, z0, u_sss_slab_decay, u_sss_eta, u_mm_per_unit, p1, p2, p3);
         float c = dot(ng, l);
-        vec3 m = sss_ramp_means(z0, sss_diffusion_k(u_sss_slab_decay, c, u_sss_eta));
-        vec3 f = sss_ramp_nodes(m);
-        vec3 vis = sss_ramp_mix(m, light_visibility_area(i, sss_ramp_point(v_world, off, l, f.x), c, v_du, v_dv),
-                                light_visibility_area(i, sss_ramp_point(v_world, off, l, f.y), c, v_du, v_dv),
-                                light_visibility_area(i, sss_ramp_point(v_world, off, l, f.z), c, v_du, v_dv));
+        vec3 vis = sss_ramp_mix(m, light_visibility_area(i, p1, c, v_du, v_dv), light_visibility_area(i, p2, c, v_du, v_dv),
+                                light_visibility_area(i, p3, c, v_du, v_dv));
 #else  // one lookup at the mean entry point
         vec3 vis = vec3(light_visibility_area(i, sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit), dot(ng, l), v_du, v_dv));
 #endif
