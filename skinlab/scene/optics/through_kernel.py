@@ -21,12 +21,12 @@ cos(theta) / pi:
 gives T(z) on average (the integral over the hemisphere is 1), so a uniformly lit slab transmits what
 the exact slab does; on a curved, folded part (the back-lit ear) each point gathers what entered the
 faces the medium connects it to, along the part, instead of what one chord along the light holds
-(issue 21, docs/ground-truth.md "The ear's light along the sheet"). A ray leaves the part where it
-first meets its boundary, so no light crosses air.
+(issue 21, docs/ground-truth.md "Light through thin parts as a transfer through the medium"). A ray
+leaves the part where it first meets its boundary, so no light crosses air.
 
-Per vertex (the records per geometry, cached; the weights per material), per channel: ``entering``
-per unit base colour, as the distance-map translucency's (lib/sss_translucency.glsl), read by the
-receiving passes as bounce light (the light arriving at a surface from elsewhere). The GPU twin is
+Per vertex (the records per geometry, cached; the weights per material), per channel: the light
+entering through, per unit base colour, as the distance-map translucency's (lib/sss_translucency.glsl),
+which every technique's translucency reads in its place (lib/through_vertex.glsl). The GPU twin is
 skinlab/render/through_kernel.py with skinlab/shaders/passes/through_entering.frag and through_rows.frag.
 """
 
