@@ -19,8 +19,8 @@ Nothing is path-traced here: the references must be cached (the commands are in 
 docs/ground-truth.md). Frames are supersampled like the truth's pixels (TRUTH_SUPERSAMPLE). The
 measures are skinlab/bench/closeup.py's, the accuracy ledger's (docs/ledger.md "Close-ups in the ledger").
 
-    python -m tools.closeup_table [SCENES] [TECHNIQUES] [--profiles OUT.npz] [--bounces N]
-        [--sss-model MODEL] [--no-translucency] [--size WxH --spp N] [--edge-bins]
+    python -m tools.closeup_table [SCENES] [TECHNIQUES] [--profiles OUT.npz] [--bounces N] [--bounce-rays N]
+        [--sss-model MODEL] [--no-translucency] [--through-kernel] [--size WxH --spp N] [--edge-bins]
 
 SCENES and TECHNIQUES are comma-separated ("" or left out: all). --bounces and --sss-model as in
 tools/truth_table.py; --no-translucency renders with every technique's translucency off; --size and
@@ -148,7 +148,13 @@ def parser() -> argparse.ArgumentParser:
     ap.add_argument("--profiles", default=None, help="write the slits' line profiles to this .npz")
     ap.add_argument("--bounces", type=int, default=None, help="orders of interreflection (0: off)")
     ap.add_argument("--sss-model", default=None, help="override every material's sss_model")
+    ap.add_argument("--bounce-rays", type=int, default=None, help="interreflection rays per vertex")
     ap.add_argument("--no-translucency", action="store_true", help="every technique's translucency off")
+    ap.add_argument(
+        "--through-kernel",
+        action="store_true",
+        help="light through thin parts from the transfer through the medium (RenderSettings.through_kernel)",
+    )
     ap.add_argument("--size", type=_size, default=None, help="WxH of the truths instead of CLOSEUPS'")
     ap.add_argument("--shadow-size", type=int, default=None, help="shadow map texels per side instead of 2048")
     ap.add_argument("--spp", type=int, default=None, help="samples per pixel of the truths instead of CLOSEUPS'")
@@ -174,6 +180,10 @@ def main(argv: list[str] | None = None) -> int:
     extra: dict[str, Any] = {} if args.bounces is None else {"bounces": args.bounces}
     if args.shadow_size:
         extra["shadow_size"] = args.shadow_size
+    if args.bounce_rays is not None:
+        extra["bounce_rays"] = args.bounce_rays
+    if args.through_kernel:
+        extra["through_kernel"] = True
     model = args.sss_model
     r = Renderer(create_headless_context())
     saved: dict[str, Any] = {}  # name -> array (np.savez's keyword arguments)

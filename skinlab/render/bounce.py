@@ -43,6 +43,7 @@ from .lights import bind_shadow_maps, light_defines, set_light_uniforms
 from .reuse import light_state, material_state
 from .technique import RenderPass
 from .texture_units import TextureUnits
+from .through_kernel import bind_through, through_defines
 
 if TYPE_CHECKING:
     from skinlab.scene.graph import LightNode, MeshNode, Scene
@@ -338,13 +339,17 @@ class BouncePass(RenderPass):
 # -- the receiving side: every pass that shades ambient light -----------------------------
 def bounce_defines(frame: Frame, node: MeshNode) -> dict:
     """``BOUNCE`` when this frame has interreflection light for `node` (lib/bounce_vertex.glsl,
-    lib/ambient.glsl)."""
+    lib/ambient.glsl); ``THROUGH_KERNEL`` when it has light through thin parts from the transfer
+    through the medium, carried per vertex beside it (skinlab/render/through_kernel.py,
+    lib/through_vertex.glsl)."""
     data = frame.data.get(DATA_KEY)
-    return {"BOUNCE": 1} if data is not None and node.uid in data["offsets"] else {}
+    scene = {"BOUNCE": 1} if data is not None and node.uid in data["offsets"] else {}
+    return {**scene, **through_defines(frame, node)}
 
 
 def bind_bounce(frame: Frame, node: MeshNode, prog, units: TextureUnits) -> None:
     """The per-vertex bounce light for a program compiled with :func:`bounce_defines`."""
+    bind_through(frame, node, prog, units)
     data = frame.data.get(DATA_KEY)
     if data is None or node.uid not in data["offsets"]:
         return

@@ -14,6 +14,7 @@ from .lights import soft_shadow
 from .registry import get_technique
 from .reuse import light_placement, scene_geometry
 from .technique import ForwardParams, PlanContext
+from .through_kernel import plan_through
 from .translucency import part_layer_size
 
 if TYPE_CHECKING:
@@ -135,9 +136,12 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
     for p in bounce:  # the environment's light bounces too
         p.after = (*p.after, *(e.name for e in environment))
     plan.passes += bounce
+    through = plan_through(scene, settings, meshes, lights, shadow_lights[:2], plan, distance)
+    plan.passes += through
     # bounce and environment light are ambient light: every pass of the technique that is kept
-    # across frames reads them (its inputs hold the environment's rotation and intensity)
-    ambient = [e.name for e in environment] + ([bounce[-1].name] if bounce else [])
+    # across frames reads them (its inputs hold the environment's rotation and intensity); the light
+    # through thin parts is carried as bounce light
+    ambient = [e.name for e in environment] + ([bounce[-1].name] if bounce else []) + [t.name for t in through]
     for p in tp.before_forward:
         if p.inputs is not None and ambient and p.reads_light:
             p.after = (*p.after, *ambient)

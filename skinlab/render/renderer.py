@@ -29,6 +29,7 @@ from .reuse import ReuseRecord, pass_key
 from .settings import RenderSettings
 from .supersample import nearest_depth
 from .technique import RenderPass, TechniqueState
+from .through_kernel import ThroughPass
 from .timing import FrameTimings, PassTimer
 
 
@@ -54,6 +55,7 @@ class Renderer:
             "shadow": ShadowPass(self),
             "shadow_fit": FittedShadowPass(self),
             "bounce": BouncePass(self),
+            "through": ThroughPass(self),
             "environment": EnvironmentPass(self),
             "sky_occlusion": SkyOcclusionPass(self),
             "forward": ForwardPass(self),

@@ -118,6 +118,23 @@ class RenderSettings:
         range=(4, 4096),
         unit="rays per vertex",
     )
+    # light through thin parts (skinlab/render/through_kernel.py): the transfer through the medium
+    through_kernel: bool = option(
+        False,
+        "light through thin parts gathered per vertex from rays into the medium (the diffusion's transmission "
+        "kernel from the part's other faces, for every technique with translucency; meshes finer than two "
+        "diffusion lengths); false: the distance map's slab along the light at each point "
+        "(docs/ground-truth.md compares them)",
+        "bool",
+    )
+    through_rays: int = option(
+        64,
+        "light through thin parts: rays each vertex casts into the medium (more: less noise, a longer first "
+        "frame after the geometry changes)",
+        "int",
+        range=(4, 4096),
+        unit="rays per vertex",
+    )
     # environment maps (skinlab/render/environment.py): what the scene hides of the map's light
     sky_occlusion: bool = option(
         True,

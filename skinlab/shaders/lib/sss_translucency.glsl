@@ -9,10 +9,16 @@
 // point's cosine to the light and its entry face's (sss_through_cosine). Only matter counts: where the point lies
 // beyond the first part the light crossed (its exit, the map's exit layer), the air between that part
 // and the point's own part is left out (passes/shadow.frag SHADOW_LAYER).
-// NumPy twin: skinlab/scene/optics/translucency.py. Bound by skinlab/render/translucency.py.
+// NumPy twin: skinlab/scene/optics/translucency.py. Bound by skinlab/render/translucency.py. Variant
+// THROUGH_KERNEL (RenderSettings.through_kernel): the light through thin parts comes from the transfer
+// through the medium (skinlab/render/through_kernel.py) as per-vertex bounce light, and the per-light
+// functions below bring none; the thickness functions still serve the transfer's senders.
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
 
+#if defined(THROUGH_KERNEL) && !defined(DEFERRED_SURFACE)
+in vec4 v_through;  // lib/through_vertex.glsl (the deferred irradiance pass reads it from its G-buffer)
+#endif
 uniform sampler2D u_distance0;   // light-space distance (scene units), slot 0: the first surface
 uniform sampler2D u_distance1;   // slot 1
 // the part layers (fewer texels than the distance maps: skinlab/render/translucency.py part_layer_size)
@@ -184,6 +190,9 @@ vec3 sss_through(float back, float d_mm) {
 // at sss_through_cosine's cosine. Zero for a light
 // without a distance map (no shadow slot) or in front of the surface.
 vec3 sss_translucent_light(int i, vec3 world, vec3 ng, vec3 l, vec3 e) {
+#ifdef THROUGH_KERNEL  // the transfer through the medium brings it instead (lib/bounce_vertex.glsl)
+    return vec3(0.0);
+#endif
     int slot = u_light_shadow[i];
     float back = -dot(ng, l);
     float d_mm;
@@ -203,6 +212,9 @@ vec3 sss_translucent_light_toward(int i, vec3 world, vec3 ng, vec3 l, vec3 e, fl
     float back = -dot(ng, l);
     float d_mm;
     through_exit = vec3(0.0);
+#ifdef THROUGH_KERNEL  // the transfer through the medium brings it instead (lib/bounce_vertex.glsl)
+    return vec3(0.0);
+#endif
     if (slot < 0 || back <= 0.0) return vec3(0.0);
 #ifdef MEASURE_NO_THICKNESS  // measurement variants (tools/forward_cost.py --translucency): a part taken out
     float c = back;
@@ -226,6 +238,9 @@ vec3 sss_translucent_light_toward(int i, vec3 world, vec3 ng, vec3 l, vec3 e, fl
 
 // The sum over the lights (for a hook that does not run its own light loop).
 vec3 sss_translucent_irradiance(vec3 world, vec3 ng) {
+#ifdef THROUGH_KERNEL
+    return v_through.rgb;
+#endif
     vec3 acc = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
@@ -237,8 +252,14 @@ vec3 sss_translucent_irradiance(vec3 world, vec3 ng) {
 }
 
 // The sum over the lights of the light through thin parts leaving toward a viewer at cosine mu
-// (sss_translucent_light_toward's through_exit); `entering` gets the light entering.
+// (sss_translucent_light_toward's through_exit); `entering` gets the light entering. With
+// THROUGH_KERNEL: the transfer's light at this point (v_through), leaving as through a slab at
+// normal incidence of its depth.
 vec3 sss_translucent_toward(vec3 world, vec3 ng, float mu, out vec3 entering) {
+#ifdef THROUGH_KERNEL
+    entering = v_through.rgb;
+    return v_through.rgb * sss_slab_exit(mu, 1.0, v_through.a);
+#endif
     vec3 acc = vec3(0.0);
     entering = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {

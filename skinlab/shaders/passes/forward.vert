@@ -7,6 +7,7 @@ in vec4 in_tangent;
 in float in_curvature;  // pre-integrated skin's vertex stream (1/scene unit); 0 in frames of other techniques
 in vec4 in_color;       // the vertex colour (glTF COLOR_0, linear; 1 where the mesh has none)
 #include "lib/bounce_vertex.glsl"
+#include "lib/through_vertex.glsl"
 #include "lib/sky_vertex.glsl"
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
@@ -26,6 +27,7 @@ void main() {
     v_curvature = in_curvature;
     v_color = in_color;
     bounce_vertex();
+    through_vertex();
     sky_vertex();
     gl_Position = u_view_proj * w;
 }

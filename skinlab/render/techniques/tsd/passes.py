@@ -158,13 +158,14 @@ class TsdNodeTargets:
         m = self.masks.get(what)
         return m[0] if m is not None and m[1] else None
 
-    def surface_buffer(self, ctx, bounce: bool, sky: bool = False) -> list:
+    def surface_buffer(self, ctx, bounce: bool, sky: bool = False, through: bool = False) -> list:
         """The irradiance pass's surface G-buffer (deferred shading, techniques/tsd/surface.glsl): world
         position and coverage, normal and the tangent's handedness, tangent, the vertex colour, with
-        `bounce` the interreflection's irradiance, and with `sky` the sky occlusion's record (one more;
-        the bounce slot is kept so the layout is fixed), as the UV raster interpolates them. Nearest
+        `bounce` the interreflection's irradiance, with `sky` the sky occlusion's record (one more;
+        the bounce slot is kept so the layout is fixed), with `through` the light through thin parts
+        from the transfer through the medium (the seventh), as the UV raster interpolates them. Nearest
         filtering."""
-        want = 6 if sky else 5 if bounce else 4
+        want = 7 if through else 6 if sky else 5 if bounce else 4
         while len(self.surface) < want:
             t = ctx.texture((self.size, self.size), 4, dtype="f4")
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)
@@ -415,10 +416,12 @@ class TsdIrradiancePass(TsdPass):
         nmax = frame.settings.max_lights
         ambient = ambient_defines(frame, node)
         # what the surface G-buffer carries besides the geometry: the vertex's bounce light and sky occlusion
-        carried = {k: v for k, v in ambient.items() if k in ("BOUNCE", "SKY_OCCLUSION")}
+        carried = {k: v for k, v in ambient.items() if k in ("BOUNCE", "THROUGH_KERNEL", "SKY_OCCLUSION")}
         surface = []
         if prm.deferred:  # the mesh's vertex outputs rasterised into the G-buffer, then shaded per texel
-            surface = t.surface_buffer(ctx, "BOUNCE" in carried, "SKY_OCCLUSION" in carried)
+            surface = t.surface_buffer(
+                ctx, "BOUNCE" in carried, "SKY_OCCLUSION" in carried, "THROUGH_KERNEL" in carried
+            )
             mask = t.coverage_mask(ctx, "irradiance")
             # only the coverage (surface0's a) is read where no triangle wrote: the rest is cleared
             # by the raster wherever it is read (techniques/tsd/surface.glsl load_surface)

@@ -382,7 +382,8 @@ def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tu
     """What the texture-space irradiance depends on besides the shadow maps it reads: the node's
     geometry and transform, its material, the lights, the ambient light, the scene scale (the
     translucency's thickness in mm), the albedo mix and the translucency's Gaussians, whether the oblique
-    entry's shadow is spread (RenderSettings.entry_spread). Not the camera."""
+    entry's shadow is spread (RenderSettings.entry_spread), whether the light through thin parts comes
+    from the transfer through the medium (RenderSettings.through_kernel). Not the camera."""
     k = t.kernel
     trans = (
         (tuple(s.variance_mm2 for s in k.steps), np.asarray(k.weights(), np.float64).tobytes())
@@ -400,6 +401,7 @@ def irradiance_inputs(t: TsdNodePlan, ctx, mix: float, translucency: bool) -> tu
         trans,
         ctx.settings.max_lights,
         ctx.settings.entry_spread,
+        ctx.settings.through_kernel and translucency,
     )
 
 

@@ -71,6 +71,10 @@ vec3 sss_radiance(Surface s) {
 #endif
     }
     entering += ambient_entering(s.m.occlusion);
+#if defined(SSS_TRANSLUCENCY) && defined(THROUGH_KERNEL)  // the transfer through the medium's, once
+    vec3 kernel_in;
+    through_exit += sss_translucent_toward(s.position, ng, abs(s.NoV), kernel_in);
+#endif
     return s.m.sss_albedo * (entering * sss_exit(abs(s.NoV)) + through_exit)
            * ((1.0 - u_metallic) * s.sss_weight * INV_PI);
 }

@@ -13,6 +13,8 @@
 // and shadow slot, unblurred, with its thickness and cosine (f_through0/1, f_through_cos): the gather
 // gives it the exit factor of light that came through. Variant DEFERRED_SURFACE: drawn fullscreen
 // over the UV layout, the inputs read from the surface G-buffer (techniques/tsd/surface.glsl).
+// Variant THROUGH_KERNEL (RenderSettings.through_kernel): the light through thin parts is the transfer
+// through the medium's (skinlab/render/through_kernel.py, per vertex: v_through), in slot 0's record.
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/ambient.glsl"
@@ -103,7 +105,7 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
         sum += e * (vis * NoL) * sss_entry(NoL)
                * sss_light_near_gain(i, v_world, ng, z0);
     }
-#ifdef TSD_TRANSLUCENCY
+#if defined(TSD_TRANSLUCENCY) && !defined(THROUGH_KERNEL)  // (with it: per-vertex bounce light)
     float back = -dot(ng, l);
     float d_mm;
     if (back > 0.0) back = sss_through_cosine(slot, v_world, ng, back);  // the part's (lib/sss_translucency.glsl)
@@ -152,6 +154,11 @@ void main() {
     e_in += shadowed_light(1, n, ng);
 #endif
     e_in += ambient_entering(occlusion);  // the sky and bounce light
+#ifdef THROUGH_KERNEL  // the light through thin parts from the transfer through the medium, one record
+    e_in += v_through.rgb;
+    through_rec[0] = v_through;
+    through_back[0] = 1.0;
+#endif
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 #ifdef TSD_TRANSLUCENCY
     f_through0 = through_rec[0];

@@ -18,6 +18,10 @@ uniform sampler2D u_surface4;  // the interreflection's irradiance (lib/bounce_v
 #ifdef SKY_OCCLUSION
 uniform sampler2D u_surface5;  // the sky occlusion's record (lib/sky_vertex.glsl)
 #endif
+#ifdef THROUGH_KERNEL
+uniform sampler2D u_surface6;  // the light through thin parts (lib/through_vertex.glsl)
+vec4 v_through;
+#endif
 vec3 v_world;
 vec3 v_normal;
 vec2 v_uv;
@@ -41,6 +45,9 @@ bool load_surface() {
 #endif
 #ifdef SKY_OCCLUSION
     v_sky = texelFetch(u_surface5, p, 0);
+#endif
+#ifdef THROUGH_KERNEL
+    v_through = texelFetch(u_surface6, p, 0);
 #endif
     return true;
 }

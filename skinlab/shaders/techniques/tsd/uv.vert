@@ -7,6 +7,7 @@ in vec2 in_uv;
 in vec4 in_tangent;
 in vec4 in_color;  // the vertex colour (1 where the mesh has none)
 #include "lib/bounce_vertex.glsl"
+#include "lib/through_vertex.glsl"
 #include "lib/sky_vertex.glsl"
 uniform mat4 u_model;
 uniform mat3 u_normal_matrix;
@@ -23,6 +24,7 @@ void main() {
     v_uv = in_uv;
     v_color = in_color;
     bounce_vertex();
+    through_vertex();
     sky_vertex();
     gl_Position = vec4(in_uv * 2.0 - 1.0, 0.0, 1.0);
 }

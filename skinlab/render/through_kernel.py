@@ -1,0 +1,287 @@
+"""Light through thin parts as a transfer through the medium, for every technique (the GPU side of
+skinlab/scene/optics/through_kernel.py, which has the model and its NumPy reference).
+
+Planned by the core when ``RenderSettings.through_kernel`` is on and the technique computes light
+through thin parts (its translucency: a scattering material, a shadow-casting light). One pass,
+``through``, in two draws on vertex-space targets (vertex i of the frame's scattering meshes at texel
+(i % 1024, i / 1024), as the interreflection's, skinlab/render/bounce.py):
+
+1. the irradiance entering each vertex (skinlab/shaders/passes/through_entering.frag): the lights with
+   their shadows, and where a shadow-casting light is hidden, what reaches the vertex through the
+   matter in front of it (the distance maps' slab, lib/sss_translucency.glsl: a part behind another);
+2. the transfer: each vertex's light through, a sparse row sum over the vertices its rays into the
+   medium met with per-channel weights (skinlab/shaders/passes/through_rows.frag).
+
+The passes that shade light read it per vertex as bounce light (lib/bounce_vertex.glsl, variant
+THROUGH_KERNEL, which also takes the distance-map translucency out of lib/sss_translucency.glsl and
+texture-space diffusion's irradiance pass): it enters the medium like the light from the scene's
+surfaces and texture-space diffusion blurs it. It depends on geometry, lights and materials only, so
+an orbiting camera keeps it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import moderngl
+import numpy as np
+
+from skinlab.gl.uniforms import set_uniform, set_uniforms
+from skinlab.scene.interreflection import MAX_RAYS, MIN_RAYS
+
+from .boundary import bind_boundary
+from .frame_plan import PlannedPass, shadow_pass_name
+from .gpu_resources import node_uniforms
+from .lights import bind_shadow_maps, light_defines, set_light_uniforms
+from .reuse import light_state, material_state
+from .technique import RenderPass
+from .texture_units import TextureUnits
+from .translucency import bind_translucency
+
+if TYPE_CHECKING:
+    from skinlab.scene.graph import LightNode, MeshNode, Scene
+    from skinlab.scene.materials import Material
+    from skinlab.scene.optics.through_kernel import ThroughRows
+
+    from .frame import Frame
+    from .frame_plan import FramePlan
+    from .settings import RenderSettings
+
+VERTEX_TEXTURE_WIDTH = 1024  # as skinlab/render/bounce.py's
+RECORD_TEXTURE_WIDTH = 4096
+DATA_KEY = "through_kernel"  # frame.data: {"offsets": node uid -> first vertex}
+PASS_NAME = "through"
+
+
+@dataclass
+class ThroughParams:
+    nodes: list[MeshNode]
+    rows: dict[int, ThroughRows]  # node uid -> its transfer
+    materials: dict[int, Material]  # node uid -> the material it scatters with (the frame's)
+    offsets: dict[int, int]  # node uid -> first vertex in the targets
+    total: int
+    lights: list[LightNode]
+    shadow_lights: list[LightNode]
+    key: str  # what the rows were computed from (for the GPU copy)
+
+
+def plan_through(
+    scene: Scene,
+    settings: RenderSettings,
+    meshes: list[MeshNode],
+    lights: list[LightNode],
+    shadow_lights: list[LightNode],
+    plan: FramePlan,
+    translucency: bool,
+) -> list[PlannedPass]:
+    """The ``through`` pass when the technique's translucency is planned and the setting is on."""
+    if not translucency:
+        return []
+    if not settings.through_kernel:
+        plan.skipped.append(("through", "the transfer through the medium is off (through_kernel = false)"))
+        return []
+    from skinlab.scene.optics.through_kernel import fine_enough, medium_rows
+
+    from .scattering import effective_material
+
+    chosen: list[tuple[MeshNode, Material]] = []
+    for node in meshes:
+        mat = effective_material(node, settings)
+        if not mat.has_subsurface:
+            continue
+        fine, why = fine_enough(node, mat, scene.mm_per_unit)
+        if not fine:
+            plan.skipped.append((f"through[{node.name}]", f"the distance map's slab instead: {why}"))
+            continue
+        chosen.append((node, mat))
+    if not chosen:
+        return []
+    vertices = sum(len(n.mesh.positions) for n, _ in chosen)
+    rays = min(settings.through_rays, MAX_RAYS // max(vertices, 1))  # the interreflection's ray budget
+    if rays < MIN_RAYS:
+        plan.warnings.append(
+            f"light through thin parts from the distance map's slab: {vertices} vertices need more than "
+            f"{MAX_RAYS:,} rays into the medium even at {MIN_RAYS} per vertex (decimate the mesh)"
+        )
+        return []
+    if rays < settings.through_rays:
+        plan.warnings.append(
+            f"light through thin parts: {rays} rays into the medium per vertex instead of {settings.through_rays} "
+            f"for {vertices} vertices (the ray budget is {MAX_RAYS:,} rays)"
+        )
+    nodes, rows, offsets, materials, total = [], {}, {}, {}, 0
+    for node, mat in chosen:
+        nodes.append(node)
+        materials[node.uid] = mat
+        rows[node.uid] = medium_rows(node, mat, scene.mm_per_unit, rays)
+        offsets[node.uid] = total
+        total += len(node.mesh.positions)
+    from skinlab.scene.optics.through_kernel import records_key
+
+    key = "|".join(records_key(n, rays, 0) + str(material_state(materials[n.uid])) for n in nodes)
+    entries = sum(len(r.senders) for r in rows.values())
+    return [
+        PlannedPass(
+            PASS_NAME,
+            "through",
+            "through_irradiance",
+            (VERTEX_TEXTURE_WIDTH, max(1, math.ceil(total / VERTEX_TEXTURE_WIDTH))),
+            f"light through thin parts: {total} vertices x {rays} rays into the medium ({entries} senders in all)",
+            ThroughParams(nodes, rows, materials, offsets, total, list(lights), list(shadow_lights), key),
+            inputs=(
+                key,
+                tuple(light_state(l) for l in lights),
+                tuple(material_state(materials[n.uid]) for n in nodes),
+                scene.mm_per_unit,
+            ),
+            after=tuple(shadow_pass_name(l) for l in shadow_lights),
+        )
+    ]
+
+
+class ThroughPass(RenderPass):
+    """Runs the planned ``through`` pass (module docstring)."""
+
+    def __init__(self, renderer):
+        super().__init__(renderer)
+        self.entering: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
+        self.target: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
+        self.rows: tuple[str, moderngl.Texture, moderngl.Texture] | None = None
+        self._vertex_data: dict[tuple[int, int], moderngl.Texture] = {}
+
+    def _held(self, name: str, size) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
+        held = getattr(self, name)
+        if held is None or held[0].size != tuple(size):
+            if held is not None:
+                held[1].release()
+                held[0].release()
+            tex = self.r.ctx.texture(size, 4, dtype="f4")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            held = (tex, self.r.ctx.framebuffer([tex]))
+            setattr(self, name, held)
+        return held
+
+    def _upload(self, rows: np.ndarray, width: int) -> moderngl.Texture:
+        n, c = rows.shape
+        height = max(1, math.ceil(n / width))
+        padded = np.zeros((height * width, c), np.float32)
+        padded[:n] = rows
+        tex = self.r.ctx.texture((width, height), c, padded.tobytes(), dtype="f4")
+        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        return tex
+
+    def _rows(self, prm: ThroughParams):
+        """Per vertex (first entry, entries) and per entry (sender, weight r, g, b), all nodes."""
+        if self.rows is None or self.rows[0] != prm.key:
+            self._release_rows()
+            index, entries, first = [], [], 0
+            for node in prm.nodes:
+                r = prm.rows[node.uid]
+                start = r.offsets[:-1][r.welded] + first
+                count = np.diff(r.offsets)[r.welded]
+                index.append(np.stack([start, count, r.depth_mm[r.welded]], 1))
+                entries.append(np.concatenate([(r.senders + prm.offsets[node.uid])[:, None], r.weights], 1))
+                first += len(r.senders)
+            idx = self._upload(np.concatenate(index).astype(np.float64), VERTEX_TEXTURE_WIDTH)
+            ent = self._upload(np.concatenate(entries), RECORD_TEXTURE_WIDTH)
+            self.rows = (prm.key, idx, ent)
+        return self.rows[1], self.rows[2]
+
+    def _vertices(self, mesh) -> moderngl.Texture:
+        """Positions and normals, vertex j at texels (2 (j % 1024) + k, j / 1024), k = 0, 1."""
+        key = (mesh.uid, mesh.version)
+        held = self._vertex_data.get(key)
+        if held is None:
+            n = len(mesh.positions)
+            height = max(1, math.ceil(n / VERTEX_TEXTURE_WIDTH))
+            padded = np.zeros((height * VERTEX_TEXTURE_WIDTH, 2, 4), np.float32)
+            padded[:n, 0, :3] = mesh.positions
+            padded[:n, 1, :3] = mesh.normals
+            tex = self.r.ctx.texture((2 * VERTEX_TEXTURE_WIDTH, height), 4, padded.tobytes(), dtype="f4")
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            for old in [k for k in self._vertex_data if k[0] == mesh.uid]:
+                self._vertex_data.pop(old).release()
+            held = self._vertex_data[key] = tex
+        return held
+
+    def _release_rows(self) -> None:
+        if self.rows is not None:
+            self.rows[1].release()
+            self.rows[2].release()
+            self.rows = None
+
+    def release(self) -> None:
+        for held in (self.entering, self.target):
+            if held is not None:
+                held[1].release()
+                held[0].release()
+        self.entering = self.target = None
+        self._release_rows()
+        for tex in self._vertex_data.values():
+            tex.release()
+        self._vertex_data.clear()
+
+    def outputs(self, frame, p) -> tuple:
+        return (self._held("target", p.resolution)[0],)
+
+    def publish(self, frame: Frame, p) -> None:
+        frame.targets["through_irradiance"] = self._held("target", p.resolution)[0]
+        frame.data[DATA_KEY] = {"offsets": dict(p.params.offsets)}
+
+    def run(self, frame: Frame, p) -> None:
+        ctx = self.r.ctx
+        prm: ThroughParams = p.params
+        entering, efbo = self._held("entering", p.resolution)
+        efbo.use()
+        efbo.clear(0.0, 0.0, 0.0, 0.0)
+        nmax = frame.settings.max_lights
+        index, entries = self._rows(prm)
+        for node in prm.nodes:
+            defines = {**light_defines(prm.shadow_lights, nmax)}
+            prog = self.r.programs.get("passes/fullscreen.vert", "passes/through_entering.frag", defines)
+            units = TextureUnits(ctx)
+            bind_shadow_maps(self.r, frame, prog, units)
+            set_light_uniforms(prog, frame, prm.lights, prm.shadow_lights, nmax)
+            bind_translucency(prog, frame, units, self.r.dummy_texture())
+            units.bind(prog, "u_vertex_data", self._vertices(node.mesh))
+            units.bind(prog, "u_row_index", index)
+            set_uniforms(
+                prog,
+                {
+                    **node_uniforms(node),
+                    "u_vertex_offset": prm.offsets[node.uid],
+                    "u_vertex_count": len(node.mesh.positions),
+                    "u_target_size": np.asarray(p.resolution, np.int32).tobytes(),
+                    "u_mm_per_unit": float(frame.scene.mm_per_unit),
+                },
+            )
+            self.r.resources.bind_material(prog, prm.materials[node.uid], units, isotropic=True)
+            bind_boundary(prog, prm.materials[node.uid])
+            self.r.fullscreen(prog)
+            self.r.resources.unbind_samplers()
+        tfbo = self._held("target", p.resolution)[1]
+        tfbo.use()
+        prog = self.r.programs.get("passes/fullscreen.vert", "passes/through_rows.frag")
+        units = TextureUnits(ctx)
+        for sampler, tex in (("u_source", entering), ("u_row_index", index), ("u_row_entries", entries)):
+            units.bind(prog, sampler, tex)
+        set_uniforms(prog, {"u_vertices": prm.total})
+        self.r.fullscreen(prog)
+        self.publish(frame, p)
+
+
+# -- the receiving side (lib/bounce_vertex.glsl), through skinlab/render/bounce.py's bounce_defines --
+def through_defines(frame: Frame, node: MeshNode) -> dict:
+    """``THROUGH_KERNEL`` when this frame has the transfer for `node` (lib/through_vertex.glsl)."""
+    data = frame.data.get(DATA_KEY)
+    return {"THROUGH_KERNEL": 1} if data is not None and node.uid in data["offsets"] else {}
+
+
+def bind_through(frame: Frame, node: MeshNode, prog, units: TextureUnits) -> None:
+    data = frame.data.get(DATA_KEY)
+    if data is None or node.uid not in data["offsets"]:
+        return
+    units.bind(prog, "u_through", frame.targets["through_irradiance"])
+    set_uniform(prog, "u_through_offset", data["offsets"][node.uid])
