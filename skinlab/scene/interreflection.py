@@ -19,6 +19,8 @@ Copies of one vertex (the same position and normal, split along UV seams) share 
 so the bounce light is continuous across seams. The estimate is then averaged over each vertex's
 one-ring (area-weighted, on the welded mesh): bounce light varies slowly, and the average of 7 or so
 independent estimates has about a third of the variance of one (a bias of about an edge length).
+Where the ray budget leaves a vertex fewer rays, the average spans more rings (the one-ring's applied k
+times, :func:`smoothing_rings`), so that about as many rays are averaged per vertex as at the default.
 
 Sources: docs/references.md#interreflection. The GPU twin is skinlab/render/bounce.py with
 skinlab/shaders/passes/bounce_exitance.frag (M per vertex) and bounce_rows.frag (the sum above, from
@@ -291,10 +293,45 @@ def _cast(nodes: list[MeshNode], rays: int, seed: int, total: int):
         k = len(node.mesh.positions)
         fractions.append(float(hit_rays[start : start + k].mean()))
         start += k
-    rings = one_rings(p_all, f_all, first, inverse)
+    rings = ring_power(one_rings(p_all, f_all, first, inverse), smoothing_rings(rays))
     welded = np.where(no_normal, -1, inverse).astype(np.int64)
     sky_rays = (dirs.astype(np.float32), ~blocked, welded)
     return vertices, weights, fractions, *rings, *sender_rows(vertices, weights, rays), *sky_rays
+
+
+# The average's reach: as many rings as make the rays averaged per vertex at least this many (the
+# default's 64 rays over a one-ring of about 7 vertices). A mesh over the ray budget casts fewer rays
+# per vertex (the nose close-up's head subdivided twice: 13), and a one-ring average of those left the
+# bounce light blotchy, 1-2 mm blobs in the nose's shadow where the truth is smooth (issue 21).
+SMOOTH_SAMPLES = 448
+
+
+def smoothing_rings(rays: int) -> int:
+    """How many rings the average spans at `rays` per vertex: the least k >= 1 with rays x (1 + 3 k
+    (k + 1)) >= SMOOTH_SAMPLES (a regular triangle mesh's k-ring has 1 + 3 k (k + 1) vertices)."""
+    k = 1
+    while rays * (1 + 3 * k * (k + 1)) < SMOOTH_SAMPLES and k < 16:
+        k += 1
+    return k
+
+
+def ring_power(rings: tuple[np.ndarray, np.ndarray, np.ndarray], k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The one-ring average (CSR offsets, vertices, weights per vertex) applied k times, as one CSR
+    average over the k-ring (each row still summing to 1); k = 1 returns the rings as they are."""
+    if k <= 1:
+        return rings
+    from scipy.sparse import csr_matrix
+
+    offsets, vertices, weights = rings
+    n = len(offsets) - 1
+    m = csr_matrix((weights.astype(np.float64), vertices, offsets), shape=(n, max(n, int(vertices.max(initial=0)) + 1)))
+    m = m[:, :n]
+    out = m
+    for _ in range(k - 1):
+        out = out @ m
+    out = out.tocsr()
+    out.sort_indices()
+    return out.indptr.astype(np.int64), out.indices.astype(np.int64), out.data.astype(np.float32)
 
 
 def sender_rows(vertices: np.ndarray, weights: np.ndarray, rays: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

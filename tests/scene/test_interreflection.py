@@ -14,9 +14,11 @@ from skinlab.scene.interreflection import (
     gather,
     one_rings,
     open_toward,
+    ring_power,
     sender_albedo,
     sky_visible_share,
     smooth,
+    smoothing_rings,
     weld,
     world_geometry,
 )
@@ -264,7 +266,7 @@ def test_copies_along_a_seam_share_their_rays_and_rings():
 
 def test_one_ring_average_keeps_constants_and_sums_to_one():
     a, b = open_book(6)
-    tr = build_transfer([a, b], 8)
+    tr = build_transfer([a, b], 64)
     sums = np.add.reduceat(tr.ring_weights.astype(np.float64), tr.ring_offsets[:-1])
     assert np.allclose(sums, 1.0, atol=1e-6)
     assert np.allclose(smooth(tr, np.full((tr.total_vertices, 2), 3.0)), 3.0)
@@ -323,3 +325,27 @@ def test_sender_rows_sum_to_the_gather_with_fewer_terms():
     # a convex mesh: every ray leaves the scene, every row is empty
     convex = build_transfer([MeshNode("box", box_mesh((1.0, 2.0, 3.0)), Material())], rays=16)
     assert len(convex.sender_vertices) == 0 and np.all(convex.sender_offsets == 0)
+
+
+def test_fewer_rays_average_over_more_rings():
+    """At the default's 64 rays a vertex averages its one-ring; at 13 (a mesh over the ray budget) its
+    3-ring (13 x 37 >= 448 rays averaged), the one-ring's average applied three times: rows still sum
+    to 1, constants kept, an interior vertex of a grid averaging its 37 nearest and its own estimate
+    weighing less; the noise of independent per-vertex estimates falls by more than the one-ring's."""
+    assert smoothing_rings(64) == 1 and smoothing_rings(13) == 3 and smoothing_rings(4) >= 5
+    a, b = open_book(12)
+    one = build_transfer([a, b], 64)
+    few = build_transfer([a, b], 13)
+    sums = np.add.reduceat(few.ring_weights.astype(np.float64), few.ring_offsets[:-1])
+    assert np.allclose(sums, 1.0, atol=1e-5)
+    assert np.allclose(smooth(few, np.full((few.total_vertices, 3), 2.0)), 2.0, atol=1e-5)
+    inner = 6 * 13 + 6  # plate A's middle vertex (a 12 x 12 grid, 13 vertices a row)
+    assert few.ring_offsets[inner + 1] - few.ring_offsets[inner] == 37
+    assert one.ring_offsets[inner + 1] - one.ring_offsets[inner] == 7
+    rng = np.random.default_rng(1)
+    noise = rng.normal(size=(few.total_vertices, 1))
+    n = a.mesh.positions.shape[0]
+    assert smooth(few, noise)[:n].std() < 0.7 * smooth(one, noise)[:n].std()
+    powered = ring_power((one.ring_offsets, one.ring_vertices, one.ring_weights), 3)
+    np.testing.assert_allclose(smooth(few, noise), smooth(one, smooth(one, smooth(one, noise))), atol=1e-5)
+    assert np.array_equal(powered[0], few.ring_offsets)
