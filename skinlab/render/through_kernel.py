@@ -148,6 +148,8 @@ class ThroughPass(RenderPass):
         super().__init__(renderer)
         self.entering: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
         self.target: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
+        self.cosine: moderngl.Texture | None = None  # the light's mean incidence per vertex (r)
+        self.rows_fbo: moderngl.Framebuffer | None = None  # target and cosine together
         self.rows: tuple[str, moderngl.Texture, moderngl.Texture] | None = None
         self._vertex_data: dict[tuple[int, int], moderngl.Texture] = {}
 
@@ -206,6 +208,23 @@ class ThroughPass(RenderPass):
             held = self._vertex_data[key] = tex
         return held
 
+    def _release_cosine(self) -> None:
+        if self.rows_fbo is not None:
+            self.rows_fbo.release()
+        if self.cosine is not None:
+            self.cosine.release()
+        self.cosine = self.rows_fbo = None
+
+    def _rows_target(self, size) -> moderngl.Framebuffer:
+        """The transfer's two outputs (the light through, its incidence) as one framebuffer."""
+        target = self._held("target", size)[0]
+        if self.cosine is None or self.cosine.size != tuple(size) or self.rows_fbo is None:
+            self._release_cosine()
+            self.cosine = self.r.ctx.texture(size, 4, dtype="f4")
+            self.cosine.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.rows_fbo = self.r.ctx.framebuffer([target, self.cosine])
+        return self.rows_fbo
+
     def _release_rows(self) -> None:
         if self.rows is not None:
             self.rows[1].release()
@@ -218,16 +237,22 @@ class ThroughPass(RenderPass):
                 held[1].release()
                 held[0].release()
         self.entering = self.target = None
+        self._release_cosine()
         self._release_rows()
         for tex in self._vertex_data.values():
             tex.release()
         self._vertex_data.clear()
 
     def outputs(self, frame, p) -> tuple:
-        return (self._held("target", p.resolution)[0],)
+        self._rows_target(p.resolution)
+        assert self.cosine is not None
+        return (self._held("target", p.resolution)[0], self.cosine)
 
     def publish(self, frame: Frame, p) -> None:
         frame.targets["through_irradiance"] = self._held("target", p.resolution)[0]
+        self._rows_target(p.resolution)
+        assert self.cosine is not None
+        frame.targets["through_cosine"] = self.cosine
         frame.data[DATA_KEY] = {"offsets": dict(p.params.offsets)}
 
     def run(self, frame: Frame, p) -> None:
@@ -261,7 +286,7 @@ class ThroughPass(RenderPass):
             bind_boundary(prog, prm.materials[node.uid])
             self.r.fullscreen(prog)
             self.r.resources.unbind_samplers()
-        tfbo = self._held("target", p.resolution)[1]
+        tfbo = self._rows_target(p.resolution)
         tfbo.use()
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/through_rows.frag")
         units = TextureUnits(ctx)
@@ -284,4 +309,5 @@ def bind_through(frame: Frame, node: MeshNode, prog, units: TextureUnits) -> Non
     if data is None or node.uid not in data["offsets"]:
         return
     units.bind(prog, "u_through", frame.targets["through_irradiance"])
+    units.bind(prog, "u_through_cos", frame.targets["through_cosine"])
     set_uniform(prog, "u_through_offset", data["offsets"][node.uid])

@@ -10,8 +10,6 @@ from skinlab.gl.glsl_eval import assert_close_fp32
 from skinlab.render.settings import RenderSettings
 from skinlab.scene.graph import MeshNode
 from skinlab.scene.optics import through_kernel as tk
-from skinlab.scene.optics.material_medium import material_medium
-from skinlab.scene.optics.slab import slab_table, slab_through
 from tests.scene.optics.test_through_kernel import slab_node
 from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
@@ -86,16 +84,17 @@ def test_planned_on_request_for_fine_meshes_only(renderer):
     assert "the distance map's slab instead" in why and "median edge" in why
 
 
-def test_an_oblique_light_enters_less_deep(renderer):
-    """Lit at 60 degrees from behind, the slab's light through falls as the exact slab's at that
-    incidence does (the entering draw's cosine factor): blue, which goes least deep, falls most."""
+@pytest.mark.parametrize("cos_light", [0.5, 0.3])
+def test_an_oblique_light_goes_through_as_through_the_exact_slab(renderer, cos_light):
+    """Lit from behind at cosine 0.5 and 0.3 (a graze: the back-lit ear's far faces), the transfer's
+    frame is the distance map's slab's within 2 % per channel (which a path-traced closed slab at cosine
+    0.3 confirms to 1.4 %, docs/ground-truth.md): the entering light's cosine factor (it goes less deep)
+    and its exit at that incidence (the mean cosine the transfer carries per vertex). Blue, which goes
+    least deep, falls most from the light along the normal."""
+    s = slab((np.sqrt(1.0 - cos_light**2), 0.0, cos_light))
+    kernel = renderer.render(s, settings(through_kernel=True)).hdr[12:20, 12:20, :3].mean((0, 1))
+    chord = renderer.render(s, settings()).hdr[12:20, 12:20, :3].mean((0, 1))
+    np.testing.assert_allclose(kernel, chord, rtol=0.02)
     straight = renderer.render(slab(), settings(through_kernel=True)).hdr[12:20, 12:20, :3].mean((0, 1))
-    s = slab((np.sin(np.radians(60)), 0.0, np.cos(np.radians(60))))
-    oblique = renderer.render(s, settings(through_kernel=True)).hdr[12:20, 12:20, :3].mean((0, 1))
-    mat = skin(radius=(8.0, 4.0, 2.0))
-    med = material_medium(mat.values)
-    table = slab_table(med.alpha_arr, mat["subsurface_color"])
-    ratio = [slab_through(c, D_MM, table, med.mfp_arr, med.alpha_arr, 1.0) for c in (0.5, 1.0)]
-    want = 0.5 * ratio[0] / ratio[1]
-    np.testing.assert_allclose(oblique / straight, want, rtol=0.05)
-    assert (oblique / straight)[2] < (oblique / straight)[0]
+    fall = kernel / straight
+    assert fall[2] < fall[1] < fall[0] < 1.0

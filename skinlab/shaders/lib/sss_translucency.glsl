@@ -17,7 +17,8 @@
 #include "lib/sss_boundary.glsl"
 
 #if defined(THROUGH_KERNEL) && !defined(DEFERRED_SURFACE)
-in vec4 v_through;  // lib/through_vertex.glsl (the deferred irradiance pass reads it from its G-buffer)
+in vec4 v_through;      // lib/through_vertex.glsl (the deferred irradiance pass reads them from its G-buffer)
+in float v_through_cos;
 #endif
 uniform sampler2D u_distance0;   // light-space distance (scene units), slot 0: the first surface
 uniform sampler2D u_distance1;   // slot 1
@@ -253,12 +254,12 @@ vec3 sss_translucent_irradiance(vec3 world, vec3 ng) {
 
 // The sum over the lights of the light through thin parts leaving toward a viewer at cosine mu
 // (sss_translucent_light_toward's through_exit); `entering` gets the light entering. With
-// THROUGH_KERNEL: the transfer's light at this point (v_through), leaving as through a slab at
-// normal incidence of its depth.
+// THROUGH_KERNEL: the transfer's light at this point (v_through), leaving as through a slab of its
+// depth lit at its mean incidence (v_through_cos).
 vec3 sss_translucent_toward(vec3 world, vec3 ng, float mu, out vec3 entering) {
 #ifdef THROUGH_KERNEL
     entering = v_through.rgb;
-    return v_through.rgb * sss_slab_exit(mu, 1.0, v_through.a);
+    return v_through.rgb * sss_slab_exit(mu, v_through_cos, v_through.a);
 #endif
     vec3 acc = vec3(0.0);
     entering = vec3(0.0);

@@ -8,7 +8,9 @@
 // lib/sss_translucency.glsl: a part lit through another part in front of it, at the vertex's
 // cosine). Drawn fullscreen over the vertex-space target once per mesh, the vertex read from the
 // mesh's vertex texture (u_vertex_data: vertex j at texels (2 (j % 1024) + k, j / 1024), k = 0
-// position, 1 normal), as passes/bounce_exitance.frag.
+// position, 1 normal), as passes/bounce_exitance.frag. Alpha: the green light entering times its
+// cosine, so that the transfer gives each vertex its light's mean incidence (the exit factor of light
+// that came through depends on it: lib/sss_boundary.glsl sss_slab_exit).
 #include "lib/brdf.glsl"
 #include "lib/lights.glsl"
 #include "lib/sss_translucency.glsl"
@@ -36,6 +38,7 @@ void main() {
     }
     vec3 n = normalize(nv);
     vec3 e = vec3(0.0);
+    float e_cos = 0.0;  // the green light entering x its cosine: the light's mean incidence (its exit factor)
     // the transfer's weights carry light entering along the normal; light entering at cosine c goes
     // less deep (lib/sss_boundary.glsl sss_slab_through), by its ratio through the part's own thickness
     float depth = texelFetch(u_row_index, t, 0).b;  // the row index has the target's layout
@@ -52,7 +55,9 @@ void main() {
         float d_mm;
         if (slot >= 0 && vis < 1.0 && sss_thickness_mm(slot, world, n, NoL, d_mm)) through = sss_through(NoL, d_mm);
         vec3 at_cos = mix(vec3(1.0), sss_through(NoL, depth) / max(normal_in, vec3(1e-30)), greaterThan(normal_in, vec3(1e-30)));
-        e += li * NoL * (vis + (1.0 - vis) * through) * at_cos;
+        vec3 in_i = li * NoL * (vis + (1.0 - vis) * through) * at_cos;
+        e += in_i;
+        e_cos += in_i.g * NoL;
     }
-    f_entering = vec4(e, 1.0);
+    f_entering = vec4(e, e_cos);
 }

@@ -9,7 +9,8 @@ uniform sampler2D u_row_index;    // per vertex: (first entry, entries, the dept
 uniform sampler2D u_row_entries;  // per entry: (vertex, weight r, g, b)
 uniform int u_vertices;
 
-out vec4 f_through;
+layout(location = 0) out vec4 f_through;
+layout(location = 1) out vec4 f_through_cos;  // r: the light's mean incidence cosine at its entry
 
 void main() {
     int w = textureSize(u_source, 0).x;
@@ -17,6 +18,7 @@ void main() {
     int i = t.y * w + t.x;
     vec3 sum = vec3(0.0);
     float depth = 0.0;
+    float green_cos = 0.0;
     if (i < u_vertices) {
         vec3 row = texelFetch(u_row_index, t, 0).rgb;
         depth = row.z;
@@ -26,8 +28,11 @@ void main() {
             int e = first + k;
             vec4 entry = texelFetch(u_row_entries, ivec2(e % ew, e / ew), 0);
             int v = int(entry.x + 0.5);
-            sum += entry.yzw * texelFetch(u_source, ivec2(v % w, v / w), 0).rgb;
+            vec4 src = texelFetch(u_source, ivec2(v % w, v / w), 0);
+            sum += entry.yzw * src.rgb;
+            green_cos += entry.z * src.a;
         }
     }
     f_through = vec4(sum, depth);
+    f_through_cos = vec4(sum.g > 0.0 ? clamp(green_cos / sum.g, 1e-3, 1.0) : 1.0, 0.0, 0.0, 1.0);
 }

@@ -163,9 +163,9 @@ class TsdNodeTargets:
         position and coverage, normal and the tangent's handedness, tangent, the vertex colour, with
         `bounce` the interreflection's irradiance, with `sky` the sky occlusion's record (one more;
         the bounce slot is kept so the layout is fixed), with `through` the light through thin parts
-        from the transfer through the medium (the seventh), as the UV raster interpolates them. Nearest
-        filtering."""
-        want = 7 if through else 6 if sky else 5 if bounce else 4
+        from the transfer through the medium and its incidence (the seventh and eighth), as the UV
+        raster interpolates them. Nearest filtering."""
+        want = 8 if through else 6 if sky else 5 if bounce else 4
         while len(self.surface) < want:
             t = ctx.texture((self.size, self.size), 4, dtype="f4")
             t.filter = (moderngl.NEAREST, moderngl.NEAREST)

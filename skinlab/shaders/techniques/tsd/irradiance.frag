@@ -157,7 +157,7 @@ void main() {
 #ifdef THROUGH_KERNEL  // the light through thin parts from the transfer through the medium, one record
     e_in += v_through.rgb;
     through_rec[0] = v_through;
-    through_back[0] = 1.0;
+    through_back[0] = v_through_cos;
 #endif
     f_irradiance = vec4(e_in * pow(max(base, vec3(0.0)), vec3(u_tsd_mix)), 1.0);
 #ifdef TSD_TRANSLUCENCY

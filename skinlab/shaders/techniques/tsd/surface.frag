@@ -17,6 +17,7 @@ in vec4 v_sky;
 #endif
 #ifdef THROUGH_KERNEL
 in vec4 v_through;
+in float v_through_cos;
 #endif
 layout(location = 0) out vec4 f_surface0;
 layout(location = 1) out vec4 f_surface1;
@@ -30,6 +31,7 @@ layout(location = 5) out vec4 f_surface5;
 #endif
 #ifdef THROUGH_KERNEL
 layout(location = 6) out vec4 f_surface6;  // the light through thin parts (lib/through_vertex.glsl)
+layout(location = 7) out vec4 f_surface7;  // r: its mean incidence cosine
 #endif
 void main() {
     f_surface0 = vec4(v_world, 1.0);
@@ -48,5 +50,6 @@ void main() {
 #endif
 #ifdef THROUGH_KERNEL
     f_surface6 = v_through;
+    f_surface7 = vec4(v_through_cos, 0.0, 0.0, 0.0);
 #endif
 }

@@ -20,7 +20,9 @@ uniform sampler2D u_surface5;  // the sky occlusion's record (lib/sky_vertex.gls
 #endif
 #ifdef THROUGH_KERNEL
 uniform sampler2D u_surface6;  // the light through thin parts (lib/through_vertex.glsl)
+uniform sampler2D u_surface7;  // r: its mean incidence cosine
 vec4 v_through;
+float v_through_cos;
 #endif
 vec3 v_world;
 vec3 v_normal;
@@ -48,6 +50,7 @@ bool load_surface() {
 #endif
 #ifdef THROUGH_KERNEL
     v_through = texelFetch(u_surface6, p, 0);
+    v_through_cos = texelFetch(u_surface7, p, 0).r;
 #endif
     return true;
 }
