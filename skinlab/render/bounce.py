@@ -44,6 +44,14 @@ from .reuse import light_state, material_state
 from .technique import RenderPass
 from .texture_units import TextureUnits
 from .through_kernel import bind_through, through_defines
+from .vertex_space import (
+    RECORD_TEXTURE_WIDTH,
+    VERTEX_TEXTURE_WIDTH,
+    float_target,
+    upload_rows,
+    vertex_data_texture,
+    vertex_target_size,
+)
 
 if TYPE_CHECKING:
     from skinlab.scene.graph import LightNode, MeshNode, Scene
@@ -53,8 +61,6 @@ if TYPE_CHECKING:
     from .frame_plan import FramePlan
     from .settings import RenderSettings
 
-VERTEX_TEXTURE_WIDTH = 1024  # vertex-space targets: vertex i at texel (i % width, i / width)
-RECORD_TEXTURE_WIDTH = 4096  # ray records: ray r (= vertex x rays + k) at texel (r % width, r / width)
 DATA_KEY = "bounce"  # frame.data: {"offsets": node uid -> first vertex}
 # the ray budget per frame's geometry (skinlab/scene/interreflection.py: MAX_RAYS, MIN_RAYS)
 
@@ -66,10 +72,6 @@ class BounceParams:
     lights: list[LightNode]
     shadow_lights: list[LightNode]
     nodes: list[MeshNode]
-
-
-def vertex_target_size(vertices: int) -> tuple[int, int]:
-    return VERTEX_TEXTURE_WIDTH, max(1, math.ceil(vertices / VERTEX_TEXTURE_WIDTH))
 
 
 def bounce_pass_name(order: int) -> str:
@@ -186,28 +188,12 @@ class BouncePass(RenderPass):
     def _target(self, size, order: int | str):
         """The vertex-space target of an order (int), or the scratch "exitance" / "gathered" one."""
         held = self.targets.get(order) if isinstance(order, int) else getattr(self, order)
-        if held is None or held[0].size != tuple(size):
-            if held is not None:
-                held[1].release()
-                held[0].release()
-            tex = self.r.ctx.texture(size, 4, dtype="f4")
-            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            held = (tex, self.r.ctx.framebuffer([tex]))
-            if isinstance(order, int):
-                self.targets[order] = held
-            else:
-                setattr(self, order, held)
+        held = float_target(self.r.ctx, size, held)
+        if isinstance(order, int):
+            self.targets[order] = held
+        else:
+            setattr(self, order, held)
         return held
-
-    def _upload(self, rows: np.ndarray, width: int) -> moderngl.Texture:
-        """Rows of 2 or 3 floats as a float texture, row r at texel (r % width, r / width)."""
-        n, c = rows.shape
-        height = max(1, math.ceil(n / width))
-        padded = np.zeros((height * width, c), np.float32)
-        padded[:n] = rows
-        tex = self.r.ctx.texture((width, height), c, padded.tobytes(), dtype="f4")
-        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        return tex
 
     def _records(self, transfer: BounceTransfer):
         """The transfer's ray records and one-rings on the GPU (uploaded once per transfer)."""
@@ -218,8 +204,9 @@ class BouncePass(RenderPass):
                 (transfer.sender_offsets, transfer.sender_vertices, transfer.sender_weights),
                 (transfer.ring_offsets, transfer.ring_vertices, transfer.ring_weights),
             ):
-                rows.append(self._upload(np.stack([offsets[:-1], np.diff(offsets)], 1), VERTEX_TEXTURE_WIDTH))
-                rows.append(self._upload(np.stack([vertices, weights], 1), RECORD_TEXTURE_WIDTH))
+                index = np.stack([offsets[:-1], np.diff(offsets)], 1)
+                rows.append(upload_rows(self.r.ctx, index, VERTEX_TEXTURE_WIDTH))
+                rows.append(upload_rows(self.r.ctx, np.stack([vertices, weights], 1), RECORD_TEXTURE_WIDTH))
             self.records = (transfer.key, *rows)
         return self.records[1:]
 
@@ -229,15 +216,7 @@ class BouncePass(RenderPass):
         key = (mesh.uid, mesh.version)
         held = self._vertex_data.get(key)
         if held is None:
-            n = len(mesh.positions)
-            height = max(1, math.ceil(n / VERTEX_TEXTURE_WIDTH))
-            padded = np.zeros((height * VERTEX_TEXTURE_WIDTH, 3, 4), np.float32)
-            padded[:n, 0, :3] = mesh.positions
-            padded[:n, 1, :3] = mesh.normals
-            if mesh.uvs is not None:
-                padded[:n, 2, :2] = mesh.uvs
-            tex = self.r.ctx.texture((3 * VERTEX_TEXTURE_WIDTH, height), 4, padded.tobytes(), dtype="f4")
-            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            tex = vertex_data_texture(self.r.ctx, mesh)
             for old_key in [k for k in self._vertex_data if k[0] == mesh.uid]:
                 self._vertex_data.pop(old_key).release()
             held = self._vertex_data[key] = tex

@@ -21,7 +21,6 @@ an orbiting camera keeps it.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -39,6 +38,14 @@ from .reuse import light_state, material_state
 from .technique import RenderPass
 from .texture_units import TextureUnits
 from .translucency import bind_translucency
+from .vertex_space import (
+    RECORD_TEXTURE_WIDTH,
+    VERTEX_TEXTURE_WIDTH,
+    float_target,
+    upload_rows,
+    vertex_data_texture,
+    vertex_target_size,
+)
 
 if TYPE_CHECKING:
     from skinlab.scene.graph import LightNode, MeshNode, Scene
@@ -49,8 +56,6 @@ if TYPE_CHECKING:
     from .frame_plan import FramePlan
     from .settings import RenderSettings
 
-VERTEX_TEXTURE_WIDTH = 1024  # as skinlab/render/bounce.py's
-RECORD_TEXTURE_WIDTH = 4096
 DATA_KEY = "through_kernel"  # frame.data: {"offsets": node uid -> first vertex}
 PASS_NAME = "through"
 
@@ -127,7 +132,7 @@ def plan_through(
             PASS_NAME,
             "through",
             "through_irradiance",
-            (VERTEX_TEXTURE_WIDTH, max(1, math.ceil(total / VERTEX_TEXTURE_WIDTH))),
+            vertex_target_size(total),
             f"light through thin parts: {total} vertices x {rays} rays into the medium ({entries} senders in all)",
             ThroughParams(nodes, rows, materials, offsets, total, list(lights), list(shadow_lights), key),
             inputs=(
@@ -154,25 +159,9 @@ class ThroughPass(RenderPass):
         self._vertex_data: dict[tuple[int, int], moderngl.Texture] = {}
 
     def _held(self, name: str, size) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
-        held = getattr(self, name)
-        if held is None or held[0].size != tuple(size):
-            if held is not None:
-                held[1].release()
-                held[0].release()
-            tex = self.r.ctx.texture(size, 4, dtype="f4")
-            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            held = (tex, self.r.ctx.framebuffer([tex]))
-            setattr(self, name, held)
+        held = float_target(self.r.ctx, size, getattr(self, name))
+        setattr(self, name, held)
         return held
-
-    def _upload(self, rows: np.ndarray, width: int) -> moderngl.Texture:
-        n, c = rows.shape
-        height = max(1, math.ceil(n / width))
-        padded = np.zeros((height * width, c), np.float32)
-        padded[:n] = rows
-        tex = self.r.ctx.texture((width, height), c, padded.tobytes(), dtype="f4")
-        tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-        return tex
 
     def _rows(self, prm: ThroughParams):
         """Per vertex (first entry, entries) and per entry (sender, weight r, g, b), all nodes."""
@@ -186,26 +175,19 @@ class ThroughPass(RenderPass):
                 index.append(np.stack([start, count, r.depth_mm[r.welded]], 1))
                 entries.append(np.concatenate([(r.senders + prm.offsets[node.uid])[:, None], r.weights], 1))
                 first += len(r.senders)
-            idx = self._upload(np.concatenate(index).astype(np.float64), VERTEX_TEXTURE_WIDTH)
-            ent = self._upload(np.concatenate(entries), RECORD_TEXTURE_WIDTH)
+            idx = upload_rows(self.r.ctx, np.concatenate(index).astype(np.float64), VERTEX_TEXTURE_WIDTH)
+            ent = upload_rows(self.r.ctx, np.concatenate(entries), RECORD_TEXTURE_WIDTH)
             self.rows = (prm.key, idx, ent)
         return self.rows[1], self.rows[2]
 
     def _vertices(self, mesh) -> moderngl.Texture:
-        """Positions and normals, vertex j at texels (2 (j % 1024) + k, j / 1024), k = 0, 1."""
+        """The mesh's vertex texture (skinlab/render/vertex_space.py), once per mesh version."""
         key = (mesh.uid, mesh.version)
         held = self._vertex_data.get(key)
         if held is None:
-            n = len(mesh.positions)
-            height = max(1, math.ceil(n / VERTEX_TEXTURE_WIDTH))
-            padded = np.zeros((height * VERTEX_TEXTURE_WIDTH, 2, 4), np.float32)
-            padded[:n, 0, :3] = mesh.positions
-            padded[:n, 1, :3] = mesh.normals
-            tex = self.r.ctx.texture((2 * VERTEX_TEXTURE_WIDTH, height), 4, padded.tobytes(), dtype="f4")
-            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
             for old in [k for k in self._vertex_data if k[0] == mesh.uid]:
                 self._vertex_data.pop(old).release()
-            held = self._vertex_data[key] = tex
+            held = self._vertex_data[key] = vertex_data_texture(self.r.ctx, mesh)
         return held
 
     def _release_cosine(self) -> None:

@@ -190,23 +190,34 @@ def gather(rows: ThroughRows, entering: np.ndarray) -> np.ndarray:
     return welded[rows.welded]
 
 
+_ROWS = Memo(4)  # (records key, medium, colour, scale) -> ThroughRows: a frame plan asks every frame
+
+
 def medium_rows(node: MeshNode, material, mm_per_unit: float, rays: int = 64) -> ThroughRows:
     """The node's transfer for its material (skinlab/scene/optics/material_medium.py: per channel
-    sigma_tr from the slab's decay, the slab table at the material's index)."""
+    sigma_tr from the slab's decay, the slab table at the material's index); cached by the records,
+    the medium and the scale."""
     from .material_medium import material_medium
     from .slab import slab_decay, slab_table, slab_through
 
     values = material.values
     med = material_medium(values)
-    table = slab_table(med.alpha_arr, values["subsurface_color"])
-    eta = med.eta
-    mfp = np.asarray(med.mfp_arr, np.float64)
-    sigma = np.where(mfp > 0, slab_decay(med.alpha_arr) / np.where(mfp > 0, mfp, 1.0), 0.0)
+    colour = np.asarray(values["subsurface_color"], np.float64)
+    rec = through_records(node, rays)
+    params = np.concatenate([med.alpha_arr, med.mfp_arr, [med.eta, float(mm_per_unit)], colour.ravel()])
+    key = rec.key + hashlib.sha1(np.asarray(params, np.float64).tobytes()).hexdigest()
 
-    def through(z_mm):
-        return slab_through(np.ones_like(z_mm), z_mm, table, med.mfp_arr, med.alpha_arr, eta)
+    def build() -> ThroughRows:
+        table = slab_table(med.alpha_arr, colour)
+        mfp = np.asarray(med.mfp_arr, np.float64)
+        sigma = np.where(mfp > 0, slab_decay(med.alpha_arr) / np.where(mfp > 0, mfp, 1.0), 0.0)
 
-    return through_rows(through_records(node, rays), sigma, mm_per_unit, through)
+        def through(z_mm):
+            return slab_through(np.ones_like(z_mm), z_mm, table, med.mfp_arr, med.alpha_arr, med.eta)
+
+        return through_rows(rec, sigma, mm_per_unit, through)
+
+    return _ROWS.get(key, build)
 
 
 # A mesh whose median edge is longer than this many of its medium's longest diffusion lengths
@@ -253,3 +264,4 @@ def fine_enough(node: MeshNode, material, mm_per_unit: float) -> tuple[bool, str
 
 def clear_cache() -> None:
     _RECORDS.clear()
+    _ROWS.clear()

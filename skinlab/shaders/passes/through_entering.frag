@@ -7,8 +7,8 @@
 // hidden, what reaches the vertex through the matter in front of it (the distance maps' slab,
 // lib/sss_translucency.glsl: a part lit through another part in front of it, at the vertex's
 // cosine). Drawn fullscreen over the vertex-space target once per mesh, the vertex read from the
-// mesh's vertex texture (u_vertex_data: vertex j at texels (2 (j % 1024) + k, j / 1024), k = 0
-// position, 1 normal), as passes/bounce_exitance.frag. Alpha: the green light entering times its
+// mesh's vertex texture (u_vertex_data: vertex j at texels (3 (j % 1024) + k, j / 1024), k = 0
+// position, 1 normal, 2 uv; skinlab/render/vertex_space.py), as passes/bounce_exitance.frag. Alpha: the green light entering times its
 // cosine, so that the transfer gives each vertex its light's mean incidence (the exit factor of light
 // that came through depends on it: lib/sss_boundary.glsl sss_slab_exit).
 #include "lib/brdf.glsl"
@@ -29,7 +29,7 @@ void main() {
     ivec2 t = ivec2(gl_FragCoord.xy);
     int j = t.y * u_target_size.x + t.x - u_vertex_offset;
     if (j < 0 || j >= u_vertex_count) discard;
-    ivec2 d = ivec2(2 * (j % 1024), j / 1024);
+    ivec2 d = ivec2(3 * (j % 1024), j / 1024);
     vec3 world = (u_model * vec4(texelFetch(u_vertex_data, d, 0).xyz, 1.0)).xyz;
     vec3 nv = u_normal_matrix * texelFetch(u_vertex_data, d + ivec2(1, 0), 0).xyz;
     if (dot(nv, nv) == 0.0) {  // a vertex without a normal (no triangle uses it) takes in nothing
