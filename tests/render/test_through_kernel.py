@@ -10,6 +10,8 @@ from skinlab.gl.glsl_eval import assert_close_fp32
 from skinlab.render.settings import RenderSettings
 from skinlab.scene.graph import MeshNode
 from skinlab.scene.optics import through_kernel as tk
+from skinlab.scene.optics.material_medium import material_medium
+from skinlab.scene.optics.slab import slab_table, slab_through
 from tests.scene.optics.test_through_kernel import slab_node
 from tests.tsd_scenes import quad_mesh, skin, slab_scene
 
@@ -31,26 +33,43 @@ def settings(technique="tsd", **kw):
     return RenderSettings.for_technique(technique, 32, 32, shadow_size=512, **kw)
 
 
-def test_entering_and_transfer_draws_match_numpy(renderer):
-    """The entering draw: the light at each vertex's cosine (the far face lit at normal incidence, the
-    near face none); the transfer draw: the rows' sum over the GPU's entering light within fp32 rounding."""
-    s = slab()
+@pytest.mark.parametrize("cos_light", [1.0, 0.3])
+def test_entering_and_transfer_draws_match_numpy(renderer, cos_light):
+    """The entering draw: the light at each vertex's cosine times the slab's incidence factor through
+    the part's thickness there (slab.py slab_through at that cosine over at normal incidence, at the
+    row's depth), the near face none; its alpha the green light times its cosine. The transfer draw:
+    the rows' sum over the GPU's entering light within fp32 rounding, the row's depth, and the light's
+    mean incidence (here the one light's cosine)."""
+    s = slab((np.sqrt(1.0 - cos_light**2), 0.0, cos_light))
     renderer.render(s, settings(through_kernel=True))
     tp = renderer.passes["through"]
     node = s.find("slab")
     v = len(node.mesh.positions)
-    entering = np.frombuffer(tp.entering[0].read(), np.float32).reshape(-1, 4)[:v, :3].astype(np.float64)
+    entering = np.frombuffer(tp.entering[0].read(), np.float32).reshape(-1, 4)[:v].astype(np.float64)
     sun = s.lights()[0]
+    rows = tk.medium_rows(node, node.material, MM, settings().through_rays)
+    depth = rows.depth_mm[rows.welded]
+    mat = node.material
+    med = material_medium(mat.values)
+    table = slab_table(med.alpha_arr, mat["subsurface_color"])
     far = np.arange(v) >= v // 2
     inner = far & (np.abs(node.mesh.positions[:, :2]).max(1) < 1.2)  # away from the shadow map's border
-    np.testing.assert_allclose(entering[inner], np.tile(sun.radiance, (inner.sum(), 1)), rtol=2e-3)
-    assert entering[~far].max() == 0.0
+    d = depth[inner]
+    factor = slab_through(np.full(len(d), cos_light), d, table, med.mfp_arr, med.alpha_arr, med.eta) / slab_through(
+        np.ones(len(d)), d, table, med.mfp_arr, med.alpha_arr, med.eta
+    )
+    want = sun.radiance * cos_light * factor
+    np.testing.assert_allclose(entering[inner, :3], want, rtol=2e-3)
+    np.testing.assert_allclose(entering[inner, 3], want[:, 1] * cos_light, rtol=2e-3)
+    assert entering[~far, :3].max() == 0.0
     got = np.frombuffer(tp.target[0].read(), np.float32).reshape(-1, 4)[:v].astype(np.float64)
-    rows = tk.medium_rows(node, node.material, MM, settings().through_rays)
-    want = tk.gather(rows, entering)
+    want = tk.gather(rows, entering[:, :3])
     assert want[: v // 2].max() > 0.01  # the near face receives the far face's light
     assert_close_fp32(got[:, :3], want, rtol=1e-4, atol=1e-6 * want.max(), what="through transfer")
-    np.testing.assert_allclose(got[:, 3], rows.depth_mm[rows.welded], rtol=1e-5)
+    np.testing.assert_allclose(got[:, 3], depth, rtol=1e-5)
+    cosine = np.frombuffer(tp.cosine.read(), np.float32).reshape(-1, 4)[:v, 0]
+    lit = want[:, 1] > 1e-3 * want[:, 1].max()
+    np.testing.assert_allclose(cosine[lit], cos_light, rtol=1e-3)
 
 
 @pytest.mark.parametrize("technique", ["tsd", "ssss"])
