@@ -152,16 +152,13 @@ class ThroughPass(RenderPass):
     def __init__(self, renderer):
         super().__init__(renderer)
         self.entering: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
-        self.target: tuple[moderngl.Texture, moderngl.Framebuffer] | None = None
-        self.cosine: moderngl.Texture | None = None  # the light's mean incidence per vertex (r)
-        self.rows_fbo: moderngl.Framebuffer | None = None  # target and cosine together
+        # the transfer's outputs: the light through (rgb, its depth in a), its mean incidence (r), and
+        # the framebuffer that writes both
+        self.target: moderngl.Texture | None = None
+        self.cosine: moderngl.Texture | None = None
+        self.rows_fbo: moderngl.Framebuffer | None = None
         self.rows: tuple[str, moderngl.Texture, moderngl.Texture] | None = None
         self._vertex_data: dict[tuple[int, int], moderngl.Texture] = {}
-
-    def _held(self, name: str, size) -> tuple[moderngl.Texture, moderngl.Framebuffer]:
-        held = float_target(self.r.ctx, size, getattr(self, name))
-        setattr(self, name, held)
-        return held
 
     def _rows(self, prm: ThroughParams):
         """Per vertex (first entry, entries) and per entry (sender, weight r, g, b), all nodes."""
@@ -190,22 +187,21 @@ class ThroughPass(RenderPass):
             held = self._vertex_data[key] = vertex_data_texture(self.r.ctx, mesh)
         return held
 
-    def _release_cosine(self) -> None:
-        if self.rows_fbo is not None:
-            self.rows_fbo.release()
-        if self.cosine is not None:
-            self.cosine.release()
-        self.cosine = self.rows_fbo = None
+    def _release_outputs(self) -> None:
+        for obj in (self.rows_fbo, self.target, self.cosine):
+            if obj is not None:
+                obj.release()
+        self.rows_fbo = self.target = self.cosine = None
 
-    def _rows_target(self, size) -> moderngl.Framebuffer:
-        """The transfer's two outputs (the light through, its incidence) as one framebuffer."""
-        target = self._held("target", size)[0]
-        if self.cosine is None or self.cosine.size != tuple(size) or self.rows_fbo is None:
-            self._release_cosine()
-            self.cosine = self.r.ctx.texture(size, 4, dtype="f4")
-            self.cosine.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            self.rows_fbo = self.r.ctx.framebuffer([target, self.cosine])
-        return self.rows_fbo
+    def _outputs(self, size) -> tuple[moderngl.Texture, moderngl.Texture, moderngl.Framebuffer]:
+        """The transfer's two outputs of `size` and their framebuffer (made once per size)."""
+        if self.target is None or self.cosine is None or self.rows_fbo is None or self.target.size != tuple(size):
+            self._release_outputs()
+            self.target, self.cosine = (self.r.ctx.texture(size, 4, dtype="f4") for _ in range(2))
+            for tex in (self.target, self.cosine):
+                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.rows_fbo = self.r.ctx.framebuffer([self.target, self.cosine])
+        return self.target, self.cosine, self.rows_fbo
 
     def _release_rows(self) -> None:
         if self.rows is not None:
@@ -214,33 +210,31 @@ class ThroughPass(RenderPass):
             self.rows = None
 
     def release(self) -> None:
-        for held in (self.entering, self.target):
-            if held is not None:
-                held[1].release()
-                held[0].release()
-        self.entering = self.target = None
-        self._release_cosine()
+        if self.entering is not None:
+            self.entering[1].release()
+            self.entering[0].release()
+        self.entering = None
+        self._release_outputs()
         self._release_rows()
         for tex in self._vertex_data.values():
             tex.release()
         self._vertex_data.clear()
 
     def outputs(self, frame, p) -> tuple:
-        self._rows_target(p.resolution)
-        assert self.cosine is not None
-        return (self._held("target", p.resolution)[0], self.cosine)
+        target, cosine, _ = self._outputs(p.resolution)
+        return (target, cosine)
 
     def publish(self, frame: Frame, p) -> None:
-        frame.targets["through_irradiance"] = self._held("target", p.resolution)[0]
-        self._rows_target(p.resolution)
-        assert self.cosine is not None
-        frame.targets["through_cosine"] = self.cosine
+        target, cosine, _ = self._outputs(p.resolution)
+        frame.targets["through_irradiance"] = target
+        frame.targets["through_cosine"] = cosine
         frame.data[DATA_KEY] = {"offsets": dict(p.params.offsets)}
 
     def run(self, frame: Frame, p) -> None:
         ctx = self.r.ctx
         prm: ThroughParams = p.params
-        entering, efbo = self._held("entering", p.resolution)
+        self.entering = float_target(ctx, p.resolution, self.entering)
+        entering, efbo = self.entering
         efbo.use()
         efbo.clear(0.0, 0.0, 0.0, 0.0)
         nmax = frame.settings.max_lights
@@ -268,7 +262,7 @@ class ThroughPass(RenderPass):
             bind_boundary(prog, prm.materials[node.uid])
             self.r.fullscreen(prog)
             self.r.resources.unbind_samplers()
-        tfbo = self._rows_target(p.resolution)
+        tfbo = self._outputs(p.resolution)[2]
         tfbo.use()
         prog = self.r.programs.get("passes/fullscreen.vert", "passes/through_rows.frag")
         units = TextureUnits(ctx)

@@ -62,7 +62,7 @@ def test_entering_and_transfer_draws_match_numpy(renderer, cos_light):
     np.testing.assert_allclose(entering[inner, :3], want, rtol=2e-3)
     np.testing.assert_allclose(entering[inner, 3], want[:, 1] * cos_light, rtol=2e-3)
     assert entering[~far, :3].max() == 0.0
-    got = np.frombuffer(tp.target[0].read(), np.float32).reshape(-1, 4)[:v].astype(np.float64)
+    got = np.frombuffer(tp.target.read(), np.float32).reshape(-1, 4)[:v].astype(np.float64)
     want = tk.gather(rows, entering[:, :3])
     assert want[: v // 2].max() > 0.01  # the near face receives the far face's light
     assert_close_fp32(got[:, :3], want, rtol=1e-4, atol=1e-6 * want.max(), what="through transfer")
