@@ -17,7 +17,9 @@
 // specular light by the split sum (lib/sky_occlusion.glsl env_specular). Variant SSS_MS_REST
 // (skinlab/render/boundary.py boundary_defines): the material's non-separable rest is not all zero;
 // NEAR_LIGHTS 0 (skinlab/render/lights.py near_defines): no point or spot light, the near-light
-// factors compiled out (lib/sss_near_light.glsl).
+// factors compiled out (lib/sss_near_light.glsl). Each light is shaded by shade_light: the lights
+// without a shadow map in the loop, each filled shadow slot's light once with its slot a constant
+// (u_slot_light), so no light pays for a slot's lookups it does not read (docs/tsd.md "Sixth round").
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
