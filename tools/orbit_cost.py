@@ -7,7 +7,7 @@ a time, beside the plain frame's forward pass (sss none, no interreflection), th
 round by round so that a change of machine load hits all alike. Process CPU time (every thread's: the
 rasteriser's own work), glFinish before and after.
 
-    .venv/bin/python -m tools.orbit_cost [--size 640] [--rounds 9] [--scene SCENE]
+    .venv/bin/python -m tools.orbit_cost [--size 640] [--rounds 9] [--scene SCENE] [--technique NAME]
 
 Variants: base (as shipped), plain (the plain frame's forward pass), no_bounce (the default frame with
 no interreflection: the forward pass without its bounce light), and measurement defines the shaders
@@ -25,6 +25,10 @@ arithmetic without per-fragment indices into uniform arrays), slab_view_only (ME
 of the slab exit only the half that depends on the view: the other's table reads replaced),
 slab_no_log (MEASURE_SLAB_NO_LOG: the slab exit's thickness node found without log2 or exp2).
 
+--technique NAME: the forward pass of that technique's frame at its defaults instead of the default frame's
+(the measurement defines are the texture-space hook's: with another technique only base, plain, no_bounce
+and --against are timed).
+
 --against DIR[,DIR...]: also the forward pass with the shaders of another checkout (DIR/skinlab/shaders,
 e.g. ``git archive main skinlab | tar -x -C DIR``; the same Python code drives them), interleaved: what a
 change of the shaders saved; its image is compared with this checkout's (max and mean relative
@@ -34,6 +38,7 @@ difference of the HDR radiance where it is above 1e-3 of the frame's peak).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import statistics
 import sys
@@ -63,6 +68,9 @@ def main(argv=None) -> int:
     ap.add_argument("--scene", default=None, help="scene name or file (default: the head)")
     ap.add_argument("--against", default=None, help="comma-separated checkouts whose shaders to time beside")
     ap.add_argument("--only", default=None, help="comma-separated variants to time (default: all)")
+    ap.add_argument(
+        "--technique", default=None, help="the technique whose frame to time (default: the default frame's)"
+    )
     args = ap.parse_args(argv)
     from pathlib import Path
 
@@ -80,7 +88,8 @@ def main(argv=None) -> int:
     ctx = create_headless_context()
     scene = load_scene(args.scene)
     n = args.size
-    full = RenderSettings(n, n)
+    full = RenderSettings.for_technique(args.technique, n, n) if args.technique else RenderSettings(n, n)
+    tsd = full.technique_name in ("tsd", "exact")
     plain = RenderSettings(n, n, sss_model="none", bounces=0)
     probe = Renderer(ctx)
     probe.render(scene, full, readback=False)
@@ -90,10 +99,10 @@ def main(argv=None) -> int:
         if frag == FWD and "tsd" in str(dict(aliases).get(HOOK_INCLUDE))
     }
     probe.release()
-    if not variants:
+    if tsd and not variants:
         raise SystemExit("no texture-space forward program in the frame")
     # the group of triangles that reads every slot's light through thin parts, where the mesh is drawn in groups
-    hook, hook_defines = min(variants, key=lambda v: int("TSD_THROUGH_READ" in dict(v[1])))
+    hook, hook_defines = min(variants, key=lambda v: int("TSD_THROUGH_READ" in dict(v[1]))) if tsd else (None, ())
     runs = {}
 
     def add(name, settings, measure=None, library=None):
@@ -109,11 +118,12 @@ def main(argv=None) -> int:
 
     wanted = set(args.only.split(",")) if args.only else None
     try:
-        for name, settings in (("base", full), ("plain", plain), ("no_bounce", RenderSettings(n, n, bounces=0))):
+        no_bounce = dataclasses.replace(full, bounces=0)
+        for name, settings in (("base", full), ("plain", plain), ("no_bounce", no_bounce)):
             if wanted is None or name in wanted or name == "base":
                 add(name, settings)
         for name, d in MEASURES.items():
-            if wanted is None or name in wanted:
+            if tsd and (wanted is None or name in wanted):
                 add(name, full, d)
         for i, d in enumerate(args.against.split(",") if args.against else ()):
             root = Path(d) / "skinlab" / "shaders"
@@ -130,7 +140,8 @@ def main(argv=None) -> int:
                 ctx.finish()
                 times[name].append((time.process_time() - c0) * 1e3)
         print(f"{describe(ctx)}; the forward pass of the orbiting frame, {n}x{n}, process CPU, median of {args.rounds}")
-        print(f"hook {hook}, defines {dict(hook_defines)} ({len(variants)} texture-space variant(s) drawn)")
+        drawn = f"{len(variants)} texture-space variant(s) drawn"
+        print(f"technique {full.technique_name}; hook {hook}, defines {dict(hook_defines)} ({drawn})")
         print(load_line(load0))
         base = statistics.median(times["base"])
         for name, v in times.items():

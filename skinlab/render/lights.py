@@ -86,7 +86,8 @@ def light_shape(light) -> tuple[np.ndarray, np.ndarray]:
 
 
 def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
-    """Upload lights (direction or position, radiance, shape, shadow slot) and shadow matrices to `prog`."""
+    """Upload lights (direction or position, radiance, shape, shadow slot), the light each filled shadow slot
+    holds (u_slot_light: every shadow light must be among `lights`) and shadow matrices to `prog`."""
     slots = {id(l): i for i, l in enumerate(shadow_lights)}
     vec = [
         np.append(-l.direction, 0.0) if l.kind == "directional" else np.append(l.world_position, 1.0) for l in lights
@@ -107,6 +108,15 @@ def set_light_uniforms(prog, frame, lights, shadow_lights, nmax: int) -> None:
         ids = np.full(nmax, -1, np.int32)
         ids[: len(lights)] = [slots.get(id(l), -1) for l in lights]
         prog["u_light_shadow"].write(ids[: max(prog["u_light_shadow"].array_length, 1)].tobytes())
+    if "u_slot_light" in prog:  # the light each filled slot holds (shaded per slot: lib/lights.glsl)
+        slot_light = np.full(SHADOW_SLOTS, -1, np.int32)
+        for k, light in enumerate(shadow_lights[:SHADOW_SLOTS]):
+            at = [j for j, x in enumerate(lights) if x is light]
+            if not at:
+                raise ValueError(f"shadow light {light.name!r} is not among the {len(lights)} lights the pass shades")
+            slot_light[k] = at[0]
+        u = prog["u_slot_light"]
+        u.write(slot_light[: max(u.array_length, 1)].tobytes())
     for name, held in (
         ("u_shadow_matrix", frame.shadow_matrices),
         ("u_shadow_fine_matrix", frame.shadow_fine_matrices),

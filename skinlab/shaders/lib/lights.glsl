@@ -90,10 +90,16 @@ void light_incidence(int i, vec3 world, vec3 n, out vec3 l, out vec3 e) {
 #define SHADOW_SLOTS 2
 #endif
 
-// Shadow-map visibility of light i at world (geometric normal's cosine for the slope bias).
-float light_visibility(int i, vec3 world, float NoL_geom) {
+// The light each shadow slot holds (an index into the arrays above, -1 for a slot no light fills;
+// skinlab/render/lights.py set_light_uniforms). A pass that shades the lights with a shadow map per slot
+// (the slot a compile-time constant: passes/forward.frag, techniques/tsd/irradiance.frag) compiles each
+// slot's lookups once, never for a light without a map.
+uniform int u_slot_light[2];
+
+// Shadow-map visibility at world from shadow slot `slot` (-1 or a slot the frame does not fill: 1);
+// NoL_geom the geometric normal's cosine for the slope bias.
+float slot_visibility(int slot, vec3 world, float NoL_geom) {
 #if SHADOW_SLOTS > 0
-    int slot = u_light_shadow[i];
 #ifdef SHADOW_SOFT0  // a light with a size: soft shadows (lib/shadow_soft.glsl)
     if (slot == 0) return shadow_soft(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom);
 #elif defined(SHADOW_FINE0)
@@ -114,11 +120,19 @@ float light_visibility(int i, vec3 world, float NoL_geom) {
     return 1.0;
 }
 
-// light_visibility from one bilinear tap of the light's full map (lib/shadow.glsl shadow_tap); a light
-// with a size as light_visibility (its penumbra's filter).
-float light_visibility_tap(int i, vec3 world, float NoL_geom) {
+// Shadow-map visibility of light i at world (geometric normal's cosine for the slope bias).
+float light_visibility(int i, vec3 world, float NoL_geom) {
 #if SHADOW_SLOTS > 0
-    int slot = u_light_shadow[i];
+    return slot_visibility(u_light_shadow[i], world, NoL_geom);
+#else
+    return 1.0;
+#endif
+}
+
+// slot_visibility from one bilinear tap of the slot's full map (lib/shadow.glsl shadow_tap); a light
+// with a size as slot_visibility (its penumbra's filter).
+float slot_visibility_tap(int slot, vec3 world, float NoL_geom) {
+#if SHADOW_SLOTS > 0
 #ifdef SHADOW_SOFT0
     if (slot == 0) return shadow_soft(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom);
 #else
@@ -135,12 +149,11 @@ float light_visibility_tap(int i, vec3 world, float NoL_geom) {
     return 1.0;
 }
 
-// light_visibility averaged over a receiver's footprint (world vectors du, dv: one texture-space
+// slot_visibility averaged over a receiver's footprint (world vectors du, dv: one texture-space
 // texel along u and v; lib/shadow.glsl shadow_pcf_area, a soft slot's lib/shadow_soft.glsl
 // shadow_soft_area).
-float light_visibility_area(int i, vec3 world, float NoL_geom, vec3 du, vec3 dv) {
+float slot_visibility_area(int slot, vec3 world, float NoL_geom, vec3 du, vec3 dv) {
 #if SHADOW_SLOTS > 0
-    int slot = u_light_shadow[i];
 #ifdef SHADOW_SOFT0
     if (slot == 0) return shadow_soft_area(u_shadow0, u_shadow_distance0, u_shadow_matrix[0], u_shadow_soft[0], u_shadow_eye[0], world, NoL_geom, du, dv);
 #elif defined(SHADOW_FINE0)

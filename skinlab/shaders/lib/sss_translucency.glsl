@@ -186,15 +186,14 @@ vec3 sss_through(float back, float d_mm) {
     return sss_slab_through(back, d_mm);
 }
 
-// Irradiance entering the medium at world through thin parts from light i (direction to it l, its
-// irradiance e on a surface facing it); ng: the surface's outward geometric normal; the part crossed
-// at sss_through_cosine's cosine. Zero for a light
-// without a distance map (no shadow slot) or in front of the surface.
-vec3 sss_translucent_light(int i, vec3 world, vec3 ng, vec3 l, vec3 e) {
+// Irradiance entering the medium at world through thin parts from the light of shadow slot `slot` (a
+// light's u_light_shadow; direction to it l, its irradiance e on a surface facing it); ng: the
+// surface's outward geometric normal; the part crossed at sss_through_cosine's cosine. Zero for a light
+// without a distance map (slot -1) or in front of the surface.
+vec3 sss_translucent_light(int slot, vec3 world, vec3 ng, vec3 l, vec3 e) {
 #ifdef THROUGH_KERNEL  // the transfer through the medium brings it instead (lib/bounce_vertex.glsl)
     return vec3(0.0);
 #endif
-    int slot = u_light_shadow[i];
     float back = -dot(ng, l);
     float d_mm;
     if (slot < 0 || back <= 0.0) return vec3(0.0);
@@ -208,8 +207,7 @@ vec3 sss_translucent_light(int i, vec3 world, vec3 ng, vec3 l, vec3 e) {
 // reflected light leaves with sss_exit instead): times base colour / pi it is radiance, as the
 // reflected light's entering x sss_exit. `through_exit` returns it; the value is the light entering
 // (as sss_translucent_light). NumPy twin: skinlab/scene/optics/translucency.py translucent_exit.
-vec3 sss_translucent_light_toward(int i, vec3 world, vec3 ng, vec3 l, vec3 e, float mu, out vec3 through_exit) {
-    int slot = u_light_shadow[i];
+vec3 sss_translucent_light_toward(int slot, vec3 world, vec3 ng, vec3 l, vec3 e, float mu, out vec3 through_exit) {
     float back = -dot(ng, l);
     float d_mm;
     through_exit = vec3(0.0);
@@ -237,21 +235,6 @@ vec3 sss_translucent_light_toward(int i, vec3 world, vec3 ng, vec3 l, vec3 e, fl
     return entering;
 }
 
-// The sum over the lights (for a hook that does not run its own light loop).
-vec3 sss_translucent_irradiance(vec3 world, vec3 ng) {
-#ifdef THROUGH_KERNEL
-    return v_through.rgb;
-#endif
-    vec3 acc = vec3(0.0);
-    for (int i = 0; i < MAX_LIGHTS; ++i) {
-        if (i >= u_num_lights) break;
-        vec3 l, e;
-        light_incidence(i, world, ng, l, e);
-        acc += sss_translucent_light(i, world, ng, l, e);
-    }
-    return acc;
-}
-
 // The sum over the lights of the light through thin parts leaving toward a viewer at cosine mu
 // (sss_translucent_light_toward's through_exit); `entering` gets the light entering. With
 // THROUGH_KERNEL: the transfer's light at this point (v_through), leaving as through a slab of its
@@ -263,12 +246,20 @@ vec3 sss_translucent_toward(vec3 world, vec3 ng, float mu, out vec3 entering) {
 #endif
     vec3 acc = vec3(0.0);
     entering = vec3(0.0);
-    for (int i = 0; i < MAX_LIGHTS; ++i) {
-        if (i >= u_num_lights) break;
-        vec3 l, e, te;
-        light_incidence(i, world, ng, l, e);
-        entering += sss_translucent_light_toward(i, world, ng, l, e, mu, te);
+#if SHADOW_SLOTS > 0  // only a light with a distance map shines through: each filled slot's, the slot a constant
+    vec3 l, e, te;
+    if (u_slot_light[0] >= 0) {
+        light_incidence(u_slot_light[0], world, ng, l, e);
+        entering += sss_translucent_light_toward(0, world, ng, l, e, mu, te);
         acc += te;
     }
+#endif
+#if SHADOW_SLOTS > 1
+    if (u_slot_light[1] >= 0) {
+        light_incidence(u_slot_light[1], world, ng, l, e);
+        entering += sss_translucent_light_toward(1, world, ng, l, e, mu, te);
+        acc += te;
+    }
+#endif
     return acc;
 }

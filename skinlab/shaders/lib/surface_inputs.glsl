@@ -44,45 +44,45 @@ Surface surface_inputs(vec3 world, vec3 normal, vec2 uv, vec4 tangent, vec4 colo
     return s;
 }
 
-// Light i's shadow where the diffusion leaving at s entered on average (oblique entry,
-// lib/sss_oblique.glsl: the mean free path x the radius map toward the light l); 1 for a light without
-// a shadow map.
-float sss_entry_visibility(Surface s, int i, vec3 l) {
-    if (u_light_shadow[i] < 0) return 1.0;
+// The shadow from slot `slot` (a light's u_light_shadow) where the diffusion leaving at s entered on
+// average (oblique entry, lib/sss_oblique.glsl: the mean free path x the radius map toward the light l);
+// 1 for a light without a shadow map (slot -1).
+float sss_entry_visibility(Surface s, int slot, vec3 l) {
+    if (slot < 0) return 1.0;
     vec3 entry = sss_entry_point(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, u_sss_eta, u_mm_per_unit);
-    return light_visibility(i, entry, dot(s.ng, l));
+    return slot_visibility(slot, entry, dot(s.ng, l));
 }
 
-// Light i's shadow per channel where the diffusion leaving at s entered, spread as the entry is (an
-// exponential distance upstream, per channel, lib/sss_oblique.glsl): three lookups along the
+// The shadow from slot `slot` per channel where the diffusion leaving at s entered, spread as the entry
+// is (an exponential distance upstream, per channel, lib/sss_oblique.glsl): three lookups along the
 // luminance offset; decay per channel sqrt(3 (1 - a')) (lib/sss_boundary.glsl u_sss_slab_decay); 1
-// for a light without a shadow map.
+// for a light without a shadow map (slot -1).
 // Without SSS_ENTRY_SPREAD (RenderSettings.entry_spread off): the shadow at the mean entry point.
-vec3 sss_entry_ramp(Surface s, int i, vec3 l, vec3 decay) {
+vec3 sss_entry_ramp(Surface s, int slot, vec3 l, vec3 decay) {
 #ifndef SSS_ENTRY_SPREAD
-    return vec3(sss_entry_visibility(s, i, l));
+    return vec3(sss_entry_visibility(s, slot, l));
 #endif
-    if (u_light_shadow[i] < 0) return vec3(1.0);
+    if (slot < 0) return vec3(1.0);
     vec3 p1, p2, p3;
     vec3 m = sss_ramp_setup(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, decay, u_sss_eta, u_mm_per_unit,
                             p1, p2, p3);
     float c = dot(s.ng, l);
-    return sss_ramp_mix(m, light_visibility(i, p1, c), light_visibility(i, p2, c), light_visibility(i, p3, c));
+    return sss_ramp_mix(m, slot_visibility(slot, p1, c), slot_visibility(slot, p2, c), slot_visibility(slot, p3, c));
 }
 
-// Light i's shadow per channel for single scattering at s (lib/sss_oblique.glsl sss_single_pair): its light
-// entered upstream by the diffusion's offset over k = 1 + mu_l / mu_v, read from the point's own shadow
-// vis and one bilinear tap at the whole offset (lights.glsl light_visibility_tap: the pair's weights
-// smooth it); vis where the light has no map.
+// The shadow from slot `slot` per channel for single scattering at s (lib/sss_oblique.glsl
+// sss_single_pair): its light entered upstream by the diffusion's offset over k = 1 + mu_l / mu_v, read
+// from the point's own shadow vis and one bilinear tap at the whole offset (lights.glsl
+// slot_visibility_tap: the pair's weights smooth it); vis where the light has no map (slot -1).
 uniform vec3 u_sss_single_ramp;  // skinlab/scene/optics/oblique.py single_pair_rate (skinlab/render/boundary.py)
-vec3 sss_single_visibility(Surface s, int i, vec3 l, float NoL, float vis) {
+vec3 sss_single_visibility(Surface s, int slot, vec3 l, float NoL, float vis) {
 #ifndef SSS_ENTRY_SPREAD  // RenderSettings.entry_spread off: the point's own shadow
     return vec3(vis);
 #endif
-    if (u_light_shadow[i] < 0) return vec3(vis);
+    if (slot < 0) return vec3(vis);
     vec3 at = sss_entry_point(s.position, s.ng, l, u_sss_mfp * s.sss_radius_scale, u_sss_eta, u_mm_per_unit);
     return sss_single_pair(sss_single_k(NoL, s.NoV, u_sss_eta), u_sss_single_ramp, vis,
-                           light_visibility_tap(i, at, dot(s.ng, l)));
+                           slot_visibility_tap(slot, at, dot(s.ng, l)));
 }
 
 // Light i's irradiance feeding the diffusion at s relative to its own (a point or spot light's

@@ -17,7 +17,9 @@
 // specular light by the split sum (lib/sky_occlusion.glsl env_specular). Variant SSS_MS_REST
 // (skinlab/render/boundary.py boundary_defines): the material's non-separable rest is not all zero;
 // NEAR_LIGHTS 0 (skinlab/render/lights.py near_defines): no point or spot light, the near-light
-// factors compiled out (lib/sss_near_light.glsl).
+// factors compiled out (lib/sss_near_light.glsl). Each light is shaded by shade_light: the lights
+// without a shadow map in the loop, each filled shadow slot's light once with its slot a constant
+// (u_slot_light), so no light pays for a slot's lookups it does not read (docs/tsd.md "Sixth round").
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
@@ -41,6 +43,87 @@ uniform vec3 u_camera_pos;
 layout(location = 0) out vec4 f_color;
 
 #include "skinlab/sss_hook.glsl"
+
+// What the frame shades once per fragment and every light reads (main below).
+struct Shading {
+    vec3 base;    // the plain diffuse part's albedo, a metal's F0
+    float rough, metal, plain, a;  // roughness, metallic, sss_plain_weight, GGX alpha
+    vec3 f0;
+    bool single;  // single scattering on (u_sss_single > 0)
+    vec3 single_w;
+    SingleView single_view;
+};
+
+// Light i's share of the fragment's radiance at s, its shadow from slot `slot` (-1: none). Every call
+// passes the slot as a constant (main below), so a slot's lookups are compiled where they are read and
+// never for a light without a map (a software rasteriser runs a branch's masked side: lib/lights.glsl).
+vec3 shade_light(int i, int slot, Surface s, Shading sh) {
+    vec3 color = vec3(0.0);
+    vec3 ng = s.ng, n = s.n, v = s.v, base = sh.base, f0 = sh.f0, single_w = sh.single_w;
+    float rough = sh.rough, metal = sh.metal, plain = sh.plain, a = sh.a, NoV = s.NoV;
+    bool single = sh.single;
+    SingleView single_view = sh.single_view;
+    vec3 l, e;
+    light_incidence(i, v_world, n, l, e);
+    float NoL = dot(n, l);
+#ifdef DIFFUSE_TRANSMISSION
+    // a thin surface lit from behind: its Lambertian transmission (lib/surface.glsl), shadowed as the far face
+    if (NoL < 0.0) {
+        float back = slot_visibility(slot, v_world, -dot(ng, l));
+        color += e * (back * -NoL) * (1.0 - metal) * plain
+                 * diffuse_transmission_btdf(NoL, u_diffuse_transmission, u_diffuse_transmission_color);
+    }
+#endif
+    if (NoL <= 0.0) return color;
+    float vis = slot_visibility(slot, v_world, dot(ng, l));
+    vec3 h = half_vector(n, v, l);
+    float LoH = dot(l, h);
+    vec3 diffuse = base * ((1.0 - metal) * plain * burley_diffuse(NoL, NoV, LoH, rough));
+#ifdef MEASURE_NO_PLAIN_DIFFUSE  // a measurement variant (tools/orbit_cost.py): no Burley diffuse per light
+    diffuse = vec3(0.0);
+#endif
+#ifdef DIFFUSE_TRANSMISSION
+    diffuse *= 1.0 - u_diffuse_transmission;  // what is not sent through
+#endif
+#ifdef AREA_LIGHTS
+    // an area light's specular from its representative point, with a widened lobe (lib/lights.glsl)
+    float a_s, energy;
+    vec3 ls = light_specular_direction(i, v_world, n, v, l, a, a_s, energy);
+    vec3 hs = half_vector(n, v, ls);
+    float NoLs = max(dot(n, ls), 0.0);
+    vec3 spec = specular_ggx(NoLs, NoV, dot(n, hs), dot(ls, hs), a_s, f0) * energy;
+    color += e * vis * (diffuse * NoL + spec * NoLs);
+#else
+    vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
+    color += e * vis * (diffuse + spec) * NoL;
+#endif
+    // single scattering where the light lands (a near light's seen from below, lib/surface_inputs.glsl
+    // sss_near_single), and there too, for a hook of the separable boundary that does not spread it
+    // with its diffusion (SSS_MS_REST_LANDS: tsd, exact, preintegrated), the multiple scattering's
+    // non-separable rest (lib/sss_boundary.glsl sss_ms_rest)
+    // (shadowed where their light entered, spread upstream: lib/surface_inputs.glsl
+    // sss_single_visibility, one bilinear tap more per light)
+    vec3 svis = vec3(vis);
+#ifndef SSS_HOOK_PLAIN  // a mesh that does not scatter (techniques/none/forward.glsl) has no single scattering
+    svis = sss_single_visibility(s, slot, l, NoL, vis);
+#endif
+    if (single) color += e * (svis * NoL) * single_w * sss_single_brdf_view(n, l, single_view) * sss_near_single(s, i);
+#if defined(SSS_MS_REST_LANDS) && defined(SSS_MS_REST) && !defined(MEASURE_NO_MS_REST)  // MEASURE_NO_MS_REST: tools/orbit_cost.py
+    if (u_sss_ms_rest_on > 0.0) color += e * (svis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
+#endif
+    // the technique's diffusion: shadowed where it entered (oblique entry, spread upstream per
+    // channel, for a hook that gathers its light here: SSS_HOOK_GATHERS_LIGHT, lib/sss_local.glsl;
+    // lib/surface_inputs.glsl sss_entry_ramp) and fed by the irradiance where it entered (a point
+    // or spot light's, lib/surface_inputs.glsl)
+#ifndef MEASURE_NO_ADD_LIGHT  // a measurement variant (tools/orbit_cost.py): the hook told of no light
+#ifdef SSS_HOOK_GATHERS_LIGHT
+    sss_add_light(s, e * sss_near_gain(s, i), sss_entry_ramp(s, slot, l, u_sss_slab_decay), NoL);
+#else
+    sss_add_light(s, e * sss_near_gain(s, i), vec3(sss_entry_visibility(s, slot, l)), NoL);
+#endif
+#endif
+    return color;
+}
 
 void main() {
 #ifdef MEASURE_RASTER_ONLY  // a measurement variant (tools/forward_cost.py): the interpolated inputs alone
@@ -73,68 +156,27 @@ void main() {
     vec3 single_w = s.m.sss_albedo * ((1.0 - metal) * s.sss_weight);  // x the weight map
     SingleView single_view;  // single scattering's half that no light changes, made once
     if (single) single_view = sss_single_view(n, v);
-    for (int i = 0; i < MAX_LIGHTS; ++i) {
+    Shading sh;
+    sh.base = base;
+    sh.rough = rough;
+    sh.metal = metal;
+    sh.plain = plain;
+    sh.a = a;
+    sh.f0 = f0;
+    sh.single = single;
+    sh.single_w = single_w;
+    sh.single_view = single_view;
+    for (int i = 0; i < MAX_LIGHTS; ++i) {  // the lights without a shadow map
         if (i >= u_num_lights) break;
-        vec3 l, e;
-        light_incidence(i, v_world, n, l, e);
-        float NoL = dot(n, l);
-#ifdef DIFFUSE_TRANSMISSION
-        // a thin surface lit from behind: its Lambertian transmission (lib/surface.glsl), shadowed as the far face
-        if (NoL < 0.0) {
-            float back = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, -dot(ng, l)) : 1.0;
-            color += e * (back * -NoL) * (1.0 - metal) * plain
-                     * diffuse_transmission_btdf(NoL, u_diffuse_transmission, u_diffuse_transmission_color);
-        }
-#endif
-        if (NoL <= 0.0) continue;
-        float vis = u_light_shadow[i] >= 0 ? light_visibility(i, v_world, dot(ng, l)) : 1.0;
-        vec3 h = half_vector(n, v, l);
-        float LoH = dot(l, h);
-        vec3 diffuse = base * ((1.0 - metal) * plain * burley_diffuse(NoL, NoV, LoH, rough));
-#ifdef MEASURE_NO_PLAIN_DIFFUSE  // a measurement variant (tools/orbit_cost.py): no Burley diffuse per light
-        diffuse = vec3(0.0);
-#endif
-#ifdef DIFFUSE_TRANSMISSION
-        diffuse *= 1.0 - u_diffuse_transmission;  // what is not sent through
-#endif
-#ifdef AREA_LIGHTS
-        // an area light's specular from its representative point, with a widened lobe (lib/lights.glsl)
-        float a_s, energy;
-        vec3 ls = light_specular_direction(i, v_world, n, v, l, a, a_s, energy);
-        vec3 hs = half_vector(n, v, ls);
-        float NoLs = max(dot(n, ls), 0.0);
-        vec3 spec = specular_ggx(NoLs, NoV, dot(n, hs), dot(ls, hs), a_s, f0) * energy;
-        color += e * vis * (diffuse * NoL + spec * NoLs);
-#else
-        vec3 spec = specular_ggx(NoL, NoV, dot(n, h), LoH, a, f0);
-        color += e * vis * (diffuse + spec) * NoL;
-#endif
-        // single scattering where the light lands (a near light's seen from below, lib/surface_inputs.glsl
-        // sss_near_single), and there too, for a hook of the separable boundary that does not spread it
-        // with its diffusion (SSS_MS_REST_LANDS: tsd, exact, preintegrated), the multiple scattering's
-        // non-separable rest (lib/sss_boundary.glsl sss_ms_rest)
-        // (shadowed where their light entered, spread upstream: lib/surface_inputs.glsl
-        // sss_single_visibility, one bilinear tap more per light)
-        vec3 svis = vec3(vis);
-#ifndef SSS_HOOK_PLAIN  // a mesh that does not scatter (techniques/none/forward.glsl) has no single scattering
-        svis = sss_single_visibility(s, i, l, NoL, vis);
-#endif
-        if (single) color += e * (svis * NoL) * single_w * sss_single_brdf_view(n, l, single_view) * sss_near_single(s, i);
-#if defined(SSS_MS_REST_LANDS) && defined(SSS_MS_REST) && !defined(MEASURE_NO_MS_REST)  // MEASURE_NO_MS_REST: tools/orbit_cost.py
-        if (u_sss_ms_rest_on > 0.0) color += e * (svis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
-#endif
-        // the technique's diffusion: shadowed where it entered (oblique entry, spread upstream per
-        // channel, for a hook that gathers its light here: SSS_HOOK_GATHERS_LIGHT, lib/sss_local.glsl;
-        // lib/surface_inputs.glsl sss_entry_ramp) and fed by the irradiance where it entered (a point
-        // or spot light's, lib/surface_inputs.glsl)
-#ifndef MEASURE_NO_ADD_LIGHT  // a measurement variant (tools/orbit_cost.py): the hook told of no light
-#ifdef SSS_HOOK_GATHERS_LIGHT
-        sss_add_light(s, e * sss_near_gain(s, i), sss_entry_ramp(s, i, l, u_sss_slab_decay), NoL);
-#else
-        sss_add_light(s, e * sss_near_gain(s, i), vec3(sss_entry_visibility(s, i, l)), NoL);
-#endif
-#endif
+        if (u_light_shadow[i] >= 0 && u_light_shadow[i] < SHADOW_SLOTS) continue;  // below, per slot
+        color += shade_light(i, -1, s, sh);
     }
+#if SHADOW_SLOTS > 0  // each filled slot's light, its slot a constant
+    if (u_slot_light[0] >= 0) color += shade_light(u_slot_light[0], 0, s, sh);
+#endif
+#if SHADOW_SLOTS > 1
+    if (u_slot_light[1] >= 0) color += shade_light(u_slot_light[1], 1, s, sh);
+#endif
     vec3 ambient = ambient_radiance(occlusion);  // the sky, and the scene's bounce light (lib/ambient.glsl)
     float kept = 1.0;
 #ifdef DIFFUSE_TRANSMISSION

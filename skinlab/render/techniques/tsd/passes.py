@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import cast
 
 import moderngl
 import numpy as np
@@ -465,12 +464,6 @@ class TsdIrradiancePass(TsdPass):
         bind_ambient(frame, node, prog, units)
         bind_boundary(prog, mat)
         bind_env_bands(prog, mat)
-        if "u_slot_light" in prog:  # the light each filled shadow slot holds (its lights are shaded per slot)
-            slot_light = np.full(2, -1, np.int32)
-            for s, light in enumerate(prm.shadow_lights[:2]):
-                slot_light[s] = next(i for i, x in enumerate(prm.lights) if x is light)
-            u = cast(moderngl.Uniform, prog["u_slot_light"])
-            u.write(slot_light[: max(u.array_length, 1)].tobytes())
         if prm.translucency:
             bind_translucency(prog, frame, units, self.r.dummy_texture())
         if prm.deferred:

@@ -33,43 +33,62 @@ float sss_plain_weight(Surface s) { return 1.0 - s.sss_weight; }
 
 void sss_add_light(Surface s, vec3 e, vec3 vis, float NoL) {}  // the hook runs its own light loop (below)
 
-// Its own light loop: each light is looked up past the terminator too (the forward pass's loop skips
-// lights behind the shading normal) and by the geometric normal (the table is over it), with the
-// shared surface inputs (normals, weight) and the shared shadow at the entry point.
+// Light i's light entering at s (through_exit: the light through thin parts leaving toward the viewer),
+// its shadow from slot `slot` (-1: none), looked up past the terminator too (the forward pass's loop
+// skips lights behind the shading normal) and by the geometric normal (the table is over it); t the
+// curvature's row, nr / nG / nb the softened normals. Every call passes the slot as a constant
+// (sss_radiance below), so a light without a shadow map compiles no lookup.
+vec3 pis_light(Surface s, int i, int slot, float t, vec3 nr, vec3 nG, vec3 nb, inout vec3 through_exit) {
+    vec3 ng = s.ng;
+    vec3 l, e;
+    light_incidence(i, s.position, ng, l, e);
+    float nlg = dot(ng, l);
+    // shadow maps only where the light faces the surface; past the terminator the ring's light
+    // comes from the lit side (looked up where the light entered, spread per channel as the
+    // entry is: lib/surface_inputs.glsl sss_entry_ramp)
+    vec3 vis = nlg > 0.0 ? sss_entry_ramp(s, slot, l, u_sss_slab_decay) : vec3(1.0);
+#ifdef HAS_NORMAL_MAP
+    vec3 D = vec3(pis_lookup(u_pis_lut, u_pis_lut_size, dot(nr, l), t).r,
+                  pis_lookup(u_pis_lut, u_pis_lut_size, dot(nG, l), t).g,
+                  pis_lookup(u_pis_lut, u_pis_lut_size, dot(nb, l), t).b);
+#else
+    vec3 D = pis_lookup(u_pis_lut, u_pis_lut_size, nlg, t);  // one normal: one lookup
+#endif
+    float flat_nl = max(nlg, 0.0);
+#ifdef SSS_TRANSLUCENCY
+    if (slot >= 0) {  // light through thin parts leaves with its own angular distribution
+        vec3 te;
+        sss_translucent_light_toward(slot, s.position, ng, l, e, abs(s.NoV), te);
+        through_exit += te;
+    }
+#endif
+    return e * sss_near_gain(s, i) * vis * (flat_nl * sss_entry(flat_nl) + (D - flat_nl) * u_sss_entry_diffuse);
+}
+
+// Its own light loop (pis_light), with the shared surface inputs (normals, weight) and the shared shadow
+// at the entry point: the lights without a shadow map, then each filled slot's.
 vec3 sss_radiance(Surface s) {
     vec3 ng = s.ng, n = s.n;
     float curv = abs(v_curvature) * u_pis_curv_scale;
     float t = u_pis_curv_max > 0.0 ? curv / u_pis_curv_max : 0.0;
+    vec3 nr = ng, nG = ng, nb = ng;
 #ifdef HAS_NORMAL_MAP
-    vec3 nr = normalize(mix(n, ng, u_pis_soften.r));
-    vec3 nG = normalize(mix(n, ng, u_pis_soften.g));
-    vec3 nb = normalize(mix(n, ng, u_pis_soften.b));
+    nr = normalize(mix(n, ng, u_pis_soften.r));
+    nG = normalize(mix(n, ng, u_pis_soften.g));
+    nb = normalize(mix(n, ng, u_pis_soften.b));
 #endif
     vec3 entering = vec3(0.0), through_exit = vec3(0.0);
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
-        vec3 l, e;
-        light_incidence(i, s.position, ng, l, e);
-        float nlg = dot(ng, l);
-        // shadow maps only where the light faces the surface; past the terminator the ring's light
-        // comes from the lit side (looked up where the light entered, spread per channel as the
-        // entry is: lib/surface_inputs.glsl sss_entry_ramp)
-        vec3 vis = nlg > 0.0 ? sss_entry_ramp(s, i, l, u_sss_slab_decay) : vec3(1.0);
-#ifdef HAS_NORMAL_MAP
-        vec3 D = vec3(pis_lookup(u_pis_lut, u_pis_lut_size, dot(nr, l), t).r,
-                      pis_lookup(u_pis_lut, u_pis_lut_size, dot(nG, l), t).g,
-                      pis_lookup(u_pis_lut, u_pis_lut_size, dot(nb, l), t).b);
-#else
-        vec3 D = pis_lookup(u_pis_lut, u_pis_lut_size, nlg, t);  // one normal: one lookup
-#endif
-        float flat_nl = max(nlg, 0.0);
-        entering += e * sss_near_gain(s, i) * vis * (flat_nl * sss_entry(flat_nl) + (D - flat_nl) * u_sss_entry_diffuse);
-#ifdef SSS_TRANSLUCENCY
-        vec3 te;  // light through thin parts leaves with its own angular distribution
-        sss_translucent_light_toward(i, s.position, ng, l, e, abs(s.NoV), te);
-        through_exit += te;
-#endif
+        if (u_light_shadow[i] >= 0 && u_light_shadow[i] < SHADOW_SLOTS) continue;  // below, per slot
+        entering += pis_light(s, i, -1, t, nr, nG, nb, through_exit);
     }
+#if SHADOW_SLOTS > 0
+    if (u_slot_light[0] >= 0) entering += pis_light(s, u_slot_light[0], 0, t, nr, nG, nb, through_exit);
+#endif
+#if SHADOW_SLOTS > 1
+    if (u_slot_light[1] >= 0) entering += pis_light(s, u_slot_light[1], 1, t, nr, nG, nb, through_exit);
+#endif
     entering += ambient_entering(s.m.occlusion);
 #if defined(SSS_TRANSLUCENCY) && defined(THROUGH_KERNEL)  // the transfer through the medium's, once
     vec3 kernel_in;

@@ -53,7 +53,6 @@ void texel_footprint(vec3 ng, vec4 t) {
     v_du = tt * (mm.x / u_mm_per_unit);
     v_dv = b * (mm.y / u_mm_per_unit);
 }
-uniform int u_slot_light[2];              // the light each shadow slot holds (lib/lights.glsl slots)
 #ifdef TSD_TRANSLUCENCY
 #include "lib/sss_translucency.glsl"
 #endif
@@ -96,10 +95,10 @@ vec3 shadowed_light(int slot, vec3 n, vec3 ng) {
         vec3 p1, p2, p3;
         vec3 m = sss_ramp_setup(v_world, ng, l, z0, u_sss_slab_decay, u_sss_eta, u_mm_per_unit, p1, p2, p3);
         float c = dot(ng, l);
-        vec3 vis = sss_ramp_mix(m, light_visibility_area(i, p1, c, v_du, v_dv), light_visibility_area(i, p2, c, v_du, v_dv),
-                                light_visibility_area(i, p3, c, v_du, v_dv));
+        vec3 vis = sss_ramp_mix(m, slot_visibility_area(slot, p1, c, v_du, v_dv), slot_visibility_area(slot, p2, c, v_du, v_dv),
+                                slot_visibility_area(slot, p3, c, v_du, v_dv));
 #else  // one lookup at the mean entry point
-        vec3 vis = vec3(light_visibility_area(i, sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit), dot(ng, l), v_du, v_dv));
+        vec3 vis = vec3(slot_visibility_area(slot, sss_entry_point(v_world, ng, l, z0, u_sss_eta, u_mm_per_unit), dot(ng, l), v_du, v_dv));
 #endif
         // a point or spot light's irradiance there too (lib/sss_near_light.glsl)
         sum += e * (vis * NoL) * sss_entry(NoL)
@@ -148,10 +147,10 @@ void main() {
         if (NoL > 0.0) e_in += e * NoL * sss_entry(NoL) * sss_light_near_gain(i, v_world, ng, u_sss_mfp * sss_radius_scale_at(v_uv));
     }
 #if SHADOW_SLOTS > 0
-    e_in += shadowed_light(0, n, ng);
+    if (u_slot_light[0] >= 0) e_in += shadowed_light(0, n, ng);
 #endif
 #if SHADOW_SLOTS > 1
-    e_in += shadowed_light(1, n, ng);
+    if (u_slot_light[1] >= 0) e_in += shadowed_light(1, n, ng);
 #endif
     e_in += ambient_entering(occlusion);  // the sky and bounce light
 #ifdef THROUGH_KERNEL  // the light through thin parts from the transfer through the medium, one record
