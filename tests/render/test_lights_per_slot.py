@@ -40,7 +40,8 @@ def _render(renderer, technique, names, **opts):
         light = LightNode(n, "directional", color=(1.0, 0.9, 0.8), intensity=intensity, cast_shadow=shadow)
         light.rotation = tf.look_at_rotation(np.zeros(3), d)
         s.add(light)
-    st = RenderSettings.for_technique(technique, 48, 48, shadow_size=512, bounces=0, **{**TECHNIQUES[technique], **opts})
+    own = {**TECHNIQUES[technique], **opts}
+    st = RenderSettings.for_technique(technique, 48, 48, shadow_size=512, bounces=0, **own)
     res = renderer.render(s, st, readback=("hdr",))
     return res.hdr[..., :3].astype(np.float64)
 
