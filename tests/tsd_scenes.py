@@ -134,3 +134,31 @@ def sky_slab(color, mfp=(1.0, 1.0, 1.0)) -> Scene:
     cam.look_at((0.0, 0.0, 1000.0), (0.0, 0.0, 0.0))
     s.add(cam)
     return s
+
+
+# Three directional lights around the 3 mm back-lit slab (reference/slab-thin-backlit-skin1.toml): the
+# direction each travels, its intensity, whether it casts a shadow. "back" reaches the camera only through
+# the slab. For the tests that the lights' order and shadow slots do not change a frame.
+SLAB_LIGHTS = {
+    "back": ((0.5, 0.0, 0.866), 3.0, True),
+    "key": ((0.3, 0.2, -1.0), 1.0, True),
+    "fill": ((-0.4, -0.1, -1.0), 0.5, False),
+}
+
+
+def backlit_slab_with(names) -> Scene:
+    """The back-lit slab's reference scene with its own light hidden and SLAB_LIGHTS' `names` added in
+    that order (the shadow-casting ones take the shadow slots in that order)."""
+    from skinlab.resources import assets_root
+    from skinlab.scene.scenefile import load_scene
+
+    s = load_scene(assets_root() / "scenes" / "reference" / "slab-thin-backlit-skin1.toml")
+    for node in s.lights():
+        node.visible = False
+    for n in names:
+        d, intensity, shadow = SLAB_LIGHTS[n]
+        d = np.asarray(d, np.float64) / np.linalg.norm(d)
+        light = LightNode(n, "directional", color=(1.0, 0.9, 0.8), intensity=intensity, cast_shadow=shadow)
+        light.rotation = tf.look_at_rotation(np.zeros(3), d)
+        s.add(light)
+    return s

@@ -14,32 +14,16 @@ import pytest
 
 from skinlab.render.lights import set_light_uniforms
 from skinlab.render.settings import RenderSettings
-from skinlab.resources import assets_root
-from skinlab.scene import transform as tf
 from skinlab.scene.graph import LightNode
-from skinlab.scene.scenefile import load_scene
+from tests.tsd_scenes import backlit_slab_with
 
-SCENE = assets_root() / "scenes" / "reference" / "slab-thin-backlit-skin1.toml"
-LIGHTS = {  # direction the light travels, intensity, shadow
-    "back": ((0.5, 0.0, 0.866), 3.0, True),  # from behind the 3 mm slab: reaches the camera only through it
-    "key": ((0.3, 0.2, -1.0), 1.0, True),
-    "fill": ((-0.4, -0.1, -1.0), 0.5, False),
-}
 # techniques whose forward pass shades the lights (none: the plain frame), with the light through the
-# slab where they have it
+# slab where they have it; the lights: tests/tsd_scenes.py SLAB_LIGHTS
 TECHNIQUES = {"none": {}, "ssss": {"translucency": True}, "preintegrated": {"translucency": True}}
 
 
 def _render(renderer, technique, names, **opts):
-    s = load_scene(SCENE)
-    for node in s.lights():
-        node.visible = False  # the scene's own light
-    for n in names:
-        d, intensity, shadow = LIGHTS[n]
-        d = np.asarray(d, np.float64) / np.linalg.norm(d)
-        light = LightNode(n, "directional", color=(1.0, 0.9, 0.8), intensity=intensity, cast_shadow=shadow)
-        light.rotation = tf.look_at_rotation(np.zeros(3), d)
-        s.add(light)
+    s = backlit_slab_with(names)
     own = {**TECHNIQUES[technique], **opts}
     st = RenderSettings.for_technique(technique, 48, 48, shadow_size=512, bounces=0, **own)
     res = renderer.render(s, st, readback=("hdr",))
