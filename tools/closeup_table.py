@@ -119,6 +119,7 @@ CLOSEUPS = {
     "ear-backlit-skin1": Closeup((96, 96), 64),
     "point-light-skin1": Closeup((64, 64), 128),
     "slabs-gap-backlit-skin1": Closeup((64, 64), 512, kind="slabs"),
+    "ball-backlit-skin1": Closeup((96, 96), 8192),
 }
 
 

@@ -127,14 +127,14 @@ def test_measure_table_reads_and_names_bad_keys(tmp_path):
 
 def test_scenes_that_say_ledger_false_are_left_out_of_the_default_list(tmp_path, monkeypatch):
     """A scene whose [measure] says `ledger = false` is left out of the ledger's default scene list; the full
-    list keeps it. The six close-ups (issue 21) are in the default list, each with its own truth's settings."""
+    list keeps it. The seven close-ups (issue 21) are in the default list, each with its own truth's settings."""
     from skinlab.bench import truth_ledger
     from skinlab.bench.sweep import FULL
     from skinlab.bench.truth_ledger import reference_scene_names, scene_truth_spec
     from skinlab.scene.scenefile import load_scene
 
     closeups = {"slit-skin1", "slit-marble", "nose-shadow-skin1", "ear-backlit-skin1", "point-light-skin1",
-                "slabs-gap-backlit-skin1"}  # fmt: skip
+                "slabs-gap-backlit-skin1", "ball-backlit-skin1"}  # fmt: skip
     assert closeups | {"head-skin1-matched", "slab-edge-skin1"} <= set(reference_scene_names())
     marble = scene_truth_spec(load_scene("slit-marble"), FULL.truth)
     assert (marble.size, marble.spp, marble.rr_depth, marble.passes) == ((256, 16), 64, 1024, 4)
