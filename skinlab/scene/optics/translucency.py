@@ -190,6 +190,19 @@ def through(back, d_mm, tables: BoundaryTables, medium, colour) -> np.ndarray:
     return slab_through(back, d, table, medium.mfp_arr, medium.alpha_arr, tables.eta).reshape(-1, 3)
 
 
+def through_incidence(c, depth_mm, tables: BoundaryTables, medium, colour) -> np.ndarray:
+    """(N, 3): what light entering at cosine `c` changes of the light a part `depth_mm` thick lets through,
+    for weights made for light entering along the normal (the transfer through the medium's,
+    skinlab/scene/optics/through_kernel.py): through(c, d) / through(1, d), and 1 where through(1, d) is not
+    above 1e-30 (no depth: a vertex whose rays met nothing, where the slab lets nothing through; or a part
+    too thick for the light to be a float). GLSL sss_through_incidence (lib/sss_translucency.glsl)."""
+    c = np.atleast_1d(np.asarray(c, np.float64))
+    d = np.broadcast_to(np.atleast_1d(np.asarray(depth_mm, np.float64)), c.shape)
+    at_c = through(c, d, tables, medium, colour)
+    normal = through(np.ones_like(c), d, tables, medium, colour)
+    return np.where(normal > 1e-30, at_c / np.maximum(normal, 1e-30), 1.0)
+
+
 def translucent_irradiance(e, back, d_mm, hit, tables: BoundaryTables, medium, colour) -> np.ndarray:
     """(N, 3) irradiance entering through thin parts from one light of irradiance e (3,) on a surface
     facing it: e back through(back, d) where the light is behind the surface (back > 0) and the map

@@ -186,6 +186,16 @@ vec3 sss_through(float back, float d_mm) {
     return sss_slab_through(back, d_mm);
 }
 
+// What light entering at cosine c changes of the light a part depth_mm thick lets through, for weights
+// made for light entering along the normal (the transfer through the medium's, passes/through_entering.frag):
+// sss_through(c, d) / sss_through(1, d), and 1 where sss_through(1, d) is not above 1e-30 (no depth: a
+// vertex whose rays met nothing, where the slab lets nothing through; or too thick for a float). NumPy twin:
+// skinlab/scene/optics/translucency.py through_incidence.
+vec3 sss_through_incidence(float c, float depth_mm) {
+    vec3 normal_in = sss_through(1.0, depth_mm);
+    return mix(vec3(1.0), sss_through(c, depth_mm) / max(normal_in, vec3(1e-30)), greaterThan(normal_in, vec3(1e-30)));
+}
+
 // Irradiance entering the medium at world through thin parts from the light of shadow slot `slot` (a
 // light's u_light_shadow; direction to it l, its irradiance e on a surface facing it); ng: the
 // surface's outward geometric normal; the part crossed at sss_through_cosine's cosine. Zero for a light

@@ -42,7 +42,6 @@ void main() {
     // the transfer's weights carry light entering along the normal; light entering at cosine c goes
     // less deep (lib/sss_boundary.glsl sss_slab_through), by its ratio through the part's own thickness
     float depth = texelFetch(u_row_index, t, 0).b;  // the row index has the target's layout
-    vec3 normal_in = sss_through(1.0, depth);
     for (int i = 0; i < MAX_LIGHTS; ++i) {
         if (i >= u_num_lights) break;
         vec3 l, li;
@@ -54,8 +53,7 @@ void main() {
         vec3 through = vec3(0.0);
         float d_mm;
         if (slot >= 0 && vis < 1.0 && sss_thickness_mm(slot, world, n, NoL, d_mm)) through = sss_through(NoL, d_mm);
-        vec3 at_cos = mix(vec3(1.0), sss_through(NoL, depth) / max(normal_in, vec3(1e-30)), greaterThan(normal_in, vec3(1e-30)));
-        vec3 in_i = li * NoL * (vis + (1.0 - vis) * through) * at_cos;
+        vec3 in_i = li * NoL * (vis + (1.0 - vis) * through) * sss_through_incidence(NoL, depth);
         e += in_i;
         e_cos += in_i.g * NoL;
     }

@@ -198,6 +198,31 @@ def test_through_matches_slab_transmission_and_glsl(glsl):
         assert_close_fp32(gpu, ref, atol=1e-4, what=f"sss_through eta {eta}")
 
 
+def test_through_incidence_is_the_slabs_ratio_and_1_where_nothing_passes(glsl):
+    """sss_through_incidence (the transfer's entering light at a cosine, passes/through_entering.frag) against
+    its twin: the slab transmittance at the cosine over at normal incidence, 1 at normal incidence, below 1
+    at an oblique one (light entering obliquely goes less deep), and 1, finite, where the slab lets nothing
+    through at normal incidence: no depth (a vertex whose rays met nothing) and a part too thick for a float;
+    grazing light (cosine 0) finite. GPU within 1e-4 of NumPy."""
+    mat = skin()
+    med, tabs = material_medium(mat.values), material_boundary(mat)
+    cs = np.array([1.0, 0.3, 0.3, 0.0, 1e-3, 0.5, 0.3, 0.3])
+    dd = np.array([3.0, 3.0, 0.5, 3.0, 3.0, 0.0, 0.0, 1e4])
+    ref = tr.through_incidence(cs, dd, tabs, med, mat["subsurface_color"])
+    assert np.all(np.isfinite(ref)) and np.all(ref >= 0)
+    np.testing.assert_allclose(ref[0], 1.0, rtol=1e-12)
+    assert np.all(ref[1] < 1.0) and np.all(ref[1] > 0.0)
+    assert np.all(ref[5:] == 1.0)  # nothing passes at normal incidence: the guard
+    gpu = glsl.evaluate(
+        "lib/sss_translucency.glsl",
+        "sss_through_incidence(c, d)",
+        {"c": cs, "d": dd},
+        3,
+        setup=lambda prog: bind_boundary(prog, mat),
+    )
+    assert_close_fp32(gpu, ref, atol=1e-4, what="sss_through_incidence")
+
+
 def test_translucent_light_matches_numpy(ctx, glsl):
     """sss_translucent_light for one shadow-casting directional light on a flat map: e back through
     where the light is behind the surface and 0 where it is in front, at grazing incidence or where
