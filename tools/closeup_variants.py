@@ -4,10 +4,12 @@ channel, FLIP; the shadow scenes' deep shadow and edge region), in variants that
 settings or by measurement defines of the shaders (``MEASURE_...``: passes/forward.frag and the texture-space
 irradiance pass; none is what the renderer runs), side by side (issue 21, docs/ground-truth.md).
 
-    python -m tools.closeup_variants SCENES TECHNIQUE NAME=KEY:VALUE,... [NAME=...]
+    python -m tools.closeup_variants SCENES TECHNIQUE NAME=KEY:VALUE,... [NAME=...] [--truth SIZE:SPP]
 
 A KEY in capitals is a define (VALUE a number, or none: 1), any other a RenderSettings field or the
-technique's option (VALUE parsed as a number, true/false, or text); NAME= alone is the defaults:
+technique's option (VALUE parsed as a number, true/false, or text); NAME= alone is the defaults. With
+--truth, the other reference scenes too (the head, the bunnies), against their cached SIZExSIZE truth of
+SPP samples (tools/truth_table.py's --truth):
 
     python -m tools.closeup_variants ball-backlit-skin1,nose-shadow-skin1 tsd base= flat=single_through:false \\
         kernel=through_kernel:true chord=MEASURE_BULGE_CHORD:0
@@ -51,12 +53,16 @@ def parse_variant(text: str) -> tuple[str, dict, dict]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = sys.argv[1:] if argv is None else argv
-    if len(args) < 3:
-        print(__doc__)
-        return 2
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="python -m tools.closeup_variants", description=__doc__.split("\n\n")[0])
+    ap.add_argument("scenes", help="comma-separated reference scenes")
+    ap.add_argument("technique")
+    ap.add_argument("variants", nargs="+", help="NAME=KEY:VALUE,...")
+    ap.add_argument("--truth", default=None, help="SIZE:SPP of the truths of scenes that are not close-ups")
+    opts = ap.parse_args(sys.argv[1:] if argv is None else argv)
     from skinlab.bench.closeup import region_error, region_level, shadow_regions
-    from skinlab.bench.truth_ledger import REFERENCE_SCENES, TRUTH_SUPERSAMPLE
+    from skinlab.bench.truth_ledger import REFERENCE_SCENES, TRUTH_SUPERSAMPLE, TruthSpec, load_truth
     from skinlab.gl.context import create_headless_context
     from skinlab.gl.shader_source import ShaderLibrary
     from skinlab.render.renderer import Renderer
@@ -67,22 +73,39 @@ def main(argv: list[str] | None = None) -> int:
 
     from .closeup_table import CLOSEUPS, load_closeup_truth
 
-    scenes, tech = args[0].split(","), args[1]
-    unknown = [s for s in scenes if s not in CLOSEUPS]
+    scenes, tech = opts.scenes.split(","), opts.technique
+    other = None
+    if opts.truth:
+        size, _, spp = opts.truth.partition(":")
+        other = TruthSpec((int(size), int(size)), int(spp))
+    unknown = [
+        s for s in scenes if s not in CLOSEUPS and (other is None or not (REFERENCE_SCENES / f"{s}.toml").exists())
+    ]
     if unknown:
-        raise SystemExit(f"closeup_variants: no close-up {', '.join(unknown)}; expected some of {', '.join(CLOSEUPS)}")
-    variants = [parse_variant(v) for v in args[2:]]
+        raise SystemExit(
+            f"closeup_variants: no close-up {', '.join(unknown)}; expected some of {', '.join(CLOSEUPS)} "
+            "(or any reference scene with --truth)"
+        )
+    variants = [parse_variant(v) for v in opts.variants]
     ctx = create_headless_context()
     print("load average at start: " + " ".join(f"{x:.2f}" for x in os.getloadavg()))
     for sname in scenes:
-        spec = CLOSEUPS[sname]
         scene = load_scene(REFERENCE_SCENES / f"{sname}.toml")
-        truth = load_closeup_truth(scene, spec)
+        if sname in CLOSEUPS:
+            spec = CLOSEUPS[sname]
+            size, kind = spec.size, spec.kind
+            truth = load_closeup_truth(scene, spec)
+            hint = spec.command(sname)
+        else:
+            assert other is not None
+            size, kind = other.size, "plain"
+            truth = load_truth(scene, other, progress=False)
+            hint = f"skinlab reference {REFERENCE_SCENES / sname}.toml --size {size[0]}x{size[1]} --spp {other.spp}"
         if truth is None:
-            print(f"{sname}: no cached reference; render it with\n    {spec.command(sname)}")
+            print(f"{sname}: no cached reference; render it with\n    {hint}")
             continue
         t = truth.image
-        masks = shadow_regions(scene, spec.size) if spec.kind == "shadow" else None
+        masks = shadow_regions(scene, size) if kind == "shadow" else None
         head = f"{sname}: truth noise 4x4 {100 * truth.noise['rel_l1_block']:.2f} %"
         if masks is not None:
             head += f", deep shadow {100 * region_level(t, masks[0], masks[1]):.3f} % of the lit level"
@@ -91,9 +114,7 @@ def main(argv: list[str] | None = None) -> int:
             library = ShaderLibrary(defines={f: defines for f in DEFINED_IN}) if defines else ShaderLibrary()
             r = Renderer(ctx, library)
             try:
-                rs = RenderSettings.for_technique(
-                    tech, spec.size[0], spec.size[1], supersample=TRUTH_SUPERSAMPLE, **settings
-                )
+                rs = RenderSettings.for_technique(tech, size[0], size[1], supersample=TRUTH_SUPERSAMPLE, **settings)
                 img = r.render(scene, rs, readback=("hdr",)).hdr
             finally:
                 r.release()

@@ -97,8 +97,14 @@ void sss_single_through(int slot, vec3 world, vec3 ng, vec3 l, SingleView sv, ve
     vec3 integral = sss_single_through_integral(sigma_t, s, d);
     if (lit) {
         gain = max(integral * ((ct + sv.cto) / ct), vec3(1.0));
+#ifdef MEASURE_ST_FLAT_LIT  // measurement variants (tools/closeup_variants.py): one side's term alone
+        gain = vec3(1.0);
+#endif
         return;
     }
+#ifdef MEASURE_ST_NO_SHADOW
+    return;
+#endif
     float ft = 1.0 - fresnel_from_cosines(c, ct, 1.0, eta);
     vec3 ti = -l / eta + (c / eta - ct) * ef.xyz;  // the beam refracted at the entry face
     float cos_s = clamp(-dot(ti, sv.to), -1.0, 1.0);
