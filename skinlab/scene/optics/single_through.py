@@ -40,10 +40,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from .constants import LUMA_B, LUMA_G, LUMA_R, SINGLE_THROUGH_DEPTHS, SINGLE_THROUGH_MIN_FACE_COS
+from .constants import (
+    LUMA_B,
+    LUMA_G,
+    LUMA_R,
+    SINGLE_THROUGH_DEPTHS,
+    SINGLE_THROUGH_MIN_FACE_COS,
+)
 from .fresnel import fresnel_from_cosines, hg_phase
 from .single_scattering import refract_cos
-from .translucency import distance_from_light, entry_face, first_hit_distance, part_layers
+from .translucency import NO_SURFACE, _distance_quad, distance_from_light, entry_face, part_layers
 
 LUMA = np.array([LUMA_R, LUMA_G, LUMA_B])
 MIN_CT = 1e-4  # refracted cosines are clamped here (GLSL alike)
@@ -86,6 +92,18 @@ def view(n, v, eta):
     return co, cto, to, t_out
 
 
+def bilinear_first(distance_map, shadow_matrix, world) -> tuple[np.ndarray, np.ndarray]:
+    """(first, hit): the distance map's bilinear first surface where all four texels around each point hold
+    one (translucency.first_hit_distance without its fallback to the containing texel: at a silhouette in
+    the light's view, no hit). GLSL: the turns of sss_single_through."""
+    dist = np.asarray(distance_map, np.float64)
+    inside, _, (fx, fy), _, (d00, d10, d01, d11) = _distance_quad(dist, shadow_matrix, np.atleast_2d(world))
+    hit = inside & (np.maximum(np.maximum(d00, d10), np.maximum(d01, d11)) < NO_SURFACE)
+    with np.errstate(invalid="ignore", over="ignore"):
+        first = (d00 * (1 - fx) + d10 * fx) * (1 - fy) + (d01 * (1 - fx) + d11 * fx) * fy
+    return np.where(hit, first, 0.0), hit
+
+
 def path_mm(distance_map, shadow_matrix, eye, world, to, cto, ct, ratio, mfp, d0, mm_per_unit):
     """(s, d), each (N, 4): the depths along the refracted view ray `to` from each point and the path
     inside to them (mm), d[:, 0] = d0; where the map has no surface in front, the flat medium's path."""
@@ -96,7 +114,7 @@ def path_mm(distance_map, shadow_matrix, eye, world, to, cto, ct, ratio, mfp, d0
     d[:, 0] = d0
     for j in range(1, s.shape[1]):
         x = world + to * (s[:, j] / mm_per_unit)[:, None]
-        first, hit = first_hit_distance(distance_map, shadow_matrix, x)
+        first, hit = bilinear_first(distance_map, shadow_matrix, x)
         air = np.maximum(distance_from_light(eye, x) - first, 0.0) * mm_per_unit
         d[:, j] = np.where(hit, air * ratio, s[:, j] * cto / ct)
     return s, d
@@ -150,10 +168,11 @@ def single_through(
         return gain, f
     co, cto, to, t_out = view(ng if n is None else n, v, eta)
     p = world - float(shrink) * ng
-    ok = (co > 0) & own_part(distance_map, exit_map, shadow_matrix, eye, world, ng, shrink, part_gap)
     cg = ng @ l
+    ok = co > 0
+    ok &= own_part(distance_map, exit_map, shadow_matrix, eye, world, ng, shrink, part_gap)
     ef = entry_face(distance_map, shadow_matrix, eye, p)
-    first, hit = first_hit_distance(distance_map, shadow_matrix, p)
+    first, hit = bilinear_first(distance_map, shadow_matrix, p)
     lit = cg > 0
     ok &= lit | ((ef[:, 3] > 0) & (np.sum(ng * ef[:, :3], -1) >= SINGLE_THROUGH_MIN_FACE_COS) & hit)
     c = np.where(ok, np.where(lit, cg, ef[:, 3]), 1.0)  # (the others are not used)

@@ -28,73 +28,73 @@ const float SSS_SINGLE_THROUGH_DEPTHS[4] = float[4](SINGLE_THROUGH_D0, SINGLE_TH
 // int_0^inf sig e^{-sig (s + d(s))} ds for d piecewise linear through (s[j], d[j]), per channel: on a
 // segment of rate k = 1 + its slope, (e_j - e_j+1) / k with e_j = e^{-sig (s_j + d_j)} (both at most 1:
 // finite however steep the segment), its series where sig k ds is small; beyond the last point e_3 / (1 + m).
+// One segment's part of that integral: rate k = 1 + its slope, length ds, e0 and e1 its ends' exponentials.
+vec3 sss_single_through_segment(vec3 sig, float ds, float k, vec3 e0, vec3 e1) {
+    vec3 x = sig * (k * ds);
+    vec3 series = sig * ds * e0 * (1.0 - 0.5 * x);
+    return mix((e0 - e1) / (abs(k) > 0.0 ? k : 1.0), series, lessThan(abs(x), vec3(1e-2)));
+}
+
 vec3 sss_single_through_integral(vec3 sig, float s[4], float d[4]) {
     vec3 e[4];
     for (int j = 0; j < 4; ++j) e[j] = exp(-sig * (s[j] + d[j]));
     vec3 tot = vec3(0.0);
     for (int j = 0; j < 3; ++j) {
         float ds = s[j + 1] - s[j];
-        float k = 1.0 + (d[j + 1] - d[j]) / ds;
-        vec3 x = sig * (k * ds);
-        vec3 series = sig * ds * e[j] * (1.0 - 0.5 * x);
-        tot += mix((e[j] - e[j + 1]) / (abs(k) > 0.0 ? k : 1.0), series, lessThan(abs(x), vec3(1e-2)));
+        tot += sss_single_through_segment(sig, ds, 1.0 + (d[j + 1] - d[j]) / ds, e[j], e[j + 1]);
     }
     float m = max((d[3] - d[2]) / (s[3] - s[2]), 0.0);
     return tot + e[3] / (1.0 + m);
-}
-
-// The path inside (mm, refracted) to the points at SSS_SINGLE_THROUGH_DEPTHS x mfp_l along the refracted
-// view ray from world; d[0] = d0 (the point itself). Where the map has no surface in front of a point, the
-// flat medium's path there.
-void sss_single_through_path(int slot, vec3 world, SingleView sv, float ct, float ratio, float mfp_l, float d0,
-                             out float s[4], out float d[4]) {
-    s[0] = 0.0;
-    d[0] = d0;
-    for (int j = 1; j < 4; ++j) {
-        s[j] = SSS_SINGLE_THROUGH_DEPTHS[j] * mfp_l;
-        vec3 x = world + sv.to * (s[j] / u_mm_per_unit);
-        float first;
-        float dj = s[j] * sv.cto / ct;
-        if (first_hit_distance(slot, x, first)) dj = max(distance_from_light(slot, x) - first, 0.0) * u_mm_per_unit * ratio;
-        d[j] = dj;
-    }
 }
 
 float sss_single_mfp(vec3 sigma_t) {
     return dot(1.0 / max(sigma_t, vec3(1e-6)), vec3(LUMA_R, LUMA_G, LUMA_B));
 }
 
+// The light's path inside (mm, refracted: the air path times `ratio`) to x, for a point on the view ray at
+// s mm: the distance map's bilinear first surface where all four texels hold one (first_hit_quad without its
+// fallback to the containing texel), else the flat medium's path s cto / ct.
+float sss_single_through_path(int slot, vec3 x, float s, float cto, float ct, float ratio) {
+    DistanceQuad q = distance_quad(slot, x);
+    bool hit = q.inside && max(max(q.d.x, q.d.y), max(q.d.z, q.d.w)) < 1e29;
+    float first = mix(mix(q.d.x, q.d.y, q.f.x), mix(q.d.z, q.d.w, q.f.x), q.f.y);
+    return hit ? max(distance_from_light(slot, x) - first, 0.0) * u_mm_per_unit * ratio : s * cto / ct;
+}
+
 // Both uses for slot `slot`'s light at world (geometric normal ng, unit direction to the light l; the
 // view's half sv, from the shading normal; sigma_t the real extinction per mm, the radius map's scale
 // applied), the path's samples shared: gain, the lit side's factor on the flat term (ng.l > 0; at least
 // 1, and 1 where it does not apply), and f, past a convex part's terminator (ng.l <= 0) the term itself
-// per unit light (0 where it does not apply: a sheet, the map without a surface or its slope there).
+// per unit light (0 where it does not apply: a sheet, a sharp edge, the map without a surface or its slope
+// there). Straight-line code (a software rasteriser runs a branch's masked side anyway).
 void sss_single_through(int slot, vec3 world, vec3 ng, vec3 l, SingleView sv, vec3 sigma_t, out vec3 gain, out vec3 f) {
     gain = vec3(1.0);
     f = vec3(0.0);
-    if (u_light_eye[slot].w != 0.0 || sv.co <= 0.0) return;
-    vec3 p = world - u_thickness_shrink * ng;
-    float at = distance_from_light(slot, p);
-    vec3 layers = part_layers(slot, p);
-    if (layers.x < 1e29 && at > layers.x + u_part_gap) return;  // past another part: the flat term's
     float cg = dot(ng, l);
-    DistanceQuad q = distance_quad(slot, p);
-    vec4 ef = entry_face_quad(slot, q);
-    float first;
-    bool hit = first_hit_quad(slot, q, first);
     bool lit = cg > 0.0;
-    // past a terminator: the entry face within 60 degrees of the point's own (a sheet's faces are opposed,
-    // a sharp edge's at 90 degrees: the slab transmittance carries their light), and known
-    if (!lit && (ef.w <= 0.0 || dot(ng, ef.xyz) < SINGLE_THROUGH_MIN_FACE_COS || !hit)) return;
     float eta = max(u_sss_eta, 1.0);
-    float c = lit ? cg : ef.w;
+    vec3 p = world - u_thickness_shrink * ng;
+    DistanceQuad q = distance_quad(slot, p);
+    bool hit = q.inside && max(max(q.d.x, q.d.y), max(q.d.z, q.d.w)) < 1e29;
+    float first = mix(mix(q.d.x, q.d.y, q.f.x), mix(q.d.z, q.d.w, q.f.x), q.f.y);
+    vec4 ef = entry_face_quad(slot, q);
+    float c = lit ? cg : max(ef.w, 1e-4);  // the entry cosine: the point's own on the lit side
     float ct = max(refract_cos(c, eta), 1e-4);
     float ratio = c / ct;
-    float d0 = lit ? 0.0 : max(at - first, 0.0) * u_mm_per_unit * ratio;
+    float at = distance_from_light(slot, p);
+    float mfp_l = sss_single_mfp(sigma_t);
     float s[4];
     float d[4];
-    sss_single_through_path(slot, world, sv, ct, ratio, sss_single_mfp(sigma_t), d0, s, d);
+    s[0] = 0.0;
+    d[0] = lit ? 0.0 : max(at - first, 0.0) * u_mm_per_unit * ratio;
+    for (int j = 1; j < 4; ++j) {  // unrolled: straight-line
+        s[j] = SSS_SINGLE_THROUGH_DEPTHS[j] * mfp_l;
+        d[j] = sss_single_through_path(slot, world + sv.to * (s[j] / u_mm_per_unit), s[j], sv.cto, ct, ratio);
+    }
     vec3 integral = sss_single_through_integral(sigma_t, s, d);
+    vec3 layers = part_layers(slot, p);
+    bool own = !(layers.x < 1e29 && at > layers.x + u_part_gap);  // not past another part: else the flat term's
+    if (u_light_eye[slot].w != 0.0 || sv.co <= 0.0 || !own) return;
     if (lit) {
         gain = max(integral * ((ct + sv.cto) / ct), vec3(1.0));
 #ifdef MEASURE_ST_FLAT_LIT  // measurement variants (tools/closeup_variants.py): one side's term alone
@@ -105,6 +105,9 @@ void sss_single_through(int slot, vec3 world, vec3 ng, vec3 l, SingleView sv, ve
 #ifdef MEASURE_ST_NO_SHADOW
     return;
 #endif
+    // past a terminator: the entry face within 60 degrees of the point's own (a sheet's faces are opposed,
+    // a sharp edge's at 90 degrees: the slab transmittance carries their light), and known
+    if (ef.w <= 0.0 || dot(ng, ef.xyz) < SINGLE_THROUGH_MIN_FACE_COS || !hit) return;
     float ft = 1.0 - fresnel_from_cosines(c, ct, 1.0, eta);
     vec3 ti = -l / eta + (c / eta - ct) * ef.xyz;  // the beam refracted at the entry face
     float cos_s = clamp(-dot(ti, sv.to), -1.0, 1.0);

@@ -13,6 +13,7 @@
 // THROUGH_KERNEL (RenderSettings.through_kernel): the light through thin parts comes from the transfer
 // through the medium (skinlab/render/through_kernel.py) as per-vertex bounce light, and the per-light
 // functions below bring none; the thickness functions still serve the transfer's senders.
+#extension GL_ARB_gpu_shader5 : enable  // textureGather (core in GLSL 4.00): distance_quad's four texels in one
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
 
@@ -72,8 +73,16 @@ DistanceQuad distance_quad(int slot, vec3 world) {
     ivec2 hi = q.size - 1;
     q.a = clamp(i0, ivec2(0), hi);
     q.b = clamp(i0 + 1, ivec2(0), hi);
+#if defined(GL_ARB_gpu_shader5) || __VERSION__ >= 400
+    // one gather of the same four texels (its footprint at the corner they share; the maps clamp to their
+    // edge as the indices do): components x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0)
+    vec2 corner = (vec2(i0) + 1.0) / vec2(q.size);
+    vec4 g = slot == 0 ? textureGather(u_distance0, corner) : textureGather(u_distance1, corner);
+    q.d = g.wzxy;
+#else
     q.d = vec4(distance_texel(slot, q.a), distance_texel(slot, ivec2(q.b.x, q.a.y)),
                distance_texel(slot, ivec2(q.a.x, q.b.y)), distance_texel(slot, q.b));
+#endif
     return q;
 }
 
