@@ -25,15 +25,10 @@ DEFINED_IN = ("passes/forward.frag", "techniques/tsd/irradiance.frag")
 
 
 def _value(text: str) -> Any:
+    from skinlab.bench.ledger_csv import _param_value  # a number where it reads as one (the ledger's CSV cells)
+
     low = text.lower()
-    if low in ("true", "false"):
-        return low == "true"
-    for kind in (int, float):
-        try:
-            return kind(text)
-        except ValueError:
-            pass
-    return text
+    return low == "true" if low in ("true", "false") else _param_value(text)
 
 
 def parse_variant(text: str) -> tuple[str, dict, dict]:
