@@ -55,7 +55,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("technique")
     ap.add_argument("variants", nargs="+", help="NAME=KEY:VALUE,...")
     ap.add_argument("--truth", default=None, help="SIZE:SPP of the truths of scenes that are not close-ups")
-    opts = ap.parse_args(sys.argv[1:] if argv is None else argv)
+    opts = ap.parse_args(argv)
     from skinlab.bench.closeup import region_error, region_level, shadow_regions
     from skinlab.bench.truth_ledger import REFERENCE_SCENES, TRUTH_SUPERSAMPLE, TruthSpec, load_truth
     from skinlab.gl.context import create_headless_context

@@ -31,7 +31,7 @@ def test_a_flat_part_renders_as_with_the_flat_term(renderer, technique):
     # corner skims below the face: a convex part's terminator, with more light)
     inner = _eroded(on.max(-1) > 0.0, 2)
     assert inner.sum() > 300
-    np.testing.assert_allclose(on[inner], off[inner], rtol=2e-5, atol=2e-6 * on.max())
+    np.testing.assert_allclose(on[inner], off[inner], rtol=1e-6, atol=1e-7 * on.max())  # to fp32 rounding
     assert np.all(on >= off - 1e-5 * on.max())
 
 

@@ -19,3 +19,14 @@ def test_a_variant_splits_into_settings_and_defines():
 def test_a_variant_without_a_name_is_refused(text):
     with pytest.raises(SystemExit, match="expected NAME=KEY:VALUE"):
         parse_variant(text)
+
+
+def test_without_cached_truths_it_says_how_to_render_them(tmp_path, monkeypatch, capsys):
+    from tools import closeup_variants
+
+    monkeypatch.setenv("SKINLAB_CACHE_DIR", str(tmp_path))  # an empty cache
+    assert closeup_variants.main(["ball-backlit-skin1", "tsd", "base="]) == 0
+    out = capsys.readouterr().out
+    assert "ball-backlit-skin1: no cached reference; render it with" in out and "skinlab reference" in out
+    with pytest.raises(SystemExit, match="no close-up head-skin1-matched"):
+        closeup_variants.main(["head-skin1-matched", "tsd", "base="])  # not a close-up, and no --truth

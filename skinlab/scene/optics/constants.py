@@ -250,6 +250,10 @@ GLSL_CONSTANTS.update({f"SINGLE_THROUGH_D{k}": v for k, v in enumerate(SINGLE_TH
 # two back-lit slabs' rims read 0.4 points worse on 4x4 blocks with the term at a 90-degree edge).
 SINGLE_THROUGH_MIN_FACE_COS = 0.5
 GLSL_CONSTANTS["SINGLE_THROUGH_MIN_FACE_COS"] = SINGLE_THROUGH_MIN_FACE_COS
+# The lit side's gain is 1 where it comes within this of 1: a flat part's, whose piecewise-linear integral
+# is exact but for fp32 rounding (a few 1e-7), renders as the flat term bit for bit.
+SINGLE_THROUGH_ROUNDING = 1e-4
+GLSL_CONSTANTS["SINGLE_THROUGH_ROUNDING"] = SINGLE_THROUGH_ROUNDING
 
 # ---------------------------------------------------------------------------------------------
 # Environment lighting (issue 22; skinlab/scene/optics/sh.py, skinlab/scene/envmap.py,

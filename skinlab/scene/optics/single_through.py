@@ -46,6 +46,7 @@ from .constants import (
     LUMA_R,
     SINGLE_THROUGH_DEPTHS,
     SINGLE_THROUGH_MIN_FACE_COS,
+    SINGLE_THROUGH_ROUNDING,
 )
 from .fresnel import fresnel_from_cosines, hg_phase
 from .single_scattering import refract_cos
@@ -183,7 +184,9 @@ def single_through(
         distance_map, shadow_matrix, eye, world, to, cto, ct, ratio, mean_free_path(sigma_t), d0, mm_per_unit
     )
     integral = through_integral(sigma_t, s, d)
-    gain = np.where((ok & lit)[:, None], np.maximum(integral * ((ct + cto) / ct)[:, None], 1.0), gain)
+    lit_gain = integral * ((ct + cto) / ct)[:, None]
+    lit_gain = np.where(lit_gain < 1.0 + SINGLE_THROUGH_ROUNDING, 1.0, lit_gain)  # a plane's 1, to rounding
+    gain = np.where((ok & lit)[:, None], lit_gain, gain)
     ft = 1.0 - fresnel_from_cosines(c, ct, 1.0, eta)
     ti = -l / eta + (c / eta - ct)[:, None] * ef[:, :3]
     cos_s = np.clip(-np.sum(ti * to, -1), -1.0, 1.0)

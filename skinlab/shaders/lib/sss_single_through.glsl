@@ -96,7 +96,9 @@ void sss_single_through(int slot, vec3 world, vec3 ng, vec3 l, SingleView sv, ve
     bool own = !(layers.x < 1e29 && at > layers.x + u_part_gap);  // not past another part: else the flat term's
     if (u_light_eye[slot].w != 0.0 || sv.co <= 0.0 || !own) return;
     if (lit) {
-        gain = max(integral * ((ct + sv.cto) / ct), vec3(1.0));
+        // at least 1; and 1 where it is within SINGLE_THROUGH_ROUNDING of it: a plane's, to fp32 rounding
+        gain = integral * ((ct + sv.cto) / ct);
+        gain = mix(gain, vec3(1.0), lessThan(gain, vec3(1.0 + SINGLE_THROUGH_ROUNDING)));
 #ifdef MEASURE_ST_FLAT_LIT  // measurement variants (tools/closeup_variants.py): one side's term alone
         gain = vec3(1.0);
 #endif
