@@ -156,7 +156,12 @@ def plan_frame(scene: Scene, settings: RenderSettings, state=None, device: Devic
             (f"{n} x {n} samples per output pixel (supersample); " if n > 1 else "")
             + ("depth pre-pass, then " if settings.depth_prepass else "")
             + f"shade {len(meshes)} visible mesh(es) with {len(lights)} light(s)"
-            + hook.reason,
+            + hook.reason
+            + (
+                "; single scattering along the light's path inside from the distance maps (single_through)"
+                if distance and settings.single_through
+                else ""
+            ),
             ForwardParams(lights, shadow_lights[:2], hook),
         )
     )

@@ -52,6 +52,15 @@ class RenderSettings:
         "bool",
         panel=False,
     )
+    single_through: bool = option(
+        True,
+        "single scattering of a shadow-casting directional light along its path through the medium as the "
+        "distance map gives it (where the frame has distance maps: a technique's translucency on): more light "
+        "near a convex part's terminator and past it, the flat medium's term on a flat part "
+        "(lib/sss_single_through.glsl); off: the flat medium's term everywhere",
+        "bool",
+        panel=False,
+    )
     background: tuple[float, float, float] = option(
         (0.045, 0.045, 0.05),
         "the colour behind the meshes where no environment map is drawn",

@@ -15,6 +15,7 @@ from skinlab.resources import asset_path
 TOOLS = Path(tools.__file__).parent
 TESTED_ELSEWHERE = {
     "truth_table", "closeup_table", "forward_cost", "irradiance_cost", "orbit_cost", "cost_variants", "gpu_reference",
+    "closeup_variants",
 }  # fmt: skip
 HERE = {
     "accuracy_table", "boundary_slab", "branch_cost", "env_sphere", "frame_times", "full_over_plain",

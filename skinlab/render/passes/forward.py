@@ -28,6 +28,16 @@ from skinlab.render.gpu_resources import node_uniforms
 from skinlab.render.lights import area_defines, bind_shadow_maps, light_defines, near_defines, set_light_uniforms
 from skinlab.render.technique import HOOK_INCLUDE, PLAIN_HOOK, ForwardParams, NodeShading, RenderPass
 from skinlab.render.texture_units import TextureUnits
+from skinlab.render.translucency import bind_translucency
+
+SINGLE_THROUGH = "SSS_SINGLE_THROUGH"  # passes/forward.frag's variant (lib/sss_single_through.glsl)
+
+
+def single_through_defines(frame, scatters: bool) -> dict:
+    """SSS_SINGLE_THROUGH for a mesh that scatters in a frame with a distance map (a technique's
+    translucency) and RenderSettings.single_through on: single scattering along the light's path inside."""
+    has_map = any(f"shadow_exit{slot}" in frame.targets for slot in (0, 1))  # its part layers too
+    return {SINGLE_THROUGH: 1} if scatters and frame.settings.single_through and has_map else {}
 
 
 class ForwardPass(RenderPass):
@@ -175,6 +185,7 @@ class ForwardPass(RenderPass):
             **near_defines(prm.lights),
             **boundary_defines(sh.material if scatters else None),
             **ambient_defines(frame, node),
+            **single_through_defines(frame, scatters),
             **sh.defines,
         }
         # the hook's parts of the triangles, each with its own variant (an opaque mesh's), or all at once
@@ -201,6 +212,8 @@ class ForwardPass(RenderPass):
         bind_env_bands(prog, sh.material if scatters else None)
         if sh.bind is not None:
             sh.bind(prog, units)
+        if SINGLE_THROUGH in defines:  # the distance maps (the hook of a technique with translucency binds them too)
+            bind_translucency(prog, frame, units)
         mesh = self.r.resources.mesh(node.mesh)
         if part is None:
             mesh.vao(prog).render(moderngl.TRIANGLES)

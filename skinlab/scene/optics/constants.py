@@ -235,6 +235,26 @@ GLSL_CONSTANTS.update(
     }
 )
 
+# Single scattering along the light's path through the medium (skinlab/scene/optics/single_through.py,
+# lib/sss_single_through.glsl): the depths along the refracted view ray where the path inside is read
+# from the distance map, in units of the luminance mean free path (real extinction), the point itself
+# first. Chosen against a brute-force integral over a skin1 ball of radius 8 mm lit near its terminator
+# (docs/ground-truth.md "Single scattering along the light's path"): denser near the surface, where a
+# convex part's path grows like a square root.
+SINGLE_THROUGH_DEPTHS = (0.0, 0.15, 0.6, 2.0)
+GLSL_CONSTANTS.update({f"SINGLE_THROUGH_D{k}": v for k, v in enumerate(SINGLE_THROUGH_DEPTHS)})
+# Past a terminator the term applies where the entry face the distance map shows in front is within 60
+# degrees of the point's own face (cosine between their normals at least this): a smoothly curved part,
+# whose light skims under its surface. A sheet's faces are opposed, a box's edge has them at 90 degrees:
+# there the slab transmittance, which counts the first order of scattering too, carries that light (the
+# two back-lit slabs' rims read 0.4 points worse on 4x4 blocks with the term at a 90-degree edge).
+SINGLE_THROUGH_MIN_FACE_COS = 0.5
+GLSL_CONSTANTS["SINGLE_THROUGH_MIN_FACE_COS"] = SINGLE_THROUGH_MIN_FACE_COS
+# The lit side's gain is 1 where it comes within this of 1: a flat part's, whose piecewise-linear integral
+# is exact but for fp32 rounding (a few 1e-7), renders as the flat term bit for bit.
+SINGLE_THROUGH_ROUNDING = 1e-4
+GLSL_CONSTANTS["SINGLE_THROUGH_ROUNDING"] = SINGLE_THROUGH_ROUNDING
+
 # ---------------------------------------------------------------------------------------------
 # Environment lighting (issue 22; skinlab/scene/optics/sh.py, skinlab/scene/envmap.py,
 # skinlab/shaders/lib/environment.glsl). Real spherical harmonics to order 2 (Sloan 2008, appendix

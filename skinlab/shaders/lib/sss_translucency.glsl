@@ -13,6 +13,7 @@
 // THROUGH_KERNEL (RenderSettings.through_kernel): the light through thin parts comes from the transfer
 // through the medium (skinlab/render/through_kernel.py) as per-vertex bounce light, and the per-light
 // functions below bring none; the thickness functions still serve the transfer's senders.
+#extension GL_ARB_gpu_shader5 : enable  // textureGather (core in GLSL 4.00): distance_quad's four texels in one
 #include "lib/lights.glsl"
 #include "lib/sss_boundary.glsl"
 
@@ -72,19 +73,27 @@ DistanceQuad distance_quad(int slot, vec3 world) {
     ivec2 hi = q.size - 1;
     q.a = clamp(i0, ivec2(0), hi);
     q.b = clamp(i0 + 1, ivec2(0), hi);
+#if defined(GL_ARB_gpu_shader5) || __VERSION__ >= 400
+    // one gather of the same four texels (its footprint at the corner they share; the maps clamp to their
+    // edge as the indices do): components x (i0, j1), y (i1, j1), z (i1, j0), w (i0, j0)
+    vec2 corner = (vec2(i0) + 1.0) / vec2(q.size);
+    vec4 g = slot == 0 ? textureGather(u_distance0, corner) : textureGather(u_distance1, corner);
+    q.d = g.wzxy;
+#else
     q.d = vec4(distance_texel(slot, q.a), distance_texel(slot, ivec2(q.b.x, q.a.y)),
                distance_texel(slot, ivec2(q.a.x, q.b.y)), distance_texel(slot, q.b));
+#endif
     return q;
 }
 
-// Distance from the light of the first surface it meets on the way to world; false outside the map
+// Distance from the light of the first surface it meets on the way to world (first_hit_quad: from its
+// distance_quad); false outside the map
 // or where the map holds no surface. Bilinear between the four nearest texel centres (a plane's
 // distance exactly; the nearest texel alone is off by up to half a texel times the surface's slope,
 // which through 3 mm of skin is +-3 % of the blue light), or the texel containing the point where
 // one of the four holds no surface (a silhouette in the light's view).
-bool first_hit_distance(int slot, vec3 world, out float first) {
+bool first_hit_quad(int slot, DistanceQuad q, out float first) {
     first = 0.0;
-    DistanceQuad q = distance_quad(slot, world);
     if (!q.inside) return false;
     vec4 d = q.d;
     if (max(max(d.x, d.y), max(d.z, d.w)) < 1e29) {
@@ -95,17 +104,21 @@ bool first_hit_distance(int slot, vec3 world, out float first) {
     return first < 1e29;  // cleared texels: no surface
 }
 
-// The face where a directional light entered the part in front of world (the first surface it meets
+bool first_hit_distance(int slot, vec3 world, out float first) {
+    return first_hit_quad(slot, distance_quad(slot, world), first);
+}
+
+// The face where a directional light entered the part in front of world (entry_face_quad: from its
+// distance_quad; the first surface it meets
 // on the way there): xyz its outward normal (toward the light), w its cosine to the light; from the
 // distance map's slope across the four texel centres first_hit_distance interpolates (the bilinear's
 // gradient; a plane's exactly): the distance z over the light's orthographic view (x, y) is a surface
 // z(x, y) with normal (grad z, -1) / sqrt(1 + |grad z|^2) in the view's frame (x, y, the direction
 // the light travels). w = 0 where it is not known: a point or spot light, outside the map, or one of
 // the four texels without a surface (a silhouette in the light's view).
-vec4 entry_face(int slot, vec3 world) {
+vec4 entry_face_quad(int slot, DistanceQuad q) {
     if (u_light_eye[slot].w != 0.0) return vec4(0.0);
     mat4 m = u_shadow_matrix[slot];
-    DistanceQuad q = distance_quad(slot, world);
     if (!q.inside) return vec4(0.0);
     float d00 = q.d.x, d10 = q.d.y, d01 = q.d.z, d11 = q.d.w;
     vec2 f = q.f;
@@ -120,6 +133,10 @@ vec4 entry_face(int slot, vec3 world) {
     float c = inversesqrt(1.0 + dot(g, g));
     vec3 n = (g.x * normalize(r0) + g.y * normalize(r1) - u_light_eye[slot].xyz) * c;
     return vec4(n, c);
+}
+
+vec4 entry_face(int slot, vec3 world) {
+    return entry_face_quad(slot, distance_quad(slot, world));
 }
 
 float distance_from_light(int slot, vec3 world) {
@@ -151,6 +168,10 @@ bool sss_thickness_mm(int slot, vec3 world, vec3 ng, float back, out float d_mm)
         d_mm = (inside + u_thickness_shrink) * u_mm_per_unit;
         return true;
     }
+#ifdef MEASURE_BULGE_CHORD  // a measurement variant (tools/closeup_variants.py): a bulge's chord x cosine^k
+    vec4 ent = entry_face(slot, p);
+    if (ent.w > 0.0 && dot(ng, ent.xyz) >= 0.0) back = pow(back, MEASURE_BULGE_CHORD);
+#endif
     d_mm = inside > 0.0 ? (inside * back + u_thickness_shrink) * u_mm_per_unit : 0.0;
     return true;
 }

@@ -20,6 +20,9 @@
 // factors compiled out (lib/sss_near_light.glsl). Each light is shaded by shade_light: the lights
 // without a shadow map in the loop, each filled shadow slot's light once with its slot a constant
 // (u_slot_light), so no light pays for a slot's lookups it does not read (docs/tsd.md "Sixth round").
+// Variant SSS_SINGLE_THROUGH (RenderSettings.single_through, where the frame has distance maps): the
+// single scattering of a slot's directional light along its path through the medium as the distance map
+// gives it, past a convex part's terminator too (lib/sss_single_through.glsl).
 #include "lib/brdf.glsl"
 #include "lib/sss_boundary.glsl"
 #include "lib/sss_oblique.glsl"
@@ -31,6 +34,7 @@
 #ifdef ENV_MAP
 #include "lib/env_single.glsl"
 #endif
+#include "lib/sss_single_through.glsl"  // unconditional: a file is included once, whatever #ifdef surrounds it
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -74,6 +78,14 @@ vec3 shade_light(int i, int slot, Surface s, Shading sh) {
                  * diffuse_transmission_btdf(NoL, u_diffuse_transmission, u_diffuse_transmission_color);
     }
 #endif
+#ifdef SSS_SINGLE_THROUGH  // single scattering along the light's path inside (lib/sss_single_through.glsl)
+    vec3 sgain = vec3(1.0), f_st = vec3(0.0);  // the lit side's gain, the light past a terminator
+    if (single && slot >= 0)
+        sss_single_through(slot, v_world, ng, l, single_view, u_sss_sigma_t / max(s.sss_radius_scale, 1e-6), sgain, f_st);
+    color += e * single_w * f_st;  // past a convex part's terminator, where the flat term is 0
+#else
+    const vec3 sgain = vec3(1.0);  // the flat term alone
+#endif
     if (NoL <= 0.0) return color;
     float vis = slot_visibility(slot, v_world, dot(ng, l));
     vec3 h = half_vector(n, v, l);
@@ -107,7 +119,7 @@ vec3 shade_light(int i, int slot, Surface s, Shading sh) {
 #ifndef SSS_HOOK_PLAIN  // a mesh that does not scatter (techniques/none/forward.glsl) has no single scattering
     svis = sss_single_visibility(s, slot, l, NoL, vis);
 #endif
-    if (single) color += e * (svis * NoL) * single_w * sss_single_brdf_view(n, l, single_view) * sss_near_single(s, i);
+    if (single) color += e * (svis * sgain * NoL) * single_w * sss_single_brdf_view(n, l, single_view) * sss_near_single(s, i);
 #if defined(SSS_MS_REST_LANDS) && defined(SSS_MS_REST) && !defined(MEASURE_NO_MS_REST)  // MEASURE_NO_MS_REST: tools/orbit_cost.py
     if (u_sss_ms_rest_on > 0.0) color += e * (svis * NoL) * single_w * sss_ms_rest(abs(NoV), NoL);
 #endif

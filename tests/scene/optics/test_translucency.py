@@ -1,68 +1,14 @@
 """Light through thin parts (skinlab/scene/optics/translucency.py) and its GLSL twin (lib/sss_translucency.glsl):
 the thickness lookup in the shadow pass's distance map and the slab transmission through it."""
 
-import moderngl
 import numpy as np
 
 from skinlab.gl.glsl_eval import assert_close_fp32
 from skinlab.render.boundary import bind_boundary, material_boundary
 from skinlab.scene.optics import translucency as tr
 from skinlab.scene.optics.material_medium import material_medium
+from tests.translucency_maps import distance_texture, layer_textures, lookup_setup, no_exit
 from tests.tsd_scenes import skin
-
-
-def _distance_texture(ctx, dist: np.ndarray):
-    """(H, W) or (H, W, 2) float map as a NEAREST texture."""
-    dist = np.asarray(dist)
-    h, w = dist.shape[:2]
-    comps = 1 if dist.ndim == 2 else dist.shape[2]
-    tex = ctx.texture((w, h), comps, np.ascontiguousarray(dist, np.float32).tobytes(), dtype="f4")
-    tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-    tex.repeat_x = tex.repeat_y = False
-    return tex
-
-
-def _layer_textures(ctx, layers: np.ndarray):
-    """The part layers (H, W, 3: exit, its cosine, next entry) as the shadow pass writes them: the
-    exit layer (RG) and the next-entry layer (R)."""
-    return _distance_texture(ctx, layers[..., :2]), _distance_texture(ctx, layers[..., 2])
-
-
-def _no_exit(ctx):
-    """Part layers with no surface: one part everywhere (the lookup as without layers)."""
-    return _layer_textures(ctx, np.array([[[1e30, 0.0, 1e30]]]))
-
-
-def _lookup_setup(maps, matrices, eyes, shrink, mm_per_unit, material=None, exits=(), part_gap=0.0):
-    """A GLSLEvaluator setup binding lib/sss_translucency.glsl's uniforms, distance maps and their
-    part layers (`exits`, per slot the (exit, entry) textures of _layer_textures; _no_exit's for one part)."""
-    from skinlab.gl.uniforms import set_array, set_uniforms
-
-    def setup(prog):
-        for slot, tex in enumerate(maps):
-            tex.use(10 + slot)
-            if f"u_distance{slot}" in prog:
-                prog[f"u_distance{slot}"].value = 10 + slot
-        for slot, (tex, entry) in enumerate(exits):
-            tex.use(12 + slot)
-            entry.use(14 + slot)
-            if f"u_exit{slot}" in prog:
-                prog[f"u_exit{slot}"].value = 12 + slot
-            if f"u_entry{slot}" in prog:
-                prog[f"u_entry{slot}"].value = 14 + slot
-        if "u_shadow_matrix" in prog:
-            mats = np.stack([m.T for m in matrices]).astype(np.float32)
-            prog["u_shadow_matrix"].write(mats[: max(prog["u_shadow_matrix"].array_length, 1)].tobytes())
-        set_array(prog, "u_light_eye", np.asarray(eyes, np.float64), 2)
-        set_uniforms(prog, {"u_thickness_shrink": shrink, "u_mm_per_unit": mm_per_unit, "u_part_gap": part_gap})
-        if "u_light_shadow" in prog:
-            ids = np.array([0, 1, -1, -1], np.int32)
-            prog["u_light_shadow"].write(ids[: max(prog["u_light_shadow"].array_length, 1)].tobytes())
-        if material is not None:
-            bind_boundary(prog, material)
-
-    return setup
-
 
 # (hit, thickness) of sss_thickness_mm as one value
 LOOK = """vec2 look(int slot, vec3 p, vec3 n, float c) {
@@ -83,7 +29,7 @@ def test_thickness_lookup_matches_numpy_twin(ctx, glsl):
         d = rng.uniform(5.0, 10.0, (h, w))
         d[rng.uniform(size=(h, w)) < 0.1] = 1e30  # cleared: no surface
         maps.append(d)
-        texes.append(_distance_texture(ctx, d))
+        texes.append(distance_texture(ctx, d))
     m = np.eye(4)
     m[:3, :3] *= 0.5
     m[:3, 3] = 0.5  # world [-1, 1]^3 -> texture [0, 1]^3
@@ -102,8 +48,8 @@ def test_thickness_lookup_matches_numpy_twin(ctx, glsl):
     back[:100] = rng.uniform(0.0, 1e-4, 100)  # grazing
     shrink, mm = 0.004, 20.0
     world, normal, back = (x.astype(np.float32).astype(np.float64) for x in (world, normal, back))
-    none = _no_exit(ctx)
-    setup = _lookup_setup(texes, [m, m], eyes, shrink, mm, exits=(none, none))
+    none = no_exit(ctx)
+    setup = lookup_setup(texes, [m, m], eyes, shrink, mm, exits=(none, none))
     for slot in (0, 1):
         gpu = glsl.evaluate(
             "lib/sss_translucency.glsl",
@@ -231,7 +177,7 @@ def test_translucent_light_matches_numpy(ctx, glsl):
     med, tabs = material_medium(mat.values), material_boundary(mat)
     dist = np.full((8, 8), 10.0)
     dist[:, :2] = 1e30
-    tex = _distance_texture(ctx, dist)
+    tex = distance_texture(ctx, dist)
     m = np.eye(4)
     m[:3, :3] *= 0.5
     m[:3, 3] = 0.5
@@ -242,8 +188,8 @@ def test_translucent_light_matches_numpy(ctx, glsl):
     l = np.array([0.0, 0.0, -1.0])
     e = np.array([2.0, 1.0, 0.5])
     shrink, mm = 0.01, 10.0
-    none = _no_exit(ctx)
-    setup = _lookup_setup([tex, tex], [m, m], [eye, eye], shrink, mm, mat, exits=(none, none))
+    none = no_exit(ctx)
+    setup = lookup_setup([tex, tex], [m, m], [eye, eye], shrink, mm, mat, exits=(none, none))
     gpu = glsl.evaluate(
         "lib/sss_translucency.glsl",
         "sss_translucent_light(0, pos, nrm, vec3(0.0, 0.0, -1.0), vec3(2.0, 1.0, 0.5))",
@@ -284,7 +230,7 @@ def test_layered_thickness_lookup_matches_numpy_twin(ctx, glsl):
     exit_d[rng.uniform(size=nxt.shape) < 0.1] = 1e30  # no exit: one part
     dist = first
     ex = np.stack([exit_d, exit_c, nxt], -1)
-    tex, etex = _distance_texture(ctx, dist), _layer_textures(ctx, ex)
+    tex, etex = distance_texture(ctx, dist), layer_textures(ctx, ex)
     m = np.eye(4)
     m[:3, :3] *= 0.5
     m[:3, 3] = 0.5
@@ -297,7 +243,7 @@ def test_layered_thickness_lookup_matches_numpy_twin(ctx, glsl):
     back = rng.uniform(0.05, 1.0, n)
     shrink, gap, mm = 0.004, 0.3, 20.0
     world, back = world.astype(np.float32).astype(np.float64), back.astype(np.float32).astype(np.float64)
-    setup = _lookup_setup([tex, tex], [m, m], [eye, eye], shrink, mm, exits=(etex, etex), part_gap=gap)
+    setup = lookup_setup([tex, tex], [m, m], [eye, eye], shrink, mm, exits=(etex, etex), part_gap=gap)
     gpu = glsl.evaluate(
         "lib/sss_translucency.glsl", "look(0, pos, nrm, c)", {"pos": world, "nrm": normal, "c": back}, 2,
         prelude=LOOK, setup=setup,
@@ -393,10 +339,10 @@ def test_entry_face_matches_numpy_twin_and_reads_a_plane(ctx, glsl):
     back = rng.uniform(0.0, 1.0, n)
     shrink = 0.004
     world, normal, back = (x.astype(np.float32).astype(np.float64) for x in (world, normal, back))
-    none = _no_exit(ctx)
+    none = no_exit(ctx)
     for dist in (rand, plane):
-        tex = _distance_texture(ctx, dist)
-        setup = _lookup_setup([tex, tex], [m, m], eyes, shrink, 20.0, exits=(none, none))
+        tex = distance_texture(ctx, dist)
+        setup = lookup_setup([tex, tex], [m, m], eyes, shrink, 20.0, exits=(none, none))
         for slot in (0, 1):
             gpu = glsl.evaluate(
                 "lib/sss_translucency.glsl",
