@@ -130,8 +130,11 @@ def test_the_integrals_glsl_twin_is_finite_however_steep_the_path(glsl):
             [1e4, 1e4, 0.0, 1e4],
         ]
     )
-    ref = st.through_integral(SIGMA, s, d)
+    sig = np.tile(SIGMA, (6, 1))
+    sig[1] = (1e-8, 1.0, 1e3)  # a channel that hardly scatters (its light goes on), one that stops at once
+    ref = st.through_integral(sig, s, d)
     assert np.all(np.isfinite(ref)) and np.all(ref >= 0)
+    np.testing.assert_allclose(ref[1, 0], 1.0, rtol=1e-6)  # d = 0: the exponential's whole weight, at any rate
     prelude = """vec4 integral(vec4 s4, vec4 d4, vec3 sig) {
         float s[4] = float[4](s4.x, s4.y, s4.z, s4.w);
         float d[4] = float[4](d4.x, d4.y, d4.z, d4.w);
@@ -140,7 +143,7 @@ def test_the_integrals_glsl_twin_is_finite_however_steep_the_path(glsl):
     gpu = glsl.evaluate(
         "lib/sss_single_through.glsl",
         "integral(s4, d4, sig)",
-        {"s4": s, "d4": d, "sig": np.tile(SIGMA, (6, 1))},
+        {"s4": s, "d4": d, "sig": sig},
         4,
         prelude=prelude,
     )[:, :3]
