@@ -257,3 +257,28 @@ def test_the_shadow_terms_amplitude_is_the_flat_terms_at_the_same_entry(eta):
     s = np.array([[0.0, 0.2, 0.7, 2.5]])
     ours = alpha * amp * st.through_integral(SIGMA, s, s * cto[0] / ct)[0]
     np.testing.assert_allclose(ours, flat, rtol=1e-9)
+
+
+def test_an_infinite_extinction_leaves_the_light_at_the_point(ctx, glsl):
+    """A subsurface radius of 0 (or a denormal) makes the extinction infinite: the term stays finite (it was a
+    NaN in blue, inf x 0 at the point: the material fuzz test's find), and none of that channel's light
+    reaches past the terminator."""
+    dist, m = _ball_map(), _matrix()
+    world, n, v = _ball_points([5.0, -12.0])
+    sig = np.array([SIGMA[0], SIGMA[1], np.inf])
+    gain, f = st.single_through(dist, None, m, EYE, world, n, L, v, sig, ALPHA, 1.0, 0.0, 0.005, 1.0)
+    assert np.all(np.isfinite(gain)) and np.all(np.isfinite(f))
+    assert gain.min() >= 1.0 and f.min() >= 0.0 and f[1, 2] < 1e-6 * f[1, 0]  # past the terminator: none of it
+    tex, none = distance_texture(ctx, dist), no_exit(ctx)
+    setup = lookup_setup([tex, tex], [m, m], [EYE, EYE], 0.005, 1.0, skin(), exits=(none, none))
+    inputs = {"pos": world, "nrm": n, "view": v, "sig": np.tile([SIGMA[0], SIGMA[1], 3.4e38], (2, 1))}
+    for what in ("through_gain", "through_shadow"):
+        gpu = glsl.evaluate(
+            "lib/sss_single_through.glsl",
+            f"{what}(pos, nrm, view, sig * vec3(1.0, 1.0, 10.0))",
+            inputs,
+            4,
+            prelude=GLSL_TERMS,
+            setup=setup,
+        )
+        assert np.all(np.isfinite(gpu)), what
