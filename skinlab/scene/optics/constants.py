@@ -254,6 +254,10 @@ GLSL_CONSTANTS["SINGLE_THROUGH_MIN_FACE_COS"] = SINGLE_THROUGH_MIN_FACE_COS
 # is exact but for fp32 rounding (a few 1e-7), renders as the flat term bit for bit.
 SINGLE_THROUGH_ROUNDING = 1e-4
 GLSL_CONSTANTS["SINGLE_THROUGH_ROUNDING"] = SINGLE_THROUGH_ROUNDING
+# The extinction it integrates with is at most this (per mm): a radius of 0 gives an infinite one, whose
+# product with the point's own path of 0 would be a NaN; the light then leaves at the point, as it should.
+SINGLE_THROUGH_MAX_SIGMA = 1e30
+GLSL_CONSTANTS["SINGLE_THROUGH_MAX_SIGMA"] = SINGLE_THROUGH_MAX_SIGMA
 
 # ---------------------------------------------------------------------------------------------
 # Environment lighting (issue 22; skinlab/scene/optics/sh.py, skinlab/scene/envmap.py,

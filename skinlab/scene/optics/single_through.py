@@ -45,6 +45,7 @@ from .constants import (
     LUMA_G,
     LUMA_R,
     SINGLE_THROUGH_DEPTHS,
+    SINGLE_THROUGH_MAX_SIGMA,
     SINGLE_THROUGH_MIN_FACE_COS,
     SINGLE_THROUGH_ROUNDING,
 )
@@ -163,6 +164,7 @@ def single_through(
     ng = np.atleast_2d(np.asarray(ng, np.float64))
     l = np.asarray(l, np.float64).reshape(3)
     eta = max(float(eta), 1.0)
+    sigma_t = np.minimum(np.asarray(sigma_t, np.float64), SINGLE_THROUGH_MAX_SIGMA)  # finite (a radius of 0)
     count = len(world)
     gain, f = np.ones((count, 3)), np.zeros((count, 3))
     if np.asarray(eye, np.float64).reshape(4)[3] != 0.0:

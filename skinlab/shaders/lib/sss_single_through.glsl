@@ -35,7 +35,7 @@ vec3 sss_single_through_segment(vec3 sig, float ds, float k, vec3 e0, vec3 e1) {
     return mix((e0 - e1) / (abs(k) > 0.0 ? k : 1.0), series, lessThan(abs(x), vec3(1e-2)));
 }
 
-vec3 sss_single_through_integral(vec3 sig, float s[4], float d[4]) {
+vec3 sss_single_through_integral(vec3 sig, float s[4], float d[4]) {  // sig finite (sss_single_through's)
     vec3 e[4];
     for (int j = 0; j < 4; ++j) e[j] = exp(-sig * (s[j] + d[j]));
     vec3 tot = vec3(0.0);
@@ -67,9 +67,12 @@ float sss_single_through_path(int slot, vec3 x, float s, float cto, float ct, fl
 // 1, and 1 where it does not apply), and f, past a convex part's terminator (ng.l <= 0) the term itself
 // per unit light (0 where it does not apply: a sheet, a sharp edge, the map without a surface or its slope
 // there). Straight-line code (a software rasteriser runs a branch's masked side anyway).
-void sss_single_through(int slot, vec3 world, vec3 ng, vec3 l, SingleView sv, vec3 sigma_t, out vec3 gain, out vec3 f) {
+void sss_single_through(int slot, vec3 world, vec3 ng, vec3 l, SingleView sv, vec3 sigma_extinction, out vec3 gain,
+                        out vec3 f) {
     gain = vec3(1.0);
     f = vec3(0.0);
+    // finite: a radius of 0 (or a denormal) makes the extinction infinite, and inf x 0 at the point a NaN
+    vec3 sigma_t = min(sigma_extinction, vec3(SINGLE_THROUGH_MAX_SIGMA));
     float cg = dot(ng, l);
     bool lit = cg > 0.0;
     float eta = max(u_sss_eta, 1.0);

@@ -130,8 +130,11 @@ def test_the_integrals_glsl_twin_is_finite_however_steep_the_path(glsl):
             [1e4, 1e4, 0.0, 1e4],
         ]
     )
-    ref = st.through_integral(SIGMA, s, d)
+    sig = np.tile(SIGMA, (6, 1))
+    sig[1] = (1e-8, 1.0, 1e3)  # a channel that hardly scatters (its light goes on), one that stops at once
+    ref = st.through_integral(sig, s, d)
     assert np.all(np.isfinite(ref)) and np.all(ref >= 0)
+    np.testing.assert_allclose(ref[1, 0], 1.0, rtol=1e-6)  # d = 0: the exponential's whole weight, at any rate
     prelude = """vec4 integral(vec4 s4, vec4 d4, vec3 sig) {
         float s[4] = float[4](s4.x, s4.y, s4.z, s4.w);
         float d[4] = float[4](d4.x, d4.y, d4.z, d4.w);
@@ -140,7 +143,7 @@ def test_the_integrals_glsl_twin_is_finite_however_steep_the_path(glsl):
     gpu = glsl.evaluate(
         "lib/sss_single_through.glsl",
         "integral(s4, d4, sig)",
-        {"s4": s, "d4": d, "sig": np.tile(SIGMA, (6, 1))},
+        {"s4": s, "d4": d, "sig": sig},
         4,
         prelude=prelude,
     )[:, :3]
@@ -254,3 +257,28 @@ def test_the_shadow_terms_amplitude_is_the_flat_terms_at_the_same_entry(eta):
     s = np.array([[0.0, 0.2, 0.7, 2.5]])
     ours = alpha * amp * st.through_integral(SIGMA, s, s * cto[0] / ct)[0]
     np.testing.assert_allclose(ours, flat, rtol=1e-9)
+
+
+def test_an_infinite_extinction_leaves_the_light_at_the_point(ctx, glsl):
+    """A subsurface radius of 0 (or a denormal) makes the extinction infinite: the term stays finite (it was a
+    NaN in blue, inf x 0 at the point: the material fuzz test's find), and none of that channel's light
+    reaches past the terminator."""
+    dist, m = _ball_map(), _matrix()
+    world, n, v = _ball_points([5.0, -12.0])
+    sig = np.array([SIGMA[0], SIGMA[1], np.inf])
+    gain, f = st.single_through(dist, None, m, EYE, world, n, L, v, sig, ALPHA, 1.0, 0.0, 0.005, 1.0)
+    assert np.all(np.isfinite(gain)) and np.all(np.isfinite(f))
+    assert gain.min() >= 1.0 and f.min() >= 0.0 and f[1, 2] < 1e-6 * f[1, 0]  # past the terminator: none of it
+    tex, none = distance_texture(ctx, dist), no_exit(ctx)
+    setup = lookup_setup([tex, tex], [m, m], [EYE, EYE], 0.005, 1.0, skin(), exits=(none, none))
+    inputs = {"pos": world, "nrm": n, "view": v, "sig": np.tile([SIGMA[0], SIGMA[1], 3.4e38], (2, 1))}
+    for what in ("through_gain", "through_shadow"):
+        gpu = glsl.evaluate(
+            "lib/sss_single_through.glsl",
+            f"{what}(pos, nrm, view, sig * vec3(1.0, 1.0, 10.0))",
+            inputs,
+            4,
+            prelude=GLSL_TERMS,
+            setup=setup,
+        )
+        assert np.all(np.isfinite(gpu)), what
