@@ -11,13 +11,14 @@
 // it, and past the terminator, where the flat term is 0). d is read at SSS_SINGLE_THROUGH_DEPTHS x the
 // luminance mean free path and taken as piecewise linear, beyond the last depth with its last slope (at
 // least 0); each segment's integral is exact, so a plane's linear d gives the flat term exactly.
-// Two uses (passes/forward.frag, variant SSS_SINGLE_THROUGH; RenderSettings.single_through):
-// - the lit side: the flat term times sss_single_through_gain, I(d from the map) / I(flat), at least 1
-//   (a cast shadow stays the shadow lookup's, a concave part the flat term's);
-// - the shadow side of a convex part's terminator (the entry face the map shows in front on the point's
-//   own side: a bulge, lib/sss_translucency.glsl sss_through_cosine), sss_single_through_shadow: the
-//   light entered at that face (its cosine and normal). A sheet's far side is left to the light through
-//   thin parts (its slab transmittance counts every order of scattering, the first included).
+// Two uses, both from sss_single_through (passes/forward.frag, variant SSS_SINGLE_THROUGH;
+// RenderSettings.single_through):
+// - the lit side: the flat term times its gain, I(d from the map) / I(flat), at least 1 (a cast shadow
+//   stays the shadow lookup's, a concave part the flat term's);
+// - past a smoothly curved part's terminator (the entry face the map shows in front within 60 degrees of
+//   the point's own, SINGLE_THROUGH_MIN_FACE_COS): the term itself for the light that entered at that face
+//   (its cosine and normal). A sheet's far side and a sharp edge's are left to the light through thin
+//   parts (its slab transmittance counts every order of scattering, the first included).
 // Only a directional light, and only where the light reached the point through its own part (no air: the
 // map's part layers); elsewhere the flat term. NumPy twin: skinlab/scene/optics/single_through.py.
 #include "lib/sss_translucency.glsl"
@@ -25,17 +26,18 @@
 
 const float SSS_SINGLE_THROUGH_DEPTHS[4] = float[4](SINGLE_THROUGH_D0, SINGLE_THROUGH_D1, SINGLE_THROUGH_D2, SINGLE_THROUGH_D3);
 
-// int_0^inf sig e^{-sig (s + d(s))} ds for d piecewise linear through (s[j], d[j]), per channel: on a
-// segment of rate k = 1 + its slope, (e_j - e_j+1) / k with e_j = e^{-sig (s_j + d_j)} (both at most 1:
-// finite however steep the segment), its series where sig k ds is small; beyond the last point e_3 / (1 + m).
-// One segment's part of that integral: rate k = 1 + its slope, length ds, e0 and e1 its ends' exponentials.
+// One segment's part of the integral below: rate k = 1 + its slope, length ds, e0 and e1 its ends'
+// exponentials: (e0 - e1) / k (both at most 1: finite however steep the segment), its series where
+// sig k ds is small.
 vec3 sss_single_through_segment(vec3 sig, float ds, float k, vec3 e0, vec3 e1) {
     vec3 x = sig * (k * ds);
     vec3 series = sig * ds * e0 * (1.0 - 0.5 * x);
     return mix((e0 - e1) / (abs(k) > 0.0 ? k : 1.0), series, lessThan(abs(x), vec3(1e-2)));
 }
 
-vec3 sss_single_through_integral(vec3 sig, float s[4], float d[4]) {  // sig finite (sss_single_through's)
+// int_0^inf sig e^{-sig (s + d(s))} ds for d piecewise linear through (s[j], d[j]), per channel (sig finite),
+// e_j = e^{-sig (s_j + d_j)}; beyond the last point e_3 / (1 + its slope, at least 0).
+vec3 sss_single_through_integral(vec3 sig, float s[4], float d[4]) {
     vec3 e[4];
     for (int j = 0; j < 4; ++j) e[j] = exp(-sig * (s[j] + d[j]));
     vec3 tot = vec3(0.0);
@@ -51,13 +53,18 @@ float sss_single_mfp(vec3 sigma_t) {
     return dot(1.0 / max(sigma_t, vec3(1e-6)), vec3(LUMA_R, LUMA_G, LUMA_B));
 }
 
+// The quad's bilinear first surface where all four texels hold one (first_hit_quad without its fallback to
+// the containing texel: at a silhouette in the light's view, no hit).
+bool sss_single_through_first(DistanceQuad q, out float first) {
+    first = mix(mix(q.d.x, q.d.y, q.f.x), mix(q.d.z, q.d.w, q.f.x), q.f.y);
+    return q.inside && max(max(q.d.x, q.d.y), max(q.d.z, q.d.w)) < 1e29;
+}
+
 // The light's path inside (mm, refracted: the air path times `ratio`) to x, for a point on the view ray at
-// s mm: the distance map's bilinear first surface where all four texels hold one (first_hit_quad without its
-// fallback to the containing texel), else the flat medium's path s cto / ct.
+// s mm; where the map has no surface in front, the flat medium's path s cto / ct.
 float sss_single_through_path(int slot, vec3 x, float s, float cto, float ct, float ratio) {
-    DistanceQuad q = distance_quad(slot, x);
-    bool hit = q.inside && max(max(q.d.x, q.d.y), max(q.d.z, q.d.w)) < 1e29;
-    float first = mix(mix(q.d.x, q.d.y, q.f.x), mix(q.d.z, q.d.w, q.f.x), q.f.y);
+    float first;
+    bool hit = sss_single_through_first(distance_quad(slot, x), first);
     return hit ? max(distance_from_light(slot, x) - first, 0.0) * u_mm_per_unit * ratio : s * cto / ct;
 }
 
@@ -78,8 +85,8 @@ void sss_single_through(int slot, vec3 world, vec3 ng, vec3 l, SingleView sv, ve
     float eta = max(u_sss_eta, 1.0);
     vec3 p = world - u_thickness_shrink * ng;
     DistanceQuad q = distance_quad(slot, p);
-    bool hit = q.inside && max(max(q.d.x, q.d.y), max(q.d.z, q.d.w)) < 1e29;
-    float first = mix(mix(q.d.x, q.d.y, q.f.x), mix(q.d.z, q.d.w, q.f.x), q.f.y);
+    float first;
+    bool hit = sss_single_through_first(q, first);
     vec4 ef = entry_face_quad(slot, q);
     float c = lit ? cg : max(ef.w, 1e-4);  // the entry cosine: the point's own on the lit side
     float ct = max(refract_cos(c, eta), 1e-4);
